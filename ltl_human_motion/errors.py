@@ -1,0 +1,67 @@
+"""Exception types shared by the whole package.
+
+Every error a user can cause derives from :class:`LtlHumanMotionError`, so the CLI and
+the ROS nodes can turn it into a message without a traceback.
+"""
+
+from __future__ import annotations
+
+
+class LtlHumanMotionError(Exception):
+    """Base class of all errors caused by user input or unmet requirements."""
+
+
+class SpecError(LtlHumanMotionError, ValueError):
+    """A malformed, ill-typed or unsatisfiable LTL specification.
+
+    ``line`` and ``column`` are 1-based positions in the specification text (or None
+    when the error is not tied to one position).
+    """
+
+    def __init__(self, message: str, text: str = "", line: int | None = None,
+                 column: int | None = None) -> None:
+        self.message = message
+        self.text = text
+        self.line = line
+        self.column = column
+        super().__init__(self.__str__())
+
+    def __str__(self) -> str:
+        if self.line is None:
+            return self.message
+        where = f"line {self.line}, column {self.column}"
+        pointer = ""
+        if self.text:
+            lines = self.text.splitlines() or [""]
+            src = lines[self.line - 1] if 0 < self.line <= len(lines) else ""
+            pointer = f"\n  {src}\n  {' ' * max((self.column or 1) - 1, 0)}^"
+        return f"{where}: {self.message}{pointer}"
+
+
+class CellError(LtlHumanMotionError, ValueError):
+    """A malformed cell description; the message names the file and the key."""
+
+
+class MotionFormatError(LtlHumanMotionError, ValueError):
+    """A corrupt or unsupported motion file; the message names the file and line/frame."""
+
+
+class PlanningError(LtlHumanMotionError):
+    """Motion planning failed; the message names the task and the reason."""
+
+    def __init__(self, message: str, task: str | None = None, reason: str | None = None) -> None:
+        self.task = task
+        self.reason = reason
+        super().__init__(message)
+
+
+class VerificationError(LtlHumanMotionError):
+    """A synthesized motion failed a verification check; ``check`` names which."""
+
+    def __init__(self, message: str, check: str) -> None:
+        self.check = check
+        super().__init__(message)
+
+
+class MissingDependencyError(LtlHumanMotionError, ImportError):
+    """An optional dependency is not installed; the message says what to install."""
