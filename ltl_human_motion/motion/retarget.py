@@ -1,0 +1,188 @@
+"""Retargeting joint positions onto the canonical skeleton.
+
+Every loader returns world joint positions already retargeted onto the canonical
+skeleton (:mod:`~ltl_human_motion.motion.skeleton`). They all go through
+:func:`retarget_points`: the loader supplies, for each canonical joint, the trajectory of
+the corresponding point of its own skeleton; this module keeps the *direction* of every
+limb bone and sets the canonical length, while the rigid parts (pelvis to hips, chest to
+clavicles and shoulders) follow the orientation of the source pelvis and chest. The root
+(pelvis) path is scaled by the ratio of canonical to source leg length, so that steps
+keep their length relative to the body, and the motion is lifted so that the feet touch
+but never go below the floor.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, Skeleton
+from ltl_human_motion.motion.types import Motion
+
+__all__ = ["REQUIRED_POINTS", "retarget_points", "enforce_bone_lengths", "mirror_positions",
+           "frame_from_axes", "FOOT_CLEARANCE"]
+
+# Source points a loader must provide (the spine is taken halfway between pelvis and chest
+# when missing; head, hands and toes may be derived by the loader).
+REQUIRED_POINTS: tuple[str, ...] = tuple(n for n in JOINT_NAMES if n not in ("spine",
+                                                                             "l_clavicle",
+                                                                             "r_clavicle"))
+# Joints placed by a rigid frame rather than by a source bone direction.
+_PELVIS_RIGID = ("l_hip", "r_hip")
+_CHEST_RIGID = ("l_clavicle", "r_clavicle", "l_shoulder", "r_shoulder")
+# Lowest foot point allowed, as a fraction of stature (toe joint height at rest is 0.010 H,
+# so the toe joint never sinks below its rest height minus this).
+FOOT_CLEARANCE = 0.0
+
+
+def frame_from_axes(lateral: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """Orthonormal frames whose y axis is ``lateral`` and whose z axis is ``up`` made orthogonal.
+
+    Parameters
+    ----------
+    lateral, up : ndarray, shape (..., 3)
+
+    Returns
+    -------
+    R : ndarray, shape (..., 3, 3)
+        Columns are the x (forward), y (left) and z (up) axes.
+    """
+    y = lateral / np.maximum(np.linalg.norm(lateral, axis=-1, keepdims=True), 1e-12)
+    z = up - np.sum(up * y, axis=-1, keepdims=True) * y
+    z = z / np.maximum(np.linalg.norm(z, axis=-1, keepdims=True), 1e-12)
+    x = np.cross(y, z)
+    return np.stack([x, y, z], axis=-1)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+
+
+def _build(points: dict[str, np.ndarray], pelvis: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+    """Canonical positions (T, J, 3) from source points and a given pelvis path."""
+    rest = skeleton.rest_positions()
+    lengths = skeleton.bone_lengths()
+    T = pelvis.shape[0]
+    out = np.zeros((T, len(JOINT_NAMES), 3))
+    out[:, 0] = pelvis
+    src_pelvis = points["pelvis"]
+    src_chest = points["chest"]
+    spine = points.get("spine")
+    if spine is None:
+        spine = 0.5 * (src_pelvis + src_chest)
+    src = dict(points)
+    src["spine"] = spine
+    r_pelvis = frame_from_axes(points["l_hip"] - points["r_hip"], src_chest - src_pelvis)
+    r_chest = frame_from_axes(points["l_shoulder"] - points["r_shoulder"],
+                              points["neck"] - src_chest)
+    for j in range(1, len(JOINT_NAMES)):
+        name, p = JOINT_NAMES[j], PARENTS[j]
+        if name in _PELVIS_RIGID:
+            out[:, j] = out[:, p] + r_pelvis @ (rest[j] - rest[p])
+        elif name in _CHEST_RIGID:
+            out[:, j] = out[:, p] + r_chest @ (rest[j] - rest[p])
+        else:
+            direction = _unit(src[name] - src[JOINT_NAMES[p]])
+            out[:, j] = out[:, p] + lengths[j] * direction
+    return out
+
+
+def _check_points(points: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    missing = [n for n in REQUIRED_POINTS if n not in points]
+    if missing:
+        raise ValueError(f"retargeting needs source points for {', '.join(missing)}")
+    arrays = {k: np.asarray(v, dtype=np.float64) for k, v in points.items()}
+    shape = arrays["pelvis"].shape
+    if len(shape) != 2 or shape[1] != 3:
+        raise ValueError(f"source points must have shape (T, 3), got {shape} for pelvis")
+    for k, v in arrays.items():
+        if v.shape != shape:
+            raise ValueError(f"source point {k!r} has shape {v.shape}, expected {shape}")
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"source point {k!r} contains NaN or infinite values")
+    return arrays
+
+
+def retarget_points(points: dict[str, np.ndarray], fps: float, skeleton: Skeleton | None = None,
+                    name: str = "", ground: bool = True) -> Motion:
+    """Retarget source joint trajectories (z up, metres) onto the canonical skeleton.
+
+    Parameters
+    ----------
+    points : dict of str to ndarray, shape (T, 3)
+        Source trajectories keyed by canonical joint name; every name of
+        :data:`REQUIRED_POINTS` is needed (``spine`` is optional). Must be z up and face
+        the same way as the source body; units only matter for the root path, which is
+        rescaled by leg length.
+    fps : float
+    skeleton : Skeleton, optional
+        Target body (default stature 1.75 m).
+    name : str
+    ground : bool
+        Lift or lower the whole motion so that its lowest foot point touches the floor.
+
+    Returns
+    -------
+    Motion
+    """
+    skeleton = skeleton or Skeleton()
+    pts = _check_points(points)
+    rest = skeleton.rest_positions()
+    src_leg = np.median(
+        np.linalg.norm(pts["l_hip"] - pts["l_knee"], axis=-1)
+        + np.linalg.norm(pts["l_knee"] - pts["l_ankle"], axis=-1))
+    canon_leg = (np.linalg.norm(rest[JOINT_INDEX["l_hip"]] - rest[JOINT_INDEX["l_knee"]])
+                 + np.linalg.norm(rest[JOINT_INDEX["l_knee"]] - rest[JOINT_INDEX["l_ankle"]]))
+    if not src_leg > 1e-9:
+        raise ValueError("source legs have zero length")
+    pelvis = pts["pelvis"] * (canon_leg / src_leg)
+    out = _build(pts, pelvis, skeleton)
+    if ground:
+        out = _ground(out, skeleton)
+    return Motion(out, fps, skeleton, name)
+
+
+def _ground(positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+    """Shift vertically so the lowest foot joint over the motion sits at its rest height."""
+    feet = [JOINT_INDEX[n] for n in ("l_ankle", "l_toe", "r_ankle", "r_toe")]
+    rest = skeleton.rest_positions()
+    # Height of each foot joint above its own rest height; the minimum over joints & frames.
+    lift = positions[:, feet, 2] - rest[feet, 2]
+    shift = -float(lift.min())
+    out = positions.copy()
+    out[..., 2] += shift
+    return out
+
+
+def enforce_bone_lengths(positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+    """Re-impose canonical bone lengths on canonical-skeleton positions (keeps directions).
+
+    Parameters
+    ----------
+    positions : ndarray, shape (T, J, 3)
+
+    Returns
+    -------
+    ndarray, shape (T, J, 3)
+        Same pelvis path; every bone has its canonical length.
+    """
+    pos = np.asarray(positions, dtype=np.float64)
+    pts = {n: pos[:, i] for i, n in enumerate(JOINT_NAMES)}
+    return _build(pts, pos[:, 0], skeleton)
+
+
+def mirror_positions(positions: np.ndarray) -> np.ndarray:
+    """Mirror canonical-skeleton positions left/right (y -> -y and swap l_/r_ joints).
+
+    Parameters
+    ----------
+    positions : ndarray, shape (..., J, 3)
+
+    Returns
+    -------
+    ndarray, shape (..., J, 3)
+    """
+    from ltl_human_motion.motion.skeleton import MIRROR_PERMUTATION
+
+    out = np.asarray(positions, dtype=np.float64)[..., list(MIRROR_PERMUTATION), :].copy()
+    out[..., 1] *= -1.0
+    return out

@@ -1,0 +1,294 @@
+"""Vectorized distance helpers: points, segments (capsule axes), boxes, cylinders, polygons.
+
+All functions broadcast over leading dimensions. Distances between a segment and a
+convex set are computed by minimising the (convex) point-to-set distance along the
+segment with a golden-section search (:func:`min_along_segment`); 48 iterations shrink
+the bracket to ``1e-10`` of the segment length, so the result is exact to well below a
+micrometre for cell-sized segments.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+__all__ = [
+    "point_segment_distance",
+    "segment_segment_distance",
+    "point_box_distance",
+    "point_box_signed_distance",
+    "point_cylinder_distance",
+    "point_cylinder_signed_distance",
+    "min_along_segment",
+    "segment_box_distance",
+    "capsule_box_distance",
+    "capsule_capsule_distance",
+    "point_polygon_signed_distance",
+    "point_circle_signed_distance",
+]
+
+_GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+_EPS = 1e-12
+
+
+def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance from points to segments.
+
+    Parameters
+    ----------
+    p, a, b : array-like, shape (..., D)
+        Points and segment end points (broadcast together).
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+    """
+    p = np.asarray(p, dtype=np.float64)
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    ab = b - a
+    denom = np.sum(ab * ab, axis=-1)
+    t = np.sum((p - a) * ab, axis=-1) / np.maximum(denom, _EPS)
+    t = np.clip(t, 0.0, 1.0)
+    closest = a + t[..., None] * ab
+    return np.linalg.norm(p - closest, axis=-1)
+
+
+def segment_segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray,
+                             q1: np.ndarray) -> np.ndarray:
+    """Minimum distance between segments ``[p0, p1]`` and ``[q0, q1]``.
+
+    Closed form (Ericson, *Real-Time Collision Detection*, Sec. 5.1.9), robust for
+    degenerate (point) segments and parallel segments.
+
+    Parameters
+    ----------
+    p0, p1, q0, q1 : array-like, shape (..., 3)
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+    """
+    p0 = np.asarray(p0, dtype=np.float64)
+    p1 = np.asarray(p1, dtype=np.float64)
+    q0 = np.asarray(q0, dtype=np.float64)
+    q1 = np.asarray(q1, dtype=np.float64)
+    d1 = p1 - p0
+    d2 = q1 - q0
+    r = p0 - q0
+    a = np.sum(d1 * d1, axis=-1)
+    e = np.sum(d2 * d2, axis=-1)
+    f = np.sum(d2 * r, axis=-1)
+    c = np.sum(d1 * r, axis=-1)
+    b = np.sum(d1 * d2, axis=-1)
+    a, e, f, c, b = np.broadcast_arrays(a, e, f, c, b)
+    denom = a * e - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(denom > _EPS * np.maximum(a * e, _EPS),
+                     np.clip((b * f - c * e) / denom, 0.0, 1.0), 0.0)
+        s = np.where(a > _EPS, s, 0.0)
+        t = np.where(e > _EPS, (b * s + f) / e, 0.0)
+        # Clamp t and recompute s where t left [0, 1].
+        s_lo = np.where(a > _EPS, np.clip(-c / a, 0.0, 1.0), 0.0)
+        s_hi = np.where(a > _EPS, np.clip((b - c) / a, 0.0, 1.0), 0.0)
+    s = np.where(t < 0.0, s_lo, np.where(t > 1.0, s_hi, s))
+    t = np.clip(t, 0.0, 1.0)
+    cp = p0 + s[..., None] * d1
+    cq = q0 + t[..., None] * d2
+    return np.linalg.norm(cp - cq, axis=-1)
+
+
+def point_box_distance(p: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Euclidean distance from points to axis-aligned boxes (0 inside).
+
+    Parameters
+    ----------
+    p : array-like, shape (..., D)
+    lo, hi : array-like, shape (..., D)
+        Box corners, broadcast against ``p``.
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+    """
+    p = np.asarray(p, dtype=np.float64)
+    excess = np.maximum(np.maximum(np.asarray(lo) - p, p - np.asarray(hi)), 0.0)
+    return np.linalg.norm(excess, axis=-1)
+
+
+def point_box_signed_distance(p: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Signed distance from points to axis-aligned boxes (negative inside).
+
+    Parameters
+    ----------
+    p : array-like, shape (..., D)
+    lo, hi : array-like, shape (..., D)
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+    """
+    p = np.asarray(p, dtype=np.float64)
+    q = np.maximum(np.asarray(lo) - p, p - np.asarray(hi))     # per-axis outside excess
+    outside = np.linalg.norm(np.maximum(q, 0.0), axis=-1)
+    inside = np.minimum(np.max(q, axis=-1), 0.0)
+    return outside + inside
+
+
+def point_cylinder_signed_distance(p: np.ndarray, center: np.ndarray, radius: float,
+                                   half_height: float) -> np.ndarray:
+    """Signed distance from points to a solid cylinder with a vertical (z) axis.
+
+    Parameters
+    ----------
+    p : array-like, shape (..., 3)
+    center : array-like, shape (3,)
+    radius, half_height : float
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+    """
+    q = np.asarray(p, dtype=np.float64) - np.asarray(center, dtype=np.float64)
+    dr = np.hypot(q[..., 0], q[..., 1]) - radius
+    dz = np.abs(q[..., 2]) - half_height
+    outside = np.hypot(np.maximum(dr, 0.0), np.maximum(dz, 0.0))
+    inside = np.minimum(np.maximum(dr, dz), 0.0)
+    return outside + inside
+
+
+def point_cylinder_distance(p: np.ndarray, center: np.ndarray, radius: float,
+                            half_height: float) -> np.ndarray:
+    """Distance from points to a solid vertical cylinder (0 inside), shape (...)."""
+    return np.maximum(point_cylinder_signed_distance(p, center, radius, half_height), 0.0)
+
+
+def min_along_segment(f: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.ndarray,
+                      iterations: int = 48) -> np.ndarray:
+    """Minimise a convex point function ``f`` over segments ``[a, b]``.
+
+    Parameters
+    ----------
+    f : callable
+        Maps points of shape (..., D) to values of shape (...); must be convex along
+        lines (distance or signed distance to a convex set).
+    a, b : array-like, shape (..., D)
+    iterations : int
+
+    Returns
+    -------
+    fmin : ndarray, shape (...)
+    """
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    a, b = np.broadcast_arrays(a, b)
+    d = b - a
+    lo = np.zeros(a.shape[:-1])
+    hi = np.ones(a.shape[:-1])
+    x1 = hi - _GOLDEN * (hi - lo)
+    x2 = lo + _GOLDEN * (hi - lo)
+    f1 = f(a + x1[..., None] * d)
+    f2 = f(a + x2[..., None] * d)
+    for _ in range(iterations):
+        left = f1 <= f2           # the minimum lies in [lo, x2]
+        hi, lo = np.where(left, x2, hi), np.where(left, lo, x1)
+        x_new = np.where(left, hi - _GOLDEN * (hi - lo), lo + _GOLDEN * (hi - lo))
+        f_new = f(a + x_new[..., None] * d)
+        x1, f1, x2, f2 = (np.where(left, x_new, x2), np.where(left, f_new, f2),
+                          np.where(left, x1, x_new), np.where(left, f1, f_new))
+    best = np.minimum(f1, f2)
+    return np.minimum(best, np.minimum(f(a), f(b)))
+
+
+def segment_box_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,
+                         hi: np.ndarray) -> np.ndarray:
+    """Distance between segments ``[a, b]`` and axis-aligned boxes (0 if they meet).
+
+    Parameters
+    ----------
+    a, b : array-like, shape (..., 3)
+    lo, hi : array-like, shape (3,) or broadcastable to (..., 3)
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+    """
+    lo = np.asarray(lo, dtype=np.float64)
+    hi = np.asarray(hi, dtype=np.float64)
+    return min_along_segment(lambda p: point_box_distance(p, lo, hi), a, b)
+
+
+def capsule_box_distance(segments: np.ndarray, radii: np.ndarray, lo: np.ndarray,
+                         hi: np.ndarray) -> np.ndarray:
+    """Clearance between capsules and an axis-aligned box (negative: they overlap).
+
+    Parameters
+    ----------
+    segments : array-like, shape (..., 2, 3)
+        Capsule axis end points.
+    radii : array-like, shape (...) (broadcast)
+    lo, hi : array-like, shape (3,)
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+        Segment-box distance minus the radius; ``d <= 0`` iff capsule and box intersect
+        (for overlaps the magnitude is a lower bound of the penetration depth).
+    """
+    seg = np.asarray(segments, dtype=np.float64)
+    if seg.ndim < 2 or seg.shape[-2:] != (2, 3):
+        raise ValueError(f"segments must have shape (..., 2, 3), got {seg.shape}")
+    return segment_box_distance(seg[..., 0, :], seg[..., 1, :], lo, hi) - np.asarray(radii)
+
+
+def capsule_capsule_distance(seg_a: np.ndarray, radii_a: np.ndarray, seg_b: np.ndarray,
+                             radii_b: np.ndarray) -> np.ndarray:
+    """Clearance between capsules (negative when they overlap).
+
+    Parameters
+    ----------
+    seg_a, seg_b : array-like, shape (..., 2, 3)
+    radii_a, radii_b : array-like, broadcast against shape (...)
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+    """
+    sa = np.asarray(seg_a, dtype=np.float64)
+    sb = np.asarray(seg_b, dtype=np.float64)
+    d = segment_segment_distance(sa[..., 0, :], sa[..., 1, :], sb[..., 0, :], sb[..., 1, :])
+    return d - np.asarray(radii_a) - np.asarray(radii_b)
+
+
+def point_polygon_signed_distance(p: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """Signed distance from 2D points to a convex polygon (negative inside).
+
+    Parameters
+    ----------
+    p : array-like, shape (..., 2)
+    vertices : array-like, shape (V, 2)
+        Convex polygon, counter-clockwise.
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+    """
+    p = np.asarray(p, dtype=np.float64)
+    v = np.asarray(vertices, dtype=np.float64)
+    a = v
+    b = np.roll(v, -1, axis=0)
+    edge = b - a                                                     # (V, 2)
+    normal = np.stack([edge[:, 1], -edge[:, 0]], axis=-1)            # outward for CCW
+    normal /= np.maximum(np.linalg.norm(normal, axis=-1, keepdims=True), _EPS)
+    pe = p[..., None, :]                                             # (..., 1, 2)
+    side = np.sum((pe - a) * normal, axis=-1)                        # (..., V)
+    inside = np.all(side <= 0.0, axis=-1)
+    dist = np.min(point_segment_distance(pe, a, b), axis=-1)
+    return np.where(inside, -dist, dist)
+
+
+def point_circle_signed_distance(p: np.ndarray, center: np.ndarray, radius: float) -> np.ndarray:
+    """Signed distance from 2D points to a disc, shape (...)."""
+    p = np.asarray(p, dtype=np.float64)
+    return np.linalg.norm(p - np.asarray(center, dtype=np.float64), axis=-1) - radius
