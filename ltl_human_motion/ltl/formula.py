@@ -27,22 +27,49 @@ _RESERVED = frozenset({"U", "R", "W", "M", "X", "F", "G", "true", "false", "xor"
 
 
 class Formula:
-    """Base class of all formula nodes (frozen dataclasses, hashable, ordered by text)."""
+    """Base class of all formula nodes (frozen dataclasses, hashable, ordered by text).
 
-    __slots__ = ()
+    Hash and text are computed once per node and cached, since the translator keys
+    dictionaries and sorts on them.
+    """
 
     def children(self) -> tuple[Formula, ...]:
         """The direct subformulas."""
         return ()
 
+    def _key(self) -> tuple:
+        return tuple(self.__dict__[name] for name in self.__dataclass_fields__)
+
+    def __eq__(self, other: object) -> bool:
+        if self is other:
+            return True
+        if type(self) is not type(other):
+            return NotImplemented if not isinstance(other, Formula) else False
+        return hash(self) == hash(other) and self._key() == other._key()
+
+    def __hash__(self) -> int:
+        cached = self.__dict__.get("_hash")
+        if cached is None:
+            cached = hash((type(self).__name__, *self._key()))
+            object.__setattr__(self, "_hash", cached)
+        return cached
+
+    def __getstate__(self) -> dict:
+        # drop cached values: string hashes differ between processes
+        return {k: self.__dict__[k] for k in self.__dataclass_fields__}
+
     def __str__(self) -> str:
-        return _render(self, spot=False)
+        cached = self.__dict__.get("_text")
+        if cached is None:
+            cached = _render(self, spot=False)
+            object.__setattr__(self, "_text", cached)
+        return cached
 
     def __lt__(self, other: Formula) -> bool:
         return str(self) < str(other)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, eq=False)
 class Const(Formula):
     """``true`` or ``false``."""
 
@@ -56,7 +83,7 @@ TRUE = Const(True)
 FALSE = Const(False)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Atom(Formula):
     """An atomic proposition: a task predicate ``grasp(O1)``, ``enter(R1)`` or a plain name.
 
@@ -78,7 +105,7 @@ class Atom(Formula):
         return f"Atom({self.key!r})"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, eq=False)
 class Not(Formula):
     """``!arg``."""
 
@@ -88,7 +115,7 @@ class Not(Formula):
         return (self.arg,)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, eq=False)
 class Next(Formula):
     """``X arg``: arg holds at the next position."""
 
@@ -98,7 +125,7 @@ class Next(Formula):
         return (self.arg,)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, eq=False)
 class Finally(Formula):
     """``F arg`` = ``true U arg``."""
 
@@ -108,7 +135,7 @@ class Finally(Formula):
         return (self.arg,)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, eq=False)
 class Globally(Formula):
     """``G arg`` = ``!F !arg``."""
 
@@ -118,7 +145,7 @@ class Globally(Formula):
         return (self.arg,)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, eq=False)
 class And(Formula):
     """``args[0] & args[1] & ...`` (at least two operands)."""
 
@@ -128,7 +155,7 @@ class And(Formula):
         return self.args
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, eq=False)
 class Or(Formula):
     """``args[0] | args[1] | ...`` (at least two operands)."""
 
@@ -138,7 +165,7 @@ class Or(Formula):
         return self.args
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, eq=False)
 class _Binary(Formula):
     left: Formula
     right: Formula

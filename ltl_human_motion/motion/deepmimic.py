@@ -143,14 +143,16 @@ def _read_frames(path: Path) -> tuple[np.ndarray, bool]:
     bad = np.nonzero(~np.all(np.isfinite(arr), axis=1))[0]
     if bad.size:
         raise MotionFormatError(f"{path}: frame {int(bad[0])}: NaN or infinite value")
-    for i, off in ((i, off) for i, off in enumerate([4, 8, 12, 16, 21, 25, 30, 35, 39])):
+    for off in (4, 8, 12, 16, 21, 25, 30, 35, 39):
         norms = np.linalg.norm(arr[:, off:off + 4], axis=1)
         if np.any(norms < 1e-6):
             raise MotionFormatError(
                 f"{path}: frame {int(np.argmax(norms < 1e-6))}: quaternion of zero length")
-    if np.any(arr[:, 0] <= 0):
+    # the last frame of a clip may carry duration 0 (it only closes the loop)
+    if np.any(arr[:-1, 0] <= 0) or arr[-1, 0] < 0:
+        bad_t = np.nonzero(np.concatenate([arr[:-1, 0] <= 0, [arr[-1, 0] < 0]]))[0]
         raise MotionFormatError(
-            f"{path}: frame {int(np.argmax(arr[:, 0] <= 0))}: frame duration must be positive")
+            f"{path}: frame {int(bad_t[0])}: frame duration must be positive")
     loop = str(data.get("Loop", "none")).lower() == "wrap"
     return arr, loop
 

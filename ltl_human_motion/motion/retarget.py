@@ -19,7 +19,7 @@ from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, 
 from ltl_human_motion.motion.types import Motion
 
 __all__ = ["REQUIRED_POINTS", "retarget_points", "enforce_bone_lengths", "mirror_positions",
-           "frame_from_axes", "FOOT_CLEARANCE"]
+           "frame_from_axes", "fix_feet"]
 
 # Source points a loader must provide (the spine is taken halfway between pelvis and chest
 # when missing; head, hands and toes may be derived by the loader).
@@ -29,9 +29,6 @@ REQUIRED_POINTS: tuple[str, ...] = tuple(n for n in JOINT_NAMES if n not in ("sp
 # Joints placed by a rigid frame rather than by a source bone direction.
 _PELVIS_RIGID = ("l_hip", "r_hip")
 _CHEST_RIGID = ("l_clavicle", "r_clavicle", "l_shoulder", "r_shoulder")
-# Lowest foot point allowed, as a fraction of stature (toe joint height at rest is 0.010 H,
-# so the toe joint never sinks below its rest height minus this).
-FOOT_CLEARANCE = 0.0
 
 
 def frame_from_axes(lateral: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -150,6 +147,64 @@ def _ground(positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
     shift = -float(lift.min())
     out = positions.copy()
     out[..., 2] += shift
+    return out
+
+
+def fix_feet(positions: np.ndarray, fps: float, skeleton: Skeleton, clearance: float = 0.02,
+             swing_speed: tuple[float, float] = (0.3, 1.0)) -> np.ndarray:
+    """Remove toe scuffing and floor penetration (keeps bone lengths).
+
+    1. A toe that moves horizontally faster than ``swing_speed[0]`` m/s is a swinging foot:
+       it is raised (by turning the foot about the ankle, keeping its length and heading)
+       to at least ``clearance`` above its rest height, fully at ``swing_speed[1]`` m/s.
+    2. Frames where a foot joint is still below its rest height lift the whole body by
+       the deficit (smoothed over 50 ms so the lift does not jerk).
+
+    Parameters
+    ----------
+    positions : ndarray, shape (T, J, 3)
+        World positions on the canonical skeleton.
+    fps : float
+    skeleton : Skeleton
+
+    Returns
+    -------
+    ndarray, shape (T, J, 3)
+    """
+    from scipy.ndimage import maximum_filter1d, uniform_filter1d
+
+    out = np.array(positions, dtype=np.float64, copy=True)
+    rest = skeleton.rest_positions()
+    T = out.shape[0]
+    for side in ("l", "r"):
+        a, t = JOINT_INDEX[f"{side}_ankle"], JOINT_INDEX[f"{side}_toe"]
+        if T > 1:
+            v = np.linalg.norm(np.gradient(out[:, t, :2], axis=0), axis=-1) * fps
+        else:
+            v = np.zeros(T)
+        ramp = np.clip((v - swing_speed[0]) / (swing_speed[1] - swing_speed[0]), 0.0, 1.0)
+        ramp = ramp * ramp * (3 - 2 * ramp)
+        width = max(1, int(round(0.03 * fps)))
+        ramp = uniform_filter1d(maximum_filter1d(ramp, 2 * width + 1), 4 * width + 1)
+        floor_t = rest[t, 2] + clearance * ramp
+        low = out[:, t, 2] < floor_t
+        if np.any(low):
+            foot = out[low, t] - out[low, a]
+            length = np.linalg.norm(foot, axis=-1)
+            vz = np.clip(floor_t[low] - out[low, a, 2], -length, length)
+            horiz = foot[:, :2]
+            hn = np.linalg.norm(horiz, axis=-1, keepdims=True)
+            hdir = horiz / np.maximum(hn, 1e-9)
+            hmag = np.sqrt(np.maximum(length ** 2 - vz ** 2, 0.0))[:, None]
+            out[low, t, :2] = out[low, a, :2] + hdir * hmag
+            out[low, t, 2] = out[low, a, 2] + vz
+    feet = [JOINT_INDEX[n] for n in ("l_ankle", "l_toe", "r_ankle", "r_toe")]
+    deficit = np.max(rest[feet, 2] - out[:, feet, 2], axis=1).clip(min=0.0)
+    if np.any(deficit > 0):
+        width = max(1, int(round(0.05 * fps)))
+        lift = maximum_filter1d(deficit, size=2 * width + 1)
+        lift = np.maximum(uniform_filter1d(lift, size=2 * width + 1), deficit)
+        out[..., 2] += lift[:, None]
     return out
 
 

@@ -1,0 +1,103 @@
+"""Robot coexistence: UR kinematics, a simulated UR controller speaking RTDE, human-robot
+separation, ISO/TS 15066 speed and separation monitoring, and commissioning metrics.
+
+Core package: no ROS imports. The simulated controller runs in its own process
+(:func:`start_ur_sim_process`) because the ``ur_rtde`` client holds the GIL while it
+connects.
+"""
+
+from ltl_human_motion.robot.coexistence import (
+    CoexistenceConfig,
+    CoexistenceController,
+    ControlDecision,
+    IOLike,
+    ReceiveLike,
+    ur_rtde_factories,
+)
+from ltl_human_motion.robot.kinematics import (
+    UR_MODELS,
+    URModel,
+    axis_angle_from_matrix,
+    forward_kinematics,
+    matrix_from_axis_angle,
+    pose_from_xyz_rpy,
+    robot_capsules,
+    tcp_pose,
+    ur_model,
+)
+from ltl_human_motion.robot.metrics import (
+    DecisionRecorder,
+    commissioning_metrics,
+    plot_commissioning,
+    write_commissioning_report,
+)
+from ltl_human_motion.robot.separation import (
+    Separation,
+    check_capsules,
+    min_distance,
+    pair_distances,
+    segment_distances,
+    separation,
+)
+from ltl_human_motion.robot.sim_state import SimulatedUR
+from ltl_human_motion.robot.ssm import (
+    SLIDER_MIN,
+    SSMParameters,
+    predictive_separation,
+    slider_from_separation,
+)
+from ltl_human_motion.robot.trajectory import (
+    JointTrajectory,
+    Waypoint,
+    default_pick_and_place,
+    load_robot_config,
+)
+from ltl_human_motion.robot.ur_sim import (
+    URSimConfig,
+    URSimHandle,
+    build_controller,
+    run_ur_sim,
+    start_ur_sim_process,
+)
+
+__all__ = [
+    "SLIDER_MIN",
+    "UR_MODELS",
+    "CoexistenceConfig",
+    "CoexistenceController",
+    "ControlDecision",
+    "DecisionRecorder",
+    "IOLike",
+    "JointTrajectory",
+    "ReceiveLike",
+    "SSMParameters",
+    "Separation",
+    "SimulatedUR",
+    "URModel",
+    "URSimConfig",
+    "URSimHandle",
+    "Waypoint",
+    "axis_angle_from_matrix",
+    "build_controller",
+    "check_capsules",
+    "commissioning_metrics",
+    "default_pick_and_place",
+    "forward_kinematics",
+    "load_robot_config",
+    "matrix_from_axis_angle",
+    "min_distance",
+    "pair_distances",
+    "plot_commissioning",
+    "pose_from_xyz_rpy",
+    "predictive_separation",
+    "robot_capsules",
+    "run_ur_sim",
+    "segment_distances",
+    "separation",
+    "slider_from_separation",
+    "start_ur_sim_process",
+    "tcp_pose",
+    "ur_model",
+    "ur_rtde_factories",
+    "write_commissioning_report",
+]

@@ -163,7 +163,7 @@ def axis_angle_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
     skew = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
                      R[..., 1, 0] - R[..., 0, 1]], axis=-1)
     sin = np.sin(angle)
-    out = np.zeros(R.shape[:-2] + (3,))
+    out = np.zeros((*R.shape[:-2], 3))
     regular = sin > 1e-6
     out[regular] = (skew[regular] * (angle[regular] / (2.0 * sin[regular]))[..., None])
     near_pi = ~regular & (angle > 1.0)
@@ -195,7 +195,7 @@ def matrix_from_axis_angle(rotvec: ArrayLike) -> NDArray[np.float64]:
     angle = np.linalg.norm(v, axis=-1)
     safe = np.where(angle > 1e-12, angle, 1.0)
     k = v / safe[..., None]
-    K = np.zeros(v.shape[:-1] + (3, 3))
+    K = np.zeros((*v.shape[:-1], 3, 3))
     K[..., 0, 1], K[..., 0, 2] = -k[..., 2], k[..., 1]
     K[..., 1, 0], K[..., 1, 2] = k[..., 2], -k[..., 0]
     K[..., 2, 0], K[..., 2, 1] = -k[..., 1], k[..., 0]

@@ -101,13 +101,13 @@ class JointTrajectory:
 
 
 def default_pick_and_place() -> JointTrajectory:
-    """A UR5e pick-and-place cycle of 6.4 s: home, above pick, pick, above place, place."""
+    """A UR5e pick-and-place cycle of 6.2 s: home, above pick, pick, lift, above place, place."""
     deg = math.radians
     w = [
         ("home", (0, -90, -90, -90, 90, 0), 1.2, 0.2),
         ("above_pick", (-40, -100, -100, -70, 90, 0), 1.0, 0.0),
         ("pick", (-40, -112, -104, -54, 90, 0), 0.6, 0.4),
-        ("above_pick2", (-40, -100, -100, -70, 90, 0), 0.6, 0.0),
+        ("lift", (-40, -100, -100, -70, 90, 0), 0.6, 0.0),
         ("above_place", (45, -95, -105, -70, 90, 0), 1.2, 0.0),
         ("place", (45, -108, -108, -54, 90, 0), 0.6, 0.4),
     ]

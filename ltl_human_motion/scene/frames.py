@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ZUP_FROM_YUP", "zup_from_yup", "yup_from_zup", "extents_zup_from_yup"]
+__all__ = ["ZUP_FROM_YUP", "extents_zup_from_yup", "yup_from_zup", "zup_from_yup"]
 
 #: Rotation matrix taking y-up vectors to z-up vectors, shape (3, 3).
 ZUP_FROM_YUP = np.array([[1.0, 0.0, 0.0],

@@ -2,8 +2,8 @@
 
 All functions broadcast over leading dimensions. Distances between a segment and a
 convex set are computed by minimising the (convex) point-to-set distance along the
-segment with a golden-section search (:func:`min_along_segment`); 48 iterations shrink
-the bracket to ``1e-10`` of the segment length, so the result is exact to well below a
+segment with a golden-section search (:func:`min_along_segment`); 40 iterations shrink
+the bracket to ``5e-9`` of the segment length, so the result is exact to well below a
 micrometre for cell-sized segments.
 """
 
@@ -14,18 +14,18 @@ from collections.abc import Callable
 import numpy as np
 
 __all__ = [
-    "point_segment_distance",
-    "segment_segment_distance",
-    "point_box_distance",
-    "point_box_signed_distance",
-    "point_cylinder_distance",
-    "point_cylinder_signed_distance",
-    "min_along_segment",
-    "segment_box_distance",
     "capsule_box_distance",
     "capsule_capsule_distance",
-    "point_polygon_signed_distance",
+    "min_along_segment",
+    "point_box_distance",
+    "point_box_signed_distance",
     "point_circle_signed_distance",
+    "point_cylinder_distance",
+    "point_cylinder_signed_distance",
+    "point_polygon_signed_distance",
+    "point_segment_distance",
+    "segment_box_distance",
+    "segment_segment_distance",
 ]
 
 _GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
@@ -165,7 +165,7 @@ def point_cylinder_distance(p: np.ndarray, center: np.ndarray, radius: float,
 
 
 def min_along_segment(f: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.ndarray,
-                      iterations: int = 48) -> np.ndarray:
+                      iterations: int = 40) -> np.ndarray:
     """Minimise a convex point function ``f`` over segments ``[a, b]``.
 
     Parameters

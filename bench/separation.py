@@ -1,0 +1,237 @@
+"""Benchmark of human-robot separation and of the coexistence control loop.
+
+1. Time per separation query: one human (17 capsules) against a UR5e (7 capsules), with
+   and without input validation, and the full per-step query (forward kinematics + capsules
+   + separation). Target < 50 us.
+2. Control-loop rate achieved against the simulated controller (own process, 127.0.0.1)
+   with the REAL ur_rtde client: paced at 125 Hz, and unpaced (headroom). Target 125 Hz.
+3. Reactive versus predictive SSM in the same closed loop: a worker walks towards the arm,
+   stays, and leaves; minimum separation, time at reduced speed, first slow-down.
+
+Prints a table and writes ``bench/results/separation.json``; medians over repeats.
+Not a test: run ``python bench/separation.py``. Needs TCP 30004 and 29999 free on loopback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from ltl_human_motion.atomic import atomic_write_text  # noqa: E402
+from ltl_human_motion.robot import (  # noqa: E402
+    CoexistenceConfig,
+    CoexistenceController,
+    DecisionRecorder,
+    SSMParameters,
+    commissioning_metrics,
+    min_distance,
+    robot_capsules,
+    start_ur_sim_process,
+    ur_rtde_factories,
+)
+
+HOST = "127.0.0.1"
+
+
+def human_capsules(x: float, y: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """17 capsules of a standing worker at (x, y), arms reaching towards -x."""
+    pts = {
+        "pelvis": (0, 0, 0.95), "spine": (0, 0, 1.2), "neck": (0, 0, 1.45),
+        "head": (0, 0, 1.65), "l_hip": (0, 0.1, 0.9), "r_hip": (0, -0.1, 0.9),
+        "l_knee": (0, 0.1, 0.5), "r_knee": (0, -0.1, 0.5), "l_ankle": (0, 0.1, 0.08),
+        "r_ankle": (0, -0.1, 0.08), "l_toe": (0.15, 0.1, 0.03), "r_toe": (0.15, -0.1, 0.03),
+        "l_sh": (0, 0.2, 1.42), "r_sh": (0, -0.2, 1.42), "l_elb": (-0.25, 0.25, 1.25),
+        "r_elb": (-0.25, -0.25, 1.25), "l_wr": (-0.5, 0.2, 1.2), "r_wr": (-0.5, -0.2, 1.2),
+    }
+    bones = [("pelvis", "spine", 0.15), ("spine", "neck", 0.16), ("neck", "head", 0.11),
+             ("pelvis", "l_hip", 0.1), ("pelvis", "r_hip", 0.1), ("l_hip", "l_knee", 0.08),
+             ("r_hip", "r_knee", 0.08), ("l_knee", "l_ankle", 0.06),
+             ("r_knee", "r_ankle", 0.06), ("l_ankle", "l_toe", 0.05),
+             ("r_ankle", "r_toe", 0.05), ("neck", "l_sh", 0.06), ("neck", "r_sh", 0.06),
+             ("l_sh", "l_elb", 0.05), ("r_sh", "r_elb", 0.05), ("l_elb", "l_wr", 0.045),
+             ("r_elb", "r_wr", 0.045)]
+    off = np.array([x, y, 0.0])
+    seg = np.array([[np.add(pts[a], off), np.add(pts[b], off)] for a, b, _ in bones])
+    return seg, np.array([r for _, _, r in bones])
+
+
+def time_call(fn, number: int, repeat: int) -> float:
+    """Median seconds per call over ``repeat`` batches of ``number`` calls."""
+    samples = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        for _ in range(number):
+            fn()
+        samples.append((time.perf_counter() - t0) / number)
+    return statistics.median(samples)
+
+
+def bench_query(repeat: int) -> dict[str, float]:
+    hs, hr = human_capsules(1.2, 0.3)
+    q = np.radians([10, -100, -90, -80, 90, 0])
+    rs, rr = robot_capsules(q, "ur5e")
+    out = {
+        "human_capsules": len(hs), "robot_capsules": len(rs),
+        "min_distance_us": 1e6 * time_call(lambda: min_distance(hs, hr, rs, rr), 2000, repeat),
+        "min_distance_unvalidated_us": 1e6 * time_call(
+            lambda: min_distance(hs, hr, rs, rr, validate=False), 2000, repeat),
+        "fk_capsules_us": 1e6 * time_call(lambda: robot_capsules(q, "ur5e"), 2000, repeat),
+    }
+
+    def full() -> float:
+        seg, rad = robot_capsules(q, "ur5e")
+        return min_distance(hs, hr, seg, rad, validate=False)
+
+    out["fk_plus_separation_us"] = 1e6 * time_call(full, 2000, repeat)
+    return out
+
+
+def walking_worker(ctl: CoexistenceController, predictive: bool):
+    """Occupancy feeder: from 4 m to 0.9 m at 1.2 m/s, 1 s still, back; 1 s prediction."""
+    def x_at(t: float) -> float:
+        approach = (4.0 - 0.9) / 1.2
+        if t < approach:
+            return 4.0 - 1.2 * t
+        if t < approach + 1.0:
+            return 0.9
+        return min(4.0, 0.9 + 1.2 * (t - approach - 1.0))
+
+    def feed(t: float) -> None:
+        seg, rad = human_capsules(x_at(t))
+        pred = None
+        if predictive:
+            pred = []
+            for h in np.arange(0.1, 1.01, 0.1):
+                pseg, prad = human_capsules(x_at(t + h))
+                pred.append((float(h), pseg, prad))
+        ctl.update_occupancy(seg, rad, time.monotonic(), pred)
+
+    return feed, (4.0 - 0.9) / 1.2 * 2 + 1.0
+
+
+def closed_loop(duration: float, rate: float | None, predictive: bool | None,
+                params: SSMParameters) -> dict[str, object]:
+    sim = start_ur_sim_process(host=HOST)
+    receive_factory, io_factory = ur_rtde_factories(HOST)
+    recorder = DecisionRecorder()
+    ctl = CoexistenceController(receive_factory, io_factory, "ur5e", params=params,
+                                config=CoexistenceConfig(use_prediction=bool(predictive)),
+                                on_decision=recorder)
+    step_times: list[float] = []
+    try:
+        ctl.step()  # connect
+        recorder.decisions.clear()
+        if predictive is None:
+            feed = None
+            seg, rad = human_capsules(2.0)
+        else:
+            feed, duration = walking_worker(ctl, predictive)
+        original_step = ctl.step
+
+        def timed_step():
+            t0 = time.perf_counter()
+            d = original_step()
+            step_times.append(time.perf_counter() - t0)
+            return d
+
+        ctl.step = timed_step  # type: ignore[method-assign]
+        if rate is None:    # unpaced: as fast as the loop goes
+            t0 = time.monotonic()
+            steps = 0
+            while time.monotonic() - t0 < duration:
+                ctl.update_occupancy(seg, rad, time.monotonic())
+                ctl.step()
+                steps += 1
+        else:
+            if feed is None:
+                def feed(_t: float) -> None:
+                    ctl.update_occupancy(seg, rad, time.monotonic())
+            steps = ctl.run(rate=rate, duration=duration, before_step=feed)
+        status = sim.status()
+    finally:
+        ctl.close()
+        sim.stop()
+    t = np.array([d.time for d in recorder.decisions])
+    dt = np.diff(t)
+    result: dict[str, object] = {
+        "duration_s": float(t[-1] - t[0]),
+        "steps": steps,
+        "achieved_rate_hz": float((len(t) - 1) / (t[-1] - t[0])),
+        "median_period_ms": 1e3 * float(np.median(dt)),
+        "p99_period_ms": 1e3 * float(np.percentile(dt, 99)),
+        "median_step_us": 1e6 * statistics.median(step_times),
+        "disconnected_steps": sum(d.mode == "disconnected" for d in recorder.decisions),
+    }
+    if predictive is not None:
+        m = commissioning_metrics(recorder.decisions, status["cycle_times"],
+                                  status["nominal_cycle_time"])
+        first_slow = next((d.time - t[0] for d in recorder.decisions if d.slider < 1.0), None)
+        result.update({
+            "min_separation_m": m["min_separation"],
+            "time_reduced_speed_s": m["time_reduced_speed"],
+            "time_min_speed_s": m["time_min_speed"],
+            "first_slowdown_s": first_slow,
+            "violations": len(m["violations"]),
+            "violations_not_at_min_speed": sum(not v["slowed_to_min"]
+                                               for v in m["violations"]),
+            "robot_cycles": len(status["cycle_times"]),
+            "mean_cycle_time_s": m["mean_cycle_time"],
+            "baseline_cycle_time_s": m["baseline_cycle_time"],
+        })
+    return result
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=15, help="timing batches (median)")
+    parser.add_argument("--loop-seconds", type=float, default=5.0)
+    parser.add_argument("--out", default=str(ROOT / "bench" / "results" / "separation.json"))
+    args = parser.parse_args()
+    params = SSMParameters()
+    results: dict[str, object] = {
+        "python": platform.python_version(), "numpy": np.__version__,
+        "machine": platform.machine(), "ssm": params.terms(),
+    }
+    results["query"] = bench_query(args.repeat)
+    q = results["query"]
+    print(f"separation query, {q['human_capsules']} x {q['robot_capsules']} capsules "
+          f"(median of {args.repeat}):")
+    for key in ("min_distance_us", "min_distance_unvalidated_us", "fk_capsules_us",
+                "fk_plus_separation_us"):
+        print(f"  {key:32s} {q[key]:8.1f} us")
+    loops = {
+        "paced_125hz": closed_loop(args.loop_seconds, 125.0, None, params),
+        "unpaced": closed_loop(2.0, None, None, params),
+        "reactive_walk_125hz": closed_loop(0.0, 125.0, False, params),
+        "predictive_walk_125hz": closed_loop(0.0, 125.0, True, params),
+    }
+    results["control_loop"] = loops
+    print("control loop against the simulated controller, real ur_rtde client:")
+    for name, r in loops.items():
+        print(f"  {name:24s} rate {r['achieved_rate_hz']:7.1f} Hz  period median "
+              f"{r['median_period_ms']:.2f} ms p99 {r['p99_period_ms']:.2f} ms  step "
+              f"{r['median_step_us']:.0f} us")
+    print("reactive vs predictive (worker walks to 0.9 m at 1.2 m/s and back):")
+    for name in ("reactive_walk_125hz", "predictive_walk_125hz"):
+        r = loops[name]
+        print(f"  {name:24s} min sep {r['min_separation_m']:.3f} m  first slow-down "
+              f"{r['first_slowdown_s']:.2f} s  reduced {r['time_reduced_speed_s']:.2f} s  "
+              f"at min {r['time_min_speed_s']:.2f} s  violations {r['violations']} "
+              f"(not at min speed: {r['violations_not_at_min_speed']})")
+    atomic_write_text(args.out, json.dumps(results, indent=2) + "\n")
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

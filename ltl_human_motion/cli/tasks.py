@@ -1,0 +1,104 @@
+"""``ltl-human-motion tasks``: task sequences (or the automaton) of an LTL specification."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from ltl_human_motion.ltl import (
+    BACKENDS,
+    MODES,
+    PAPER_SPECS,
+    Automaton,
+    HoaError,
+    automaton_from_hoa,
+    build_specification,
+    dot_from_automaton,
+    hoa_from_automaton,
+    synthesize_sequences,
+    task_automaton,
+)
+from ltl_human_motion.ltl.automaton import degeneralize
+
+NAME = "tasks"
+HELP = "Print task sequences (or the Büchi automaton) satisfying an LTL specification."
+
+
+def _positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a number >= 1, got {value}")
+    return value
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the options of ``tasks``."""
+    parser.add_argument("spec", help="LTL specification, e.g. \"grasp(O1) & G F walk(R1)\", "
+                        f"or a paper specification name ({', '.join(PAPER_SPECS)})")
+    parser.add_argument("--cell", help="cell description (YAML) naming objects, regions, "
+                        "shorthands and the final region")
+    parser.add_argument("-n", type=_positive, default=None,
+                        help="number of sequences (default 5; coverage/all: the full set)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of --mode random")
+    parser.add_argument("--mode", choices=MODES, default="random",
+                        help="variations: seeded random walks, transition coverage, or all "
+                        "distinct sequences by length")
+    parser.add_argument("--cycles", type=_positive, default=1,
+                        help="passes through the accepting cycle (default 1)")
+    parser.add_argument("--min-steps", type=int, default=0,
+                        help="repeat the cycle until a sequence has this many steps")
+    parser.add_argument("--max-length", type=_positive, default=None,
+                        help="bound on prefix+cycle length for --mode all")
+    parser.add_argument("--backend", choices=BACKENDS, default="auto",
+                        help="LTL translator (auto: Spot if installed, else built-in)")
+    parser.add_argument("--hoa", metavar="FILE",
+                        help="take the automaton from a HOA file (e.g. from Spot's ltl2tgba) "
+                        "instead of translating; sequences are still checked against the spec")
+    parser.add_argument("--automaton", choices=("hoa", "dot"),
+                        help="print the automaton instead of sequences")
+    parser.add_argument("--state-based", action="store_true",
+                        help="with --automaton: a state-based Büchi automaton (as ltl2tgba -B)")
+    parser.add_argument("--json", action="store_true", help="print sequences as JSON")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``tasks``; errors derive from LtlHumanMotionError (printed by the dispatcher)."""
+    spec = build_specification(args.spec, args.cell)
+    given = _read_hoa(args.hoa) if args.hoa else None
+    if args.automaton:
+        aut = given if given is not None else task_automaton(spec, args.backend)
+        if args.state_based:
+            aut = degeneralize(aut)
+        text = hoa_from_automaton(aut) if args.automaton == "hoa" else dot_from_automaton(aut)
+        print(text, end="")
+        return 0
+    n = args.n if args.n is not None else (5 if args.mode == "random" else None)
+    seqs = synthesize_sequences(spec, n=n, seed=args.seed, mode=args.mode,
+                                cycles=args.cycles, min_steps=args.min_steps,
+                                backend=args.backend, max_length=args.max_length,
+                                automaton=given)
+    if args.json:
+        print(json.dumps({"spec": spec.text, "formula": str(spec.formula), "sequences": [
+            {"prefix": list(map(str, s.prefix)), "cycle": list(map(str, s.cycle)),
+             "repetitions": s.repetitions, "tasks": list(map(str, s.tasks))}
+            for s in seqs]}, indent=2))
+        return 0
+    print(f"# specification: {spec.text}")
+    print(f"# with always-on conjuncts: {spec.formula}")
+    for i, seq in enumerate(seqs, 1):
+        print(f"{i}: {' -> '.join(map(str, seq.tasks))}")
+        print(f"   prefix [{', '.join(map(str, seq.prefix))}] cycle "
+              f"[{', '.join(map(str, seq.cycle))}] x{seq.repetitions}")
+    return 0
+
+
+def _read_hoa(path: str) -> Automaton:
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise HoaError(f"cannot read HOA file {path}: {exc}") from None
+    return automaton_from_hoa(text)

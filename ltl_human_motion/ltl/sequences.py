@@ -1,0 +1,456 @@
+"""Task sequences: finite paths through the automaton (Sec. II-C).
+
+A sequence is a lasso ``prefix . cycle^omega`` accepted by the automaton of the full
+specification, cut after ``repetitions`` passes through the accepting cycle, so the
+acceptance condition is passed at least once. Edges are given concrete letters: the
+letter of a candidate task step (:func:`~ltl_human_motion.ltl.spec.letter_of`) that
+satisfies the edge guard. Only if no lasso exists over task letters is the empty letter
+(a step with no task) allowed; such steps are dropped and the shortened word is checked
+again. Every emitted sequence is checked by the independent evaluator.
+
+Variation modes:
+
+``"all"``
+    All distinct lassos in order of length (shortest first), up to ``max_length`` letters.
+``"coverage"``
+    A set of lassos in which every reachable transition that lies on an accepting run
+    (and has a task letter) appears at least once, in the spirit of transition coverage
+    in state-machine testing (ref. [48]).
+``"random"``
+    Seeded random walks: a random prefix, then a random accepting cycle.
+
+Lassos are put in a canonical form (shortest prefix, primitive cycle), so two sequences
+are distinct only if they describe different infinite words. The same seed gives the
+same output.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ltl_human_motion.errors import SpecError, VerificationError
+from ltl_human_motion.ltl.automaton import Automaton, accepting_components
+from ltl_human_motion.ltl.automaton import strongly_connected_components as _sccs
+from ltl_human_motion.ltl.evaluator import evaluate_lasso
+from ltl_human_motion.ltl.formula import Atom, Formula, conj
+from ltl_human_motion.ltl.spec import Specification, build_specification, letter_of
+from ltl_human_motion.ltl.translate import translate
+
+__all__ = ["MODES", "TaskSequence", "synthesize_sequences", "task_automaton",
+           "unsat_core"]
+
+MODES = ("random", "coverage", "all")
+_WORK_LIMIT = 200_000
+
+
+@dataclass(frozen=True)
+class TaskSequence:
+    """``prefix + cycle * repetitions``: a finite task sequence from an accepting lasso.
+
+    Attributes
+    ----------
+    prefix : tuple of Task
+    cycle : tuple of Task
+        Non-empty; passing it once passes the acceptance condition.
+    repetitions : int
+        How often the cycle is performed (>= 1).
+    letters : tuple of frozenset, optional
+        The letter of each distinct task step (filled by the synthesizer).
+    """
+
+    prefix: tuple[Atom, ...]
+    cycle: tuple[Atom, ...]
+    repetitions: int = 1
+    letter_map: tuple[tuple[Atom, frozenset[str]], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.cycle:
+            raise ValueError("a task sequence needs a non-empty cycle")
+        if self.repetitions < 1:
+            raise ValueError(f"repetitions must be >= 1, got {self.repetitions}")
+
+    @property
+    def tasks(self) -> tuple[Atom, ...]:
+        """The finite sequence of task steps."""
+        return self.prefix + self.cycle * self.repetitions
+
+    def lasso(self, cell: object = None) -> tuple[list[frozenset[str]], list[frozenset[str]]]:
+        """(letters of the prefix, letters of the cycle)."""
+        known = dict(self.letter_map)
+
+        def letter(t: Atom) -> frozenset[str]:
+            return known[t] if t in known else letter_of(t, cell)
+
+        return [letter(t) for t in self.prefix], [letter(t) for t in self.cycle]
+
+    def __str__(self) -> str:
+        pre = ", ".join(map(str, self.prefix))
+        cyc = ", ".join(map(str, self.cycle))
+        head = f"{pre}, " if pre else ""
+        return f"{head}({cyc}) x{self.repetitions}"
+
+
+# --------------------------------------------------------------------------- graph
+
+@dataclass(frozen=True)
+class _Arc:
+    src: int
+    dst: int
+    edge: int          # index into automaton edges
+    letter: int        # index into the letters, -1 = empty letter
+    acc: frozenset[int]
+
+
+class _LetterGraph:
+    """The automaton with each edge expanded into the task letters satisfying its guard."""
+
+    def __init__(self, aut: Automaton, letters: Sequence[frozenset[str]],
+                 allow_empty: bool) -> None:
+        self.aut = aut
+        self.out: list[list[_Arc]] = [[] for _ in aut.states]
+        for k, e in enumerate(aut.edges):
+            options = [i for i, letter in enumerate(letters) if e.guard.satisfied_by(letter)]
+            if allow_empty and e.guard.satisfied_by(frozenset()):
+                options.append(-1)
+            for i in options:
+                self.out[e.src].append(_Arc(e.src, e.dst, k, i, e.acc))
+        adj = [[(a.dst, a.acc) for a in arcs] for arcs in self.out]
+        self.comp = _sccs(adj)
+        self.good = accepting_components(adj, aut.num_sets)
+        reach = self._reach([aut.initial], self.out)
+        rev: list[list[_Arc]] = [[] for _ in aut.states]
+        for arcs in self.out:
+            for a in arcs:
+                rev[a.dst].append(_Arc(a.dst, a.src, a.edge, a.letter, a.acc))
+        seeds = [q for q in aut.states if self.comp[q] in self.good]
+        self.useful = reach & self._reach(seeds, rev)
+        for q in aut.states:
+            self.out[q] = [a for a in self.out[q] if a.dst in self.useful]
+
+    @staticmethod
+    def _reach(seeds: list[int], out: list[list[_Arc]]) -> set[int]:
+        seen = set(seeds)
+        stack = list(seeds)
+        while stack:
+            q = stack.pop()
+            for a in out[q]:
+                if a.dst not in seen:
+                    seen.add(a.dst)
+                    stack.append(a.dst)
+        return seen
+
+    def nonempty(self) -> bool:
+        return self.aut.initial in self.useful
+
+    def in_good_scc(self, q: int) -> bool:
+        return self.comp[q] in self.good
+
+    def path(self, src: int, goal, inside: int | None = None) -> list[_Arc] | None:
+        """Shortest path (>= 0 arcs) from src to an arc ``a`` with ``goal(a)`` (included),
+        or to a state if goal is an int (then the path may be empty)."""
+        if isinstance(goal, int) and goal == src:
+            return []
+        parent: dict[int, _Arc | None] = {src: None}
+        queue = deque([src])
+        while queue:
+            q = queue.popleft()
+            for a in self.out[q]:
+                if inside is not None and self.comp[a.dst] != inside:
+                    continue
+                hit = a.dst == goal if isinstance(goal, int) else goal(a)
+                if hit:
+                    return [*self._unwind(parent, q), a]
+                if a.dst not in parent:
+                    parent[a.dst] = a
+                    queue.append(a.dst)
+        return None
+
+    @staticmethod
+    def _unwind(parent: dict[int, _Arc | None], q: int) -> list[_Arc]:
+        out = []
+        while parent[q] is not None:
+            a = parent[q]
+            out.append(a)
+            q = a.src
+        return out[::-1]
+
+    def accepting_cycle(self, start: int, rng: random.Random | None = None) -> list[_Arc]:
+        """A cycle from ``start`` (in an accepting SCC) back to it with every mark."""
+        comp = self.comp[start]
+        cycle: list[_Arc] = []
+        here = start
+        if rng is not None:
+            for _ in range(rng.randint(0, 4)):
+                arcs = [a for a in self.out[here] if self.comp[a.dst] == comp]
+                a = rng.choice(arcs)
+                cycle.append(a)
+                here = a.dst
+        seen = set().union(*(a.acc for a in cycle)) if cycle else set()
+        for m in range(self.aut.num_sets):
+            if m in seen:
+                continue
+            seg = self.path(here, lambda a, m=m: m in a.acc, inside=comp)
+            cycle += seg
+            seen |= set().union(*(a.acc for a in seg))
+            here = cycle[-1].dst
+        if here != start or not cycle:
+            if here == start:  # need at least one arc: leave and come back
+                seg = self.path(start, lambda a: True, inside=comp)
+                cycle += seg
+                here = seg[-1].dst
+            if here != start:
+                cycle += self.path(here, start, inside=comp)
+        return cycle
+
+
+# --------------------------------------------------------------------------- lassos
+
+def _canonical(prefix: list[int], cycle: list[int]) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """Same infinite word with the shortest prefix and a primitive cycle."""
+    prefix, cycle = list(prefix), list(cycle)
+    m = len(cycle)
+    for p in range(1, m + 1):
+        if m % p == 0 and cycle[:p] * (m // p) == cycle:
+            cycle = cycle[:p]
+            break
+    while prefix and prefix[-1] == cycle[-1]:
+        cycle = [prefix.pop(), *cycle[:-1]]
+    return tuple(prefix), tuple(cycle)
+
+
+def task_automaton(spec: Specification, backend: str = "auto") -> Automaton:
+    """The automaton of the full specification (user formula and always-on conjuncts)."""
+    return translate(spec.formula, backend=backend)
+
+
+def _graph_for(formula: Formula, spec: Specification, backend: str,
+               allow_empty: bool) -> _LetterGraph:
+    return _LetterGraph(translate(formula, backend=backend), spec.letters, allow_empty)
+
+
+def unsat_core(spec: Specification, backend: str = "auto",
+               allow_empty: bool = True, limit: int = 16) -> list[str]:
+    """A minimal set of labelled conjuncts that admits no task sequence (deletion-based).
+
+    Returns all conjunct labels if there are more than ``limit`` of them.
+    """
+    parts = spec.labelled_conjuncts()
+    if len(parts) > limit:
+        return [label for label, _ in parts]
+    keep = list(parts)
+    for item in list(parts):
+        trial = [p for p in keep if p is not item]
+        graph = _graph_for(conj(*(f for _, f in trial)), spec, backend, allow_empty)
+        if not graph.nonempty():
+            keep = trial
+    return [label for label, _ in keep]
+
+
+def _raise_unsat(spec: Specification, backend: str) -> None:
+    aut = translate(spec.formula, backend=backend)
+    core = unsat_core(spec, backend)
+    reason = ("is unsatisfiable" if aut.is_empty() else
+              "admits no sequence of task steps " +
+              "(candidate steps: " + ", ".join(map(str, spec.tasks)) + ")")
+    listed = "\n  ".join(core)
+    raise SpecError(f"specification '{spec.text}' {reason}; these conjuncts conflict:\n"
+                    f"  {listed}", text=spec.text)
+
+
+class _Synth:
+    def __init__(self, spec: Specification, graph: _LetterGraph, cycles: int,
+                 min_steps: int, strict: bool = True) -> None:
+        self.spec = spec
+        self.strict = strict
+        self.graph = graph
+        self.cycles = cycles
+        self.min_steps = min_steps
+        self.out: list[TaskSequence] = []
+        self.seen: set[tuple[tuple[int, ...], tuple[int, ...]]] = set()
+
+    def add(self, prefix: list[_Arc], cycle: list[_Arc]) -> bool:
+        """Turn a lasso of arcs into a checked TaskSequence; False if a duplicate."""
+        pre = [a.letter for a in prefix if a.letter >= 0]
+        cyc = [a.letter for a in cycle if a.letter >= 0]
+        dropped = len(pre) + len(cyc) != len(prefix) + len(cycle)
+        if not cyc:
+            return False
+        key = _canonical(pre, cyc)
+        if key in self.seen:
+            return False
+        tasks, letters = self.spec.tasks, self.spec.letters
+        ok = evaluate_lasso(self.spec.formula, [letters[i] for i in key[0]],
+                            [letters[i] for i in key[1]])
+        if not ok:
+            if dropped or not self.strict:
+                # the word without its empty steps (or a run of an automaton given by the
+                # caller) does not satisfy the full specification: not emitted
+                return False
+            raise VerificationError(
+                f"internal error: lasso {key} of '{self.spec.text}' is accepted by the "
+                "automaton but violates the specification", check="ltl")
+        self.seen.add(key)
+        reps = self.cycles
+        if self.min_steps:
+            reps = max(reps, math.ceil((self.min_steps - len(key[0])) / len(key[1])))
+        used = sorted(set(key[0]) | set(key[1]))
+        self.out.append(TaskSequence(tuple(tasks[i] for i in key[0]),
+                                     tuple(tasks[i] for i in key[1]), reps,
+                                     tuple((tasks[i], letters[i]) for i in used)))
+        return True
+
+    # ----------------------------------------------------------------- modes
+    def lasso_through(self, arc: _Arc) -> tuple[list[_Arc], list[_Arc]]:
+        g = self.graph
+        head = [*g.path(g.aut.initial, arc.src), arc]
+        here = arc.dst
+        tail = g.path(here, lambda a: g.in_good_scc(a.dst)) if not g.in_good_scc(here) else []
+        if tail:
+            here = tail[-1].dst
+        return head + tail, g.accepting_cycle(here)
+
+    def coverage(self, n: int | None) -> None:
+        g = self.graph
+        reach = g._reach([g.aut.initial], g.out)
+        targets: dict[int, _Arc] = {}
+        for q in sorted(reach):
+            for a in g.out[q]:
+                targets.setdefault(a.edge, a)
+        covered: set[int] = set()
+        for edge in sorted(targets):
+            if edge in covered:
+                continue
+            prefix, cycle = self.lasso_through(targets[edge])
+            covered.update(a.edge for a in prefix + cycle)
+            self.add(prefix, cycle)
+            if n is not None and len(self.out) >= n:
+                return
+
+    def random(self, n: int, seed: int, max_length: int) -> None:
+        g = self.graph
+        rng = random.Random(seed)
+        for _ in range(max(50 * n, 200)):
+            if len(self.out) >= n:
+                return
+            here, prefix = g.aut.initial, []
+            for _ in range(rng.randint(0, max_length)):
+                prefix.append(rng.choice(g.out[here]))
+                here = prefix[-1].dst
+            if not g.in_good_scc(here):
+                tail = g.path(here, lambda a: g.in_good_scc(a.dst))
+                prefix += tail
+                here = tail[-1].dst
+            self.add(prefix, g.accepting_cycle(here, rng))
+
+    def all(self, n: int | None, max_length: int) -> None:
+        g = self.graph
+        work = 0
+        for length in range(1, max_length + 1):
+            found: list[tuple[list[_Arc], list[_Arc]]] = []
+            stack: list[tuple[list[_Arc], list[int]]] = [([], [g.aut.initial])]
+            while stack and work < _WORK_LIMIT:
+                path, states = stack.pop()
+                work += 1
+                if len(path) == length:
+                    for j in range(length):
+                        if states[j] == states[-1]:
+                            marks = set().union(*(a.acc for a in path[j:]))
+                            if len(marks) >= g.aut.num_sets:
+                                found.append((path[:j], path[j:]))
+                    continue
+                for a in reversed(g.out[states[-1]]):
+                    stack.append(([*path, a], [*states, a.dst]))
+            found.sort(key=lambda pc: (len(pc[0]) + len(pc[1]),
+                                       [a.letter for a in pc[0] + pc[1]], len(pc[0])))
+            for prefix, cycle in found:
+                self.add(prefix, cycle)
+            if n is not None and len(self.out) >= n:
+                break
+        self.out.sort(key=lambda s: (len(s.prefix) + len(s.cycle), list(map(str, s.tasks))))
+        if n is not None:
+            del self.out[n:]
+
+
+def synthesize_sequences(spec: str | Specification, cell: object = None, n: int | None = 5,
+                         seed: int = 0, mode: str = "random", cycles: int = 1, *,
+                         min_steps: int = 0, backend: str = "auto",
+                         max_length: int | None = None, free_atoms: bool = False,
+                         automaton: Automaton | None = None) -> list[TaskSequence]:
+    """Task sequences satisfying ``spec`` (with the always-on conjuncts).
+
+    Parameters
+    ----------
+    spec : str or Specification
+        Specification text (or a name of ``PAPER_SPECS``, e.g. "S1").
+    cell : CellVocabulary, dict, path or None
+    n : int or None
+        Maximum number of sequences; None with ``mode="coverage"`` or ``"all"`` returns
+        the full coverage set / all sequences up to ``max_length``.
+    seed : int
+        Seed of ``mode="random"``; the same seed gives the same output.
+    mode : {"random", "coverage", "all"}
+    cycles : int
+        Passes through the accepting cycle (>= 1).
+    min_steps : int
+        Repeat the cycle until the sequence has at least this many steps.
+    backend : {"auto", "builtin", "spot"}
+    max_length : int, optional
+        Bound on prefix + cycle letters for "all" and on random prefixes
+        (default: twice the number of automaton states, at least 6).
+    free_atoms : bool
+        Accept plain propositions (see :func:`~ltl_human_motion.ltl.parser.parse`).
+    automaton : Automaton, optional
+        Use this automaton (e.g. read from Spot's ``ltl2tgba`` output with
+        :func:`~ltl_human_motion.ltl.hoa.automaton_from_hoa`; its propositions are atom
+        keys such as ``grasp(O1)``) instead of translating ``spec``. Its lassos that
+        violate the full specification are not emitted.
+
+    Returns
+    -------
+    list of TaskSequence
+        Each one checked with :func:`~ltl_human_motion.ltl.evaluator.evaluate_lasso`.
+
+    Raises
+    ------
+    SpecError
+        Malformed, ill-typed or unsatisfiable specification (naming conflicting conjuncts).
+    ValueError
+        Bad ``mode``, ``n``, ``cycles``.
+    """
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    if n is not None and n < 1:
+        raise ValueError(f"n must be >= 1 (or None), got {n}")
+    if cycles < 1:
+        raise ValueError(f"cycles must be >= 1, got {cycles}")
+    if mode == "random" and n is None:
+        raise ValueError("mode='random' needs a number of sequences n")
+    if not isinstance(spec, Specification):
+        spec = build_specification(spec, cell, free_atoms=free_atoms)
+    aut = automaton if automaton is not None else task_automaton(spec, backend)
+    graph = _LetterGraph(aut, spec.letters, allow_empty=False)
+    if not graph.nonempty():
+        graph = _LetterGraph(aut, spec.letters, allow_empty=True)
+        if not graph.nonempty():
+            _raise_unsat(spec, backend)
+    bound = max_length if max_length is not None else max(6, 2 * aut.num_states)
+    synth = _Synth(spec, graph, cycles, min_steps, strict=automaton is None)
+    if mode == "coverage":
+        synth.coverage(n)
+    elif mode == "all":
+        synth.all(n, bound)
+    else:
+        synth.random(n, seed, bound)
+    if not synth.out and automaton is not None:
+        raise SpecError(f"no lasso of the given automaton ({aut.name or 'unnamed'}) "
+                        f"satisfies the specification '{spec.text}' with its always-on "
+                        "conjuncts", text=spec.text)
+    if not synth.out:
+        raise SpecError(f"specification '{spec.text}' has accepting runs only through steps "
+                        "without a task, and dropping them violates it; add a task such as "
+                        "wait(1.0) to the specification", text=spec.text)
+    return synth.out

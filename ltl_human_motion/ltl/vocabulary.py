@@ -1,0 +1,182 @@
+"""The task vocabulary of Table I and the cell names a specification may use.
+
+A cell is anything with the attributes of :class:`CellVocabulary` (the scene module's
+``Cell`` is one), a plain ``dict`` with the same keys, or a YAML file read by
+:func:`load_vocabulary`. Only names are used here; the geometry stays in ``scene/``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol, runtime_checkable
+
+from ltl_human_motion.errors import CellError
+
+__all__ = [
+    "REGION_ATOM", "TASK_SIGNATURES", "CellVocabulary", "Vocabulary", "load_vocabulary",
+    "vocabulary_from",
+]
+
+#: Argument kinds of every Table I task: "object", "region" or "number".
+TASK_SIGNATURES: dict[str, tuple[str, ...]] = {
+    "grasp": ("object",),
+    "release": ("object",),
+    "carry": ("object", "region"),
+    "move": ("object", "region"),
+    "insert": ("object", "object"),
+    "extract": ("object", "object"),
+    "leftHand": ("region",),
+    "rightHand": ("region",),
+    "walk": ("region",),
+    "wait": ("number",),
+    "sit": ("object",),
+    "standUp": (),
+    "bend": (),
+    "stoop": (),
+    "kneel": (),
+}
+
+#: The region atom ``enter(R)``: true at a step whose task puts the body into R.
+REGION_ATOM = "enter"
+
+#: Tasks whose termination condition puts the body into their region argument.
+ENTERING_TASKS: dict[str, int] = {"walk": 0, "carry": 1, "leftHand": 0, "rightHand": 0}
+
+
+@runtime_checkable
+class CellVocabulary(Protocol):
+    """What the LTL layer needs from a cell: names only."""
+
+    objects: Mapping[str, Any]
+    regions: Mapping[str, Any]
+    shorthands: Mapping[str, tuple[tuple[str, ...], str]]
+    final_region: Any  # a region name, or an object with ``.name``, or None
+
+
+@dataclass(frozen=True)
+class Vocabulary:
+    """Names a specification may use.
+
+    ``objects``/``regions`` of None mean "not checked" (no cell given).
+    ``shorthands`` maps a name to ``(params, body_text)``.
+    """
+
+    objects: frozenset[str] | None = None
+    regions: frozenset[str] | None = None
+    shorthands: Mapping[str, tuple[tuple[str, ...], str]] = field(default_factory=dict)
+    final_region: str | None = None
+    source: str = "<cell>"
+
+
+def _names(value: Any, key: str, source: str) -> frozenset[str] | None:
+    if value is None:
+        return None
+    if isinstance(value, Mapping):
+        return frozenset(str(k) for k in value)
+    if isinstance(value, (list, tuple, set, frozenset)):
+        out = []
+        for item in value:
+            if isinstance(item, Mapping) and "name" in item:
+                out.append(str(item["name"]))
+            elif isinstance(item, str):
+                out.append(item)
+            else:
+                raise CellError(f"{source}: '{key}' must list names, got {item!r}")
+        return frozenset(out)
+    raise CellError(f"{source}: '{key}' must be a mapping or a list of names, "
+                    f"got {type(value).__name__}")
+
+
+def _shorthands(value: Any, source: str) -> dict[str, tuple[tuple[str, ...], str]]:
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise CellError(f"{source}: 'shorthands' must be a mapping name -> definition")
+    out: dict[str, tuple[tuple[str, ...], str]] = {}
+    for name, spec in value.items():
+        if isinstance(spec, (tuple, list)) and len(spec) == 2 and isinstance(spec[1], str):
+            params, body = tuple(str(p) for p in spec[0]), spec[1]
+        elif isinstance(spec, Mapping) and "body" in spec:
+            params, body = tuple(str(p) for p in spec.get("params", ())), str(spec["body"])
+        elif isinstance(spec, str):
+            params, body = (), spec
+        else:
+            raise CellError(f"{source}: shorthand '{name}' must be (params, body) or "
+                            f"{{params: [...], body: '...'}}, got {spec!r}")
+        name = str(name)
+        if "(" in name:  # "assemble(R)" as the key
+            head, _, rest = name.partition("(")
+            params = tuple(p.strip() for p in rest.rstrip(")").split(",") if p.strip())
+            name = head.strip()
+        out[name] = (params, body)
+    return out
+
+
+def vocabulary_from(cell: Any) -> Vocabulary:
+    """A :class:`Vocabulary` from a cell object, a dict, a YAML path, or None.
+
+    Raises
+    ------
+    CellError
+        If the cell lacks the names or they have the wrong type.
+    """
+    if cell is None:
+        return Vocabulary()
+    if isinstance(cell, Vocabulary):
+        return cell
+    if isinstance(cell, (str, Path)):
+        return load_vocabulary(cell)
+    if isinstance(cell, Mapping):
+        source = str(cell.get("source", "<cell>"))
+        get = cell.get
+    else:
+        source = str(getattr(cell, "source", "<cell>"))
+
+        def get(key: str, default: Any = None) -> Any:
+            return getattr(cell, key, default)
+    objects = _names(get("objects"), "objects", source) or frozenset()
+    regions = _names(get("regions"), "regions", source) or frozenset()
+    final = get("final_region")
+    if final is not None and not isinstance(final, str):
+        final = getattr(final, "name", final)  # the scene's Region object
+    if final is not None and str(final) not in regions:
+        raise CellError(f"{source}: final_region '{final}' is not one of the regions "
+                        f"{sorted(regions)}")
+    return Vocabulary(objects=objects, regions=regions,
+                      shorthands=_shorthands(get("shorthands"), source),
+                      final_region=None if final is None else str(final), source=source)
+
+
+def load_vocabulary(path: str | Path) -> Vocabulary:
+    """Read the names of a cell YAML file.
+
+    Uses ``ltl_human_motion.scene.cell.load_cell`` when the scene module provides it,
+    else reads the keys ``objects``, ``regions``, ``shorthands`` and ``final_region``.
+
+    Raises
+    ------
+    CellError
+        If the file is missing or malformed.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise CellError(f"cell file not found: {path}")
+    try:
+        from ltl_human_motion.scene.cell import load_cell
+    except ImportError:
+        load_cell = None
+    if load_cell is not None:
+        return vocabulary_from(load_cell(path))
+    import yaml
+
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise CellError(f"{path}: cannot read cell description: {exc}") from None
+    if not isinstance(data, Mapping):
+        raise CellError(f"{path}: a cell description must be a YAML mapping")
+    data = dict(data)
+    data["source"] = str(path)
+    return vocabulary_from(data)

@@ -1,0 +1,866 @@
+"""Goal primitives made by a body model: inverse kinematics plus posture rules.
+
+There is no reachable real clip of reaching to a table, assembling, bending, stooping,
+kneeling or sitting (see ``notes/data-sources.md``), so every goal primitive of Table I is
+*made* on the canonical skeleton for the exact target:
+
+* **Body model.** A pose is given by the pelvis position, a trunk flexion angle (spread
+  over the lumbar and thoracic spine: 50 % below the spine joint, 85 % below the chest,
+  100 % above), the ankle and toe positions of both feet, and the palm positions of both
+  hands. Knees and elbows come from analytic two-bone IK (:func:`.ik.two_bone_ik`), so
+  every bone keeps its canonical length in every frame.
+* **Posture rules.** For hand targets the trunk flexion and the knee bend (pelvis drop)
+  are chosen on a grid minimizing ``flexion^2 + (drop / 0.14 H)^2 + 0.5 (d / arm - 0.8)^2``
+  subject to the hand being within 93 % of the arm's length from the shoulder, the legs
+  being able to reach the planted feet, and balance. ``bend`` flexes the trunk with nearly
+  straight knees so that the head comes within chest height of the floor while the
+  buttocks stay above knee height; ``stoop`` bends the knees until the buttocks are
+  below knee height and flexes the trunk (Table I).
+* **Balance.** After a posture is chosen the pelvis is shifted back or forth until the
+  whole-body centre of mass (Winter's segment masses, :func:`.ik.center_of_mass`) lies
+  over the middle half of the support polygon of the feet.
+* **Hand paths.** Between key poses the palm moves with the minimum-jerk profile (Flash &
+  Hogan 1985). The shoulder-to-palm vector is interpolated (direction slerped, length
+  interpolated) relative to the moving shoulder, so the path stays within reach and swings
+  in an arc rather than through the shoulder, plus a small seeded outward/upward bow; the
+  body posture leads the hand slightly.
+
+All targets are in the primitive's **start frame**: the root's floor position at the
+origin, facing +x, left = +y, z = height above the floor. Every goal primitive starts in
+``start_pose`` (default: the standing pose gait start primitives begin with) and, except
+``sit`` (ends seated) and ``standUp`` (starts seated), ends in it again.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from ltl_human_motion.motion.gait import LIBRARY_FPS
+from ltl_human_motion.motion.ik import center_of_mass, min_jerk, two_bone_ik
+from ltl_human_motion.motion.ops import relative_root
+from ltl_human_motion.motion.rotations import yaw_from_positions
+from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
+from ltl_human_motion.motion.types import MotionPrimitive
+
+__all__ = ["GOAL_TASKS", "HAND_TASKS", "make_goal_primitive", "reach_placement", "max_reach",
+           "min_reach_height", "chest_height", "knee_height", "seat_height_range"]
+
+HAND_TASKS: tuple[str, ...] = ("grasp", "release", "move", "leftHand", "rightHand", "assemble",
+                               "insert", "extract")
+POSTURE_TASKS: tuple[str, ...] = ("bend", "stoop", "kneel", "sit", "standUp", "wait")
+GOAL_TASKS: tuple[str, ...] = HAND_TASKS + POSTURE_TASKS
+
+_J = JOINT_INDEX
+_SIDES = ("l", "r")
+_REACH_FRACTION = 0.93          # hand never further than this fraction of the arm length
+_ASSEMBLE_HALF_GAP = 0.035      # m, hands either side of an assembly target
+_INSERT_TRAVEL = 0.08           # m, straight push of insert / pull of extract
+
+
+def chest_height(skeleton: Skeleton) -> float:
+    """Table I ``chestHeight``: the chest joint's height when standing."""
+    return float(skeleton.rest_positions()[_J["chest"], 2])
+
+
+def knee_height(skeleton: Skeleton) -> float:
+    """Table I ``kneeHeight``: the knee joint's height when standing."""
+    return float(skeleton.rest_positions()[_J["l_knee"], 2])
+
+
+def seat_height_range(skeleton: Skeleton) -> tuple[float, float]:
+    """Seat heights (m) ``sit`` can use: 0.20 H to 0.34 H."""
+    return 0.20 * skeleton.stature, 0.34 * skeleton.stature
+
+
+def _arm_length(skeleton: Skeleton) -> float:
+    b = skeleton.bone_lengths()
+    return float(b[_J["l_elbow"]] + b[_J["l_wrist"]] + b[_J["l_hand"]])
+
+
+def max_reach(task: str, skeleton: Skeleton) -> float:
+    """Highest target (m above the floor) ``task`` can reach; for ``sit``/``standUp`` the
+    highest seat. Tasks without a target (bend, stoop, kneel, wait) return ``inf``."""
+    _check_task(task)
+    if task in ("sit", "standUp"):
+        return seat_height_range(skeleton)[1]
+    if task in ("bend", "stoop", "kneel", "wait"):
+        return float("inf")
+    shoulder = skeleton.rest_positions()[_J["l_shoulder"], 2]
+    return float(shoulder + 0.97 * _REACH_FRACTION * _arm_length(skeleton))
+
+
+def min_reach_height(task: str, skeleton: Skeleton) -> float:
+    """Lowest target height (m) for ``task`` (0 for hand tasks: the floor)."""
+    _check_task(task)
+    if task in ("sit", "standUp"):
+        return seat_height_range(skeleton)[0]
+    return 0.0
+
+
+def _check_task(task: str) -> None:
+    if task not in GOAL_TASKS:
+        if task in ("walk", "carry"):
+            raise ValueError(f"{task!r} is a gait task: use the gait library, not a goal "
+                             f"primitive")
+        raise ValueError(f"unknown goal task {task!r}; expected one of {', '.join(GOAL_TASKS)}")
+
+
+# ------------------------------------------------------------------------ body model
+def _rot_y(angle: np.ndarray) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    z, o = np.zeros_like(angle), np.ones_like(angle)
+    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1),
+                     np.stack([-s, z, c], -1)], -2)
+
+
+_TRUNK = (("spine", "pelvis", 0.5), ("chest", "spine", 0.85), ("neck", "chest", 1.0),
+          ("head", "neck", 1.0), ("l_clavicle", "chest", 1.0), ("l_shoulder", "l_clavicle", 1.0),
+          ("r_clavicle", "chest", 1.0), ("r_shoulder", "r_clavicle", 1.0))
+
+
+def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray) -> np.ndarray:
+    """Pelvis, spine, head, clavicles, shoulders and hips of frames (T,) -> (T, J, 3)."""
+    rest = skeleton.rest_positions()
+    T = pelvis.shape[0]
+    out = np.zeros((T, len(rest), 3))
+    out[:, 0] = pelvis
+    for name, parent, frac in _TRUNK:
+        j, p = _J[name], _J[parent]
+        out[:, j] = out[:, p] + _rot_y(frac * pitch) @ (rest[j] - rest[p])
+    for name in ("l_hip", "r_hip"):
+        out[:, _J[name]] = pelvis + (rest[_J[name]] - rest[0])
+    return out
+
+
+def _body(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, ankles: np.ndarray,
+          toes: np.ndarray, knee_pole: np.ndarray, hands: np.ndarray, hand_dir: np.ndarray,
+          elbow_pole: np.ndarray) -> np.ndarray:
+    """Full pose of every frame.
+
+    Parameters
+    ----------
+    pelvis : (T, 3); pitch : (T,); ankles, toes, knee_pole, hands, hand_dir, elbow_pole :
+    (T, 2, 3) with index 0 = left, 1 = right.
+
+    Returns
+    -------
+    ndarray, shape (T, J, 3)
+    """
+    b = skeleton.bone_lengths()
+    out = _trunk(skeleton, pelvis, pitch)
+    for k, s in enumerate(_SIDES):
+        hip, knee, ank, toe = (_J[f"{s}_{n}"] for n in ("hip", "knee", "ankle", "toe"))
+        kn, an = two_bone_ik(out[:, hip], ankles[:, k], b[knee], b[ank], knee_pole[:, k],
+                             max_stretch=1.0)
+        out[:, knee], out[:, ank] = kn, an
+        fdir = toes[:, k] - an
+        out[:, toe] = an + b[toe] * fdir / np.linalg.norm(fdir, axis=-1, keepdims=True)
+        sh, el, wr, ha = (_J[f"{s}_{n}"] for n in ("shoulder", "elbow", "wrist", "hand"))
+        hd = hand_dir[:, k] / np.linalg.norm(hand_dir[:, k], axis=-1, keepdims=True)
+        elbow, wrist = two_bone_ik(out[:, sh], hands[:, k] - b[ha] * hd, b[el], b[wr],
+                                   elbow_pole[:, k], max_stretch=1.0)
+        out[:, el], out[:, wr], out[:, ha] = elbow, wrist, wrist + b[ha] * hd
+    return out
+
+
+class _Start:
+    """Quantities of the start pose the model interpolates from."""
+
+    def __init__(self, skeleton: Skeleton, start_pose: np.ndarray | None) -> None:
+        rest = skeleton.rest_positions()
+        if start_pose is None:
+            p0 = rest.copy()
+        else:
+            p0 = np.asarray(start_pose, dtype=np.float64)
+            if p0.shape != rest.shape or not np.all(np.isfinite(p0)):
+                raise ValueError(f"start_pose must be a finite array of shape {rest.shape}, "
+                                 f"got {p0.shape}")
+            p0 = p0.copy()
+            if np.linalg.norm(p0[0]) < 1e-6:       # root-relative pose: stand it on the floor
+                feet = [_J[n] for n in ("l_ankle", "l_toe", "r_ankle", "r_toe")]
+                p0[:, 2] += np.max(rest[feet, 2] - p0[feet, 2])
+            p0[:, :2] -= p0[0, :2]
+        self.pose = p0
+        self.pelvis = p0[0].copy()
+        self.ankles = np.stack([p0[_J["l_ankle"]], p0[_J["r_ankle"]]])
+        self.toes = np.stack([p0[_J["l_toe"]], p0[_J["r_toe"]]])
+        self.hands = np.stack([p0[_J["l_hand"]], p0[_J["r_hand"]]])
+        self.shoulders = np.stack([p0[_J["l_shoulder"]], p0[_J["r_shoulder"]]])
+        self.hand_rel = self.hands - self.shoulders
+        hd = self.hands - np.stack([p0[_J["l_wrist"]], p0[_J["r_wrist"]]])
+        self.hand_dir = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
+        self.elbow_pole = np.stack([p0[_J["l_elbow"]], p0[_J["r_elbow"]]]) - self.shoulders
+        self.knee_pole = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+
+
+def _support_x(ankles: np.ndarray, toes: np.ndarray, stature: float) -> tuple[float, float]:
+    """Safe range of the centre of mass along x: the middle half of the feet's extent."""
+    heel = float(np.min(ankles[..., 0])) - 0.035 * stature
+    front = float(np.max(toes[..., 0])) + 0.01 * stature
+    quarter = 0.25 * (front - heel)
+    return heel + quarter, front - quarter
+
+
+def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
+                   st: _Start, hands: np.ndarray | None = None) -> np.ndarray:
+    """Pelvis x shift (T,) that keeps the centre of mass over the feet (2 iterations)."""
+    T = pelvis.shape[0]
+    shift = np.zeros(T)
+    lo, hi = _support_x(st.ankles, st.toes, skeleton.stature)
+    for _ in range(3):
+        pel = pelvis.copy()
+        pel[:, 0] += shift
+        tr = _trunk(skeleton, pel, pitch)
+        sh = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
+        hnd = sh + st.hand_rel if hands is None else hands
+        pose = _body(skeleton, pel, pitch, np.broadcast_to(st.ankles, (T, 2, 3)),
+                     np.broadcast_to(st.toes, (T, 2, 3)), np.broadcast_to(st.knee_pole,
+                                                                          (T, 2, 3)),
+                     hnd, np.broadcast_to(st.hand_dir, (T, 2, 3)),
+                     np.broadcast_to(st.elbow_pole, (T, 2, 3)))
+        cx = center_of_mass(pose)[:, 0]
+        shift += (np.clip(cx, lo, hi) - cx) / 0.8
+    return shift
+
+
+# ------------------------------------------------------------------- posture search
+def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...]
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Costs of trunk flexion / pelvis drop candidates for hand targets.
+
+    Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
+    """
+    H = skeleton.stature
+    b = skeleton.bone_lengths()
+    leg = b[_J["l_knee"]] + b[_J["l_ankle"]]
+    arm = _arm_length(skeleton)
+    pitch_v = np.linspace(0.0, 1.45, 30)
+    drop_v = np.linspace(0.0, 0.36 * H, 25)
+    P, D = np.meshgrid(pitch_v, drop_v, indexing="ij")
+    P, D = P.ravel(), D.ravel()
+    pelvis = np.tile(st.pelvis, (P.size, 1))
+    pelvis[:, 2] -= D
+    shift = _balance_shift(skeleton, pelvis, P, st)
+    pelvis[:, 0] += shift
+    tr = _trunk(skeleton, pelvis, P)
+    cost = P ** 2 + (D / (0.14 * H)) ** 2
+    feasible = np.ones(P.size, bool)
+    for k in active:
+        sh = tr[:, _J[f"{_SIDES[k]}_shoulder"]]
+        d = np.linalg.norm(targets[k] - sh, axis=-1)
+        feasible &= d <= _REACH_FRACTION * arm
+        cost = cost + 0.5 * (d / arm - 0.8) ** 2
+    for k, s in enumerate(_SIDES):
+        hip = tr[:, _J[f"{s}_hip"]]
+        d = np.linalg.norm(hip - st.ankles[k], axis=-1)
+        feasible &= (d <= leg * 1.0000001) & (d >= 0.30 * leg)
+    # the head must not go below the hands' height band (no diving into the floor)
+    feasible &= tr[:, _J["head"], 2] > 0.12 * H
+    cost = np.where(feasible, cost, np.inf)
+    return P, D, shift, cost
+
+
+def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray, tuple, str]:
+    """Palm targets (2, 3), active hand indices and the meta hand name."""
+    t = np.asarray(target, dtype=np.float64)
+    targets = np.stack([t, t])
+    if task == "assemble" or hand == "both":
+        targets[0, 1] += _ASSEMBLE_HALF_GAP
+        targets[1, 1] -= _ASSEMBLE_HALF_GAP
+        return targets, (0, 1), "both"
+    if task == "leftHand":
+        side = "l"
+    elif task == "rightHand":
+        side = "r"
+    elif hand == "auto":
+        side = "l" if t[1] > 0.0 else "r"
+    elif hand in ("l_hand", "left", "l"):
+        side = "l"
+    elif hand in ("r_hand", "right", "r"):
+        side = "r"
+    else:
+        raise ValueError(f"hand must be 'auto', 'l_hand', 'r_hand' or 'both', got {hand!r}")
+    return targets, ((0,) if side == "l" else (1,)), f"{side}_hand"
+
+
+def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
+                 task: str, target: np.ndarray) -> tuple[float, float, float]:
+    P, D, S, cost = _grid(skeleton, st, targets, active)
+    i = int(np.argmin(cost))
+    if not np.isfinite(cost[i]):
+        raise ValueError(
+            f"{task}: target {np.round(target, 3).tolist()} (start frame) is out of reach for a "
+            f"{skeleton.stature:.2f} m worker; place the worker with reach_placement()")
+    return float(P[i]), float(D[i]), float(S[i])
+
+
+# ----------------------------------------------------------------------- timelines
+def _profile(t: np.ndarray, keys: list[tuple[float, float]]) -> np.ndarray:
+    """Piecewise minimum-jerk interpolation of scalar key values ``[(time, value), ...]``."""
+    out = np.full_like(t, keys[0][1], dtype=np.float64)
+    for (t0, v0), (t1, v1) in zip(keys[:-1], keys[1:]):
+        if t1 <= t0:
+            continue
+        m = (t >= t0) & (t <= t1)
+        out[m] = v0 + (v1 - v0) * min_jerk((t[m] - t0) / (t1 - t0))
+    out[t > keys[-1][0]] = keys[-1][1]
+    return out
+
+
+def _interp_keys(t: np.ndarray, keys: list[tuple[float, np.ndarray]]) -> np.ndarray:
+    """Piecewise minimum-jerk interpolation of array key values (same shapes)."""
+    first = np.asarray(keys[0][1], dtype=np.float64)
+    out = np.broadcast_to(first, (t.size,) + first.shape).copy()
+    for (t0, v0), (t1, v1) in zip(keys[:-1], keys[1:]):
+        if t1 <= t0:
+            continue
+        m = (t >= t0) & (t <= t1)
+        s = min_jerk((t[m] - t0) / (t1 - t0)).reshape((-1,) + (1,) * first.ndim)
+        out[m] = np.asarray(v0) + s * (np.asarray(v1) - np.asarray(v0))
+    out[t > keys[-1][0]] = np.asarray(keys[-1][1])
+    return out
+
+
+def _arc_keys(t: np.ndarray, keys: list[tuple[float, np.ndarray]]) -> np.ndarray:
+    """Like :func:`_interp_keys` for shoulder-to-palm vectors (..., 3): the direction is
+    slerped and the length interpolated, so the palm swings in an arc about the shoulder
+    (never through it), with the minimum-jerk timing."""
+    first = np.asarray(keys[0][1], dtype=np.float64)
+    out = np.broadcast_to(first, (t.size,) + first.shape).copy()
+    for (t0, v0), (t1, v1) in zip(keys[:-1], keys[1:]):
+        if t1 <= t0:
+            continue
+        m = (t >= t0) & (t <= t1)
+        s = min_jerk((t[m] - t0) / (t1 - t0)).reshape((-1,) + (1,) * (first.ndim - 1))[..., None]
+        v0, v1 = np.asarray(v0, dtype=np.float64), np.asarray(v1, dtype=np.float64)
+        n0 = np.linalg.norm(v0, axis=-1, keepdims=True)
+        n1 = np.linalg.norm(v1, axis=-1, keepdims=True)
+        u0, u1 = v0 / np.maximum(n0, 1e-9), v1 / np.maximum(n1, 1e-9)
+        omega = np.arccos(np.clip(np.sum(u0 * u1, axis=-1, keepdims=True), -1.0, 1.0))
+        so = np.sin(omega)
+        small = so < 1e-6
+        a = np.where(small, 1.0 - s, np.sin((1.0 - s) * omega) / np.where(small, 1.0, so))
+        b = np.where(small, s, np.sin(s * omega) / np.where(small, 1.0, so))
+        u = a * u0 + b * u1
+        u /= np.maximum(np.linalg.norm(u, axis=-1, keepdims=True), 1e-12)
+        out[m] = u * ((1.0 - s) * n0 + s * n1)
+    out[t > keys[-1][0]] = np.asarray(keys[-1][1])
+    return out
+
+
+def _n_frames(total: float, fps: float) -> int:
+    return int(round(total * fps)) + 1
+
+
+def _finish(name: str, task: str, world: np.ndarray, st: _Start, fps: float, source: str,
+            meta: dict, start_exact: bool = True, end_exact: bool = True) -> MotionPrimitive:
+    """Blend the model residual against ``start_pose`` in at the ends, build the primitive."""
+    T = world.shape[0]
+    if start_exact or end_exact:
+        ref = world[0] if start_exact else world[-1]
+        pose = st.pose.copy()
+        pose[:, :2] += ref[0, :2] - pose[0, :2]
+        residual = pose - ref
+        if np.max(np.abs(residual)) > 1e-9:
+            t = np.arange(T) / fps
+            w = np.zeros(T)
+            ramp = 0.3
+            if start_exact:
+                w = np.maximum(w, 1.0 - min_jerk(t / ramp))
+            if end_exact:
+                w = np.maximum(w, 1.0 - min_jerk((t[-1] - t) / ramp))
+            world = world + w[:, None, None] * residual[None]
+    yaw = np.zeros(T)
+    root = np.concatenate([world[:, 0, :], yaw[:, None]], axis=1)
+    root = relative_root(root)
+    root[:, :2] = world[:, 0, :2] - world[0, 0, :2]
+    poses = world - world[:, :1, :]
+    meta = dict(meta)
+    meta.setdefault("kind", "goal")
+    return MotionPrimitive(name=name, task=task, poses=poses, root=root, fps=fps,
+                           source=source, meta=meta)
+
+
+# ------------------------------------------------------------------------- builders
+def _frames(skeleton: Skeleton, st: _Start, t: np.ndarray, pelvis: np.ndarray,
+            pitch: np.ndarray, hands: np.ndarray, hand_dir: np.ndarray,
+            elbow_pole: np.ndarray, ankles: np.ndarray | None = None,
+            toes: np.ndarray | None = None, knee_pole: np.ndarray | None = None) -> np.ndarray:
+    T = t.size
+    ankles = np.broadcast_to(st.ankles, (T, 2, 3)) if ankles is None else ankles
+    toes = np.broadcast_to(st.toes, (T, 2, 3)) if toes is None else toes
+    knee_pole = np.broadcast_to(st.knee_pole, (T, 2, 3)) if knee_pole is None else knee_pole
+    return _body(skeleton, pelvis, pitch, ankles, toes, knee_pole, hands, hand_dir, elbow_pole)
+
+
+def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
+               rng: np.random.Generator, duration: float | None, hand: str,
+               fps: float) -> MotionPrimitive:
+    H = skeleton.stature
+    if target is None:
+        raise ValueError(f"{task} needs a target position (3,) in the start frame")
+    target = np.asarray(target, dtype=np.float64)
+    if target.shape != (3,) or not np.all(np.isfinite(target)):
+        raise ValueError(f"target must be a finite array of shape (3,), got {target.shape}")
+    if target[2] < 0.0 or target[2] > max_reach(task, skeleton):
+        raise ValueError(f"{task}: target height {target[2]:.3f} m is outside [0, "
+                         f"{max_reach(task, skeleton):.3f}] m for a {H:.2f} m worker")
+    targets, active, hand_name = _hand_targets(task, target, hand)
+    # insert pushes into the target from a point before it; extract pulls back from it
+    approach = np.zeros(3)
+    if task in ("insert", "extract"):
+        sh = st.shoulders[active[0]]
+        a = target - sh
+        a[2] = 0.0
+        n = np.linalg.norm(a)
+        approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
+    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target)
+    # timing
+    jitter = rng.uniform(0.9, 1.1)
+    dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
+    t_reach = float(np.clip(0.5 + 0.55 * dist + 0.35 * pitch1 + 1.2 * drop1 / H, 0.6, 2.2))
+    t_reach *= jitter
+    t_ret = t_reach * rng.uniform(0.95, 1.05)
+    holds = {"grasp": 0.3, "release": 0.3, "move": 0.3, "leftHand": 1.0, "rightHand": 1.0,
+             "assemble": 3.0, "insert": 0.9, "extract": 0.9}
+    hold = holds[task]
+    if duration is not None:
+        hold = float(duration) - t_reach - t_ret
+        if hold < 0.1 + (0.6 if task in ("insert", "extract") else 0.0):
+            raise ValueError(f"{task}: duration {duration:.2f} s is too short; this motion "
+                             f"needs at least {t_reach + t_ret + 0.1:.2f} s")
+    total = t_reach + hold + t_ret
+    T = _n_frames(total, fps)
+    t = np.arange(T) / fps
+    t1, t2 = t_reach, t_reach + hold
+    # body posture leads the hand: it is reached at 85 % of the reach time
+    body_keys = [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)]
+    sb = _profile(t, body_keys)
+    pelvis = np.tile(st.pelvis, (T, 1))
+    pelvis[:, 2] -= drop1 * sb
+    pelvis[:, 0] += shift1 * sb
+    pitch = pitch1 * sb
+    tr = _trunk(skeleton, pelvis, pitch)
+    shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)   # (T,2,3)
+    f1 = min(int(round(t1 * fps)), T - 1)
+    f2 = min(int(round(t2 * fps)), T - 1)
+    sh1 = shoulders[f1]
+    # hand key positions relative to the shoulder
+    rel_home = st.hand_rel
+    rel_goal = rel_home.copy()
+    rel_pre = rel_home.copy()
+    for k in active:
+        rel_goal[k] = targets[k] - sh1[k]
+        rel_pre[k] = targets[k] - _INSERT_TRAVEL * approach - sh1[k]
+    if task == "insert":
+        push = min(0.5, 0.6 * hold)
+        keys = [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
+                (total, rel_home)]
+        contact_t = t1 + push
+    elif task == "extract":
+        pull = min(0.5, 0.6 * hold)
+        keys = [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
+                (total, rel_home)]
+        contact_t = t2
+    else:
+        keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
+        contact_t = t1
+    rel = _arc_keys(t, keys)
+    # a small seeded bow of the hand path (outward and up), zero at every key pose
+    s_out = _profile(t, [(0.0, 0.0), (t1, 1.0)])
+    s_back = _profile(t, [(t2, 0.0), (total, 1.0)])
+    bow = np.sin(np.pi * s_out) * (t <= t1) + np.sin(np.pi * s_back) * (t >= t2)
+    for k in active:
+        out_dir = np.array([0.0, 1.0 if k == 0 else -1.0, 0.6])
+        out_dir /= np.linalg.norm(out_dir)
+        amp = rng.uniform(0.02, 0.05) * min(1.0, dist / 0.5)
+        rel[:, k] += amp * bow[:, None] * out_dir
+    # small manipulation movements while the hands are in the region
+    if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
+        env = _profile(t, [(t1, 0.0), (t1 + 0.2, 1.0), (t2 - 0.2, 1.0), (t2, 0.0)])
+        env = np.where((t > t1) & (t < t2), env, 0.0)
+        for k in active:
+            f = rng.uniform(0.7, 1.4, size=3)
+            ph = rng.uniform(0.0, 2 * np.pi, size=3)
+            amp = np.array([0.010, 0.008, 0.008])
+            wob = amp * np.sin(2 * np.pi * f * t[:, None] + ph)
+            rel[:, k] += env[:, None] * wob
+    hands = shoulders + rel
+    # palm direction and elbow pole blend from the start pose to the reaching posture
+    s_hand = _interp_keys(t, [(0.0, 0.0), (t1, 1.0), (t2, 1.0), (total, 0.0)])
+    hand_dir = np.broadcast_to(st.hand_dir, (T, 2, 3)).copy()
+    elbow_pole = np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy()
+    for k in active:
+        reach_dir = rel_goal[k] / max(np.linalg.norm(rel_goal[k]), 1e-9)
+        if task == "assemble":
+            reach_dir = np.array([0.75, -0.35 if k == 0 else 0.35, -0.55])
+        goal_dir = reach_dir + np.array([0.0, 0.0, -0.3])
+        goal_dir /= np.linalg.norm(goal_dir)
+        hd = (1 - s_hand)[:, None] * st.hand_dir[k] + s_hand[:, None] * goal_dir
+        hand_dir[:, k] = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
+        side = 1.0 if k == 0 else -1.0
+        goal_pole = np.array([-0.35, 1.0 * side, -0.45])
+        elbow_pole[:, k] = (1 - s_hand)[:, None] * st.elbow_pole[k] + s_hand[:, None] * goal_pole
+    world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole)
+    contact = min(int(round(contact_t * fps)), T - 1)
+    meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
+            "hold_frames": [f1, f2], "trunk_flexion": pitch1, "pelvis_drop": drop1,
+            "posture": _posture_name(world[f1], skeleton)}
+    return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
+                   f"goals.make_goal_primitive({task!r}, target={_fmt(target)})", meta)
+
+
+def _fmt(target: np.ndarray | None) -> str:
+    if target is None:
+        return "none"
+    return "[" + ",".join(f"{v:.3f}" for v in np.asarray(target)) + "]"
+
+
+def _posture_name(pose: np.ndarray, skeleton: Skeleton) -> str:
+    """Table I posture of a pose: 'stoop', 'bend' or 'upright' (joint-based)."""
+    head_low = pose[_J["head"], 2] < chest_height(skeleton)
+    butt_low = min(pose[_J["l_hip"], 2], pose[_J["r_hip"], 2]) < knee_height(skeleton)
+    if head_low and butt_low:
+        return "stoop"
+    if head_low:
+        return "bend"
+    return "upright"
+
+
+def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator,
+             duration: float | None, fps: float, target: np.ndarray | None,
+             hand: str) -> MotionPrimitive:
+    """bend, stoop and kneel: go down, stay, come back up."""
+    H = skeleton.stature
+    b = skeleton.bone_lengths()
+    jitter = rng.uniform(0.9, 1.1)
+    t_down = {"bend": 1.1, "stoop": 1.3, "kneel": 1.7}[task] * jitter
+    t_up = t_down * rng.uniform(1.0, 1.15)
+    hold = 1.0 if duration is None else float(duration) - t_down - t_up
+    if hold < 0.1:
+        raise ValueError(f"{task}: duration {duration:.2f} s is too short; this motion needs "
+                         f"at least {t_down + t_up + 0.1:.2f} s")
+    total = t_down + hold + t_up
+    T = _n_frames(total, fps)
+    t = np.arange(T) / fps
+    t1, t2 = t_down, t_down + hold
+    s = _profile(t, [(0.0, 0.0), (t1, 1.0), (t2, 1.0), (total, 0.0)])
+    ankles = np.broadcast_to(st.ankles, (T, 2, 3)).copy()
+    toes = np.broadcast_to(st.toes, (T, 2, 3)).copy()
+    knee_pole = np.broadcast_to(st.knee_pole, (T, 2, 3)).copy()
+    pelvis = np.tile(st.pelvis, (T, 1))
+    if task == "bend":
+        # head to 0.62 H (below chest height 0.72 H), knees nearly straight
+        head_off = skeleton.rest_positions()[_J["head"]] - skeleton.rest_positions()[0]
+        want = 0.60 * H + rng.uniform(-0.02, 0.02) * H
+        drop = 0.01 * H
+        c = np.clip((want - (st.pelvis[2] - drop)) / np.linalg.norm(head_off), -1, 1)
+        pitch1 = float(np.arccos(c))
+        pitch = pitch1 * s
+        pelvis[:, 2] -= drop * s
+        shift = _balance_shift(skeleton, pelvis[[-1]].copy() * 0 + np.array(
+            [st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]), np.array([pitch1]), st)[0]
+        pelvis[:, 0] += shift * s
+    elif task == "stoop":
+        # buttocks (hips) below knee height, trunk flexed forward
+        hip_h = 0.20 * H + rng.uniform(-0.01, 0.01) * H
+        rest = skeleton.rest_positions()
+        drop = st.pelvis[2] - (hip_h + (rest[0, 2] - rest[_J["l_hip"], 2]))
+        pitch1 = float(0.85 + rng.uniform(-0.05, 0.05))
+        p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
+        shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
+        pelvis[:, 2] -= drop * s
+        pelvis[:, 0] += shift * s
+        pitch = pitch1 * s
+    else:  # kneel on one knee (right by default, hand="l_hand" kneels on the left)
+        k = 0 if hand in ("l_hand", "left", "l") else 1
+        rest = skeleton.rest_positions()
+        thigh, shank, foot = b[_J["l_knee"]], b[_J["l_ankle"]], b[_J["l_toe"]]
+        knee_z = 0.026 * H
+        hip_above = 0.97 * thigh
+        hip_x = -0.6 * thigh
+        knee = np.array([hip_x + 0.24 * thigh, st.ankles[k, 1], knee_z])
+        hip = np.array([knee[0] - np.sqrt(thigh ** 2 - hip_above ** 2), knee[1],
+                        knee_z + hip_above])
+        ankle_z = 0.075 * H
+        ankle = np.array([knee[0] - np.sqrt(shank ** 2 - (ankle_z - knee_z) ** 2), knee[1],
+                          ankle_z])
+        toe_z = rest[_J["l_toe"], 2]
+        toe = ankle + np.array([np.sqrt(foot ** 2 - (ankle_z - toe_z) ** 2), 0.0,
+                                toe_z - ankle_z])
+        pel1 = hip - (rest[_J[f"{_SIDES[k]}_hip"]] - rest[0])
+        # the moving foot lifts while it steps back
+        s_foot = _profile(t, [(0.0, 0.0), (0.55 * t1, 1.0), (t2 + 0.45 * t_up, 1.0),
+                              (total, 0.0)])
+        lift = 0.05 * H * np.sin(np.pi * s_foot) * ((t < 0.55 * t1) | (t > t2 + 0.45 * t_up))
+        ankles[:, k] = st.ankles[k] + s_foot[:, None] * (ankle - st.ankles[k])
+        ankles[:, k, 2] += lift
+        toes[:, k] = st.toes[k] + s_foot[:, None] * (toe - st.toes[k])
+        toes[:, k, 2] += lift
+        knee_pole[:, k] = np.array([0.35, 0.0, -1.0])
+        pelvis = st.pelvis + s[:, None] * (pel1 - st.pelvis)
+        pitch = 0.15 * s
+    tr = _trunk(skeleton, pelvis, pitch)
+    shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
+    hands = shoulders + st.hand_rel
+    hand_dir = np.broadcast_to(st.hand_dir, (T, 2, 3)).copy()
+    elbow_pole = np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy()
+    hand_name = "none"
+    if target is not None:
+        target = np.asarray(target, dtype=np.float64)
+        if target.shape != (3,):
+            raise ValueError(f"target must have shape (3,), got {target.shape}")
+        targets, active, hand_name = _hand_targets("grasp", target, hand if hand != "auto"
+                                                   else "auto")
+        f1 = min(int(round(t1 * fps)), T - 1)
+        arm = _arm_length(skeleton)
+        rel = np.broadcast_to(st.hand_rel, (T, 2, 3)).copy()
+        for k in active:
+            goal = targets[k] - shoulders[f1, k]
+            if np.linalg.norm(goal) > _REACH_FRACTION * arm:
+                raise ValueError(f"{task}: target {np.round(target, 3).tolist()} is out of reach "
+                                 f"from the {task} posture")
+            rel[:, k] = _arc_keys(t, [(0.0, st.hand_rel[k]), (t1, goal), (t2, goal),
+                                      (total, st.hand_rel[k])])
+        hands = shoulders + rel
+    world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, ankles, toes,
+                    knee_pole)
+    f1 = min(int(round(t1 * fps)), T - 1)
+    meta = {"contact_frame": f1, "hand": hand_name,
+            "target": None if target is None else np.asarray(target).tolist(),
+            "hold_frames": [f1, min(int(round(t2 * fps)), T - 1)],
+            "posture": "kneel" if task == "kneel" else _posture_name(world[f1], skeleton)}
+    return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
+                   f"goals.make_goal_primitive({task!r})", meta)
+
+
+def _sit(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: float | None,
+         fps: float, target: np.ndarray | None) -> tuple[np.ndarray, dict, np.ndarray]:
+    """World frames of sitting down onto the seat point ``target`` (start frame)."""
+    H = skeleton.stature
+    lo, hi = seat_height_range(skeleton)
+    if target is None:
+        target = np.array([reach_placement("sit", 0.26 * H, skeleton)[0], 0.0, 0.26 * H])
+    target = np.asarray(target, dtype=np.float64)
+    if target.shape != (3,) or not np.all(np.isfinite(target)):
+        raise ValueError(f"target must be a finite array of shape (3,), got {target.shape}")
+    if not lo - 1e-9 <= target[2] <= hi + 1e-9:
+        raise ValueError(f"sit: seat height {target[2]:.3f} m is outside [{lo:.3f}, {hi:.3f}] m "
+                         f"for a {H:.2f} m worker")
+    rest = skeleton.rest_positions()
+    b = skeleton.bone_lengths()
+    leg = b[_J["l_knee"]] + b[_J["l_ankle"]]
+    hip_z = target[2] + 0.055 * H
+    pel1 = np.array([target[0], target[1], hip_z + (rest[0, 2] - rest[_J["l_hip"], 2])])
+    for k in range(2):
+        hip = pel1 + (rest[_J[f"{_SIDES[k]}_hip"]] - rest[0])
+        if np.linalg.norm(hip - st.ankles[k]) > 0.999 * leg or target[0] > -0.02 * H:
+            raise ValueError(f"sit: seat point {np.round(target, 3).tolist()} cannot be reached "
+                             f"from the start position; it must be behind the worker within "
+                             f"reach (see reach_placement)")
+    t_down = (1.5 if duration is None else float(duration)) * (
+        rng.uniform(0.92, 1.08) if duration is None else 1.0)
+    if t_down < 0.6:
+        raise ValueError(f"sit: duration {t_down:.2f} s is too short (at least 0.6 s)")
+    T = _n_frames(t_down, fps)
+    t = np.arange(T) / fps
+    s = min_jerk(t / t_down)
+    # the hips move back early and down later; the trunk leans forward while descending
+    s_back = min_jerk(np.clip(t / (0.75 * t_down), 0, 1))
+    pelvis = np.empty((T, 3))
+    pelvis[:, 0] = st.pelvis[0] + s_back * (pel1[0] - st.pelvis[0])
+    pelvis[:, 1] = st.pelvis[1] + s * (pel1[1] - st.pelvis[1])
+    pelvis[:, 2] = st.pelvis[2] + s * (pel1[2] - st.pelvis[2])
+    lean = rng.uniform(0.45, 0.6)
+    pitch = 0.12 * s + lean * np.sin(np.pi * s)
+    tr = _trunk(skeleton, pelvis, pitch)
+    shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
+    hands = shoulders + st.hand_rel
+    hands[..., 0] += 0.08 * H * np.sin(np.pi * s)[:, None]     # arms swing forward a little
+    world = _frames(skeleton, st, t, pelvis, pitch, hands,
+                    np.broadcast_to(st.hand_dir, (T, 2, 3)).copy(),
+                    np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy())
+    return world, {"target": target.tolist()}, target
+
+
+def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton, *,
+                        start_pose: np.ndarray | None = None,
+                        rng: np.random.Generator | None = None, duration: float | None = None,
+                        hand: str = "auto", fps: float = LIBRARY_FPS) -> MotionPrimitive:
+    """A goal primitive for one Table I task, made for the exact target.
+
+    Parameters
+    ----------
+    task : str
+        One of :data:`GOAL_TASKS`: grasp, release, move, leftHand, rightHand, assemble,
+        insert, extract, bend, stoop, kneel, sit, standUp, wait.
+    target : array-like, shape (3,), or None
+        In the primitive's start frame (root floor position at the origin, facing +x,
+        z = height above the floor). Hand tasks: where the palm goes (assemble: the middle
+        between both palms; insert: the end of the push, which starts 8 cm before it along
+        the horizontal shoulder-target direction; extract: where the hand takes the part,
+        it is then pulled back 8 cm). sit: the point of the seat surface under the
+        buttocks (must be behind the worker); standUp: the seat (only its height is used;
+        the worker starts seated above the origin). bend/stoop/kneel: optional hand target
+        reached in the low posture. wait: ignored.
+    skeleton : Skeleton
+    start_pose : array-like, shape (J, 3), optional
+        Pose to start from (and return to): start-frame positions, or a root-relative
+        pose (pelvis at the origin) which is then stood on the floor. Default: the standing
+        pose of the gait library. For standUp it is the pose *ended in*.
+    rng : numpy.random.Generator, optional
+        Seeded variation of timing, hand-path bow, manipulation and sway (default seed 0).
+    duration : float, optional
+        Total length in seconds (hand and down-up tasks: the hold absorbs the change;
+        sit/standUp: the descent/ascent; wait: the wait). ValueError when too short.
+    hand : {"auto", "l_hand", "r_hand", "both"}
+        Acting hand; auto = left for targets with y > 0, else right. For kneel,
+        "l_hand" kneels on the left knee.
+    fps : float
+
+    Returns
+    -------
+    MotionPrimitive
+        ``meta``: ``contact_frame`` (frame where the hand reaches the target / the task's
+        termination condition first holds), ``hand`` (``"l_hand"``, ``"r_hand"``,
+        ``"both"`` or ``"none"``), ``target``, ``hold_frames``, ``posture``.
+
+    Raises
+    ------
+    ValueError
+        Unknown task, malformed or unreachable target, too short duration.
+    """
+    _check_task(task)
+    if not isinstance(skeleton, Skeleton):
+        raise ValueError(f"skeleton must be a Skeleton, got {type(skeleton).__name__}")
+    if not fps > 0:
+        raise ValueError(f"fps must be positive, got {fps!r}")
+    if duration is not None and not duration > 0:
+        raise ValueError(f"duration must be positive, got {duration!r}")
+    rng = np.random.default_rng(0) if rng is None else rng
+    st = _Start(skeleton, start_pose)
+    if task in HAND_TASKS:
+        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps)
+    if task in ("bend", "stoop", "kneel"):
+        return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
+    if task == "wait":
+        return _wait(skeleton, st, rng, duration, fps)
+    if task == "sit":
+        world, meta, tgt = _sit(skeleton, st, rng, duration, fps, target)
+        meta.update({"contact_frame": world.shape[0] - 1, "hand": "none",
+                     "posture": "seated", "hold_frames": [world.shape[0] - 1] * 2})
+        return _finish(f"sit_{_fmt(tgt)}", "sit", world, st, fps,
+                       f"goals.make_goal_primitive('sit', target={_fmt(tgt)})", meta,
+                       start_exact=True, end_exact=False)
+    # standUp: sitting down on a seat behind the standing pose, played backwards and
+    # re-rooted at the seated pelvis
+    H = skeleton.stature
+    seat_z = 0.26 * H if target is None else float(np.asarray(target, dtype=np.float64)[2])
+    dist, _ = reach_placement("sit", seat_z, skeleton)
+    world, meta, tgt = _sit(skeleton, st, rng, duration, fps, np.array([dist, 0.0, seat_z]))
+    world = world[::-1].copy()
+    world[..., :2] -= world[0, 0, :2]
+    # Table I's condition (head above chest height) already holds for an upright seated
+    # worker; the contact frame marks the end of rising: the pelvis at 95 % of its
+    # standing height
+    risen = np.nonzero(world[:, 0, 2] >= 0.95 * st.pelvis[2])[0]
+    contact = int(risen[0]) if risen.size else world.shape[0] - 1
+    meta = {"contact_frame": contact, "hand": "none", "target": [0.0, 0.0, seat_z],
+            "posture": "upright", "hold_frames": [0, 0]}
+    return _finish(f"standUp_{_fmt(np.array([0.0, 0.0, seat_z]))}", "standUp", world, st, fps,
+                   f"goals.make_goal_primitive('standUp', seat height {seat_z:.3f})", meta,
+                   start_exact=False, end_exact=True)
+
+
+def _wait(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: float | None,
+          fps: float) -> MotionPrimitive:
+    """Stand still with a small postural sway (under 1 cm) and a breathing-like arm drift."""
+    total = 2.0 if duration is None else float(duration)
+    T = _n_frames(total, fps)
+    t = np.arange(T) / fps
+    env = np.minimum(min_jerk(t / 0.4), min_jerk((total - t) / 0.4)) if total > 0.8 else \
+        np.sin(np.pi * t / max(total, 1e-9)) ** 2
+    f = rng.uniform(0.2, 0.35, size=2)
+    ph = rng.uniform(0.0, 2 * np.pi, size=2)
+    pelvis = np.tile(st.pelvis, (T, 1))
+    pelvis[:, 0] += env * 0.004 * np.sin(2 * np.pi * f[0] * t + ph[0])
+    pelvis[:, 1] += env * 0.006 * np.sin(2 * np.pi * f[1] * t + ph[1])
+    pitch = env * 0.01 * np.sin(2 * np.pi * f[0] * t + ph[1])
+    tr = _trunk(skeleton, pelvis, pitch)
+    shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
+    world = _frames(skeleton, st, t, pelvis, pitch, shoulders + st.hand_rel,
+                    np.broadcast_to(st.hand_dir, (T, 2, 3)).copy(),
+                    np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy())
+    meta = {"contact_frame": T - 1, "hand": "none", "target": None, "hold_frames": [0, T - 1],
+            "posture": "upright", "duration": total}
+    return _finish(f"wait_{total:.2f}s", "wait", world, st, fps,
+                   f"goals.make_goal_primitive('wait', duration={total:.2f})", meta)
+
+
+@lru_cache(maxsize=512)
+def _placement(task: str, height: float, stature: float, hand: str) -> tuple[float, float]:
+    skeleton = Skeleton(stature)
+    H = stature
+    if task in ("sit", "standUp"):
+        return -0.10 * H, 0.0
+    if task in ("bend", "stoop", "kneel", "wait"):
+        return 0.0, 0.0
+    both = task == "assemble" or hand == "both"
+    lateral = 0.0 if both else (0.07 * H if (task == "leftHand" or hand in ("l_hand", "left"))
+                                else -0.07 * H)
+    st = _Start(skeleton, None)
+    best = (np.inf, None)
+    for x in np.linspace(0.12 * H, 0.45 * H, 12):
+        target = np.array([x, lateral, height])
+        targets, active, _ = _hand_targets(task, target, "both" if both else (
+            "l_hand" if lateral > 0 else "r_hand"))
+        _, _, _, cost = _grid(skeleton, st, targets, active)
+        c = float(np.min(cost))
+        if c < best[0]:
+            best = (c, float(x))
+    if best[1] is None:
+        raise ValueError(f"{task}: no standing place reaches a target at height {height:.3f} m")
+    return best[1], lateral
+
+
+def reach_placement(task: str, target_height: float, skeleton: Skeleton,
+                    hand: str = "auto") -> tuple[float, float]:
+    """Where to put the target relative to the standing root for a comfortable posture.
+
+    Parameters
+    ----------
+    task : str
+    target_height : float
+        Height of the target above the floor (for sit/standUp: the seat height).
+    skeleton : Skeleton
+    hand : str
+        ``"auto"`` uses the right hand for one-handed tasks (leftHand: left).
+
+    Returns
+    -------
+    distance_in_front, lateral_offset : float
+        The target should be at ``(distance_in_front, lateral_offset, target_height)`` in
+        the goal primitive's start frame (x forward, y left); equivalently the worker stands
+        ``distance_in_front`` behind the target, facing it, with the target
+        ``lateral_offset`` to the left. sit: negative distance (the seat is behind).
+        Tasks without a target return (0, 0).
+
+    Raises
+    ------
+    ValueError
+        Unknown task, or the height is outside ``[min_reach_height, max_reach]``.
+    """
+    _check_task(task)
+    h = float(target_height)
+    lo, hi = min_reach_height(task, skeleton), max_reach(task, skeleton)
+    if not (lo - 1e-9 <= h <= hi + 1e-9):
+        raise ValueError(f"{task}: target height {h:.3f} m is outside [{lo:.3f}, {hi:.3f}] m "
+                         f"for a {skeleton.stature:.2f} m worker")
+    return _placement(task, round(h, 4), float(skeleton.stature), hand)
+
+
+def heading_of(primitive: MotionPrimitive) -> np.ndarray:  # pragma: no cover - debugging aid
+    """Body heading (T,) of a goal primitive's frames (should stay near 0)."""
+    return yaw_from_positions(primitive.poses)

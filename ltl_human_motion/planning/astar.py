@@ -1,0 +1,219 @@
+"""A* over the gait primitives of the motion automaton (Sec. III-B of the paper).
+
+Nodes are gait primitives placed on the floor. Cost is time; the heuristic is
+``dist(occ, R) / v`` with a relaxed (lower than maximal) speed ``v``, so the search is
+greedy but fast, as the paper found. The closed set is a grid over (x, y, heading), so
+near-identical placements are expanded once (whichever primitive led there first).
+"""
+
+from __future__ import annotations
+
+import heapq
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ltl_human_motion.planning.gait_index import GaitIndex
+
+Pose = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class SearchBudget:
+    """Limits of one search: expanded nodes and wall-clock seconds."""
+
+    max_nodes: int = 20000
+    max_seconds: float = 2.0
+
+
+@dataclass
+class Goal:
+    """What ends a walk, as vectorized tests on root floor poses.
+
+    Attributes
+    ----------
+    reached : callable
+        ``reached(x (M,), y (M,), yaw (M,)) -> bool (M,)``.
+    distance : callable
+        ``distance(x (M,), y (M,)) -> (M,)``: metres left to walk (0 at the goal), used
+        by the heuristic.
+    heading : callable or None
+        ``heading(x (M,), y (M,)) -> (M,)``: direction the walk should head; the
+        heuristic adds the time to turn towards it.
+    description : str
+    """
+
+    reached: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+    distance: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    heading: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
+    description: str = ""
+
+
+@dataclass
+class SearchResult:
+    """Outcome of one A* search.
+
+    Attributes
+    ----------
+    primitives : list of int
+        Gait primitive indices from the start to the goal (empty if already there).
+    poses : list of (x, y, yaw)
+        Floor pose at which each primitive starts.
+    end_pose : (x, y, yaw)
+        Pose after the last primitive's hand-over frame.
+    expanded : int
+    seconds : float
+    """
+
+    primitives: list[int]
+    poses: list[Pose]
+    end_pose: Pose
+    expanded: int
+    seconds: float
+
+
+@dataclass
+class SearchFailure:
+    """Why a search ended without reaching the goal: ``"blocked"`` or ``"budget"``."""
+
+    reason: str
+    expanded: int
+    seconds: float
+    closest: float = field(default=float("inf"))
+
+
+def _place(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float) -> np.ndarray:
+    """End poses of primitives ``ids`` started at (x, y, yaw), shape (M, 3)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    d = index.disp[ids]
+    return np.stack([x + c * d[:, 0] - s * d[:, 1], y + s * d[:, 0] + c * d[:, 1],
+                     yaw + d[:, 2]], axis=-1)
+
+
+def _paths_clear(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float,
+                 clearance: Callable[[np.ndarray], np.ndarray], radius: float) -> np.ndarray:
+    """True where the root path of primitive ``ids[m]`` keeps ``radius`` from obstacles."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    p = index.path[ids]                                    # (M, S, 2)
+    wx = x + c * p[..., 0] - s * p[..., 1]
+    wy = y + s * p[..., 0] + c * p[..., 1]
+    pts = np.stack([wx, wy], axis=-1).reshape(-1, 2)
+    ok = clearance(pts).reshape(p.shape[:2]) > radius
+    return ok.all(axis=1)
+
+
+def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | None = None,
+          clearance: Callable[[np.ndarray], np.ndarray], body_radius: float = 0.25,
+          heuristic_speed: float = 0.7, turn_rate: float = 2.0, carry: bool = False,
+          budget: SearchBudget = SearchBudget(), rng: np.random.Generator | None = None,
+          cost_noise: float = 0.0, grid: float = 0.08, yaw_bins: int = 24
+          ) -> SearchResult | SearchFailure:
+    """Search a sequence of gait primitives from ``start`` until ``goal.reached``.
+
+    Parameters
+    ----------
+    index : GaitIndex
+    start : (x, y, yaw)
+        Floor pose of the root where walking begins.
+    goal : Goal
+    start_primitive : int or None
+        The gait primitive being executed at ``start``; None when standing.
+    clearance : callable
+        ``clearance(xy (M, 2)) -> (M,)`` signed distance of floor points from the
+        obstacles' footprints.
+    body_radius : float
+        Clearance the root path must keep, metres.
+    heuristic_speed : float
+        Relaxed walking speed of the heuristic, m/s.
+    turn_rate : float
+        Turning speed of the heuristic's heading term, rad/s.
+    carry : bool
+        Use carry primitives (arms holding an object) instead of walk primitives.
+    budget : SearchBudget
+    rng, cost_noise
+        Seeded multiplicative noise on primitive costs, for varied but valid paths.
+
+    Returns
+    -------
+    SearchResult or SearchFailure
+    """
+    t0 = time.perf_counter()
+    sx, sy, syaw = start
+    if bool(goal.reached(np.array([sx]), np.array([sy]), np.array([syaw]))[0]):
+        return SearchResult([], [], start, 0, time.perf_counter() - t0)
+    allowed = index.carry == carry
+    if not allowed.any():
+        allowed = np.ones_like(allowed)
+    noise = (1.0 + cost_noise * rng.random(len(index.cost)) if (rng is not None and cost_noise)
+             else np.ones(len(index.cost)))
+    step_cost = index.cost * noise
+    inv_v = 1.0 / heuristic_speed
+    yaw_scale = yaw_bins / (2.0 * np.pi)
+
+    # Node arrays: parent, primitive, pose, g.
+    parents: list[int] = [-1]
+    prims: list[int] = [-1 if start_primitive is None else start_primitive]
+    poses: list[Pose] = [start]
+    g_cost: list[float] = [0.0]
+    def heuristic(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+        h = goal.distance(x, y) * inv_v
+        if goal.heading is not None:
+            h = h + np.abs((goal.heading(x, y) - yaw + np.pi) % (2.0 * np.pi) - np.pi) / turn_rate
+        return h
+
+    h0 = float(heuristic(np.array([sx]), np.array([sy]), np.array([syaw]))[0])
+    open_heap: list[tuple[float, int]] = [(h0, 0)]
+    closed: set[tuple[int, int, int]] = set()
+    expanded = 0
+    closest = float(goal.distance(np.array([sx]), np.array([sy]))[0])
+    while open_heap:
+        _, node = heapq.heappop(open_heap)
+        px, py, pyaw = poses[node]
+        key = (round(px / grid), round(py / grid),
+               round(pyaw * yaw_scale) % yaw_bins, prims[node])
+        if key in closed:
+            continue
+        closed.add(key)
+        expanded += 1
+        if expanded > budget.max_nodes or time.perf_counter() - t0 > budget.max_seconds:
+            return SearchFailure("budget", expanded, time.perf_counter() - t0, closest)
+        succ = index.starts if prims[node] < 0 else index.successors(prims[node])
+        succ = succ[allowed[succ]]
+        if succ.size == 0:
+            continue
+        ends = _place(index, succ, px, py, pyaw)
+        clear = _paths_clear(index, succ, px, py, pyaw, clearance, body_radius)
+        if not clear.any():
+            continue
+        succ, ends = succ[clear], ends[clear]
+        done = goal.reached(ends[:, 0], ends[:, 1], ends[:, 2]) & index.stops[succ]
+        g_new = g_cost[node] + step_cost[succ]
+        if done.any():
+            best = int(np.argmin(np.where(done, g_new, np.inf)))
+            chain = [int(succ[best])]
+            chain_poses = [poses[node]]
+            n = node
+            while parents[n] >= 0:
+                chain.append(prims[n])
+                chain_poses.append(poses[parents[n]])
+                n = parents[n]
+            chain.reverse()
+            chain_poses.reverse()
+            end = tuple(float(v) for v in ends[best])
+            return SearchResult(chain, chain_poses, end, expanded, time.perf_counter() - t0)
+        h_new = heuristic(ends[:, 0], ends[:, 1], ends[:, 2])
+        keep = np.isfinite(h_new)
+        if not keep.any():
+            continue
+        closest = min(closest, float(goal.distance(ends[keep, 0], ends[keep, 1]).min()))
+        succ, ends, g_new = succ[keep], ends[keep], g_new[keep]
+        f_new = g_new + h_new[keep]
+        for m in range(len(succ)):
+            parents.append(node)
+            prims.append(int(succ[m]))
+            poses.append((float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2])))
+            g_cost.append(float(g_new[m]))
+            heapq.heappush(open_heap, (float(f_new[m]), len(prims) - 1))
+    return SearchFailure("blocked", expanded, time.perf_counter() - t0, closest)

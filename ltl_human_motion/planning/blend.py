@@ -1,0 +1,102 @@
+"""Motion blending (Sec. III-C of the paper).
+
+Consecutive placed motions overlap by ``nf`` frames. Over the overlap a cubic weight
+``w`` with ``w(0) = 1``, ``w(1) = 0`` and ``w'(0) = w'(1) = 0`` (C1) mixes them
+(Eq. (2)): ``M_syn = w M_i + (1 - w) M_j``. Joint positions and root positions are mixed
+linearly; the heading is mixed along the shorter arc.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def blend_weights(nf: int) -> np.ndarray:
+    """Cubic C1 blend weights from 1 to 0 over ``nf`` frames, shape (nf,).
+
+    ``w(s) = 1 - 3 s^2 + 2 s^3`` sampled at ``s = (k + 1) / (nf + 1)``, k = 0..nf-1, so
+    neither end of the overlap is a pure copy of one input.
+    """
+    if nf < 0:
+        raise ValueError(f"nf must be >= 0, got {nf}")
+    s = np.arange(1, nf + 1, dtype=np.float64) / (nf + 1)
+    return 1.0 - 3.0 * s**2 + 2.0 * s**3
+
+
+def wrap_angle(a: np.ndarray | float) -> np.ndarray:
+    """Angles wrapped to [-pi, pi)."""
+    return (np.asarray(a) + np.pi) % (2.0 * np.pi) - np.pi
+
+
+@dataclass
+class PlacedSegment:
+    """One motion placed in the world, ready to be concatenated.
+
+    Attributes
+    ----------
+    positions : ndarray, shape (T, J, 3)
+        World joint positions.
+    root_yaw : ndarray, shape (T,)
+        Heading of the root about +z, radians (unwrapped within the segment).
+    label : int
+        Index into the task timeline, or -1 for walking between tasks.
+    blend_in : int
+        Number of frames this segment overlaps the previous one.
+    """
+
+    positions: np.ndarray
+    root_yaw: np.ndarray
+    label: int = -1
+    blend_in: int = 0
+
+
+def concatenate(segments: list[PlacedSegment]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                         list[tuple[int, int]]]:
+    """Concatenate placed segments, blending each overlap with the cubic weight.
+
+    Returns
+    -------
+    positions : ndarray, shape (T, J, 3)
+    root_yaw : ndarray, shape (T,)
+        Continuous (unwrapped) heading.
+    labels : ndarray of int, shape (T,)
+        Segment label of each frame; blended frames take the incoming segment's label
+        once its weight exceeds one half.
+    spans : list of (start, end)
+        Frame span of each segment in the result (end exclusive, overlaps included).
+    """
+    if not segments:
+        raise ValueError("no segments to concatenate")
+    pos_parts: list[np.ndarray] = [segments[0].positions]
+    yaw_parts: list[np.ndarray] = [np.unwrap(segments[0].root_yaw)]
+    lab_parts: list[np.ndarray] = [np.full(len(segments[0].root_yaw), segments[0].label)]
+    spans = [(0, len(segments[0].root_yaw))]
+    length = spans[0][1]
+    for seg in segments[1:]:
+        nf = int(seg.blend_in)
+        prev_pos, prev_yaw, prev_lab = pos_parts[-1], yaw_parts[-1], lab_parts[-1]
+        nf = min(nf, len(prev_yaw), len(seg.root_yaw))
+        yaw_in = np.unwrap(seg.root_yaw)
+        # Continue the heading without a 2*pi jump.
+        ref = prev_yaw[-nf] if nf else prev_yaw[-1]
+        yaw_in = yaw_in + 2.0 * np.pi * np.round((ref - yaw_in[0]) / (2.0 * np.pi))
+        if nf:
+            w = blend_weights(nf)
+            a_pos, b_pos = prev_pos[-nf:], seg.positions[:nf]
+            mixed = w[:, None, None] * a_pos + (1.0 - w[:, None, None]) * b_pos
+            a_yaw, b_yaw = prev_yaw[-nf:], yaw_in[:nf]
+            mixed_yaw = a_yaw + (1.0 - w) * wrap_angle(b_yaw - a_yaw)
+            mixed_lab = np.where(w >= 0.5, prev_lab[-nf:], seg.label)
+            pos_parts[-1] = np.concatenate([prev_pos[:-nf], mixed])
+            yaw_parts[-1] = np.concatenate([prev_yaw[:-nf], mixed_yaw])
+            lab_parts[-1] = np.concatenate([prev_lab[:-nf], mixed_lab])
+        pos_parts.append(seg.positions[nf:])
+        yaw_parts.append(yaw_in[nf:])
+        lab_parts.append(np.full(len(yaw_in) - nf, seg.label))
+        start = length - nf
+        length = start + len(seg.root_yaw)
+        spans.append((start, length))
+    return (np.concatenate(pos_parts), np.concatenate(yaw_parts),
+            np.concatenate(lab_parts).astype(np.int64), spans)

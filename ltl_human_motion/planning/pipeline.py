@@ -1,0 +1,338 @@
+"""The synthesis pipeline: LTL specification and cell in, verified motions out.
+
+Stages (timed separately, as in the paper's Tab. III):
+
+1. ``automaton``  parse the specification, add the always-on conjuncts, translate;
+2. ``sequence``   task sequences from accepting lassos (variations);
+3. ``planning``   A* over the gait primitives and goal primitives per task;
+4. ``blending``   concatenate with the cubic C1 blend, track the objects;
+5. ``verification`` every check of :mod:`.verify`; a failing motion is not returned.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ltl_human_motion.errors import CellError, PlanningError
+from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
+from ltl_human_motion.motion.types import Motion
+from ltl_human_motion.planning.blend import concatenate
+from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner
+from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
+from ltl_human_motion.planning.verify import VerificationOptions, verify_motion
+
+__all__ = ["SynthesisOptions", "resolve_cell", "synthesize", "get_library"]
+
+
+@dataclass(frozen=True)
+class SynthesisOptions:
+    """Options of :func:`synthesize`.
+
+    Attributes
+    ----------
+    sequence_mode : {"coverage", "random", "all"}
+        How task-sequence variations are chosen (see :mod:`ltl_human_motion.ltl`).
+    backend : {"auto", "builtin", "spot"}
+        LTL translator.
+    planner : PlannerOptions
+    verification : VerificationOptions
+    verify : bool
+        Refuse motions that fail a check (default). False returns them with the report.
+    library_source : str or None
+        Extra motion files or a folder (e.g. a CMU BVH database) for the gait library.
+    """
+
+    sequence_mode: str = "all"
+    backend: str = "auto"
+    planner: PlannerOptions = field(default_factory=PlannerOptions)
+    verification: VerificationOptions = field(default_factory=VerificationOptions)
+    verify: bool = True
+    library_source: str | None = None
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SynthesisOptions:
+        """Options from plain values, e.g. the ROS service's ``options_json``.
+
+        Keys: ``sequence_mode``, ``backend``, ``verify``, ``library_source``,
+        ``heuristic_speed``, ``max_nodes``, ``max_seconds``, ``cost_noise``, ``eps``,
+        ``max_joint_speed``. Unknown keys raise ValueError naming them.
+        """
+        from ltl_human_motion.planning.astar import SearchBudget
+        known = {"sequence_mode", "backend", "verify", "library_source", "heuristic_speed",
+                 "max_nodes", "max_seconds", "cost_noise", "eps", "max_joint_speed"}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(f"unknown synthesis options {unknown}; expected some of "
+                             f"{sorted(known)}")
+        base = cls()
+        planner = base.planner
+        if "heuristic_speed" in data or "cost_noise" in data:
+            planner = replace(planner, heuristic_speed=float(data.get(
+                "heuristic_speed", planner.heuristic_speed)), cost_noise=float(data.get(
+                    "cost_noise", planner.cost_noise)))
+        if "max_nodes" in data or "max_seconds" in data:
+            planner = replace(planner, budget=SearchBudget(
+                int(data.get("max_nodes", planner.budget.max_nodes)),
+                float(data.get("max_seconds", planner.budget.max_seconds))))
+        ver = base.verification
+        if "eps" in data or "max_joint_speed" in data:
+            ver = replace(ver, eps=float(data.get("eps", ver.eps)),
+                          max_joint_speed=float(data.get("max_joint_speed", ver.max_joint_speed)))
+        return cls(sequence_mode=str(data.get("sequence_mode", base.sequence_mode)),
+                   backend=str(data.get("backend", base.backend)),
+                   planner=planner, verification=ver, verify=bool(data.get("verify", True)),
+                   library_source=data.get("library_source"))
+
+
+def resolve_cell(cell):  # noqa: ANN001, ANN201 - Cell | str | Path
+    """A :class:`~ltl_human_motion.scene.cell.Cell` from a Cell, a name, a path or YAML text."""
+    from ltl_human_motion.scene.cell import Cell, cell_by_name, cell_from_yaml, load_cell
+    if isinstance(cell, Cell):
+        return cell
+    if isinstance(cell, Path):
+        return load_cell(cell)
+    if not isinstance(cell, str) or not cell.strip():
+        raise CellError(f"cell must be a Cell, a cell name, a YAML path or YAML text, got "
+                        f"{cell!r}")
+    text = cell.strip()
+    if "\n" in text or text.startswith("{"):
+        return cell_from_yaml(text, source="<inline>")
+    if text.endswith((".yaml", ".yml")) or "/" in text:
+        return load_cell(text)
+    return cell_by_name(text)
+
+
+@functools.lru_cache(maxsize=8)
+def get_library(stature: float = DEFAULT_STATURE, source: str | None = None):  # noqa: ANN201
+    """The motion library for one body size, cached in memory and on disk."""
+    from ltl_human_motion.motion.library import load_library
+    return load_library(stature=stature, source=source)
+
+
+def _start_pose(cell, first_target: np.ndarray | None, rng: np.random.Generator
+                ) -> tuple[float, float, float]:
+    """A floor pose inside the start region, facing the first target (seeded jitter)."""
+    r0 = cell.start_region
+    lo, hi = np.asarray(r0.lo, dtype=float), np.asarray(r0.hi, dtype=float)
+    centre = (lo + hi) / 2.0
+    half = np.maximum((hi - lo) / 2.0 - 0.05, 0.0)
+    xy = centre[:2] + rng.uniform(-1.0, 1.0, 2) * np.minimum(half[:2], 0.1)
+    if first_target is not None:
+        yaw = math.atan2(first_target[1] - xy[1], first_target[0] - xy[0])
+    else:
+        yaw = 0.0
+    yaw += float(rng.uniform(-0.3, 0.3))
+    return float(xy[0]), float(xy[1]), yaw
+
+
+def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np.ndarray,
+                   overlap: int) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """Per-frame object positions (T, 3) and held masks (T,) from the step effects."""
+    T = positions.shape[0]
+    tracks: dict[str, np.ndarray] = {}
+    held: dict[str, np.ndarray] = {}
+    supply = {name: np.asarray(obj.position, dtype=float) for name, obj in cell.objects.items()}
+    events: list[tuple[int, int, str, str, str | None]] = []
+    for order, step in enumerate(plan.steps):
+        if step.goal_segment is None:
+            continue
+        start = spans[step.goal_segment][0]
+        contact = min(start + int(step.contact_frame or 0), T - 1)
+        eff = step.objects_effect
+        for name, joint in eff.get("attach", {}).items():
+            begin = spans[step.first_segment][0]
+            events.append((begin, order, "respawn", name, None))
+            events.append((contact, order, "attach", name, joint))
+        for name in eff.get("detach", []):
+            events.append((contact, order, "detach", name, None))
+        for name in eff.get("detach_after", []):
+            events.append((spans[step.goal_segment][1] - overlap, order, "detach", name, None))
+    events.sort(key=lambda e: (e[0], e[1]))
+    for name in cell.objects:
+        pos = np.repeat(supply[name][None], T, axis=0)
+        mask = np.zeros(T, dtype=bool)
+        current = supply[name].copy()
+        joint: str | None = None
+        offset = np.zeros(3)
+        last = 0
+        for frame, _, kind, obj, j in events:
+            if obj != name:
+                continue
+            if joint is None:
+                pos[last:frame] = current
+            else:
+                pos[last:frame] = positions[last:frame, JOINT_INDEX[joint]] + offset
+                mask[last:frame] = True
+            if kind == "respawn" and joint is None:
+                current = supply[name].copy()
+            elif kind == "attach":
+                current = pos[frame - 1] if frame > 0 and joint is not None else current
+                joint = j
+                offset = current - positions[frame, JOINT_INDEX[j]]
+            elif kind == "detach" and joint is not None:
+                current = positions[frame, JOINT_INDEX[joint]] + offset
+                joint = None
+            last = frame
+        if joint is None:
+            pos[last:] = current
+        else:
+            pos[last:] = positions[last:, JOINT_INDEX[joint]] + offset
+            mask[last:] = True
+        tracks[name] = pos
+        held[name] = mask
+    return tracks, held
+
+
+def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,  # noqa: ANN001
+               cycles: int = 1, stature: float = DEFAULT_STATURE,
+               options: SynthesisOptions | None = None) -> list[SynthesizedMotion]:
+    """Synthesize ``variants`` verified full-body motions satisfying ``spec`` in ``cell``.
+
+    Parameters
+    ----------
+    spec : str
+        LTL specification (task predicates of Table I; a name of ``PAPER_SPECS`` such as
+        ``"S1"`` also works).
+    cell : Cell, str or Path
+        The cell, its name (``config/<name>.yaml``), a YAML path or YAML text.
+    library : MotionLibrary, optional
+        Default: the cached library for ``stature``.
+    variants : int
+        Number of motions. Different task sequences come first (from the LTL
+        variations); further variants re-plan sequences with other seeds.
+    seed : int
+        The same seed gives the same motions, byte for byte.
+    cycles : int
+        Repetitions of the accepting cycle.
+    stature : float
+        Body height in metres.
+    options : SynthesisOptions, optional
+
+    Returns
+    -------
+    list of SynthesizedMotion
+        Each verified (``.verification``) unless ``options.verify`` is False.
+
+    Raises
+    ------
+    SpecError
+        Malformed, ill-typed or unsatisfiable specification.
+    CellError
+        Malformed cell.
+    PlanningError
+        A task could not be planned (the message names the task and why).
+    VerificationError
+        A motion failed a check (the message names it).
+    """
+    from ltl_human_motion.ltl.sequences import synthesize_sequences
+    from ltl_human_motion.ltl.spec import build_specification
+
+    if variants < 1:
+        raise ValueError(f"variants must be >= 1, got {variants}")
+    if cycles < 1:
+        raise ValueError(f"cycles must be >= 1, got {cycles}")
+    options = options or SynthesisOptions()
+    t_all = time.perf_counter()
+    cell = resolve_cell(cell)
+    t0 = time.perf_counter()
+    specification = build_specification(spec, cell)
+    from ltl_human_motion.ltl.sequences import task_automaton
+    task_automaton(specification, backend=options.backend)
+    t_automaton = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    sequences = synthesize_sequences(specification, cell, n=variants, seed=seed,
+                                     mode=options.sequence_mode, cycles=cycles,
+                                     backend=options.backend)
+    t_sequence = time.perf_counter() - t0
+    if library is None:
+        t0 = time.perf_counter()
+        library = get_library(float(stature), options.library_source)
+        t_library = time.perf_counter() - t0
+    else:
+        t_library = 0.0
+    results = []
+    for v in range(variants):
+        seq = sequences[v % len(sequences)]
+        rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, v])
+        results.append(_synthesize_one(spec, specification, seq, cell, library, rng, seed, v,
+                                       options, t_automaton, t_sequence, t_library,
+                                       float(stature)))
+    total = time.perf_counter() - t_all
+    for r in results:
+        r.stats["batch_total_time"] = total
+    return results
+
+
+def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, variant,  # noqa: ANN001
+                    options, t_automaton, t_sequence, t_library, stature
+                    ) -> SynthesizedMotion:
+    t_start = time.perf_counter()
+    steps = [(t.key, t.name, tuple(t.args)) for t in seq.tasks]
+    planner = SequencePlanner(cell, library, rng, options.planner)
+    first_target = None
+    if steps:
+        from ltl_human_motion.planning.planner import task_kind
+        kind, args = task_kind(steps[0][1], steps[0][2], cell.shorthands)
+        try:
+            first_target = planner._target_of(kind, args)
+            if first_target is None and kind in ("walk", "carry"):
+                first_target = np.asarray(cell.region(args[-1]).center, dtype=float)
+        except (KeyError, ValueError):
+            first_target = None
+    start = _start_pose(cell, first_target, rng)
+    t0 = time.perf_counter()
+    plan = planner.plan(steps, start)
+    t_planning = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    positions, root_yaw, labels, spans = concatenate(plan.segments)
+    tracks, held = _object_tracks(cell, plan, spans, positions, library.overlap)
+    timeline = []
+    for i, step in enumerate(plan.steps):
+        if step.goal_segment is not None:
+            a, b = spans[step.goal_segment]
+        else:
+            a = spans[step.first_segment][0]
+            b = spans[step.last_segment][1]
+        timeline.append(TaskSegment(step.task, a, b, step.primitive, step.target))
+    task_index = np.full(positions.shape[0], -1, dtype=np.int64)
+    for i, seg in enumerate(timeline):
+        task_index[seg.start_frame:seg.end_frame] = i
+    motion = Motion(positions, library.fps, library.skeleton,
+                    name=f"{cell.name}-seed{seed}-v{variant}")
+    t_blending = time.perf_counter() - t0
+    synth = SynthesizedMotion(motion=motion, root_yaw=root_yaw, task_index=task_index,
+                              timeline=timeline, objects=tracks, spec=spec_text,
+                              sequence=[s[0] for s in steps], seed=int(seed))
+
+    t0 = time.perf_counter()
+    report = verify_motion(synth, cell, specification, seq, [(s[1], s[2]) for s in steps],
+                           options.verification, held=held, stature=stature,
+                           raise_on_failure=options.verify)
+    t_verify = time.perf_counter() - t0
+    compute = time.perf_counter() - t_start + t_automaton + t_sequence
+    synth.verification = report
+    synth.stats = {
+        "automaton_time": t_automaton, "sequence_time": t_sequence,
+        "library_time": t_library, "planning_time": t_planning, "blending_time": t_blending,
+        "verification_time": t_verify, "total_time": compute,
+        "nodes_expanded": int(plan.expanded), "duration": motion.duration,
+        "real_time_factor": motion.duration / compute if compute > 0 else float("inf"),
+        "variant": variant, "lasso": str(seq),
+        "goal_primitives": [{"task": s.task, "primitive": s.primitive,
+                             "target": None if s.target is None else [float(x) for x in s.target],
+                             "frames": [timeline[i].start_frame, timeline[i].end_frame],
+                             "walk_primitives": s.walk_segments, "expanded": s.expanded}
+                            for i, s in enumerate(plan.steps)],
+        "start_pose": list(plan.start_pose),
+    }
+    if not steps:
+        raise PlanningError("the task sequence is empty", reason="empty")
+    return synth

@@ -1,0 +1,479 @@
+"""From a task sequence to placed motion segments (Sec. III-B of the paper).
+
+For each task step the planner
+
+1. works out the target point (object grasp point, region centre, ...);
+2. searches gait primitives with A* (:mod:`.astar`) until the worker stands where a
+   goal primitive can reach the target, facing it (walk/carry tasks: until the body
+   enters the region);
+3. makes the goal primitive for the exact target (:mod:`ltl_human_motion.motion.goals`)
+   and places it at the pose where the walk hands over.
+
+Objects follow the hand that grasped them until they are released, placed (move,
+insert, extract) or assembled. A part that was assembled is replenished at its supply
+position (its pose in the cell) when it is grasped again, as in the paper's Fig. 3,
+where every grasp picks a new part from the floor.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.motion.skeleton import JOINT_INDEX
+from ltl_human_motion.motion.types import MotionPrimitive, world_positions
+from ltl_human_motion.planning.astar import Goal, SearchBudget, SearchFailure, astar
+from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
+from ltl_human_motion.planning.gait_index import GaitIndex
+from ltl_human_motion.planning.navigation import ClearanceMap, NavigationField
+
+Pose = tuple[float, float, float]
+
+#: Goal-primitive generator used for each Table I task (shorthand expansions map below).
+HAND_TASKS = {"grasp", "release", "move", "insert", "extract", "leftHand", "rightHand",
+              "assemble"}
+IN_PLACE_TASKS = {"wait", "standUp", "bend", "stoop", "kneel"}
+
+
+@dataclass(frozen=True)
+class PlannerOptions:
+    """Tunable planner settings.
+
+    Attributes
+    ----------
+    heuristic_speed : float
+        Relaxed speed of the A* heuristic, m/s (paper Sec. III-B).
+    budget : SearchBudget
+        Node and time limits of each search.
+    cost_noise : float
+        Seeded relative noise on primitive costs: different seeds, different paths.
+    reach_tolerance : float
+        Accepted error of the standing distance to the target, metres.
+    heading_tolerance : float
+        Accepted heading error towards the target, radians.
+    body_radius : float
+        Clearance the walking root keeps from obstacle footprints, metres.
+    grid_resolution : float
+        Cell size of the navigation field behind the heuristic, metres.
+    """
+
+    heuristic_speed: float = 0.5
+    budget: SearchBudget = field(default_factory=SearchBudget)
+    cost_noise: float = 0.15
+    reach_tolerance: float = 0.15
+    heading_tolerance: float = 0.30
+    body_radius: float = 0.18
+    grid_resolution: float = 0.1
+
+
+@dataclass
+class StepPlan:
+    """What the planner made for one task step.
+
+    Attributes
+    ----------
+    task : str
+        The step as written, e.g. ``"assemble(R1)"``.
+    kind : str
+        Goal-primitive task used (``"grasp"``, ``"assemble"``, ...) or ``"walk"``.
+    target : ndarray, shape (3,) or None
+    walk_segments : int
+        Number of gait primitives walked before the task.
+    goal_segment : int or None
+        Index of the goal segment in the segment list.
+    contact_frame : int or None
+        Frame of the goal primitive where the task condition first holds.
+    hand : str or None
+    expanded : int
+        A* nodes expanded for this step.
+    primitive : str
+        Name of the goal primitive (or of the last gait primitive for walks).
+    """
+
+    task: str
+    kind: str
+    target: np.ndarray | None
+    walk_segments: int = 0
+    goal_segment: int | None = None
+    first_segment: int = 0
+    last_segment: int = 0
+    contact_frame: int | None = None
+    hand: str | None = None
+    expanded: int = 0
+    search_seconds: float = 0.0
+    primitive: str = ""
+    objects_effect: dict = field(default_factory=dict)
+
+
+@dataclass
+class Plan:
+    """Placed segments and the step plans that produced them."""
+
+    segments: list[PlacedSegment]
+    steps: list[StepPlan]
+    start_pose: Pose
+    expanded: int
+    search_seconds: float
+
+
+def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, tuple[str, ...]]:
+    """The goal-primitive task realising a step and its arguments.
+
+    A shorthand whose expansion is ``leftHand(R) & rightHand(R)`` becomes ``assemble``.
+    """
+    if name in shorthands:
+        params, body = shorthands[name]
+        text = body.replace(" ", "")
+        if len(params) == 1 and len(args) == 1:
+            p = params[0]
+            if {t for t in text.split("&")} == {f"leftHand({p})", f"rightHand({p})"}:
+                return "assemble", args
+        raise PlanningError(f"shorthand {name} ({body}) has no motion of its own; only "
+                            "two-hand shorthands like leftHand(R) & rightHand(R) can be "
+                            "planned as one step", task=name, reason="unsupported")
+    return name, args
+
+
+_INDEX_CACHE: dict[int, tuple[object, GaitIndex]] = {}
+
+
+def gait_index(library) -> GaitIndex:  # noqa: ANN001
+    """The library's gait index extended with turns on the spot, built once per library."""
+    hit = _INDEX_CACHE.get(id(library))
+    if hit is not None and hit[0] is library:
+        return hit[1]
+    from ltl_human_motion.planning.turns import turn_primitives
+    index = GaitIndex.from_library(library).with_standing_primitives(turn_primitives(library))
+    if len(_INDEX_CACHE) > 8:
+        _INDEX_CACHE.clear()
+    _INDEX_CACHE[id(library)] = (library, index)
+    return index
+
+
+_CLEARANCE_CACHE: dict[int, tuple[object, ClearanceMap]] = {}
+
+
+def clearance_map(cell) -> ClearanceMap:  # noqa: ANN001
+    """The clearance map of ``cell``, computed once per cell object."""
+    hit = _CLEARANCE_CACHE.get(id(cell))
+    if hit is not None and hit[0] is cell:
+        return hit[1]
+    cmap = ClearanceMap(cell)
+    if len(_CLEARANCE_CACHE) > 32:
+        _CLEARANCE_CACHE.clear()
+    _CLEARANCE_CACHE[id(cell)] = (cell, cmap)
+    return cmap
+
+
+class SequencePlanner:
+    """Plans one task sequence in one cell with one motion library.
+
+    Parameters
+    ----------
+    cell : Cell
+    library : MotionLibrary
+    rng : numpy.random.Generator
+    options : PlannerOptions
+    """
+
+    def __init__(self, cell, library, rng: np.random.Generator,  # noqa: ANN001
+                 options: PlannerOptions = PlannerOptions()) -> None:
+        self.cell = cell
+        self.library = library
+        self.index = gait_index(library)
+        self.rng = rng
+        self.options = options
+        self.clearance = clearance_map(cell)
+        self.overlap = int(library.overlap)
+        self.segments: list[PlacedSegment] = []
+        self.steps: list[StepPlan] = []
+        self.pose: Pose = (0.0, 0.0, 0.0)
+        self.gait_state: int | None = None          # None = standing
+        self.seated = False
+        self.held: dict[str, str] = {}               # object -> hand joint
+        self.consumed: set[str] = set()
+        self.expanded = 0
+        self.search_seconds = 0.0
+
+    # ---------------------------------------------------------------- geometry
+    def _target_of(self, kind: str, args: tuple[str, ...]) -> np.ndarray | None:
+        cell = self.cell
+        if kind in ("grasp",):
+            obj = cell.object(args[0])
+            return np.asarray(obj.grasp_points_at(obj.position)[0], dtype=np.float64)
+        if kind in ("move",):
+            return np.asarray(cell.region(args[1]).center, dtype=np.float64)
+        if kind in ("insert", "extract"):
+            return np.asarray(cell.object(args[1]).position, dtype=np.float64)
+        if kind in ("leftHand", "rightHand", "assemble"):
+            return np.asarray(cell.region(args[0]).center, dtype=np.float64)
+        if kind == "sit":
+            obj = cell.object(args[0])
+            return np.asarray(obj.sitting_surface_at(obj.position).center, dtype=np.float64)
+        return None
+
+    def _placement(self, kind: str, target: np.ndarray) -> tuple[float, float]:
+        """Where the target should be in the standing root's frame: (ahead, left), metres."""
+        from ltl_human_motion.motion import goals
+        try:
+            d, lat = goals.reach_placement(kind, float(target[2]), self.library.skeleton)
+            return float(d), float(lat)
+        except ValueError as exc:
+            raise PlanningError(f"{kind} target at height {target[2]:.2f} m is unreachable: "
+                                f"{exc}", task=kind, reason="unreachable") from None
+
+    def _clearance(self, xy: np.ndarray) -> np.ndarray:
+        return self.clearance(xy)
+
+    def _field(self, goal_cells) -> NavigationField:  # noqa: ANN001
+        lo, hi = self.cell.workspace_lo[:2], self.cell.workspace_hi[:2]
+        radius = self.options.body_radius
+        return NavigationField(lo, hi, lambda xy: self._clearance(xy) > radius, goal_cells,
+                               self.options.grid_resolution)
+
+    def _goal_from_field(self, field: NavigationField, reached, desc: str,  # noqa: ANN001
+                         task: str) -> Goal:
+        if not field.has_goal:
+            raise PlanningError(f"task {task}: {desc}: every place to stand there is blocked "
+                                "by obstacles; the region is unreachable", task=task,
+                                reason="unreachable")
+        if not field.reachable_from(self.pose[0], self.pose[1]):
+            raise PlanningError(f"task {task}: {desc}: obstacles block every way from "
+                                f"({self.pose[0]:.2f}, {self.pose[1]:.2f})", task=task,
+                                reason="blocked")
+        slack = 0.5 * self.options.grid_resolution
+
+        def distance(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+            return np.maximum(field.distance(x, y) - slack, 0.0)
+
+        return Goal(reached, distance, field.heading, desc)
+
+    def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
+                    task: str) -> Goal:
+        tx, ty = float(target[0]), float(target[1])
+        tol, htol = self.options.reach_tolerance, self.options.heading_tolerance
+        dist = float(np.hypot(*placement))
+        offset = float(np.arctan2(placement[1], placement[0]))
+
+        def ring(xy: np.ndarray) -> np.ndarray:
+            return np.abs(np.hypot(tx - xy[:, 0], ty - xy[:, 1]) - dist) <= tol
+
+        def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+            dx, dy = tx - x, ty - y
+            r = np.hypot(dx, dy)
+            bearing = np.arctan2(dy, dx)
+            return (np.abs(r - dist) <= tol) & (np.abs(wrap_angle(bearing - yaw - offset)) <= htol)
+
+        field = self._field(ring)
+        goal = self._goal_from_field(field, reached, desc, task)
+        base_heading = field.heading
+
+        def heading(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+            near = np.hypot(tx - x, ty - y) <= dist + 2 * tol
+            return np.where(near, np.arctan2(ty - y, tx - x) - offset, base_heading(x, y))
+
+        goal.heading = heading
+        return goal
+
+    def _region_goal(self, region, desc: str, task: str) -> Goal:  # noqa: ANN001
+        lo, hi = np.asarray(region.lo, dtype=float), np.asarray(region.hi, dtype=float)
+        margin = 0.15
+
+        def gap(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+            gx = np.maximum(np.maximum(lo[0] - x, x - hi[0]), 0.0)
+            gy = np.maximum(np.maximum(lo[1] - y, y - hi[1]), 0.0)
+            return np.hypot(gx, gy)
+
+        def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+            return gap(x, y) <= margin
+
+        field = self._field(lambda xy: gap(xy[:, 0], xy[:, 1]) <= margin)
+        return self._goal_from_field(field, reached, desc, task)
+
+    # ---------------------------------------------------------------- segments
+    def _add(self, mp: MotionPrimitive, pose: Pose, label: int, blend: int) -> int:
+        pos = world_positions(mp, *pose)
+        yaw = pose[2] + mp.root[:, 3]
+        self.segments.append(PlacedSegment(pos, yaw, label, blend if self.segments else 0))
+        return len(self.segments) - 1
+
+    def _hand_over_pose(self, mp: MotionPrimitive, pose: Pose) -> Pose:
+        k = max(mp.n_frames - self.overlap, 0)
+        r = mp.root[k]
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        return (pose[0] + c * r[0] - s * r[1], pose[1] + s * r[0] + c * r[1], pose[2] + r[3])
+
+    def _stand_still(self, label: int, seconds: float) -> None:
+        """A short standing segment (start of the motion, end of a walk task)."""
+        n = max(int(round(seconds * self.library.fps)), self.overlap + 2)
+        rel = np.repeat(self._stance(bool(self.held))[None], n, axis=0)
+        root = np.zeros((n, 4))
+        root[:, 2] = self.library.standing_height
+        mp = MotionPrimitive("stand", "wait", rel, root, self.library.fps, "planner: stand")
+        self._add(mp, self.pose, label, self.overlap)
+
+    def _stance(self, carrying: bool) -> np.ndarray:
+        lib = self.library
+        return np.asarray(lib.carry_standing_pose if carrying else lib.standing_pose)
+
+    def _arm_transition(self, carrying_before: bool, label: int) -> None:
+        """Bring the arms from the walk stance to the carry stance or back.
+
+        The hands first come in to the body, then go to the other stance (two min-jerk
+        legs), so they never sweep through a bench in front of the worker.
+        """
+        from ltl_human_motion.motion.ik import min_jerk
+        a, b = self._stance(carrying_before), self._stance(not carrying_before)
+        carry, free = (a, b) if carrying_before else (b, a)
+        tucked = carry.copy()
+        arms = [self.library.skeleton.index(f"{s}_{j}") for s in "lr"
+                for j in ("elbow", "wrist", "hand")]
+        tucked[arms, 0] = np.minimum(carry[arms, 0], free[arms, 0] + 0.08)
+        waypoints = [a, tucked, b]
+        legs = []
+        for p, q in zip(waypoints[:-1], waypoints[1:]):
+            n = max(int(round(0.3 * self.library.fps)), self.overlap + 2)
+            s = min_jerk(np.linspace(0.0, 1.0, n))[:, None, None]
+            legs.append(p[None] + s * (q - p)[None])
+        rel = np.concatenate([legs[0], legs[1][1:]])
+        root = np.zeros((len(rel), 4))
+        root[:, 2] = self.library.standing_height
+        mp = MotionPrimitive("arms_to_carry" if not carrying_before else "arms_to_walk", "wait",
+                             rel, root, self.library.fps, "planner: arm transition")
+        self._add(mp, self.pose, label, self.overlap)
+
+    def _walk(self, goal: Goal, task: str, label: int, carry: bool) -> int:
+        """A* from the current pose; appends the gait segments; returns their count."""
+        res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
+                    clearance=self._clearance, body_radius=self.options.body_radius,
+                    heuristic_speed=self.options.heuristic_speed, carry=carry,
+                    budget=self.options.budget, rng=self.rng,
+                    cost_noise=self.options.cost_noise)
+        self.expanded += res.expanded
+        self.search_seconds += res.seconds
+        if isinstance(res, SearchFailure):
+            if res.reason == "budget":
+                why = (f"the search budget ran out ({res.expanded} nodes, {res.seconds:.2f} s; "
+                       f"closest approach {res.closest:.2f} m)")
+            else:
+                why = (f"obstacles block every way to the target (searched {res.expanded} "
+                       f"placements; closest approach {res.closest:.2f} m)")
+            raise PlanningError(f"task {task}: {goal.description}: {why}", task=task,
+                                reason=res.reason)
+        for prim_id, pose in zip(res.primitives, res.poses):
+            self._add(self.index.primitives[prim_id], pose, label, self.overlap)
+        if res.primitives:
+            self.pose = res.end_pose
+            self.gait_state = None  # every walk ends with a stop primitive
+        return len(res.primitives)
+
+    # ---------------------------------------------------------------- tasks
+    def plan(self, tasks: list[tuple[str, str, tuple[str, ...]]], start: Pose) -> Plan:
+        """Plan every step; ``tasks`` holds (text, name, args) per step."""
+        self.pose = start
+        self._stand_still(-1, 0.3)
+        for i, (text, name, args) in enumerate(tasks):
+            kind, args = task_kind(name, args, self.cell.shorthands)
+            first = len(self.segments)
+            step = self._plan_step(i, text, kind, args)
+            step.first_segment = first
+            step.last_segment = len(self.segments) - 1
+            self.steps.append(step)
+        self._stand_still(-1, 0.3)
+        return Plan(self.segments, self.steps, start, self.expanded, self.search_seconds)
+
+    def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...]) -> StepPlan:
+        t0 = time.perf_counter()
+        expanded0 = self.expanded
+        if self.seated and kind not in ("standUp", "wait", "leftHand", "rightHand",
+                                        "assemble", "sit"):
+            self._goal_segment("standUp", None, -1, text)
+            self.seated = False
+        if kind in ("walk", "carry"):
+            region = self.cell.region(args[-1])
+            if kind == "carry" and args[0] not in self.held:
+                self._plan_step(i, f"grasp({args[0]})", "grasp", (args[0],))
+            n = self._walk(self._region_goal(region, f"walk into {region.name}", text), text,
+                           i, carry=bool(self.held))
+            self._stand_still(i, 0.25)
+            return StepPlan(text, kind, np.asarray(region.center, dtype=float), walk_segments=n,
+                            expanded=self.expanded - expanded0,
+                            search_seconds=time.perf_counter() - t0,
+                            primitive=f"{n} gait primitives")
+        target = self._target_of(kind, args)
+        if kind == "grasp" and args[0] in self.consumed:
+            self.consumed.discard(args[0])           # a fresh part from the supply
+        walked = 0
+        if target is not None and kind != "release":
+            goal = self._reach_goal(target, self._placement(kind, target), f"reach {text} at "
+                                    f"({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})", text)
+            walked = self._walk(goal, text, -1, carry=bool(self.held))
+        if kind == "release":
+            obj = args[0]
+            c, s = math.cos(self.pose[2]), math.sin(self.pose[2])
+            height = 0.75 * self.library.skeleton.stature / 1.75
+            target = np.array([self.pose[0] + 0.45 * c, self.pose[1] + 0.45 * s, height])
+            if obj not in self.held:
+                raise PlanningError(f"task {text}: {obj} is not held, so it cannot be "
+                                    "released", task=text, reason="precondition")
+        carrying_before = bool(self.held)
+        seg, mp = self._goal_segment(kind, target, i, text)
+        hand = mp.meta.get("hand")
+        effect = self._apply_effects(kind, args, hand)
+        if bool(self.held) != carrying_before:
+            self._arm_transition(carrying_before, i)
+        self.seated = kind == "sit" or (self.seated and kind != "standUp")
+        return StepPlan(text, kind, target, walk_segments=walked, goal_segment=seg,
+                        contact_frame=int(mp.meta.get("contact_frame", mp.n_frames - 1)),
+                        hand=hand, expanded=self.expanded - expanded0,
+                        search_seconds=time.perf_counter() - t0, primitive=mp.name,
+                        objects_effect=effect)
+
+    def _goal_segment(self, kind: str, target: np.ndarray | None, label: int,
+                      text: str) -> tuple[int, MotionPrimitive]:
+        x, y, yaw = self.pose
+        local = None
+        if target is not None:
+            c, s = math.cos(-yaw), math.sin(-yaw)
+            dx, dy = target[0] - x, target[1] - y
+            local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
+        hold_hand = next(iter(self.held.values()), None)
+        kwargs = {"rng": self.rng, "start_pose": self._stance(bool(self.held))}
+        if kind in ("move", "insert", "extract", "release") and hold_hand:
+            kwargs["hand"] = hold_hand
+        try:
+            mp = self.library.goal(kind, local, **kwargs)
+        except ValueError as exc:
+            raise PlanningError(f"task {text}: cannot make a {kind} motion for the target: "
+                                f"{exc}", task=text, reason="unreachable") from None
+        seg = self._add(mp, self.pose, label, self.overlap)
+        self.pose = self._hand_over_pose(mp, self.pose)
+        self.gait_state = None
+        return seg, mp
+
+    def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None) -> dict:
+        """Update which objects are held; return the effect for the object tracks."""
+        hand_joint = {"l_hand": "l_hand", "r_hand": "r_hand", "both": "r_hand",
+                      None: "r_hand"}.get(hand, "r_hand")
+        if kind == "grasp":
+            self.held[args[0]] = hand_joint
+            return {"attach": {args[0]: hand_joint}}
+        if kind == "release":
+            self.held.pop(args[0], None)
+            return {"detach": [args[0]]}
+        if kind in ("move", "insert", "extract"):
+            # The part is placed where the hand put it.
+            if args[0] not in self.held:
+                self.held[args[0]] = hand_joint
+                return {"attach": {args[0]: hand_joint}, "detach_after": [args[0]]}
+            return {}
+        if kind == "assemble":
+            parts = list(self.held)
+            self.consumed.update(parts)
+            self.held.clear()
+            return {"detach": parts, "consume": parts}
+        return {}

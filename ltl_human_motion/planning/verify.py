@@ -1,0 +1,191 @@
+"""Verification of every synthesized motion before it is returned.
+
+Checks (each a key of the report):
+
+``start``        frame 0 of the body enters the start region R0;
+``collision``    no frame collides with an obstacle (body capsules and carried objects);
+``termination``  every task's Table I termination condition holds within its step;
+``ltl``          the trace of predicates observed on the motion satisfies the
+                 specification (with the always-on conjuncts), checked by the
+                 independent lasso evaluator;
+``smoothness``   no joint moves faster than a human can (no jumps);
+``feet``         the feet never go below the floor and never all leave it for long.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ltl_human_motion.errors import VerificationError
+from ltl_human_motion.motion.skeleton import JOINT_INDEX
+
+FOOT_JOINTS = ("l_ankle", "l_toe", "r_ankle", "r_toe")
+
+
+@dataclass(frozen=True)
+class VerificationOptions:
+    """Limits of the checks.
+
+    Attributes
+    ----------
+    eps : float
+        Radius of B(eps) in Table I, metres.
+    max_joint_speed : float
+        Fastest allowed joint speed, m/s (an 8 cm jump between frames at 120 Hz is 10 m/s; swinging toes reach 5-8 m/s).
+    floor_tolerance : float
+        How far a foot joint may dip below the floor, metres.
+    max_flight : float
+        Longest time both feet may be more than ``flight_height`` above the floor, s.
+    flight_height : float
+    """
+
+    eps: float = 0.05
+    max_joint_speed: float = 10.0
+    floor_tolerance: float = 0.02
+    max_flight: float = 0.15
+    flight_height: float = 0.12
+
+
+def _check(passed: bool, detail: str, **values: object) -> dict:
+    return {"passed": bool(passed), "detail": detail, **values}
+
+
+def step_windows(synth, n_steps: int) -> list[tuple[int, int]]:  # noqa: ANN001
+    """Frame window of each task step: from the end of the previous step to its own end."""
+    windows = []
+    prev_end = 0
+    for seg in synth.timeline[:n_steps]:
+        windows.append((prev_end, max(seg.end_frame, prev_end + 1)))
+        prev_end = seg.end_frame
+    return windows
+
+
+def observed_letters(synth, cell, spec, steps: list[tuple[str, tuple[str, ...]]],  # noqa: ANN001
+                     termination: list[bool], stature: float) -> list[frozenset[str]]:
+    """The letter of each step as observed on the motion.
+
+    A task atom holds at a step when that step executed the task and its termination
+    condition held; ``enter(R)`` holds when the body's occupancy meets R in the window.
+    """
+    from ltl_human_motion.ltl.spec import letter_of
+    from ltl_human_motion.scene.predicates import enter
+
+    pos = synth.motion.positions
+    windows = step_windows(synth, len(steps))
+    regions = list(cell.regions.values())
+    letters = []
+    for (name, args), ok, (a, b) in zip(steps, termination, windows):
+        letter: set[str] = set()
+        if ok:
+            from ltl_human_motion.ltl.formula import Atom
+            letter |= {key for key in letter_of(Atom(name, args), spec.vocabulary)
+                       if not key.startswith("enter(")}
+        window = pos[a:b]
+        for region in regions:
+            if np.any(enter(window, region, stature=stature)):
+                letter.add(f"enter({region.name})")
+        letters.append(frozenset(letter))
+    return letters
+
+
+def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str, ...]]],  # noqa: ANN001
+                  options: VerificationOptions = VerificationOptions(), *,
+                  held: dict[str, np.ndarray] | None = None, stature: float = 1.75,
+                  raise_on_failure: bool = True) -> dict:
+    """Run every check on ``synth``; return the report, raising on failure if asked.
+
+    Parameters
+    ----------
+    synth : SynthesizedMotion
+    cell : Cell
+    spec : Specification
+        With the always-on conjuncts (``spec.formula``).
+    sequence : TaskSequence
+        Gives the lasso structure (prefix, cycle, repetitions).
+    steps : list of (name, args)
+        The executed task steps, in order.
+    options : VerificationOptions
+    held : dict of str to ndarray of bool, shape (T,), optional
+        Frames at which each object is carried (its occupancy then counts for collision).
+    stature : float
+    raise_on_failure : bool
+
+    Returns
+    -------
+    report : dict
+        ``{check: {"passed": bool, "detail": str, ...}}`` plus ``"passed"``.
+
+    Raises
+    ------
+    VerificationError
+        Naming the first failed check, when ``raise_on_failure``.
+    """
+    from ltl_human_motion.ltl.evaluator import evaluate_lasso
+    from ltl_human_motion.scene.predicates import collision, enter
+    from ltl_human_motion.scene.termination import termination_series
+
+    pos = synth.motion.positions
+    fps = synth.motion.fps
+    report: dict = {}
+
+    start_ok = bool(enter(pos[0], cell.start_region, stature=stature))
+    report["start"] = _check(start_ok, f"frame 0 {'enters' if start_ok else 'is outside'} "
+                             f"the start region {cell.start_region.name}")
+
+    carried = {name: np.where(np.asarray(mask)[:, None], synth.objects[name], np.nan)
+               for name, mask in (held or {}).items() if np.any(mask)}
+    hits = collision(pos, cell, stature=stature, carried=carried)
+    n_hit = int(np.sum(hits))
+    report["collision"] = _check(n_hit == 0, "no frame collides" if n_hit == 0 else
+                                 f"{n_hit} frames collide, first at t = "
+                                 f"{int(np.argmax(hits)) / fps:.2f} s", frames=n_hit)
+
+    windows = step_windows(synth, len(steps))
+    term_ok: list[bool] = []
+    failed_tasks = []
+    for (name, args), (a, b), seg in zip(steps, windows, synth.timeline):
+        objects_state = {k: v[a:b] for k, v in synth.objects.items()}
+        holds = termination_series(name, args, pos[a:b], cell, objects_state,
+                                   eps=options.eps, stature=stature, fps=fps)
+        ok = bool(np.all(holds)) if name == "wait" else bool(np.any(holds))
+        term_ok.append(ok)
+        if not ok:
+            failed_tasks.append(f"{seg.task} (frames {a}-{b})")
+    report["termination"] = _check(not failed_tasks, "every task's termination condition holds"
+                                   if not failed_tasks else
+                                   "termination condition not met: " + ", ".join(failed_tasks))
+
+    letters = observed_letters(synth, cell, spec, steps, term_ok, stature)
+    n_pre = len(sequence.prefix) + (sequence.repetitions - 1) * len(sequence.cycle)
+    u, v = letters[:n_pre], letters[n_pre:]
+    ltl_ok = bool(v) and evaluate_lasso(spec.formula, u, v)
+    report["ltl"] = _check(ltl_ok, "the observed trace satisfies the specification" if ltl_ok
+                           else "the observed trace violates the specification",
+                           trace=[sorted(x) for x in letters])
+
+    speed = np.linalg.norm(np.diff(pos, axis=0), axis=-1) * fps       # (T-1, J)
+    vmax = float(speed.max()) if speed.size else 0.0
+    worst = synth.motion.skeleton.names[int(np.argmax(speed.max(axis=0)))] if speed.size else ""
+    report["smoothness"] = _check(vmax <= options.max_joint_speed,
+                                  f"fastest joint {worst} at {vmax:.2f} m/s (limit "
+                                  f"{options.max_joint_speed} m/s)", max_speed=vmax)
+
+    feet = pos[:, [JOINT_INDEX[j] for j in FOOT_JOINTS], 2] - cell.floor_z
+    lowest = float(feet.min())
+    flying = feet.min(axis=1) > options.flight_height
+    longest = 0
+    run = 0
+    for f in flying:
+        run = run + 1 if f else 0
+        longest = max(longest, run)
+    feet_ok = lowest >= -options.floor_tolerance and longest / fps <= options.max_flight
+    report["feet"] = _check(feet_ok, f"lowest foot joint {lowest:+.3f} m, longest flight "
+                            f"{longest / fps:.2f} s", lowest=lowest, flight=longest / fps)
+
+    report["passed"] = all(c["passed"] for c in report.values() if isinstance(c, dict))
+    if raise_on_failure and not report["passed"]:
+        name = next(k for k, c in report.items() if isinstance(c, dict) and not c["passed"])
+        raise VerificationError(f"verification failed ({name}): {report[name]['detail']}", name)
+    return report

@@ -1,0 +1,135 @@
+"""Small pieces the nodes share: QoS profiles, clock seconds, cell lookup, spinning."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Sequence
+from functools import lru_cache
+from typing import Any
+
+import rclpy
+from rclpy.executors import (
+    Executor,
+    ExternalShutdownException,
+    MultiThreadedExecutor,
+    SingleThreadedExecutor,
+)
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+#: /tf as tf2_ros.TransformBroadcaster publishes it.
+TF_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST,
+                    reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE)
+#: /tf_static as tf2_ros.StaticTransformBroadcaster publishes it (latched).
+TF_STATIC_QOS = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
+                           reliability=ReliabilityPolicy.RELIABLE,
+                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
+#: Latched state such as the motion catalog: a late subscriber gets the last message.
+LATCHED_QOS = TF_STATIC_QOS
+#: Streams (markers, task state, occupancy).
+STREAM_QOS = QoSProfile(depth=10, history=HistoryPolicy.KEEP_LAST,
+                        reliability=ReliabilityPolicy.RELIABLE,
+                        durability=DurabilityPolicy.VOLATILE)
+
+DEFAULT_EXECUTOR_THREADS = 16
+
+
+def now_seconds(node: Node) -> float:
+    """The node clock (ROS time when use_sim_time is set) in seconds."""
+    return node.get_clock().now().nanoseconds * 1e-9
+
+
+def stamp_seconds(stamp: Any) -> float:
+    """A builtin_interfaces/Time in seconds."""
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def looks_like_yaml(cell: str) -> bool:
+    """True if ``cell`` is inline YAML rather than a cell name or path."""
+    return "\n" in cell or ":" in cell
+
+
+def resolve_cell(cell: str) -> Any:
+    """A Cell from a name (``config/<name>.yaml``), a path to a YAML file or inline YAML."""
+    cell = cell.strip()
+    if not cell:
+        raise ValueError("cell is empty: give a cell name such as 'paper_cell' or inline YAML")
+    if looks_like_yaml(cell):
+        from ltl_human_motion.scene.cell import cell_from_yaml
+
+        return cell_from_yaml(cell)
+    return _named_cell(cell)
+
+
+@lru_cache(maxsize=32)
+def _named_cell(name: str) -> Any:
+    if name.endswith((".yaml", ".yml")):
+        from ltl_human_motion.scene.cell import load_cell
+
+        return load_cell(name)
+    from ltl_human_motion.scene.cell import cell_by_name
+
+    return cell_by_name(name)
+
+
+def spin_nodes(nodes: Sequence[Node], num_threads: int = DEFAULT_EXECUTOR_THREADS,
+               context: Any = None, until: Callable[[], bool] | None = None,
+               timeout: float | None = None) -> None:
+    """Spin ``nodes`` in one MultiThreadedExecutor until Ctrl-C, shutdown, ``until()`` or
+    ``timeout`` seconds; always removes the nodes from the executor and shuts it down."""
+    executor = MultiThreadedExecutor(num_threads=num_threads, context=context)
+    for node in nodes:
+        executor.add_node(node)
+    stop_at = None if timeout is None else time.monotonic() + timeout
+    try:
+        while (context or rclpy.get_default_context()).ok():
+            executor.spin_once(timeout_sec=0.1)
+            if until is not None and until():
+                break
+            if stop_at is not None and time.monotonic() >= stop_at:
+                break
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        for node in nodes:
+            executor.remove_node(node)
+        executor.shutdown()
+
+
+class SpinThread:
+    """Spin nodes on a background thread (for in-process use).
+
+    ``num_threads`` > 1 uses a MultiThreadedExecutor; 1 a SingleThreadedExecutor, which
+    runs callbacks inline (best for many short callbacks, such as a recorder's).
+    """
+
+    def __init__(self, nodes: Sequence[Node], context: Any,
+                 num_threads: int = DEFAULT_EXECUTOR_THREADS) -> None:
+        self.context = context
+        self.executor: Executor = (
+            MultiThreadedExecutor(num_threads=num_threads, context=context) if num_threads > 1
+            else SingleThreadedExecutor(context=context))
+        for node in nodes:
+            self.executor.add_node(node)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._spin, name="ltl-hm-executor", daemon=True)
+        self._thread.start()
+
+    def add_node(self, node: Node) -> None:
+        self.executor.add_node(node)
+
+    def _spin(self) -> None:
+        try:
+            while not self._stop.is_set() and self.context.ok():
+                self.executor.spin_once(timeout_sec=0.05)
+        except ExternalShutdownException:
+            pass
+
+    def stop(self, timeout: float = 5.0) -> None:
+        """Stop spinning, wait for the thread and the running callbacks."""
+        self._stop.set()
+        self._thread.join(timeout=timeout)
+        for node in list(self.executor.get_nodes()):
+            self.executor.remove_node(node)
+        self.executor.shutdown(timeout_sec=timeout)

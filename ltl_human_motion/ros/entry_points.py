@@ -1,0 +1,72 @@
+"""``ros2 run`` / console-script entry points: one function per node, plus ``bringup``.
+
+Each node entry point follows ros2/examples: ``rclpy.init(args=args)`` (so ``--ros-args
+-p name:=value --params-file f.yaml -r __ns:=/human_2`` work), spin in a
+MultiThreadedExecutor, shut down cleanly on Ctrl-C, and return the exit code (2 for
+invalid parameters, with the message on stderr).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+from ltl_human_motion.ros.common import spin_nodes
+
+
+def _run_node(factory: Callable[[], Node], args: list[str] | None) -> int:
+    rclpy.init(args=args)
+    node: Node | None = None
+    try:
+        node = factory()
+        spin_nodes([node])
+        return 0
+    except (KeyboardInterrupt, ExternalShutdownException):
+        return 0
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def synthesis_node(args: list[str] | None = None) -> int:
+    """Serve ``synthesize_motion``."""
+    from ltl_human_motion.ros.synthesis_node import SynthesisNode
+
+    return _run_node(SynthesisNode, args)
+
+
+def skeleton_publisher(args: list[str] | None = None) -> int:
+    """Play motions on TF, markers and ``task_state``."""
+    from ltl_human_motion.ros.skeleton_publisher import SkeletonPublisher
+
+    return _run_node(SkeletonPublisher, args)
+
+
+def occupancy_node(args: list[str] | None = None) -> int:
+    """Stream ``occupancy``, following the skeleton publisher's ``task_state``."""
+    from ltl_human_motion.ros.occupancy_node import OccupancyNode
+
+    return _run_node(OccupancyNode, args)
+
+
+def coexistence_node(args: list[str] | None = None) -> int:
+    """The robot-coexistence node (not available yet)."""
+    from ltl_human_motion.ros.bringup import coexistence_unavailable
+
+    raise coexistence_unavailable()
+
+
+def bringup(args: list[str] | None = None) -> int:
+    """``ltl-human-motion bringup`` under another name (``ros2 run ... bringup``)."""
+    from ltl_human_motion.cli import main
+
+    argv = sys.argv[1:] if args is None else list(args)
+    return main(["bringup", *rclpy.utilities.remove_ros_args(argv)])

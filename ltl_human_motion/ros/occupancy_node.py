@@ -1,0 +1,195 @@
+"""The occupancy node: streams the space one human occupies, as capsules, and predicts it.
+
+Publishes ``occupancy`` (ltl_human_motion/msg/HumanOccupancy) at ``rate`` Hz (default
+100), stamped with the node clock at the instant of the pose; capsules come from
+``scene.occupancy.capsules_from_positions`` and part names from ``BODY_CAPSULES``. With
+``prediction_horizon`` > 0 each message also carries the capsules the planned motion will
+occupy ``prediction_step``, 2 ``prediction_step``, ... up to ``prediction_horizon``
+seconds later (following playback rate, looping and pauses) -- only a planned human can
+offer this, and a robot controller can use it to slow down early. With ``marker_rate``
+> 0 it also publishes ``markers_topic`` (``/occupancy_markers``): the current capsules
+(``human_<id>/occupancy``) and those at the end of the horizon (``human_<id>/predicted``).
+
+Playback clock, so the occupancy never drifts from the skeleton shown on TF:
+
+* In one process (``ltl-human-motion bringup``) the node shares the skeleton publisher's
+  :class:`~ltl_human_motion.ros.playback.Playback` object.
+* Standing alone, it follows the skeleton publisher's ``task_state`` topic (same
+  namespace): each message gives motion id, motion time at its stamp, rate, loop and
+  state; the node re-anchors its own playback on it and extrapolates in between. The
+  motion itself is loaded by id from the folder named on ``catalog_topic``.
+
+Parameters: ``human_id`` ("1"), ``world_frame`` ("world"), ``rate`` (100.0 Hz),
+``prediction_horizon`` (0.0 s = off), ``prediction_step`` (0.1 s), ``marker_rate``
+(10.0 Hz; 0 = off), ``store_dir`` (""), ``catalog_topic`` ("/motion_catalog"),
+``task_state_topic`` ("task_state"), ``markers_topic`` ("/occupancy_markers").
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from visualization_msgs.msg import MarkerArray
+
+from ltl_human_motion.msg import HumanOccupancy, MotionCatalog, TaskState
+from ltl_human_motion.ros import conversions as cv
+from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS, now_seconds, stamp_seconds
+from ltl_human_motion.ros.motion_store import MotionSource, MotionStore
+from ltl_human_motion.ros.occupancy_cdr import encode_human_occupancy
+from ltl_human_motion.ros.params import (
+    ParamSpec,
+    declare_parameters,
+    frame_id,
+    identifier,
+    non_negative,
+    positive,
+    topic_name,
+)
+from ltl_human_motion.ros.playback import STATES, STOPPED, Playback
+
+
+def occupancy_parameters() -> list[ParamSpec]:
+    """The occupancy node's parameters."""
+    return [
+        ParamSpec("human_id", "1", "Id of the human", identifier, read_only=True),
+        ParamSpec("world_frame", "world", "Frame of the capsules", frame_id, read_only=True),
+        ParamSpec("rate", 100.0, "Occupancy messages per second", positive),
+        ParamSpec("prediction_horizon", 0.0, "Seconds of predicted occupancy (0 = none)",
+                  non_negative),
+        ParamSpec("prediction_step", 0.1, "Seconds between predicted samples", positive),
+        ParamSpec("marker_rate", 10.0, "Occupancy marker messages per second (0 = none)",
+                  non_negative),
+        ParamSpec("store_dir", "", "Folder of <motion_id>.npz ('' = use the catalog's)",
+                  read_only=True),
+        ParamSpec("catalog_topic", "/motion_catalog", "Latched MotionCatalog topic",
+                  topic_name, read_only=True),
+        ParamSpec("task_state_topic", "task_state", "TaskState topic to follow when alone",
+                  topic_name, read_only=True),
+        ParamSpec("markers_topic", "/occupancy_markers", "MarkerArray topic", topic_name,
+                  read_only=True),
+    ]
+
+
+class OccupancyNode(Node):
+    """Streams ``HumanOccupancy`` for one human.
+
+    Parameters
+    ----------
+    playback : Playback, optional
+        The skeleton publisher's playback (same process). Without it the node follows
+        ``task_state``.
+    store : MotionStore, optional
+        Where to find motions when following ``task_state``.
+    """
+
+    def __init__(self, *, playback: Playback | None = None, store: MotionStore | None = None,
+                 node_name: str = "occupancy_node", **node_kwargs: Any) -> None:
+        super().__init__(node_name, **node_kwargs)
+        declare_parameters(self, occupancy_parameters())
+        self.human_id: str = self.param("human_id")
+        self.world_frame: str = self.param("world_frame")
+        self.following = playback is None
+        self.playback = playback if playback is not None else Playback()
+        store_dir = self.param("store_dir")
+        self.source = MotionSource(store if store is not None
+                                   else MotionStore(store_dir) if store_dir else None)
+        self._part_names: list[str] | None = None
+        self._missing_warned: set[str] = set()
+        self.messages_published = 0
+
+        self._pub = self.create_publisher(HumanOccupancy, "occupancy", STREAM_QOS)
+        self._marker_pub = self.create_publisher(MarkerArray, self.param("markers_topic"),
+                                                 STREAM_QOS)
+        if self.following:
+            self.create_subscription(TaskState, self.param("task_state_topic"),
+                                     self._on_task_state, STREAM_QOS)
+            self.create_subscription(MotionCatalog, self.param("catalog_topic"),
+                                     self.source.on_catalog, LATCHED_QOS)
+        self._group = MutuallyExclusiveCallbackGroup()
+        self._timer = self.create_timer(1.0 / self.param("rate"), self._tick,
+                                        callback_group=self._group)
+        self._marker_timer = None
+        self._set_marker_timer(self.param("marker_rate"))
+        self.add_post_set_parameters_callback(self._on_parameters_set)
+        mode = "following task_state" if self.following else "sharing the playback clock"
+        self.get_logger().info(f"occupancy of human {self.human_id} at {self.param('rate'):g} Hz"
+                               f" ({mode})")
+
+    def param(self, name: str) -> Any:
+        return self.get_parameter(name).value
+
+    def _set_marker_timer(self, rate: float) -> None:
+        if self._marker_timer is not None:
+            self._marker_timer.cancel()
+            self.destroy_timer(self._marker_timer)
+            self._marker_timer = None
+        if rate > 0:
+            self._marker_timer = self.create_timer(1.0 / rate, self._publish_markers,
+                                                   callback_group=MutuallyExclusiveCallbackGroup())
+
+    def _on_parameters_set(self, params: list[Parameter]) -> None:
+        for p in params:
+            if p.name == "rate":
+                self._timer.cancel()
+                self.destroy_timer(self._timer)
+                self._timer = self.create_timer(1.0 / p.value, self._tick,
+                                                callback_group=self._group)
+            elif p.name == "marker_rate":
+                self._set_marker_timer(p.value)
+
+    def _on_task_state(self, msg: TaskState) -> None:
+        if msg.playback_state not in STATES or msg.playback_state == STOPPED \
+                or not msg.motion_id:
+            if self.playback.state(now_seconds(self)) != STOPPED:
+                self.playback.stop()
+            return
+        motion = None
+        if msg.motion_id != self.playback.motion_id:
+            try:
+                motion = self.source.get(msg.motion_id)
+            except (KeyError, ValueError, OSError) as exc:
+                if msg.motion_id not in self._missing_warned:
+                    self._missing_warned.add(msg.motion_id)
+                    self.get_logger().warning(f"cannot follow {msg.motion_id!r} yet: {exc}")
+                return
+        self.playback.sync(msg.motion_id, motion, msg.motion_time,
+                           stamp_seconds(msg.header.stamp), msg.rate, msg.loop,
+                           msg.playback_state)
+
+    def offsets(self) -> np.ndarray:
+        """Clock offsets (s) of the published samples: 0, then the predicted ones."""
+        horizon, step = self.param("prediction_horizon"), self.param("prediction_step")
+        n = int(np.floor(horizon / step + 1e-9)) if horizon > 0 else 0
+        return np.arange(n + 1) * step
+
+    def _tick(self) -> None:
+        now = self.get_clock().now()
+        offsets = self.offsets()
+        positions = self.playback.positions_ahead(now.nanoseconds * 1e-9, offsets)
+        if positions is None:
+            return
+        segments, radii, names = cv.body_capsules(positions, self.playback.stature)
+        sec, nanosec = divmod(now.nanoseconds, 1_000_000_000)
+        self._pub.publish(encode_human_occupancy(sec, nanosec, self.world_frame, self.human_id,
+                                                 names, segments, radii, offsets))
+        self.messages_published += 1
+
+    def _publish_markers(self) -> None:
+        now = self.get_clock().now()
+        offsets = self.offsets()
+        positions = self.playback.positions_ahead(now.nanoseconds * 1e-9, offsets[[0, -1]])
+        if positions is None:
+            return
+        segments, radii, _ = cv.body_capsules(positions, self.playback.stature)
+        f = cv.MarkerFactory(self.world_frame, now.to_msg(), 2.0 / max(self.param("marker_rate"),
+                                                                        1e-3))
+        ns = cv.human_prefix(self.human_id)
+        markers = f.capsules(f"{ns}/occupancy", segments[0], radii, cv.color(0.9, 0.2, 0.2, 0.3))
+        if len(offsets) > 1:
+            markers += f.capsules(f"{ns}/predicted", segments[1], radii,
+                                  cv.color(1.0, 0.6, 0.0, 0.15))
+        self._marker_pub.publish(MarkerArray(markers=markers))

@@ -1,0 +1,216 @@
+"""The predicates of Sec. II-B: enter, enclose and collision, vectorized over frames.
+
+* ``enter(x, BP, R)``  iff occ(x, BP) ∩ R ≠ ∅: some capsule of the body part meets the
+  region, i.e. its segment-to-region distance is at most its radius.
+  ``enter(x, BP, occ(O) ⊕ B(eps))`` is ``enter(..., margin=eps)``.
+* ``enclose(x, BP, R)`` iff occ(x, BP) ⊆ R: for a convex region (boxes) a capsule lies
+  inside iff both end points lie in the region shrunk by the radius, i.e. their signed
+  distance is at most ``-radius``. For mesh regions this test is exact when the mesh is
+  convex.
+* ``enter(O, R)`` / ``enclose(O, R)`` compare an object's solid with a region.
+* ``collision(x)`` iff occ(x) ∩ O(t) ≠ ∅, where O(t) holds the static obstacles; a
+  carried object counts as part of the body (it must not meet an obstacle either).
+  Objects that are not carried are not obstacles (the hands reach for them).
+* ``ground(x, BP, h)``: occ(x, BP) ∩ (occ(ground) ⊕ B(h)) ≠ ∅, the ground being the
+  half-space below ``floor_z``: the lowest capsule point is at most ``h`` above it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+
+import numpy as np
+
+from ltl_human_motion.motion.skeleton import DEFAULT_STATURE
+from ltl_human_motion.scene.cell import Cell, Region, SceneObject
+from ltl_human_motion.scene.occupancy import capsules_from_positions
+from ltl_human_motion.scene.shapes import Box, Shape, shape_distance, shape_enclosed_in
+
+__all__ = [
+    "as_shape",
+    "body_clearance",
+    "collision",
+    "enclose",
+    "enclose_object",
+    "enter",
+    "enter_object",
+    "ground_enter",
+    "object_clearance",
+]
+
+Target = Region | Shape | SceneObject
+
+
+def as_shape(target: Target) -> Shape:
+    """The solid of a region, shape or object (an object at its initial position)."""
+    if isinstance(target, Region):
+        return target.shape
+    if isinstance(target, SceneObject):
+        return target.occupancy
+    if isinstance(target, Shape):
+        return target
+    raise ValueError(f"expected a Region, Shape or SceneObject, got {type(target).__name__}")
+
+
+def enter(positions: np.ndarray, region: Target, parts: str | Iterable[str] | None = None, *,
+          margin: float = 0.0, stature: float = DEFAULT_STATURE) -> np.ndarray:
+    """enter(x, BP, R ⊕ B(margin)) for every frame.
+
+    Parameters
+    ----------
+    positions : array-like, shape (..., J, 3)
+    region : Region, Shape or SceneObject
+    parts : str or iterable of str, optional
+        Body parts (default: the whole body).
+    margin : float
+        Radius of the ball added to the region (Minkowski sum).
+    stature : float
+
+    Returns
+    -------
+    holds : ndarray of bool, shape (...)
+    """
+    if margin < 0:
+        raise ValueError(f"margin must be non-negative, got {margin!r}")
+    seg, rad = capsules_from_positions(positions, stature, parts)
+    return np.any(as_shape(region).capsule_clearance(seg, rad) <= margin, axis=-1)
+
+
+def enclose(positions: np.ndarray, region: Target, parts: str | Iterable[str] | None = None, *,
+            stature: float = DEFAULT_STATURE) -> np.ndarray:
+    """enclose(x, BP, R): every capsule of the parts lies inside the region.
+
+    Parameters
+    ----------
+    positions : array-like, shape (..., J, 3)
+    region : Region, Shape or SceneObject
+    parts : str or iterable of str, optional
+    stature : float
+
+    Returns
+    -------
+    holds : ndarray of bool, shape (...)
+    """
+    seg, rad = capsules_from_positions(positions, stature, parts)
+    shape = as_shape(region)
+    sd = shape.signed_distance(seg)                               # (..., K, 2)
+    return np.all(sd <= -rad[:, None] + 1e-12, axis=(-1, -2))
+
+
+def enter_object(obj: Shape | SceneObject, region: Target, margin: float = 0.0) -> bool:
+    """enter(O, R ⊕ B(margin)): the object's solid meets the region."""
+    return shape_distance(as_shape(obj), as_shape(region)) <= margin
+
+
+def enclose_object(obj: Shape | SceneObject, region: Target) -> bool:
+    """enclose(O, R): the object's solid lies inside the region."""
+    return shape_enclosed_in(as_shape(obj), as_shape(region))
+
+
+def ground_enter(positions: np.ndarray, parts: str | Iterable[str] | None, height: float, *,
+                 floor_z: float = 0.0, stature: float = DEFAULT_STATURE) -> np.ndarray:
+    """enter(x, BP, occ(ground) ⊕ B(height)): the part comes within ``height`` of the floor.
+
+    Returns
+    -------
+    holds : ndarray of bool, shape (...)
+    """
+    seg, rad = capsules_from_positions(positions, stature, parts)
+    low = np.min(seg[..., 2], axis=-1) - rad                      # (..., K)
+    return np.any(low <= floor_z + height, axis=-1)
+
+
+def body_clearance(positions: np.ndarray, cell: Cell, *,
+                   stature: float = DEFAULT_STATURE) -> np.ndarray:
+    """Smallest distance between the body and any obstacle per frame.
+
+    Parameters
+    ----------
+    positions : array-like, shape (..., J, 3)
+
+    Returns
+    -------
+    clearance : ndarray, shape (...)
+        Negative (or 0) when the body touches an obstacle; ``inf`` without obstacles.
+    """
+    seg, rad = capsules_from_positions(positions, stature)
+    return np.min(cell.obstacle_clearance(seg, rad), axis=-1)
+
+
+def object_clearance(cell: Cell, name: str, trajectory: np.ndarray) -> np.ndarray:
+    """Distance between object ``name`` and the obstacles along a trajectory.
+
+    Parameters
+    ----------
+    cell : Cell
+    name : str
+    trajectory : array-like, shape (T, 3) or (3,)
+        Object positions; rows with NaN are skipped (clearance ``inf``).
+
+    Returns
+    -------
+    clearance : ndarray, shape (T,) or ()
+        0 when touching or overlapping; exact up to 0.5 m, a lower bound (the gap of
+        the bounding boxes) beyond.
+    """
+    obj = cell.object(name)
+    traj = np.asarray(trajectory, dtype=np.float64)
+    single = traj.ndim == 1
+    traj = np.atleast_2d(traj)
+    if traj.shape[-1] != 3:
+        raise ValueError(f"trajectory must have shape (T, 3), got {traj.shape}")
+    out = np.full(len(traj), np.inf)
+    valid = np.all(np.isfinite(traj), axis=-1)
+    if valid.any() and cell.obstacles:
+        lo0, hi0 = obj.shape.aabb()
+        rel_lo, rel_hi = lo0 - obj.position, hi0 - obj.position
+        parts = [p for ob in cell.obstacles for p in ob.parts]
+        for part in parts:
+            plo, phi = part.aabb()
+            # Cheap bound: the gap between bounding boxes; exact distance only when close.
+            gap = np.maximum(np.maximum(plo - (traj + rel_hi), (traj + rel_lo) - phi), 0.0)
+            bound = np.linalg.norm(gap, axis=-1)
+            exact_needed = valid & (bound < out)
+            axis_box = isinstance(part, Box) and part.axis_aligned and \
+                isinstance(obj.shape, Box) and obj.shape.axis_aligned
+            if axis_box:
+                out = np.where(valid, np.minimum(out, bound), out)
+                continue
+            for t in np.flatnonzero(exact_needed & (bound <= 0.5)):
+                out[t] = min(out[t], shape_distance(obj.occupancy_at(traj[t]), part))
+            far = exact_needed & (bound > 0.5)
+            out = np.where(far, np.minimum(out, bound), out)
+    return out[0] if single else out
+
+
+def collision(positions: np.ndarray, cell: Cell, *, stature: float = DEFAULT_STATURE,
+              carried: Mapping[str, np.ndarray] | None = None,
+              margin: float = 0.0) -> np.ndarray:
+    """collision(x(t)) for every frame: occ(x) (plus carried objects) meets an obstacle.
+
+    Parameters
+    ----------
+    positions : array-like, shape (T, J, 3) or (J, 3)
+    cell : Cell
+    stature : float
+    carried : mapping of str to array (T, 3), optional
+        Positions of carried objects per frame (NaN rows: not carried at that frame).
+    margin : float
+        Safety margin: count as a collision when the clearance is at most this.
+
+    Returns
+    -------
+    collides : ndarray of bool, shape (T,) or ()
+    """
+    pos = np.asarray(positions, dtype=np.float64)
+    if margin < 0:
+        raise ValueError(f"margin must be non-negative, got {margin!r}")
+    hit = body_clearance(pos, cell, stature=stature) <= margin
+    for name, traj in (carried or {}).items():
+        traj = np.asarray(traj, dtype=np.float64)
+        if traj.shape != (*pos.shape[:-2], 3):
+            raise ValueError(f"carried[{name!r}] must have shape {(*pos.shape[:-2], 3)}, "
+                             f"got {traj.shape}")
+        d = object_clearance(cell, name, traj)
+        hit = hit | (d <= margin)
+    return hit

@@ -1,0 +1,217 @@
+"""CoexistenceController with the REAL ur_rtde client against the simulated controller.
+
+No mocks of ur_rtde here: every test that claims RTDE behaviour starts the simulated
+controller in its own process on 127.0.0.1:30004 (ur_rtde cannot use another port) and
+skips with a clear message if that port is taken by another program.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ltl_human_motion.robot import (
+    CoexistenceConfig,
+    CoexistenceController,
+    DecisionRecorder,
+    SSMParameters,
+    URSimHandle,
+    min_distance,
+    slider_from_separation,
+    start_ur_sim_process,
+    ur_rtde_factories,
+    write_commissioning_report,
+)
+
+rtde_receive = pytest.importorskip("rtde_receive")
+pytest.importorskip("rtde_io")
+
+HOST = "127.0.0.1"
+PARAMS = SSMParameters()
+MIN = PARAMS.min_slider
+
+
+def start_sim_or_skip() -> URSimHandle:
+    try:
+        return start_ur_sim_process(host=HOST)
+    except OSError as exc:
+        pytest.skip(f"cannot run the simulated UR controller on {HOST}:30004/29999 (another "
+                    f"program holds the port?): {exc}")
+
+
+def human_at(x: float, y: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """A standing worker (legs, torso, head, one arm reaching towards -x) at (x, y)."""
+    segments = np.array([
+        [[x, y, 0.1], [x, y, 0.9]],
+        [[x, y, 0.9], [x, y, 1.5]],
+        [[x, y, 1.6], [x, y, 1.75]],
+        [[x, y, 1.4], [x - 0.5, y, 1.2]],
+    ])
+    return segments, np.array([0.15, 0.2, 0.12, 0.06])
+
+
+@pytest.fixture(scope="module")
+def sim() -> Iterator[URSimHandle]:
+    handle = start_sim_or_skip()
+    yield handle
+    handle.stop()
+
+
+@pytest.fixture
+def controller(sim: URSimHandle) -> Iterator[CoexistenceController]:
+    receive_factory, io_factory = ur_rtde_factories(HOST)
+    config = CoexistenceConfig(stale_after=0.15, backoff_initial=0.02, backoff_max=0.2)
+    ctl = CoexistenceController(receive_factory, io_factory, "ur5e", params=PARAMS,
+                                config=config)
+    yield ctl
+    ctl.close()
+
+
+@pytest.fixture(scope="module")
+def readback(sim: URSimHandle) -> Iterator[object]:
+    r = rtde_receive.RTDEReceiveInterface(HOST)
+    yield r
+    r.disconnect()
+
+
+def feed_and_step(ctl: CoexistenceController, occupancy: tuple[np.ndarray, np.ndarray],
+                  steps: int = 5, period: float = 0.008) -> list:
+    decisions = []
+    for _ in range(steps):
+        ctl.update_occupancy(*occupancy, stamp=time.monotonic())
+        decisions.append(ctl.step())
+        time.sleep(period)
+    return decisions
+
+
+def settle(readback: object, value: float, timeout: float = 2.0) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if abs(readback.getTargetSpeedFraction() - value) < 1e-9:
+            return True
+        time.sleep(0.005)
+    return False
+
+
+def test_speed_follows_separation(controller: CoexistenceController, readback: object) -> None:
+    far = feed_and_step(controller, human_at(4.0))
+    assert far[-1].mode == "full" and far[-1].slider == 1.0 and far[-1].connected
+    assert settle(readback, 1.0)
+    assert readback.getSpeedScaling() == pytest.approx(1.0)
+    near = feed_and_step(controller, human_at(0.6))
+    assert near[-1].mode == "stop" and near[-1].slider == MIN
+    assert near[-1].separation <= PARAMS.protective_distance
+    assert settle(readback, MIN)
+    assert readback.getSpeedScaling() == pytest.approx(MIN)
+    # Inside the band the command is the linear map of the separation.
+    band = feed_and_step(controller, human_at(1.9), steps=10)
+    reduced = [d for d in band if d.mode == "reduced"]
+    assert reduced, [d.separation for d in band]
+    for d in reduced:
+        assert d.slider == pytest.approx(slider_from_separation(d.separation, PARAMS))
+    assert settle(readback, band[-1].slider)
+
+
+def test_stale_occupancy_commands_the_minimum(controller: CoexistenceController,
+                                              readback: object) -> None:
+    assert controller.step().mode == "stale"          # nothing received yet
+    feed_and_step(controller, human_at(4.0))
+    assert settle(readback, 1.0)
+    time.sleep(0.2)                                   # > stale_after, no new occupancy
+    d = controller.step()
+    assert d.mode == "stale" and d.slider == MIN and d.sent
+    assert settle(readback, MIN)
+    d = feed_and_step(controller, human_at(4.0))[-1]  # data returns: recovers by itself
+    assert d.mode == "full"
+    assert settle(readback, 1.0)
+
+
+def test_rejected_occupancy_never_raises_speed(controller: CoexistenceController,
+                                               readback: object) -> None:
+    feed_and_step(controller, human_at(0.6))
+    assert settle(readback, MIN)
+    segs, radii = human_at(4.0)
+    bad_inputs = [
+        (np.where(np.arange(12).reshape(4, 1, 3) == 5, np.nan, segs), radii),
+        (segs, -radii),
+        (segs[:, :1], radii),
+        (segs + 1e6, radii),
+        (segs, radii[:2]),
+    ]
+    for bad in bad_inputs:
+        assert not controller.update_occupancy(*bad, stamp=time.monotonic())
+        d = controller.step()
+        assert d.slider == MIN
+    assert controller.rejections == len(bad_inputs)
+    assert not controller.update_occupancy(segs, radii, stamp=math.inf)
+    assert not controller.update_occupancy(segs, radii, stamp=time.monotonic() + 10.0)
+    # A reduced command is a ceiling while only rejected data arrives, even though the
+    # robot moves and the (still fresh) last valid occupancy would allow more.
+    mid = feed_and_step(controller, human_at(1.9), steps=3)[-1]
+    ceiling = mid.slider
+    controller.update_occupancy(np.full((4, 2, 3), np.nan), radii, stamp=time.monotonic())
+    for _ in range(15):
+        d = controller.step()
+        assert d.slider <= ceiling + 1e-12
+        time.sleep(0.008)
+    assert readback.getTargetSpeedFraction() <= ceiling + 1e-12
+    assert feed_and_step(controller, human_at(4.0))[-1].slider == 1.0
+
+
+def test_prediction_slows_down_earlier(controller: CoexistenceController) -> None:
+    q = np.zeros(6)
+    segs, radii = human_at(2.2)
+    # The worker walks towards the robot at 1.2 m/s: predicted 0.5 s and 1 s ahead.
+    step = np.array([0.6, 0.0, 0.0])
+    predicted = [(0.5, segs - step, radii), (1.0, segs - 2 * step, radii)]
+    now = time.monotonic()
+    assert controller.update_occupancy(segs, radii, now, predicted)
+    current, effective = controller.separations(q)
+    assert effective < current
+    rseg, rrad = controller.robot_capsules(q)
+    expected = min(current, *(min_distance(s, r, rseg, rrad)
+                              + PARAMS.prediction_discount_speed * h for h, s, r in predicted))
+    assert effective == pytest.approx(expected, abs=1e-9)
+    reactive = CoexistenceController(lambda: None, lambda: None, "ur5e", params=PARAMS,
+                                     config=CoexistenceConfig(use_prediction=False))
+    reactive.update_occupancy(segs, radii, now, predicted)
+    assert reactive.separations(q) == (current, current)
+    assert slider_from_separation(effective, PARAMS) < slider_from_separation(current, PARAMS)
+    # Walking away: the prediction never raises the command above the reactive one.
+    away = [(1.0, segs + np.array([1.0, 0, 0]), radii)]
+    controller.update_occupancy(segs, radii, time.monotonic(), away)
+    assert controller.separations(q)[1] == pytest.approx(current)
+
+
+def test_control_loop_rate_and_commissioning_report(sim: URSimHandle,
+                                                    controller: CoexistenceController,
+                                                    tmp_path: Path) -> None:
+    recorder = DecisionRecorder()
+    controller.on_decision = recorder
+
+    def walk(t: float) -> None:      # approach from 4 m to 0.6 m and back within 1.5 s
+        x = 0.6 + 3.4 * abs(1.0 - t / 0.75)
+        controller.update_occupancy(*human_at(x), stamp=time.monotonic())
+
+    steps = controller.run(rate=125.0, duration=1.5, before_step=walk)
+    assert steps >= 0.8 * 125 * 1.5
+    times = np.array([d.time for d in recorder.decisions])
+    assert np.median(np.diff(times)) == pytest.approx(1 / 125, rel=0.2)
+    status = sim.status()
+    json_path, png_path = write_commissioning_report(
+        recorder.decisions, tmp_path, "run", status["cycle_times"],
+        status["nominal_cycle_time"])
+    metrics = json.loads(json_path.read_text())
+    assert png_path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert metrics["steps"] == steps
+    assert metrics["min_separation"] < PARAMS.protective_distance
+    assert metrics["time_reduced_speed"] > 0.2
+    assert metrics["time_by_mode"]["stop"] > 0
+    assert all(v["slowed_to_min"] for v in metrics["violations"][1:])
+    assert metrics["baseline_cycle_time"] == pytest.approx(6.2)

@@ -1,0 +1,94 @@
+"""The coexistence controller survives a controller crash: REAL ur_rtde client, simulated
+controller in its own process on 127.0.0.1:30004 (killed, then restarted)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+
+from ltl_human_motion.robot import (
+    CoexistenceConfig,
+    CoexistenceController,
+    SSMParameters,
+    URSimHandle,
+    start_ur_sim_process,
+    ur_rtde_factories,
+)
+
+pytest.importorskip("rtde_receive")
+pytest.importorskip("rtde_io")
+
+HOST = "127.0.0.1"
+PARAMS = SSMParameters()
+MIN = PARAMS.min_slider
+
+
+def start_sim_or_skip() -> URSimHandle:
+    try:
+        return start_ur_sim_process(host=HOST)
+    except OSError as exc:
+        pytest.skip(f"cannot run the simulated UR controller on {HOST}:30004/29999 (another "
+                    f"program holds the port?): {exc}")
+
+
+def human_at(x: float, y: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """A standing worker (legs, torso, head, one arm reaching towards -x) at (x, y)."""
+    segments = np.array([
+        [[x, y, 0.1], [x, y, 0.9]],
+        [[x, y, 0.9], [x, y, 1.5]],
+        [[x, y, 1.6], [x, y, 1.75]],
+        [[x, y, 1.4], [x - 0.5, y, 1.2]],
+    ])
+    return segments, np.array([0.15, 0.2, 0.12, 0.06])
+
+
+def feed_and_step(ctl: CoexistenceController, occupancy: tuple[np.ndarray, np.ndarray],
+                  steps: int = 5, period: float = 0.008) -> list:
+    decisions = []
+    for _ in range(steps):
+        ctl.update_occupancy(*occupancy, stamp=time.monotonic())
+        decisions.append(ctl.step())
+        time.sleep(period)
+    return decisions
+
+
+@pytest.fixture
+def sim() -> Iterator[URSimHandle]:
+    handle = start_sim_or_skip()
+    yield handle
+    handle.stop()
+
+
+def test_dropped_connection_goes_to_minimum_and_reconnects(sim: URSimHandle) -> None:
+    receive_factory, io_factory = ur_rtde_factories(HOST)
+    config = CoexistenceConfig(stale_after=0.5, backoff_initial=0.02, backoff_max=0.2)
+    ctl = CoexistenceController(receive_factory, io_factory, "ur5e", params=PARAMS,
+                                config=config)
+    new_sim = None
+    try:
+        d = feed_and_step(ctl, human_at(1.9), steps=10)[-1]
+        assert d.connected and d.mode in ("reduced", "full")
+        sim.kill()                                        # controller crash / cable pulled
+        modes = [d.mode for d in feed_and_step(ctl, human_at(1.9), steps=40)]
+        assert modes[-1] == "disconnected"
+        lost = [d for d in feed_and_step(ctl, human_at(1.9), steps=5)]
+        assert all(x.slider == MIN and not x.connected for x in lost)
+        new_sim = start_sim_or_skip()                     # the controller comes back
+        deadline = time.monotonic() + 5.0
+        while time.monotonic() < deadline:
+            d = feed_and_step(ctl, human_at(1.9), steps=1)[0]
+            if d.connected and d.mode != "disconnected":
+                break
+        assert d.connected and d.mode in ("reduced", "full"), d
+        assert ctl.reconnects == 2
+        time.sleep(0.05)
+        d = feed_and_step(ctl, human_at(1.9), steps=1)[0]
+        time.sleep(0.05)
+        assert new_sim.status()["speed_slider"] == pytest.approx(d.slider, abs=0.05)
+    finally:
+        ctl.close()
+        if new_sim is not None:
+            new_sim.stop()
