@@ -37,6 +37,14 @@ PARAMS = SSMParameters()
 MIN = PARAMS.min_slider
 
 
+class FakeClock:
+    def __init__(self) -> None:
+        self.t = time.monotonic()
+
+    def __call__(self) -> float:
+        return self.t
+
+
 def start_sim_or_skip() -> URSimHandle:
     try:
         return start_ur_sim_process(host=HOST)
@@ -118,18 +126,27 @@ def test_speed_follows_separation(controller: CoexistenceController, readback: o
     assert settle(readback, band[-1].slider)
 
 
-def test_stale_occupancy_commands_the_minimum(controller: CoexistenceController,
-                                              readback: object) -> None:
-    assert controller.step().mode == "stale"          # nothing received yet
-    feed_and_step(controller, human_at(4.0))
-    assert settle(readback, 1.0)
-    time.sleep(0.2)                                   # > stale_after, no new occupancy
-    d = controller.step()
-    assert d.mode == "stale" and d.slider == MIN and d.sent
-    assert settle(readback, MIN)
-    d = feed_and_step(controller, human_at(4.0))[-1]  # data returns: recovers by itself
-    assert d.mode == "full"
-    assert settle(readback, 1.0)
+def test_stale_occupancy_commands_the_minimum(sim: URSimHandle, readback: object) -> None:
+    clock = FakeClock()                               # injected: staleness is deterministic
+    receive_factory, io_factory = ur_rtde_factories(HOST)
+    ctl = CoexistenceController(receive_factory, io_factory, "ur5e", params=PARAMS,
+                                config=CoexistenceConfig(stale_after=0.15), clock=clock)
+    try:
+        assert ctl.step().mode == "stale"             # nothing received yet
+        ctl.update_occupancy(*human_at(4.0), stamp=clock())
+        assert ctl.step().mode == "full"
+        assert settle(readback, 1.0)
+        clock.t += 0.1
+        assert ctl.step().mode == "full"              # 0.1 s old: still fresh
+        clock.t += 0.1
+        d = ctl.step()                                # 0.2 s old: stale
+        assert d.mode == "stale" and d.slider == MIN and d.sent
+        assert settle(readback, MIN)
+        ctl.update_occupancy(*human_at(4.0))          # data returns (stamped on receipt)
+        assert ctl.step().mode == "full"              # and it recovers by itself
+        assert settle(readback, 1.0)
+    finally:
+        ctl.close()
 
 
 def test_rejected_occupancy_never_raises_speed(controller: CoexistenceController,

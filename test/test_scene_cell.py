@@ -185,7 +185,8 @@ def test_error_names_file_and_key(tmp_path):
 @pytest.mark.parametrize("old, new, pattern", [
     ("frame: zup", "frame: zup\ncolour: red", r"colour: unknown key"),
     ("    grasp_points: [[0.0, 0.0, 0.05]]\n    color: tab:orange",
-     "    grasp_points: [[0.0, 0.0, 0.05]]\n    colour: tab:orange", r"objects\.O1\.colour: unknown"),
+     "    grasp_points: [[0.0, 0.0, 0.05]]\n    colour: tab:orange",
+     r"objects\.O1\.colour: unknown"),
     ("start_region: R0", "start_region: R7", r"start_region: unknown region 'R7'"),
     ("final_region: R1", "final_region: 5", r"final_region: unknown region"),
     ("R1: {lo: [0.9, -1.1, 0.9], hi: [1.1, -0.9, 1.1]}",

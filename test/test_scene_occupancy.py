@@ -45,7 +45,7 @@ def test_rest_pose_occupancy_has_the_body_size():
 def test_segments_follow_the_joints_and_vectorize():
     rng = np.random.default_rng(2)
     pos = rng.normal(size=(4, 5, len(JOINT_NAMES), 3))
-    seg, rad = capsules_from_positions(pos)
+    seg, _ = capsules_from_positions(pos)
     assert seg.shape == (4, 5, len(BODY_CAPSULES), 2, 3)
     k = BODY_PARTS.index("r_lower_arm")
     np.testing.assert_array_equal(seg[..., k, 0, :], pos[..., JOINT_INDEX["r_elbow"], :])
@@ -57,9 +57,9 @@ def test_segments_follow_the_joints_and_vectorize():
 def test_parts_and_aliases():
     rest = Skeleton().rest_positions()
     seg, rad = occ(rest, "rh")
-    assert seg.shape == (1, 2, 3)
+    assert seg.shape == (1, 2, 3) and rad.shape == (1,)
     np.testing.assert_array_equal(seg[0, 1], rest[JOINT_INDEX["r_hand"]])
-    seg, rad = occ(rest, ["lk", "rk", "head"])
+    seg, _ = occ(rest, ["lk", "rk", "head"])
     assert seg.shape == (3, 2, 3)
     assert list(part_indices("hands")) == sorted([BODY_PARTS.index("l_hand"),
                                                  BODY_PARTS.index("r_hand")])

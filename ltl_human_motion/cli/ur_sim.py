@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import sys
 
 NAME = "ur-sim"
 HELP = ("Run a simulated UR e-Series controller (RTDE on TCP 30004, dashboard on 29999) "
@@ -35,7 +36,9 @@ def run(args: argparse.Namespace) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(asctime)s %(name)s: %(message)s")
     if not 0.0 <= args.speed_slider <= 1.0:
-        raise SystemExit(f"ur-sim: --speed-slider must be in [0, 1], got {args.speed_slider}")
+        print(f"ur-sim: --speed-slider must be in [0, 1], got {args.speed_slider}",
+              file=sys.stderr)
+        return 2
     config = URSimConfig(args.model, args.trajectory, args.host, args.rtde_port,
                          args.dashboard_port, args.rate, args.speed_slider)
     print(f"ur-sim: {config.model or 'model from config'} on {args.host}, RTDE port "
@@ -43,5 +46,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         return run_ur_sim(config)
     except OSError as exc:
-        print(f"ur-sim: cannot serve on {args.host}: {exc}", flush=True)
+        print(f"ur-sim: cannot serve on {args.host}: {exc}", file=sys.stderr)
+        return 2
+    except ValueError as exc:   # a malformed trajectory file or option
+        print(f"ur-sim: {exc}", file=sys.stderr)
         return 2

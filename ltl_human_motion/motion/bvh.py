@@ -40,13 +40,13 @@ NAME_CANDIDATES: dict[str, tuple[str, ...]] = {
     "l_shoulder": ("LeftArm", "LeftUpArm", "LeftUpperArm", "LeftShoulder", "l_shoulder"),
     "l_elbow": ("LeftForeArm", "LeftElbow", "LeftLowArm", "LeftLowerArm", "l_elbow"),
     "l_wrist": ("LeftHand", "LeftWrist", "l_wrist"),
-    "l_hand": ("LeftFingerBase", "LeftHandIndex1", "LeftHandMiddle1", "LeftHand_End",
-               "LeftWrist_End", "l_hand"),
+    "l_hand": ("LeftFingerBase", "LFingers", "LeftHandIndex1", "LeftHandMiddle1",
+               "LeftHand_End", "LeftWrist_End", "l_hand"),
     "r_shoulder": ("RightArm", "RightUpArm", "RightUpperArm", "RightShoulder", "r_shoulder"),
     "r_elbow": ("RightForeArm", "RightElbow", "RightLowArm", "RightLowerArm", "r_elbow"),
     "r_wrist": ("RightHand", "RightWrist", "r_wrist"),
-    "r_hand": ("RightFingerBase", "RightHandIndex1", "RightHandMiddle1", "RightHand_End",
-               "RightWrist_End", "r_hand"),
+    "r_hand": ("RightFingerBase", "RFingers", "RightHandIndex1", "RightHandMiddle1",
+               "RightHand_End", "RightWrist_End", "r_hand"),
     "l_hip": ("LeftUpLeg", "LeftHip", "LeftThigh", "LeftUpperLeg", "l_hip"),
     "l_knee": ("LeftLeg", "LeftKnee", "LeftShin", "LeftLowerLeg", "l_knee"),
     "l_ankle": ("LeftFoot", "LeftAnkle", "l_ankle"),
@@ -327,20 +327,15 @@ def canonical_points(skel: BvhSkeleton, positions: np.ndarray,
         while parent >= 0 and JOINT_NAMES[parent] not in points:
             parent = PARENTS[parent]
         ref = points.get(JOINT_NAMES[parent]) if parent >= 0 else None
-        fallback = None
         for c in cands:
             j = index.get(_norm(c))
             if j is None:
                 continue
-            if ref is not None and canon not in ("spine",) and float(np.median(
+            if ref is not None and float(np.median(
                     np.linalg.norm(positions[:, j] - ref, axis=-1))) < 1e-3 * scale:
-                fallback = positions[:, j] if fallback is None else fallback
                 continue
             points[canon] = positions[:, j]
             break
-        else:
-            if fallback is not None:
-                points[canon] = fallback
     for side in ("l", "r"):
         if f"{side}_hand" not in points and f"{side}_wrist" in points and \
                 f"{side}_elbow" in points:

@@ -335,8 +335,12 @@ def build_library(stature: float = DEFAULT_STATURE, source=None, delta: float = 
     stats["sources"] = [str(f) for f in files]
     lib = _assemble(auto, skeleton, k_comp, key, stats)
     if quality:
-        from ltl_human_motion.motion.quality import check_primitives
-        lib.quality = check_primitives(lib.primitives, skeleton, kind="gait")
+        from ltl_human_motion.motion.quality import check_primitives, goal_sample
+        lib.quality = {
+            "gait": check_primitives(lib.primitives, skeleton, kind="gait"),
+            "goal": check_primitives(goal_sample(skeleton), skeleton, kind="goal"),
+        }
+        lib.quality["ok"] = bool(lib.quality["gait"]["ok"] and lib.quality["goal"]["ok"])
     return lib
 
 

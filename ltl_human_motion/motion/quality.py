@@ -26,7 +26,7 @@ import numpy as np
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, PARENTS, Skeleton
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 
-__all__ = ["QualityThresholds", "primitive_metrics", "check_primitives"]
+__all__ = ["QualityThresholds", "primitive_metrics", "check_primitives", "goal_sample"]
 
 _FEET = tuple(JOINT_INDEX[n] for n in ("l_ankle", "l_toe", "r_ankle", "r_toe"))
 
@@ -129,3 +129,28 @@ def check_primitives(primitives: Iterable[MotionPrimitive], skeleton: Skeleton,
     if details:
         report["primitives"] = per
     return report
+
+
+def goal_sample(skeleton: Skeleton, seed: int = 0) -> list[MotionPrimitive]:
+    """One or more goal primitives of every Table I goal task, at representative targets.
+
+    Hand tasks are made at reach placements for heights from the floor to near the maximum
+    reach; posture tasks with their defaults.
+    """
+    from ltl_human_motion.motion.goals import (
+        GOAL_TASKS, HAND_TASKS, make_goal_primitive, max_reach, reach_placement)
+
+    rng = np.random.default_rng(seed)
+    out: list[MotionPrimitive] = []
+    H = skeleton.stature
+    for task in GOAL_TASKS:
+        if task in HAND_TASKS:
+            top = max_reach(task, skeleton)
+            heights = (0.03, 0.45, 0.9, 1.2, top - 0.05) if task in (
+                "grasp", "release", "move") else (0.55 * H,)
+            for h in heights:
+                x, y = reach_placement(task, h, skeleton)
+                out.append(make_goal_primitive(task, np.array([x, y, h]), skeleton, rng=rng))
+        else:
+            out.append(make_goal_primitive(task, None, skeleton, rng=rng))
+    return out

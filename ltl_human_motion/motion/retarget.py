@@ -50,10 +50,6 @@ def frame_from_axes(lateral: np.ndarray, up: np.ndarray) -> np.ndarray:
     return np.stack([x, y, z], axis=-1)
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
-
-
 def _build(points: dict[str, np.ndarray], pelvis: np.ndarray, skeleton: Skeleton) -> np.ndarray:
     """Canonical positions (T, J, 3) from source points and a given pelvis path."""
     rest = skeleton.rest_positions()
@@ -78,7 +74,11 @@ def _build(points: dict[str, np.ndarray], pelvis: np.ndarray, skeleton: Skeleton
         elif name in _CHEST_RIGID:
             out[:, j] = out[:, p] + r_chest @ (rest[j] - rest[p])
         else:
-            direction = _unit(src[name] - src[JOINT_NAMES[p]])
+            vec = src[name] - src[JOINT_NAMES[p]]
+            norm = np.linalg.norm(vec, axis=-1, keepdims=True)
+            # a degenerate (zero-length) source bone keeps the canonical rest direction
+            rest_dir = (rest[j] - rest[p]) / max(float(np.linalg.norm(rest[j] - rest[p])), 1e-12)
+            direction = np.where(norm > 1e-9, vec / np.maximum(norm, 1e-12), rest_dir)
             out[:, j] = out[:, p] + lengths[j] * direction
     return out
 

@@ -108,6 +108,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
           clearance: Callable[[np.ndarray], np.ndarray], body_radius: float = 0.25,
           heuristic_speed: float = 0.7, turn_rate: float = 2.0, carry: bool = False,
           budget: SearchBudget = SearchBudget(), rng: np.random.Generator | None = None,
+          body_clear: Callable[[np.ndarray], np.ndarray] | None = None,
           cost_noise: float = 0.0, grid: float = 0.08, yaw_bins: int = 24
           ) -> SearchResult | SearchFailure:
     """Search a sequence of gait primitives from ``start`` until ``goal.reached``.
@@ -134,6 +135,9 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     budget : SearchBudget
     rng, cost_noise
         Seeded multiplicative noise on primitive costs, for varied but valid paths.
+    body_clear : callable, optional
+        ``body_clear(poses (M, S, J, 3)) -> bool (M,)``: whole-body obstacle test for the
+        primitives listed in ``index.body`` (turns and steps on the spot).
 
     Returns
     -------
@@ -188,6 +192,19 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         if not clear.any():
             continue
         succ, ends = succ[clear], ends[clear]
+        if body_clear is not None and index.body:
+            exact = np.array([int(j) in index.body for j in succ])
+            if exact.any():
+                c, s_ = np.cos(pyaw), np.sin(pyaw)
+                rot = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+                sweep = np.stack([index.body[int(j)] for j in succ[exact]]) @ rot.T
+                sweep[..., 0] += px
+                sweep[..., 1] += py
+                ok = np.ones(len(succ), dtype=bool)
+                ok[exact] = body_clear(sweep)
+                if not ok.any():
+                    continue
+                succ, ends = succ[ok], ends[ok]
         done = goal.reached(ends[:, 0], ends[:, 1], ends[:, 2]) & index.stops[succ]
         g_new = g_cost[node] + step_cost[succ]
         if done.any():

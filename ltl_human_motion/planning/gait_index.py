@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ltl_human_motion.motion.types import MotionPrimitive
+from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 
 
 @dataclass(frozen=True, eq=False)
@@ -37,6 +37,11 @@ class GaitIndex:
         True for carry primitives (arms holding an object).
     nf : int
         Blend overlap between gait primitives, frames.
+    body : dict of int to ndarray, shape (S, J, 3)
+        Sampled world poses (start frame) of primitives whose whole body must be
+        checked against obstacles during the search (turns and steps on the spot, where
+        the root path says nothing about the sweeping arms).
+        Blend overlap between gait primitives, frames.
     """
 
     primitives: list[MotionPrimitive]
@@ -49,6 +54,7 @@ class GaitIndex:
     stops: np.ndarray
     carry: np.ndarray
     nf: int
+    body: dict = field(default_factory=dict)
 
     @classmethod
     def from_library(cls, library) -> GaitIndex:
@@ -122,12 +128,16 @@ class GaitIndex:
             succ.append(start_set[self.carry[start_set] == add.carry[k]])
         lengths = np.array([len(x) for x in succ])
         indptr = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
+        body = dict(self.body)
+        for k, mp in enumerate(extra):
+            frames = np.linspace(0, mp.n_frames - 1, 7).round().astype(int)
+            body[n0 + k] = world_positions(mp)[frames]
         return GaitIndex(
             self.primitives + list(extra), np.concatenate([self.disp, add.disp]),
             np.concatenate([self.cost, add.cost]), np.concatenate([self.path, add.path]),
             indptr, np.concatenate(succ).astype(np.int64),
             np.concatenate([self.starts, new_ids]), np.concatenate([self.stops, add.stops]),
-            np.concatenate([self.carry, add.carry]), self.nf)
+            np.concatenate([self.carry, add.carry]), self.nf, body)
 
     def successors(self, j: int) -> np.ndarray:
         """Indices of the primitives that may follow primitive ``j``."""

@@ -316,6 +316,12 @@ class SequencePlanner:
         mp = MotionPrimitive("stand", "wait", rel, root, self.library.fps, "planner: stand")
         self._add(mp, self.pose, label, self.overlap)
 
+    def _body_clear(self, poses: np.ndarray) -> np.ndarray:
+        """Whether sampled poses (M, S, J, 3) keep 2 cm from every obstacle, shape (M,)."""
+        from ltl_human_motion.scene.predicates import body_clearance
+        d = body_clearance(poses, self.cell, stature=self.library.skeleton.stature)
+        return np.all(d > 0.02, axis=-1)
+
     def _stance(self, carrying: bool) -> np.ndarray:
         lib = self.library
         return np.asarray(lib.carry_standing_pose if carrying else lib.standing_pose)
@@ -352,7 +358,7 @@ class SequencePlanner:
                     clearance=self._clearance, body_radius=self.options.body_radius,
                     heuristic_speed=self.options.heuristic_speed, carry=carry,
                     budget=self.options.budget, rng=self.rng,
-                    cost_noise=self.options.cost_noise)
+                    cost_noise=self.options.cost_noise, body_clear=self._body_clear)
         self.expanded += res.expanded
         self.search_seconds += res.seconds
         if isinstance(res, SearchFailure):

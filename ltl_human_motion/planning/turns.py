@@ -15,6 +15,9 @@ from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import MotionPrimitive, yaw_matrix
 
 TURN_ANGLES_DEG = (-180.0, -135.0, -90.0, -45.0, 45.0, 90.0, 135.0)
+#: Steps on the spot: (back, left, turn in degrees).
+STEPS = ((-0.3, 0.0, 0.0), (-0.3, 0.0, 90.0), (-0.3, 0.0, -90.0), (0.0, 0.25, 0.0),
+         (0.0, -0.25, 0.0))
 _FOOT = {"l": ("l_ankle", "l_toe"), "r": ("r_ankle", "r_toe")}
 
 
@@ -22,9 +25,14 @@ def _progress(t: np.ndarray, a: float, b: float) -> np.ndarray:
     return min_jerk(np.clip((t - a) / (b - a), 0.0, 1.0))
 
 
-def make_turn_primitive(stand: np.ndarray, height: float, angle: float, skeleton: Skeleton,
-                        fps: float, task: str = "walk", lift: float = 0.06) -> MotionPrimitive:
-    """A primitive turning the standing body by ``angle`` radians about +z.
+def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, angle: float,
+                        skeleton: Skeleton, fps: float, task: str = "walk",
+                        lift: float = 0.06) -> MotionPrimitive:
+    """A standing-to-standing primitive: step by (dx, dy) and turn by ``angle``.
+
+    The pelvis follows a minimum-jerk path; the feet step one after the other (the
+    foot on the side of the turn or of the step first), each lifted on a sine arc, and
+    the knees follow by two-bone IK.
 
     Parameters
     ----------
@@ -32,6 +40,8 @@ def make_turn_primitive(stand: np.ndarray, height: float, angle: float, skeleton
         Root-relative standing pose facing +x (walk or carry arms).
     height : float
         Pelvis height above the floor.
+    dx, dy : float
+        Displacement of the root in its start frame, metres (dx < 0 steps back).
     angle : float
         Turn, radians (positive: to the left).
     skeleton : Skeleton
@@ -43,15 +53,19 @@ def make_turn_primitive(stand: np.ndarray, height: float, angle: float, skeleton
     Returns
     -------
     MotionPrimitive
-        Starts and ends in ``stand``; ``root[-1, 3] == angle``.
+        Starts and ends in ``stand``; ``root[-1] == (dx, dy, height, angle)``.
     """
     stand = np.asarray(stand, dtype=np.float64)
-    duration = 0.5 + 0.45 * abs(angle) / (np.pi / 2)
+    duration = 0.5 + 0.45 * abs(angle) / (np.pi / 2) + 1.2 * np.hypot(dx, dy)
     n = int(round(duration * fps)) + 1
     t = np.linspace(0.0, 1.0, n)
-    heading = angle * _progress(t, 0.05, 0.95)
+    s_root = _progress(t, 0.05, 0.95)
+    heading = angle * s_root
+    root_xy = np.stack([dx * s_root, dy * s_root], axis=-1)
     body = np.einsum("tij,kj->tki", yaw_matrix(heading), stand)        # (T, J, 3)
-    first, second = ("l", "r") if angle > 0 else ("r", "l")
+    body[:, :, :2] += root_xy[:, None, :]
+    lead = "l" if (angle > 0 or (angle == 0 and dy > 0)) else "r"
+    first, second = (lead, "r" if lead == "l" else "l")
     windows = {first: (0.05, 0.55), second: (0.45, 0.95)}
     for side, (a, b) in windows.items():
         s = _progress(t, a, b)
@@ -59,6 +73,8 @@ def make_turn_primitive(stand: np.ndarray, height: float, angle: float, skeleton
         for name in _FOOT[side]:
             j = JOINT_INDEX[name]
             body[:, j] = np.einsum("tij,j->ti", yaw_matrix(foot_yaw), stand[j])
+            body[:, j, 0] += dx * s
+            body[:, j, 1] += dy * s
             body[:, j, 2] += lift * np.sin(np.pi * s)
         hip, knee, ankle = (JOINT_INDEX[f"{side}_{x}"] for x in ("hip", "knee", "ankle"))
         l1 = float(np.linalg.norm(stand[knee] - stand[hip]))
@@ -66,21 +82,34 @@ def make_turn_primitive(stand: np.ndarray, height: float, angle: float, skeleton
         pole = np.stack([np.cos(foot_yaw), np.sin(foot_yaw), np.zeros(n)], axis=-1)
         body[:, knee], body[:, ankle] = two_bone_ik(body[:, hip], body[:, ankle], l1, l2,
                                                      pole, max_stretch=1.0)
+    body[:, :, :2] -= root_xy[:, None, :]
     poses = np.einsum("tji,tkj->tki", yaw_matrix(heading), body)     # back to heading frame
     root = np.zeros((n, 4))
+    root[:, :2] = root_xy
     root[:, 2] = height
     root[:, 3] = heading
     deg = int(round(np.degrees(angle)))
-    return MotionPrimitive(name=f"{task}_turn_{deg:+d}", task=task, poses=poses, root=root,
-                           fps=fps, source=f"planner: turn on the spot by {deg} degrees",
-                           meta={"turn": float(angle)})
+    name = (f"{task}_turn_{deg:+d}" if dx == 0 and dy == 0 else
+            f"{task}_step_{dx:+.2f}_{dy:+.2f}_{deg:+d}")
+    return MotionPrimitive(name=name, task=task, poses=poses, root=root, fps=fps,
+                           source=f"planner: step ({dx:+.2f}, {dy:+.2f}) m, turn {deg} deg",
+                           meta={"turn": float(angle), "step": [float(dx), float(dy)]})
+
+
+def make_turn_primitive(stand: np.ndarray, height: float, angle: float, skeleton: Skeleton,
+                        fps: float, task: str = "walk", lift: float = 0.06) -> MotionPrimitive:
+    """Turn on the spot by ``angle`` radians (see :func:`make_step_primitive`)."""
+    return make_step_primitive(stand, height, 0.0, 0.0, angle, skeleton, fps, task, lift)
 
 
 def turn_primitives(library) -> list[MotionPrimitive]:  # noqa: ANN001 - MotionLibrary
-    """Turn primitives for walking and carrying on the library's body."""
+    """Turns and steps on the spot for walking and carrying on the library's body."""
     out = []
     for task, stand in (("walk", library.standing_pose), ("carry", library.carry_standing_pose)):
         for deg in TURN_ANGLES_DEG:
             out.append(make_turn_primitive(stand, library.standing_height, np.radians(deg),
                                            library.skeleton, library.fps, task))
+        for dx, dy, deg in STEPS:
+            out.append(make_step_primitive(stand, library.standing_height, dx, dy,
+                                           np.radians(deg), library.skeleton, library.fps, task))
     return out

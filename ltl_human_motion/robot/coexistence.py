@@ -28,6 +28,7 @@ from __future__ import annotations
 import ctypes
 import logging
 import math
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -253,12 +254,14 @@ class CoexistenceController:
         self._last_sent_time = -math.inf
         self._robot_stamp: float | None = None
         self._robot_stamp_changed = -math.inf
+        self._lock = threading.Lock()
         self.rejections = 0
         self.reconnects = 0
         self.last_rejection: str | None = None
 
     # ------------------------------------------------------------------ occupancy input
-    def update_occupancy(self, segments: ArrayLike, radii: ArrayLike, stamp: float,
+    def update_occupancy(self, segments: ArrayLike, radii: ArrayLike,
+                         stamp: float | None = None,
                          predicted: Sequence[tuple[float, ArrayLike, ArrayLike]] | None = None
                          ) -> bool:
         """Offer the latest human occupancy.
@@ -268,8 +271,9 @@ class CoexistenceController:
         segments : array-like, shape (K, 2, 3)
             Human capsule axes in the world frame (m).
         radii : array-like, shape (K,)
-        stamp : float
-            Time of the occupancy on the controller's clock (s).
+        stamp : float, optional
+            Time of the occupancy on the controller's clock (s); default: now (receipt
+            time, for sources whose clock differs from the controller's).
         predicted : sequence of (horizon, segments (K_i, 2, 3), radii (K_i,)), optional
             Predicted occupancy ``horizon`` seconds after ``stamp``.
 
@@ -277,22 +281,29 @@ class CoexistenceController:
         -------
         bool
             True if accepted; False if rejected (logged) or older than the current one.
+
+        Notes
+        -----
+        May be called from another thread than :meth:`step`.
         """
         try:
-            occ = self._validated(segments, radii, stamp, predicted)
+            occ = self._validated(segments, radii, self.clock() if stamp is None else stamp,
+                                  predicted)
         except ValueError as exc:
-            self.rejections += 1
-            self.last_rejection = str(exc)
-            cap = self._last_command if self._ceiling is None else min(self._ceiling,
-                                                                       self._last_command)
-            self._ceiling = cap
+            with self._lock:
+                self.rejections += 1
+                self.last_rejection = str(exc)
+                cap = self._last_command if self._ceiling is None \
+                    else min(self._ceiling, self._last_command)
+                self._ceiling = cap
             log.warning("human occupancy rejected (%s); speed held at <= %.3f", exc, cap)
             return False
-        if self._occ is not None and occ.stamp < self._occ.stamp:
-            log.debug("out-of-order occupancy (%.3f < %.3f) ignored", occ.stamp, self._occ.stamp)
-            return False
-        self._occ = occ
-        self._ceiling = None
+        with self._lock:
+            if self._occ is not None and occ.stamp < self._occ.stamp:
+                log.debug("out-of-order occupancy (%.3f) ignored", occ.stamp)
+                return False
+            self._occ = occ
+            self._ceiling = None
         return True
 
     def _validated(self, segments: ArrayLike, radii: ArrayLike, stamp: float,
@@ -436,12 +447,13 @@ class CoexistenceController:
         """World-frame capsules (7, 2, 3), (7,) of the arm at joint positions ``q``."""
         return robot_capsules(q, self.model, self.base)
 
-    def separations(self, q: ArrayLike) -> tuple[float, float]:
+    def separations(self, q: ArrayLike, occupancy: _Occupancy | None = None
+                    ) -> tuple[float, float]:
         """Current and effective (prediction-aware) separation for joint positions ``q``.
 
-        Returns NaN for both without an occupancy.
+        Uses the latest accepted occupancy; returns NaN for both without one.
         """
-        occ = self._occ
+        occ = self._occ if occupancy is None else occupancy
         if occ is None:
             return math.nan, math.nan
         rseg, rrad = self.robot_capsules(q)
@@ -460,20 +472,24 @@ class CoexistenceController:
         sp = self.params.protective_distance
         q = self._read_q(now) if self._connect(now) else None
         sep = eff = math.nan
+        with self._lock:
+            occ = self._occ
         if q is None:
             mode, slider = "disconnected", self.params.min_slider
-        elif self._occ is None or now - self._occ.stamp > self.config.stale_after:
+        elif occ is None or now - occ.stamp > self.config.stale_after:
             mode, slider = "stale", self.params.min_slider
         else:
-            sep, eff = self.separations(q)
+            sep, eff = self.separations(q, occ)
             slider = slider_from_separation(eff, self.params)
             mode = ("full" if slider >= self.params.max_slider
                     else "stop" if slider <= self.params.min_slider else "reduced")
-        capped = self._ceiling is not None and slider > self._ceiling
-        if capped:
-            slider = float(self._ceiling)  # type: ignore[arg-type]
+        with self._lock:
+            ceiling = self._ceiling
+            capped = ceiling is not None and slider > ceiling
+            if capped:
+                slider = float(ceiling)  # type: ignore[arg-type]
+            self._last_command = slider
         sent = self._send(slider, now)
-        self._last_command = slider
         decision = ControlDecision(now, slider, sent, mode, sep, eff, sp, self.connected,
                                    capped, None if q is None else tuple(float(v) for v in q))
         if self.on_decision is not None:

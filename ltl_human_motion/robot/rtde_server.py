@@ -106,6 +106,11 @@ class ControllerServer:
         self.sim = sim
         self.rate = float(rate)
         self.controller_version = controller_version
+        self._clients: dict[int, _Client] = {}
+        self._input_owner: dict[str, int] = {}
+        self._next_cid = 1
+        self._stop = False
+        self._extra: list[tuple[object, Callable[[], None]]] = []
         self._sel = selectors.DefaultSelector()
         self._rtde = listen_socket(host, rtde_port)
         self._listeners = [self._rtde]
@@ -119,11 +124,6 @@ class ControllerServer:
                 raise
             self._listeners.append(self._dash)
             self._sel.register(self._dash, selectors.EVENT_READ, ("accept", "dashboard"))
-        self._clients: dict[int, _Client] = {}
-        self._input_owner: dict[str, int] = {}
-        self._next_cid = 1
-        self._stop = False
-        self._extra: list[tuple[object, Callable[[], None]]] = []
 
     @property
     def rtde_port(self) -> int:

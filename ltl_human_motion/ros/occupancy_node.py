@@ -55,7 +55,8 @@ from ltl_human_motion.ros.playback import STATES, STOPPED, Playback
 def occupancy_parameters() -> list[ParamSpec]:
     """The occupancy node's parameters."""
     return [
-        ParamSpec("human_id", "1", "Id of the human", identifier, read_only=True),
+        ParamSpec("human_id", "1", "Id of the human", identifier, read_only=True,
+                  dynamic_typing=True),
         ParamSpec("world_frame", "world", "Frame of the capsules", frame_id, read_only=True),
         ParamSpec("rate", 100.0, "Occupancy messages per second", positive),
         ParamSpec("prediction_horizon", 0.0, "Seconds of predicted occupancy (0 = none)",
@@ -90,7 +91,7 @@ class OccupancyNode(Node):
                  node_name: str = "occupancy_node", **node_kwargs: Any) -> None:
         super().__init__(node_name, **node_kwargs)
         declare_parameters(self, occupancy_parameters())
-        self.human_id: str = self.param("human_id")
+        self.human_id = str(self.param("human_id"))
         self.world_frame: str = self.param("world_frame")
         self.following = playback is None
         self.playback = playback if playback is not None else Playback()

@@ -30,6 +30,7 @@ class ParamSpec:
     description: str
     check: Check | None = None
     read_only: bool = False
+    dynamic_typing: bool = False
 
 
 def declare_parameters(node: Node, specs: Sequence[ParamSpec]) -> None:
@@ -43,7 +44,8 @@ def declare_parameters(node: Node, specs: Sequence[ParamSpec]) -> None:
     by_name = {spec.name: spec for spec in specs}
     for spec in specs:
         node.declare_parameter(spec.name, spec.default, ParameterDescriptor(
-            description=spec.description, read_only=spec.read_only))
+            description=spec.description, read_only=spec.read_only,
+            dynamic_typing=spec.dynamic_typing))
     errors = [msg for spec in specs
               if (msg := _error(spec, node.get_parameter(spec.name).value))]
     if errors:
@@ -90,8 +92,10 @@ _FRAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_/]*$")
 
 
 def identifier(value: Any) -> str | None:
-    """Check: letters, digits and underscores (a human id, a name)."""
-    ok = isinstance(value, str) and bool(_NAME.match(value))
+    """Check: letters, digits and underscores (a human id, a name); an integer is fine
+    too (``-p human_id:=1`` arrives as one)."""
+    ok = (isinstance(value, int) and not isinstance(value, bool) and value >= 0) or (
+        isinstance(value, str) and bool(_NAME.match(value)))
     return None if ok else f"expected letters, digits or '_', got {value!r}"
 
 

@@ -76,7 +76,7 @@ def skeleton_parameters() -> list[ParamSpec]:
     """The skeleton publisher's parameters."""
     return [
         ParamSpec("human_id", "1", "Id of the human (frames human_<id>/...)", identifier,
-                  read_only=True),
+                  read_only=True, dynamic_typing=True),
         ParamSpec("world_frame", "world", "Fixed frame of the cell", frame_id, read_only=True),
         ParamSpec("publish_rate", 30.0, "TF, marker and task state rate (Hz)", positive),
         ParamSpec("cell", "paper_cell", "Cell shown as markers ('' for none)"),
@@ -119,7 +119,7 @@ class SkeletonPublisher(Node):
                  node_name: str = "skeleton_publisher", **node_kwargs: Any) -> None:
         super().__init__(node_name, **node_kwargs)
         declare_parameters(self, skeleton_parameters())
-        self.human_id: str = self.param("human_id")
+        self.human_id = str(self.param("human_id"))
         self.world_frame: str = self.param("world_frame")
         store_dir = self.param("store_dir")
         self.source = MotionSource(store if store is not None

@@ -135,6 +135,8 @@ class SynthesisNode(Node):
                                             self._on_request,
                                             callback_group=ReentrantCallbackGroup())
         self.requests_served = 0
+        self.in_flight = 0
+        self._count_lock = threading.Lock()
         self._publish_catalog()
         self.get_logger().info(
             f"serving {self._service.service_name} (store: "
@@ -143,6 +145,8 @@ class SynthesisNode(Node):
     def _on_request(self, request: SynthesizeMotion.Request,
                     response: SynthesizeMotion.Response) -> SynthesizeMotion.Response:
         started = time.perf_counter()
+        with self._count_lock:
+            self.in_flight += 1
         try:
             with self._slots:
                 motions = self._run(request)
@@ -159,7 +163,9 @@ class SynthesisNode(Node):
             response.success = False
             response.error_message = f"internal error ({type(exc).__name__}): {exc}"
         finally:
-            self.requests_served += 1
+            with self._count_lock:
+                self.in_flight -= 1
+                self.requests_served += 1
         return response
 
     def _run(self, request: SynthesizeMotion.Request) -> list:

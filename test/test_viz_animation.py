@@ -1,0 +1,61 @@
+"""GIF animation: offscreen, frame count follows the requested rate, reasonably fast."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from ltl_human_motion.errors import MissingDependencyError
+from ltl_human_motion.scene import cell_by_name
+from ltl_human_motion.viz import demo_synthesized_motion, render_animation
+
+
+@pytest.fixture(scope="module")
+def paper():
+    return cell_by_name("paper_cell")
+
+
+@pytest.fixture(scope="module")
+def synth(paper):
+    return demo_synthesized_motion(paper, fps=30.0)
+
+
+def test_gif_frames_follow_the_rate(synth, paper, tmp_path):
+    path = tmp_path / "a.gif"
+    t0 = time.perf_counter()
+    n = render_animation(synth, paper, path, fps=10.0)
+    elapsed = time.perf_counter() - t0
+    assert n == int(np.floor(synth.duration * 10.0)) + 1
+    with Image.open(path) as im:
+        assert im.n_frames == n
+        assert im.info["duration"] == 100
+        im.seek(0)
+        first = np.asarray(im.convert("RGB")).astype(int)
+        im.seek(n - 1)
+        last = np.asarray(im.convert("RGB")).astype(int)
+    assert np.abs(first - last).sum() > 0                     # the worker moved
+    assert elapsed / n < 0.25                                 # seconds per frame
+
+
+def test_gif_with_capsules_and_frame_cap(synth, paper, tmp_path):
+    path = tmp_path / "b.gif"
+    n = render_animation(synth, paper, path, fps=15.0, capsules=True, max_frames=12,
+                         size=(4.0, 3.0))
+    assert n == 12
+    with Image.open(path) as im:
+        assert im.n_frames == 12 and im.size == (320, 240)
+
+
+def test_bad_arguments_and_missing_pillow(synth, paper, tmp_path, monkeypatch):
+    with pytest.raises(ValueError, match="fps must be positive"):
+        render_animation(synth, paper, tmp_path / "c.gif", fps=0.0)
+    with pytest.raises(ValueError, match="max_frames must be positive"):
+        render_animation(synth, paper, tmp_path / "c.gif", max_frames=0)
+    monkeypatch.setitem(sys.modules, "PIL", None)
+    with pytest.raises(MissingDependencyError, match="pip install pillow"):
+        render_animation(synth, paper, tmp_path / "c.gif")
+    assert not (tmp_path / "c.gif").exists()
