@@ -93,6 +93,15 @@ def bench_query(repeat: int) -> dict[str, float]:
         return min_distance(hs, hr, seg, rad, validate=False)
 
     out["fk_plus_separation_us"] = 1e6 * time_call(full, 2000, repeat)
+    try:   # the project's own body capsules (scene.occupancy), if that layer is present
+        from ltl_human_motion.motion.skeleton import Skeleton
+        from ltl_human_motion.scene.occupancy import capsules_from_positions
+    except ImportError:
+        return out
+    bs, br = capsules_from_positions(Skeleton().rest_positions() + np.array([1.2, 0.3, 0.0]))
+    out["body_capsules"] = len(bs)
+    out["min_distance_body_us"] = 1e6 * time_call(lambda: min_distance(bs, br, rs, rr), 2000,
+                                                  repeat)
     return out
 
 
@@ -207,8 +216,11 @@ def main() -> int:
     print(f"separation query, {q['human_capsules']} x {q['robot_capsules']} capsules "
           f"(median of {args.repeat}):")
     for key in ("min_distance_us", "min_distance_unvalidated_us", "fk_capsules_us",
-                "fk_plus_separation_us"):
-        print(f"  {key:32s} {q[key]:8.1f} us")
+                "fk_plus_separation_us", "min_distance_body_us"):
+        if key in q:
+            print(f"  {key:32s} {q[key]:8.1f} us")
+    if "body_capsules" in q:
+        print(f"  (min_distance_body_us: the skeleton's {q['body_capsules']} body capsules)")
     loops = {
         "paced_125hz": closed_loop(args.loop_seconds, 125.0, None, params),
         "unpaced": closed_loop(2.0, None, None, params),

@@ -251,8 +251,8 @@ def test_bvh_round_trip_with_independent_fk(synth, tmp_path, up, scale):
         assert names == list(JOINT_NAMES)
         assert frame_time == pytest.approx(1.0 / synth.fps)
         pos = pos / scale
-        if up == "y":                                    # file (x, y, z) = ours (x, z, -y)
-            pos = np.stack([pos[..., 0], -pos[..., 2], pos[..., 1]], axis=-1)
+        if up == "y":                                    # file (x, y, z) = ours (y, z, x)
+            pos = np.stack([pos[..., 2], pos[..., 0], pos[..., 1]], axis=-1)
         ref = motion.positions if isinstance(motion, Motion) else motion.motion.positions
         assert np.max(np.linalg.norm(pos - ref, axis=-1)) < 0.003
 
@@ -263,8 +263,20 @@ def test_bvh_rest_frame_is_upright(synth, tmp_path):
     save_bvh(rest, path)
     joints, values, _ = _parse_bvh(path)
     np.testing.assert_allclose(values[0, 3:], 0.0, atol=1e-6)         # no rotation at rest
-    head = next(j for j in joints if j[0] == "neck")
-    assert head[2][1] > 0                                              # y up: neck above chest
+    neck = next(j for j in joints if j[0] == "neck")
+    toe = next(j for j in joints if j[0] == "l_toe")
+    assert neck[2][1] > 0                                   # y up: neck above the chest
+    assert toe[2][2] > 0 and abs(toe[2][0]) < 1e-9          # the feet point along +z
+
+
+def test_bvh_loads_back_with_the_project_bvh_reader(synth, tmp_path):
+    bvh = pytest.importorskip("ltl_human_motion.motion.bvh")
+    path = tmp_path / "m.bvh"
+    save_bvh(synth, path)
+    skel, pos, fps = bvh.load_raw(path)
+    assert fps == pytest.approx(synth.fps)
+    idx = [list(skel.names).index(n) for n in JOINT_NAMES]
+    assert np.max(np.linalg.norm(pos[:, idx] - synth.positions, axis=-1)) < 0.003
 
 
 def test_bvh_rejects_bad_arguments(synth, tmp_path):

@@ -83,54 +83,53 @@ def test_bvh_save_load_round_trip(tmp_path: Path) -> None:
     assert np.abs(diff[..., 2] - diff[..., 2].mean()).max() < 2e-3
 
 
-LAFAN_STYLE = """HIERARCHY
-ROOT Hips
-{
-\tOFFSET 0 90 0
-\tCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation
-\tJOINT LeftUpLeg { OFFSET 10 -5 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t JOINT LeftLeg { OFFSET 0 -40 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t  JOINT LeftFoot { OFFSET 0 -40 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t   JOINT LeftToe { OFFSET 0 -5 12 CHANNELS 3 Zrotation Yrotation Xrotation
-\t    End Site { OFFSET 0 0 5 } } } } }
-\tJOINT RightUpLeg { OFFSET -10 -5 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t JOINT RightLeg { OFFSET 0 -40 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t  JOINT RightFoot { OFFSET 0 -40 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t   JOINT RightToe { OFFSET 0 -5 12 CHANNELS 3 Zrotation Yrotation Xrotation
-\t    End Site { OFFSET 0 0 5 } } } } }
-\tJOINT Spine { OFFSET 0 10 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t JOINT Spine1 { OFFSET 0 10 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t  JOINT Spine2 { OFFSET 0 10 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t   JOINT Neck { OFFSET 0 15 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t    JOINT Head { OFFSET 0 10 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t     End Site { OFFSET 0 10 0 } } }
-\t   JOINT LeftShoulder { OFFSET 5 12 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t    JOINT LeftArm { OFFSET 12 0 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t     JOINT LeftForeArm { OFFSET 0 -28 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t      JOINT LeftHand { OFFSET 0 -25 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t       End Site { OFFSET 0 -8 0 } } } } }
-\t   JOINT RightShoulder { OFFSET -5 12 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t    JOINT RightArm { OFFSET -12 0 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t     JOINT RightForeArm { OFFSET 0 -28 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t      JOINT RightHand { OFFSET 0 -25 0 CHANNELS 3 Zrotation Yrotation Xrotation
-\t       End Site { OFFSET 0 -8 0 } } } } } } } }
-}
-MOTION
-Frames: 3
-Frame Time: 0.0333333
-"""
+# A LAFAN1-style hierarchy (names as in the LAFAN1 takes), offsets in centimetres, Y up.
+LAFAN_JOINTS = [  # name, parent, offset
+    ("Hips", None, (0, 90, 0)),
+    ("LeftUpLeg", "Hips", (10, -5, 0)), ("LeftLeg", "LeftUpLeg", (0, -40, 0)),
+    ("LeftFoot", "LeftLeg", (0, -40, 0)), ("LeftToe", "LeftFoot", (0, -5, 12)),
+    ("RightUpLeg", "Hips", (-10, -5, 0)), ("RightLeg", "RightUpLeg", (0, -40, 0)),
+    ("RightFoot", "RightLeg", (0, -40, 0)), ("RightToe", "RightFoot", (0, -5, 12)),
+    ("Spine", "Hips", (0, 10, 0)), ("Spine1", "Spine", (0, 10, 0)),
+    ("Spine2", "Spine1", (0, 10, 0)), ("Neck", "Spine2", (0, 15, 0)),
+    ("Head", "Neck", (0, 10, 0)),
+    ("LeftShoulder", "Spine2", (5, 12, 0)), ("LeftArm", "LeftShoulder", (12, 0, 0)),
+    ("LeftForeArm", "LeftArm", (0, -28, 0)), ("LeftHand", "LeftForeArm", (0, -25, 0)),
+    ("RightShoulder", "Spine2", (-5, 12, 0)), ("RightArm", "RightShoulder", (-12, 0, 0)),
+    ("RightForeArm", "RightArm", (0, -28, 0)), ("RightHand", "RightForeArm", (0, -25, 0)),
+]
 
 
 def _lafan_text(frames: np.ndarray) -> str:
-    body = "\n".join(" ".join(f"{v:.4f}" for v in row) for row in frames)
-    # braces on one line are legal BVH once split into tokens per line
-    text = LAFAN_STYLE.replace("{ ", "{\n").replace(" }", "\n}").replace(" CHANNELS", "\nCHANNELS")
-    text = text.replace(" JOINT", "\nJOINT").replace(" End Site", "\nEnd Site")
-    return text + body + "\n"
+    out = ["HIERARCHY"]
+
+    def emit(name: str, depth: int) -> None:
+        pad = "  " * depth
+        parent = next(p for n, p, _ in LAFAN_JOINTS if n == name)
+        off = next(o for n, _, o in LAFAN_JOINTS if n == name)
+        out.append(f"{pad}{'ROOT' if parent is None else 'JOINT'} {name}")
+        out.append(pad + "{")
+        out.append(f"{pad}  OFFSET {off[0]} {off[1]} {off[2]}")
+        if parent is None:
+            out.append(f"{pad}  CHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation "
+                       "Xrotation")
+        else:
+            out.append(f"{pad}  CHANNELS 3 Zrotation Yrotation Xrotation")
+        kids = [n for n, p, _ in LAFAN_JOINTS if p == name]
+        for k in kids:
+            emit(k, depth + 1)
+        if not kids:
+            out.extend([f"{pad}  End Site", pad + "  {", f"{pad}    OFFSET 0 -5 0", pad + "  }"])
+        out.append(pad + "}")
+
+    emit("Hips", 0)
+    out += ["MOTION", f"Frames: {len(frames)}", "Frame Time: 0.0333333"]
+    out += [" ".join(f"{v:.4f}" for v in row) for row in frames]
+    return "\n".join(out) + "\n"
 
 
 def test_lafan_style_names_and_rotation(tmp_path: Path) -> None:
-    n_ch = 6 + 3 * 21
+    n_ch = 6 + 3 * (len(LAFAN_JOINTS) - 1)
     frames = np.zeros((3, n_ch))
     frames[:, 0:3] = [[0, 90, 0], [0, 90, 10], [0, 90, 20]]   # walk forward along BVH +z
     path = tmp_path / "lafan_like.bvh"
@@ -165,13 +164,14 @@ def test_truncated_bvh_names_file_and_frame(tmp_path: Path) -> None:
     (lambda t: t.replace("Frame Time: 0.0333333", "Frame Time: fast"), r"line \d+: frame time"),
     (lambda t: t.replace("CHANNELS 3 Zrotation Yrotation Xrotation", "CHANNELS 4 Zrotation",
                          1), r"line \d+: CHANNELS 4"),
-    (lambda t: t.replace("MOTION", ""), r"no MOTION"),
+    (lambda t: t.replace("MOTION", ""), r"line \d+: unexpected .Frames:. in HIERARCHY"),
+    (lambda t: t[: t.index("MOTION")], r"no MOTION section"),
     (lambda t: t.replace("HIERARCHY", "HIERARCH"), r"line 1: expected 'HIERARCHY'"),
     (lambda t: t.replace("\n0.0000 90.0000", "\n0.0000 nan", 1), r"line \d+: frame 0"),
     (lambda t: t.replace("0.0000 90.0000 10.0000", "0.0000 abc 10.0000"), r"frame 1: not a number"),
 ])
 def test_corrupt_bvh_errors(tmp_path: Path, mutate, message: str) -> None:
-    n_ch = 6 + 3 * 21
+    n_ch = 6 + 3 * (len(LAFAN_JOINTS) - 1)
     frames = np.zeros((3, n_ch))
     frames[:, 0:3] = [[0, 90, 0], [0, 90, 10], [0, 90, 20]]
     path = tmp_path / "broken.bvh"
@@ -220,7 +220,7 @@ def test_deepmimic_quaternion_order_and_axes() -> None:
     (lambda d: d["Frames"][2].__setitem__(5, "x"), r"frame 2: contains a value"),
     (lambda d: d["Frames"][1][4:8].__init__([0, 0, 0, 0]) or d["Frames"][1].__setitem__(
         slice(4, 8), [0, 0, 0, 0]), r"frame 1: quaternion of zero length"),
-    (lambda d: d.pop("Frames"), r"'Frames' list"),
+    (lambda d: d.pop("Frames"), r"expected a JSON object with a 'Frames' list"),
 ])
 def test_corrupt_deepmimic_errors(tmp_path: Path, mutate, message: str) -> None:
     data = json.loads((deepmimic.motions_dir() / "walker/0walk_forward.txt").read_text())
@@ -323,7 +323,8 @@ def test_asfamc_hand_written_forward_kinematics(tmp_path: Path) -> None:
     # frame 2: the root moved 5 units along its forward axis (+z ASF -> +x ours) and yawed 90
     np.testing.assert_allclose(pts["root"][2], [5.0, 0.0, 20.0], atol=1e-9)
     hips = pts["lhipjoint"][2] - pts["root"][2]
-    assert hips[0] > 0.9 * np.linalg.norm(hips[:2])    # the left hip now points forward
+    # a +90 degree yaw about the up axis turns the body left: its left hip points backwards
+    assert hips[0] < -0.9 * np.linalg.norm(hips[:2])
 
     m = asfamc.load(asf, amc, fps=120.0)
     assert m.n_frames == 3 and m.fps == 120.0

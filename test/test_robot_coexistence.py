@@ -166,6 +166,11 @@ def test_rejected_occupancy_never_raises_speed(controller: CoexistenceController
         d = controller.step()
         assert d.slider == MIN
     assert controller.rejections == len(bad_inputs)
+    nan_prediction = [(0.5, np.full_like(segs, np.nan), radii)]
+    assert not controller.update_occupancy(segs, radii, time.monotonic(), nan_prediction)
+    assert not controller.update_occupancy(segs, radii, time.monotonic(),
+                                           [(-1.0, segs, radii)])
+    assert controller.step().slider == MIN
     assert not controller.update_occupancy(segs, radii, stamp=math.inf)
     assert not controller.update_occupancy(segs, radii, stamp=time.monotonic() + 10.0)
     # A reduced command is a ceiling while only rejected data arrives, even though the

@@ -172,7 +172,11 @@ def test_malformed_and_out_of_order_packets(sim: URSimHandle, receive: object) -
         raw.send(rp.RTDE_DATA_PACKAGE, b"\x09\x00\x00")
         assert b"recipe" in raw.recv(rp.RTDE_TEXT_MESSAGE).payload
         raw.send(rp.RTDE_CONTROL_PACKAGE_SETUP_OUTPUTS, b"\x00\x01")   # no frequency
+        assert raw.recv(rp.RTDE_CONTROL_PACKAGE_SETUP_OUTPUTS).payload == b"\x00"
         assert raw.recv(rp.RTDE_TEXT_MESSAGE)
+        raw.send(rp.RTDE_CONTROL_PACKAGE_SETUP_INPUTS, b"\xff\xfe,speed_slider_mask")
+        assert raw.recv(rp.RTDE_CONTROL_PACKAGE_SETUP_INPUTS).payload.startswith(
+            b"\x00NOT_FOUND,")
         # Unknown variables are NOT_FOUND, like the real controller, and get recipe id 0.
         raw.send(rp.RTDE_CONTROL_PACKAGE_SETUP_OUTPUTS,
                  struct.pack(">d", 125.0) + b"actual_q,no_such_variable")
@@ -192,6 +196,17 @@ def test_malformed_and_out_of_order_packets(sim: URSimHandle, receive: object) -
         assert raw.recv(rp.RTDE_CONTROL_PACKAGE_START).payload == b"\x01"
         data = raw.recv(rp.RTDE_DATA_PACKAGE).payload
         assert len(data) == 1 + 16 and data[0] == reply[0]
+        # PAUSE stops the stream; START resumes it.
+        raw.send(rp.RTDE_CONTROL_PACKAGE_PAUSE)
+        assert raw.recv(rp.RTDE_CONTROL_PACKAGE_PAUSE).payload == b"\x01"
+        raw.pending.clear()
+        time.sleep(0.05)
+        raw.pending.clear()
+        with pytest.raises(TimeoutError):
+            raw.recv(rp.RTDE_DATA_PACKAGE, timeout=0.1)
+        raw.send(rp.RTDE_CONTROL_PACKAGE_START)
+        assert raw.recv(rp.RTDE_CONTROL_PACKAGE_START).payload == b"\x01"
+        assert raw.recv(rp.RTDE_DATA_PACKAGE).payload[0] == reply[0]
     finally:
         raw.close()
     # A broken header (size < 3) cannot be resynchronised: that client is dropped...
@@ -208,6 +223,19 @@ def test_malformed_and_out_of_order_packets(sim: URSimHandle, receive: object) -
     stamp = receive.getTimestamp()
     assert wait_for(lambda: receive.getTimestamp() > stamp)
     assert receive.isConnected() and sim.is_alive()
+
+
+def test_speed_slider_at_zero_then_changed_is_a_protective_stop(sim: URSimHandle,
+                                                                 receive: object,
+                                                                 io: object) -> None:
+    # Why SSM never commands 0: the next slider change after 0 stops the arm.
+    assert io.setSpeedSlider(0.0)
+    assert wait_for(lambda: receive.getTargetSpeedFraction() == 0.0)
+    assert receive.getSafetyMode() == 1
+    assert io.setSpeedSlider(0.5)
+    assert wait_for(lambda: receive.getSafetyMode() == 3)
+    assert sim.unlock_protective_stop()
+    assert wait_for(lambda: receive.getSafetyMode() == 1)
 
 
 def test_second_writer_of_an_input_is_in_use(sim: URSimHandle, io: object) -> None:

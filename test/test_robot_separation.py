@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 
 from ltl_human_motion.robot import (
     SLIDER_MIN,
@@ -141,3 +144,21 @@ def test_predictive_separation_discounts_by_time() -> None:
     assert predictive_separation(0.3, [], [], p) == pytest.approx(0.3)
     with pytest.raises(ValueError, match="equal length"):
         predictive_separation(1.0, [1.0, 2.0], [0.1], p)
+
+
+coords = arrays(np.float64, (4, 2, 3), elements=st.floats(-2.0, 2.0, allow_nan=False))
+
+
+@settings(max_examples=60, deadline=None)
+@given(P=coords, Q=coords, angle=st.floats(-np.pi, np.pi), shift=st.floats(-3.0, 3.0))
+def test_segment_distance_properties(P: np.ndarray, Q: np.ndarray, angle: float,
+                                     shift: float) -> None:
+    d = segment_distances(P, Q)
+    assert np.all(d >= 0)
+    assert np.allclose(d, segment_distances(Q, P).T, atol=1e-6)          # symmetric
+    ends = np.linalg.norm(P[:, None, :, None] - Q[None, :, None, :], axis=-1)
+    assert np.all(d <= ends.min(axis=(2, 3)) + 1e-9)                     # <= endpoint gaps
+    c, s = np.cos(angle), np.sin(angle)
+    R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+    moved = segment_distances(P @ R.T + shift, Q @ R.T + shift)
+    assert np.allclose(d, moved, atol=1e-6)                              # rigid invariance

@@ -17,11 +17,11 @@ import pytest
 
 rclpy = pytest.importorskip("rclpy")
 
+from ltl_human_motion.msg import HumanOccupancy  # noqa: E402
+from ltl_human_motion.srv import PlayMotion  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 
-from ltl_human_motion.msg import HumanOccupancy  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
-from ltl_human_motion.srv import PlayMotion  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -114,7 +114,7 @@ def test_service_of_this_package_between_processes(session: ClientSession) -> No
             "sys.exit(skeleton_publisher())")
     proc = subprocess.Popen(
         [sys.executable, "-c", code, "--ros-args", "-r", "__ns:=/foundation_human",
-         "-p", "human_id:=9", "-p", "cell:="],
+         "-p", "human_id:=9", "-p", "cell:=''"],
         env=_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         service = "/foundation_human/play_motion"

@@ -21,19 +21,19 @@ import pytest
 
 rclpy = pytest.importorskip("rclpy")
 
+from ltl_human_motion.msg import HumanOccupancy, TaskState  # noqa: E402
+from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray  # noqa: E402
 
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton  # noqa: E402
-from ltl_human_motion.msg import HumanOccupancy, TaskState  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
 from ltl_human_motion.ros.common import TF_STATIC_QOS  # noqa: E402
 from ltl_human_motion.ros.occupancy_node import OccupancyNode  # noqa: E402
 from ltl_human_motion.ros.testing import scripted_synthesize  # noqa: E402
-from ltl_human_motion.scene.occupancy import BODY_PARTS  # noqa: E402
-from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
+from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_radii  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -156,7 +156,9 @@ def test_occupancy_streams_at_100_hz_with_prediction(client: ClientSession) -> N
     time.sleep(2.0)
     log = client.occupancy
     received = log.count - start
-    assert received >= 180, f"only {received} occupancy messages in 2 s (want ~200)"
+    # 100 Hz nominal; the floor leaves room for a loaded CI machine (this process also
+    # runs two humans and the client). bench/occupancy_stream.py measures the real rate.
+    assert received >= 160, f"only {received} occupancy messages in 2 s (want ~200)"
     msgs = log.messages[-150:]
     stamps = np.array([m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in msgs])
     periods = np.diff(stamps)
@@ -171,7 +173,8 @@ def test_occupancy_streams_at_100_hz_with_prediction(client: ClientSession) -> N
         [round(0.1 * k, 6) for k in range(1, 11)]
     assert all(len(p.capsules) == len(BODY_PARTS) for p in last.predicted)
     head = last.capsules[list(last.part_names).index("head")]
-    assert 1.3 < head.b.z < 1.8 and head.radius == pytest.approx(0.105)
+    assert 1.3 < head.b.z < 1.8
+    assert head.radius == pytest.approx(capsule_radii(1.75)[BODY_PARTS.index("head")])
 
 
 def test_task_state_reports_the_playback(client: ClientSession) -> None:

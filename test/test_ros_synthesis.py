@@ -23,12 +23,13 @@ import pytest
 rclpy = pytest.importorskip("rclpy")
 
 from ltl_human_motion.msg import MotionCatalog  # noqa: E402
+from ltl_human_motion.srv import SynthesizeMotion  # noqa: E402
+
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.bringup_config import load_bringup_config  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
 from ltl_human_motion.ros.common import LATCHED_QOS  # noqa: E402
 from ltl_human_motion.ros.testing import scripted_synthesize  # noqa: E402
-from ltl_human_motion.srv import SynthesizeMotion  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -229,12 +230,12 @@ def test_killed_and_restarted_client_does_not_disturb_the_server(
 
 # ---------------------------------------------------------------- the real pipeline
 def _pipeline_available() -> bool:
+    """True once the lead exports ``planning.synthesize`` (the contract's name)."""
     try:
-        from ltl_human_motion.ros.synthesis_node import _planning
-
-        return callable(_planning("synthesize"))
-    except (ImportError, AttributeError):
+        from ltl_human_motion import planning
+    except ImportError:
         return False
+    return callable(getattr(planning, "synthesize", None))
 
 
 pipeline = pytest.mark.skipif(not _pipeline_available(),

@@ -276,3 +276,22 @@ obstacles:
     assert zone.contains(np.array([[1.0, 1.0, 1.0], [1.0, 1.0, 1.25]])).tolist() == [True, False]
     with pytest.raises(CellError, match=r"regions\.Z\.mesh: mesh file not found"):
         cell_from_yaml(text, source="m.yaml", base_dir=tmp_path / "elsewhere")
+
+
+def test_cells_pickle_for_worker_processes(tmp_path):
+    import pickle
+
+    import trimesh
+    trimesh.creation.box(extents=[0.4, 0.6, 1.0]).export(tmp_path / "crate.stl")
+    cell = cell_from_yaml("""
+start_region: R0
+regions: {R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}}
+obstacles: {crate: {mesh: crate.stl, position: [2.0, 0.0, 0.5]}}
+""", base_dir=tmp_path)
+    seg = np.array([[[1.0, 0.0, 0.5], [1.5, 0.0, 0.5]]])
+    before = cell.obstacle_clearance(seg, np.array([0.1]))          # builds the fcl model
+    again = pickle.loads(pickle.dumps(cell))
+    np.testing.assert_allclose(again.obstacle_clearance(seg, np.array([0.1])), before)
+    np.testing.assert_allclose(before, [0.2], atol=1e-6)
+    paper = pickle.loads(pickle.dumps(cell_by_name("paper_cell")))
+    np.testing.assert_allclose(paper.region("R1").center, [1.0, -1.0, 1.0])

@@ -145,3 +145,17 @@ def test_ground_enter():
     floor_cell = cell_from_yaml("start_region: R0\nfloor_z: 0.5\nregions:\n"
                                 "  R0: {lo: [-1, -1, 0.5], hi: [1, 1, 0.6]}\n")
     assert ground_enter(REST, "l_knee", 0.0, floor_z=floor_cell.floor_z)
+
+
+def test_distance_to_is_the_exact_body_region_gap(paper):
+    from ltl_human_motion.scene import distance_to, segment_box_distance
+    r1 = paper.region("R1")
+    poses = np.stack([_placed([0.0, 0.0, 0.0]), _placed([0.5, -1.0, 0.0]),
+                      _placed([1.0, -1.0, 0.3])])
+    got = distance_to(poses, r1)
+    seg, rad = capsules_from_positions(poses)
+    ref = np.maximum(np.min(segment_box_distance(seg[..., 0, :], seg[..., 1, :], r1.lo, r1.hi)
+                            - rad, axis=-1), 0.0)
+    np.testing.assert_allclose(got, ref, atol=1e-9)
+    assert got[0] > 1.0 and got[2] == 0.0
+    assert distance_to(poses[1], r1, "r_hand") >= got[1]

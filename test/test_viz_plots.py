@@ -68,7 +68,14 @@ def test_snapshots_show_worker_in_every_panel(motions, paper, tmp_path):
     for k in range(3):
         panel = img[:, k * w // 3:(k + 1) * w // 3]
         assert _near(panel, BONE_RGB, 25).sum() > 30           # the bones
-    assert not (tmp_path / "snap.png.tmp").exists()
+    # With capsules (the default) the body shows as translucent blue in every panel.
+    render_snapshots(synth, paper, times, path, ncols=3)
+    img = _pixels(path)
+    for k in range(3):
+        panel = img[:, k * w // 3:(k + 1) * w // 3]
+        blue = (panel[..., 2] - panel[..., 0] > 60) & (panel[..., 2] > 150)
+        assert blue.sum() > 300
+    assert [p.name for p in tmp_path.iterdir()] == ["snap.png"]
     with pytest.raises(ValueError, match="at least one time"):
         render_snapshots(synth, paper, [], path)
 

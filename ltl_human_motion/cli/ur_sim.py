@@ -31,6 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Serve until Ctrl-C; returns the exit code."""
+    from ltl_human_motion.robot.rtde_server import ControllerServer
     from ltl_human_motion.robot.ur_sim import URSimConfig, run_ur_sim
 
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
@@ -41,10 +42,13 @@ def run(args: argparse.Namespace) -> int:
         return 2
     config = URSimConfig(args.model, args.trajectory, args.host, args.rtde_port,
                          args.dashboard_port, args.rate, args.speed_slider)
-    print(f"ur-sim: {config.model or 'model from config'} on {args.host}, RTDE port "
-          f"{args.rtde_port}, dashboard port {args.dashboard_port}; Ctrl-C to stop", flush=True)
+    def announce(server: ControllerServer) -> None:
+        print(f"ur-sim: simulated {server.sim.model.name} on {args.host}: RTDE port "
+              f"{server.rtde_port}, dashboard port {server.dashboard_port}; Ctrl-C to stop",
+              flush=True)
+
     try:
-        return run_ur_sim(config)
+        return run_ur_sim(config, announce)
     except OSError as exc:
         print(f"ur-sim: cannot serve on {args.host}: {exc}", file=sys.stderr)
         return 2

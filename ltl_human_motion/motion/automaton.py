@@ -139,7 +139,6 @@ def transition_distances(end_windows: np.ndarray, start_windows: np.ndarray,
     k = ew.shape[1]
     ax, ay, az = _flat(ew)
     bx, by, bz = _flat(start_windows)
-    n = ax.shape[1]
     # centred floor coordinates: the centring terms are rank-one corrections
     ax_c, ay_c = ax - ax.mean(1, keepdims=True), ay - ay.mean(1, keepdims=True)
     bx_c, by_c = bx - bx.mean(1, keepdims=True), by - by.mean(1, keepdims=True)
@@ -152,17 +151,17 @@ def transition_distances(end_windows: np.ndarray, start_windows: np.ndarray,
     sq_b = np.einsum("ij,ij->i", B1, B1) + np.einsum("ij,ij->i", bz, bz)
     zz = az @ bz.T
     sse = sq_a[:, None] + sq_b[None, :] - 2.0 * np.hypot(c, s) - 2.0 * zz
-    del n
     return np.sqrt(np.maximum(sse, 0.0) / k) * (REFERENCE_STATURE / stature)
 
 
 def build_transitions(end_windows: np.ndarray, start_windows: np.ndarray, delta: float,
-                      stature: float = REFERENCE_STATURE, block: int = 1024,
+                      stature: float = REFERENCE_STATURE, block: int | None = None,
                       progress=None) -> csr_matrix:
     """Sparse matrix of the distances of all pairs with ``d_ij < delta``.
 
     Pairs with distance exactly 0 are stored as a tiny positive number so they stay in the
-    sparsity pattern.
+    sparsity pattern. Rows are processed in blocks (default: about 4 million pairs, i.e.
+    some 30 MB per temporary array) so memory stays bounded for large libraries.
 
     Returns
     -------
@@ -171,6 +170,8 @@ def build_transitions(end_windows: np.ndarray, start_windows: np.ndarray, delta:
     if not delta > 0:
         raise ValueError(f"delta must be positive, got {delta!r}")
     N = end_windows.shape[0]
+    if block is None:
+        block = int(np.clip(4_000_000 // max(start_windows.shape[0], 1), 16, 4096))
     rows_l, cols_l, vals_l = [], [], []
     for r0 in range(0, N, block):
         D = transition_distances(end_windows, start_windows, stature, slice(r0, r0 + block))

@@ -358,20 +358,19 @@ def _finish(name: str, task: str, world: np.ndarray, st: _Start, fps: float, sou
             meta: dict, start_exact: bool = True, end_exact: bool = True) -> MotionPrimitive:
     """Blend the model residual against ``start_pose`` in at the ends, build the primitive."""
     T = world.shape[0]
-    if start_exact or end_exact:
-        ref = world[0] if start_exact else world[-1]
+    t = np.arange(T) / fps
+    ramp = 0.3
+    corrected = world.copy()
+    for exact, ref, w in ((start_exact, world[0], 1.0 - min_jerk(t / ramp)),
+                          (end_exact, world[-1], 1.0 - min_jerk((t[-1] - t) / ramp))):
+        if not exact:
+            continue
         pose = st.pose.copy()
         pose[:, :2] += ref[0, :2] - pose[0, :2]
         residual = pose - ref
-        if np.max(np.abs(residual)) > 1e-9:
-            t = np.arange(T) / fps
-            w = np.zeros(T)
-            ramp = 0.3
-            if start_exact:
-                w = np.maximum(w, 1.0 - min_jerk(t / ramp))
-            if end_exact:
-                w = np.maximum(w, 1.0 - min_jerk((t[-1] - t) / ramp))
-            world = world + w[:, None, None] * residual[None]
+        if np.max(np.abs(residual)) > 0.0:
+            corrected += w[:, None, None] * residual[None]
+    world = corrected
     yaw = np.zeros(T)
     root = np.concatenate([world[:, 0, :], yaw[:, None]], axis=1)
     root = relative_root(root)

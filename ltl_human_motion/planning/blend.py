@@ -44,12 +44,15 @@ class PlacedSegment:
         Index into the task timeline, or -1 for walking between tasks.
     blend_in : int
         Number of frames this segment overlaps the previous one.
+    name : str
+        Name of the primitive placed.
     """
 
     positions: np.ndarray
     root_yaw: np.ndarray
     label: int = -1
     blend_in: int = 0
+    name: str = ""
 
 
 def concatenate(segments: list[PlacedSegment]) -> tuple[np.ndarray, np.ndarray, np.ndarray,

@@ -10,9 +10,14 @@ The hierarchy is the canonical skeleton (:mod:`ltl_human_motion.motion.skeleton`
 its rest pose as offsets: 23 ``JOINT`` entries (the root ``pelvis`` has six channels
 ``Xposition Yposition Zposition Zrotation Yrotation Xrotation``, every other joint three
 ``Zrotation Yrotation Xrotation``; R = Rz · Ry · Rx, angles in degrees) and an
-``End Site`` after each leaf (head, hands, toes). By default the file is **y up**
-(``(x, y, z)_ours -> (x, z, -y)``), metres, which Blender's BVH importer (default
-axes: forward -Z, up Y) turns back into our z-up frame; pass ``up="z"`` to keep z up.
+``End Site`` after each leaf (head, hands, toes). Units are metres (``scale`` changes
+them). By default the file follows the motion-capture convention, **y up with the
+character facing +z** and its left at +x: ``(x, y, z)_ours -> (y, z, x)_bvh``, the
+inverse of what :mod:`ltl_human_motion.motion.bvh` applies when loading, so exported
+files load back with it. Blender's importer (default axes: forward -Z, up Y) shows the
+worker standing on its floor, facing -Y (towards the front view), i.e. our frame turned
+by -90 degrees about the vertical. ``up="z"`` writes our frame unchanged (z up, facing
++x; import into Blender with forward Y, up Z).
 
 Joint rotations are derived from positions: a joint with several children (pelvis,
 chest) gets the rotation that best maps its rest child offsets onto the current ones
@@ -258,7 +263,8 @@ _TWIST_REF: dict[str, tuple[str, str]] = {
     "l_ankle": ("l_knee", "l_ankle"), "r_ankle": ("r_knee", "r_ankle"),
     "spine": ("r_clavicle", "l_clavicle"),
 }
-_UP_FROM_Z = {"z": np.eye(3), "y": np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])}
+# File axes from ours: bvh = C @ ours.
+_UP_FROM_Z = {"z": np.eye(3), "y": np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])}
 
 
 def _normalize(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -373,7 +379,7 @@ def save_bvh(motion: SynthesizedMotion | Motion, path: PathLike, up: str = "y",
     motion : SynthesizedMotion or Motion
     path : path-like
     up : {"y", "z"}
-        Up axis of the file (default y, the BVH convention).
+        ``"y"``: y up, facing +z (the mocap convention, default); ``"z"``: our frame.
     scale : float
         Unit scale (1.0 = metres, 100.0 = centimetres).
 

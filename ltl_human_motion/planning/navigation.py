@@ -108,7 +108,7 @@ class ClearanceMap:
         Grid step in metres.
     """
 
-    def __init__(self, cell, resolution: float = 0.025) -> None:  # noqa: ANN001
+    def __init__(self, cell, resolution: float = 0.04) -> None:  # noqa: ANN001
         from scipy.interpolate import RegularGridInterpolator
         lo = np.asarray(cell.workspace_lo[:2], dtype=np.float64)
         hi = np.asarray(cell.workspace_hi[:2], dtype=np.float64)

@@ -332,6 +332,7 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
                              "walk_primitives": s.walk_segments, "expanded": s.expanded}
                             for i, s in enumerate(plan.steps)],
         "start_pose": list(plan.start_pose),
+        "segments": [[seg.name, int(a), int(b)] for seg, (a, b) in zip(plan.segments, spans)],
     }
     if not steps:
         raise PlanningError("the task sequence is empty", reason="empty")

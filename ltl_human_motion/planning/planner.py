@@ -154,18 +154,20 @@ def gait_index(library) -> GaitIndex:  # noqa: ANN001
     return index
 
 
-_CLEARANCE_CACHE: dict[int, tuple[object, ClearanceMap]] = {}
+_CLEARANCE_CACHE: dict[str, ClearanceMap] = {}
 
 
 def clearance_map(cell) -> ClearanceMap:  # noqa: ANN001
-    """The clearance map of ``cell``, computed once per cell object."""
-    hit = _CLEARANCE_CACHE.get(id(cell))
-    if hit is not None and hit[0] is cell:
-        return hit[1]
-    cmap = ClearanceMap(cell)
-    if len(_CLEARANCE_CACHE) > 32:
-        _CLEARANCE_CACHE.clear()
-    _CLEARANCE_CACHE[id(cell)] = (cell, cmap)
+    """The clearance map of ``cell``, computed once per obstacle layout."""
+    import hashlib
+    import pickle
+    key = hashlib.sha1(pickle.dumps((np.asarray(cell.workspace_lo), np.asarray(
+        cell.workspace_hi), cell.obstacles))).hexdigest()
+    cmap = _CLEARANCE_CACHE.get(key)
+    if cmap is None:
+        if len(_CLEARANCE_CACHE) > 64:
+            _CLEARANCE_CACHE.clear()
+        cmap = _CLEARANCE_CACHE[key] = ClearanceMap(cell)
     return cmap
 
 
@@ -298,7 +300,8 @@ class SequencePlanner:
     def _add(self, mp: MotionPrimitive, pose: Pose, label: int, blend: int) -> int:
         pos = world_positions(mp, *pose)
         yaw = pose[2] + mp.root[:, 3]
-        self.segments.append(PlacedSegment(pos, yaw, label, blend if self.segments else 0))
+        self.segments.append(PlacedSegment(pos, yaw, label, blend if self.segments else 0,
+                                           mp.name))
         return len(self.segments) - 1
 
     def _hand_over_pose(self, mp: MotionPrimitive, pose: Pose) -> Pose:
@@ -350,7 +353,23 @@ class SequencePlanner:
         root[:, 2] = self.library.standing_height
         mp = MotionPrimitive("arms_to_carry" if not carrying_before else "arms_to_walk", "wait",
                              rel, root, self.library.fps, "planner: arm transition")
+        if not self._placed_clear(mp, self.pose):
+            self._step_back(carrying_before, label)
         self._add(mp, self.pose, label, self.overlap)
+
+    def _placed_clear(self, mp: MotionPrimitive, pose: Pose) -> bool:
+        """Whether ``mp`` placed at ``pose`` keeps clear of every obstacle (sampled)."""
+        frames = np.linspace(0, mp.n_frames - 1, 9).round().astype(int)
+        return bool(self._body_clear(world_positions(mp, *pose)[frames][None])[0])
+
+    def _step_back(self, carrying: bool, label: int) -> None:
+        """Step back from an obstacle in front (a step primitive of the gait index)."""
+        task = "carry" if carrying else "walk"
+        for j, mp in enumerate(self.index.primitives):
+            if mp.task == task and mp.meta.get("step") == [-0.3, 0.0] and not mp.meta.get("turn"):
+                self._add(mp, self.pose, label, self.overlap)
+                self.pose = self._hand_over_pose(mp, self.pose)
+                return
 
     def _walk(self, goal: Goal, task: str, label: int, carry: bool) -> int:
         """A* from the current pose; appends the gait segments; returns their count."""

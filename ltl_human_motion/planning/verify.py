@@ -48,6 +48,32 @@ class VerificationOptions:
     flight_height: float = 0.12
 
 
+_MAX_RADIUS = 0.16   # largest body capsule radius (m) at the tallest stature
+
+
+def near_frames(positions: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                margin: float = 0.0) -> np.ndarray:
+    """Frames whose body bounding box comes within ``margin`` of the box [lo, hi].
+
+    A cheap broad phase: frames not returned cannot enter, touch or collide with
+    anything inside the box.
+
+    Parameters
+    ----------
+    positions : ndarray, shape (T, J, 3)
+    lo, hi : array-like, shape (3,)
+    margin : float
+
+    Returns
+    -------
+    frames : ndarray of int
+    """
+    body_lo = positions.min(axis=1) - _MAX_RADIUS - margin
+    body_hi = positions.max(axis=1) + _MAX_RADIUS + margin
+    hit = np.all((body_lo <= np.asarray(hi)) & (body_hi >= np.asarray(lo)), axis=1)
+    return np.flatnonzero(hit)
+
+
 def _check(passed: bool, detail: str, **values: object) -> dict:
     return {"passed": bool(passed), "detail": detail, **values}
 
@@ -84,7 +110,8 @@ def observed_letters(synth, cell, spec, steps: list[tuple[str, tuple[str, ...]]]
                        if not key.startswith("enter(")}
         window = pos[a:b]
         for region in regions:
-            if np.any(enter(window, region, stature=stature)):
+            cand = near_frames(window, region.lo, region.hi)
+            if cand.size and np.any(enter(window[cand], region, stature=stature)):
                 letter.add(f"enter({region.name})")
         letters.append(frozenset(letter))
     return letters
@@ -136,7 +163,15 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
 
     carried = {name: np.where(np.asarray(mask)[:, None], synth.objects[name], np.nan)
                for name, mask in (held or {}).items() if np.any(mask)}
-    hits = collision(pos, cell, stature=stature, carried=carried)
+    hits = np.zeros(len(pos), dtype=bool)
+    if cell.obstacles:
+        boxes = [ob.aabb() for ob in cell.obstacles]
+        lo = np.min([b[0] for b in boxes], axis=0)
+        hi = np.max([b[1] for b in boxes], axis=0)
+        cand = near_frames(pos, lo, hi, margin=0.3)   # carried objects reach past the hands
+        if cand.size:
+            hits[cand] = collision(pos[cand], cell, stature=stature,
+                                   carried={k: v[cand] for k, v in carried.items()})
     n_hit = int(np.sum(hits))
     report["collision"] = _check(n_hit == 0, "no frame collides" if n_hit == 0 else
                                  f"{n_hit} frames collide, first at t = "

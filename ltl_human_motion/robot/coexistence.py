@@ -31,7 +31,7 @@ import math
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -193,7 +193,6 @@ class _Occupancy:
     pred_radii: NDArray[np.float64] | None = None
     pred_offsets: NDArray[np.intp] | None = None       # start of each horizon
     horizons: NDArray[np.float64] | None = None
-    extra: dict[str, Any] = field(default_factory=dict)
 
 
 _KEEP_ALIVE: list[object] = []
@@ -447,13 +446,14 @@ class CoexistenceController:
         """World-frame capsules (7, 2, 3), (7,) of the arm at joint positions ``q``."""
         return robot_capsules(q, self.model, self.base)
 
-    def separations(self, q: ArrayLike, occupancy: _Occupancy | None = None
-                    ) -> tuple[float, float]:
-        """Current and effective (prediction-aware) separation for joint positions ``q``.
+    def separations(self, q: ArrayLike) -> tuple[float, float]:
+        """Current and effective (prediction-aware) separation (m) for joint positions
+        ``q`` (6,) and the latest accepted occupancy; NaN for both without one."""
+        with self._lock:
+            occ = self._occ
+        return self._separations(q, occ)
 
-        Uses the latest accepted occupancy; returns NaN for both without one.
-        """
-        occ = self._occ if occupancy is None else occupancy
+    def _separations(self, q: ArrayLike, occ: _Occupancy | None) -> tuple[float, float]:
         if occ is None:
             return math.nan, math.nan
         rseg, rrad = self.robot_capsules(q)
@@ -479,7 +479,7 @@ class CoexistenceController:
         elif occ is None or now - occ.stamp > self.config.stale_after:
             mode, slider = "stale", self.params.min_slider
         else:
-            sep, eff = self.separations(q, occ)
+            sep, eff = self._separations(q, occ)
             slider = slider_from_separation(eff, self.params)
             mode = ("full" if slider >= self.params.max_slider
                     else "stop" if slider <= self.params.min_slider else "reduced")

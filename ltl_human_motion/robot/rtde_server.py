@@ -299,7 +299,7 @@ class ControllerServer:
         self._send(client, rp.encode_packet(rp.RTDE_REQUEST_PROTOCOL_VERSION, bytes([int(ok)])))
 
     def _names(self, raw: bytes) -> list[str]:
-        text = raw.decode("ascii")
+        text = raw.decode("ascii", "replace")   # junk becomes names that are NOT_FOUND
         names = [n.strip() for n in text.split(",")]
         while names and names[-1] == "":
             names.pop()
@@ -309,6 +309,8 @@ class ControllerServer:
         frequency = self.rate
         if client.protocol >= 2:
             if len(payload) < 8:
+                self._send(client, rp.encode_packet(rp.RTDE_CONTROL_PACKAGE_SETUP_OUTPUTS,
+                                                    b"\x00"))
                 raise rp.ProtocolError("output setup without a frequency")
             (frequency,) = struct.unpack(">d", payload[:8])
             payload = payload[8:]

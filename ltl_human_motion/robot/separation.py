@@ -114,15 +114,14 @@ def segment_distances(P: NDArray[np.float64], Q: NDArray[np.float64]) -> NDArray
     d1 = P[:, 1] - p0
     d2 = Q[:, 1] - q0
     K = len(P)
-    # One matrix product gives p0.q0, p0.d2, d1.q0 and d1.d2 for all pairs.
+    # One matrix product gives p0.d2, d1.q0 and d1.d2 for all pairs.
     G = np.concatenate((p0, d1)) @ np.concatenate((q0, d2)).T   # (2K, 2L)
     L = len(Q)
-    p0q0, p0d2, d1q0, b = G[:K, :L], G[:K, L:], G[K:, :L], G[K:, L:]
+    p0d2, d1q0, b = G[:K, L:], G[K:, :L], G[K:, L:]
     a = (d1 * d1).sum(axis=1)[:, None]                          # (K, 1)
     e = (d2 * d2).sum(axis=1)[None, :]                          # (1, L)
     c = (d1 * p0).sum(axis=1)[:, None] - d1q0                   # d1 . (p0 - q0)
     f = p0d2 - (d2 * q0).sum(axis=1)[None, :]                   # d2 . (p0 - q0)
-    rr = (p0 * p0).sum(axis=1)[:, None] + (q0 * q0).sum(axis=1)[None, :] - 2.0 * p0q0
     a_s = np.maximum(a, _EPS)   # a point has d1 = 0, so b = c = 0 as well
     e_s = np.maximum(e, _EPS)
     # Closest points of the two lines, clamped to P; for parallel lines (denom ~ 0) any s
@@ -133,8 +132,11 @@ def segment_distances(P: NDArray[np.float64], Q: NDArray[np.float64]) -> NDArray
     # Re-project Q(t) on P: where t was clamped this is the closest point on P; elsewhere
     # it cannot increase the (already minimal) distance.
     s = np.minimum(np.maximum((b * t - c) / a_s, 0.0), 1.0)
-    sq = rr + s * (s * a + 2.0 * (c - t * b)) + t * (t * e - 2.0 * f)
-    return np.sqrt(np.maximum(sq, 0.0))
+    # The closest points themselves (not an expansion of |r + s d1 - t d2|^2, which loses
+    # precision to cancellation when the segments nearly touch).
+    gap = (p0[:, None, :] - q0[None, :, :]) + s[..., None] * d1[:, None, :] \
+        - t[..., None] * d2[None, :, :]
+    return np.sqrt((gap * gap).sum(axis=-1))
 
 
 def pair_distances(human_segments: ArrayLike, human_radii: ArrayLike,

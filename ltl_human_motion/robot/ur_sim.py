@@ -12,6 +12,7 @@ import logging
 import multiprocessing as mp
 import signal
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -70,11 +71,17 @@ def build_controller(config: URSimConfig) -> ControllerServer:
     return ControllerServer(sim, config.host, config.rtde_port, dash, config.rate)
 
 
-def run_ur_sim(config: URSimConfig) -> int:
-    """Serve in the foreground until Ctrl-C or SIGTERM; returns an exit code."""
+def run_ur_sim(config: URSimConfig,
+               on_ready: Callable[[ControllerServer], None] | None = None) -> int:
+    """Serve in the foreground until Ctrl-C or SIGTERM; returns an exit code.
+
+    ``on_ready(server)`` is called once the ports listen (e.g. to print them).
+    """
     server = build_controller(config)
     log.info("simulated %s: RTDE on %s:%d, dashboard on %s", server.sim.model.name, config.host,
              server.rtde_port, server.dashboard_port)
+    if on_ready is not None:
+        on_ready(server)
     previous = signal.signal(signal.SIGTERM, lambda *_: server.stop())
     try:
         server.serve_forever()

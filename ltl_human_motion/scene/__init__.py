@@ -41,6 +41,7 @@ from ltl_human_motion.scene.occupancy import (
 from ltl_human_motion.scene.predicates import (
     body_clearance,
     collision,
+    distance_to,
     enclose,
     enclose_object,
     enter,
@@ -101,6 +102,7 @@ __all__ = [
     "cell_search_paths",
     "chest_height",
     "collision",
+    "distance_to",
     "enclose",
     "enclose_object",
     "enter",

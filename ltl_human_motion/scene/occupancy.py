@@ -52,6 +52,10 @@ BODY_CAPSULES: tuple[tuple[str, str, str, float], ...] = (
     ("r_shank", "r_knee", "r_ankle", 0.055),
     ("l_foot", "l_ankle", "l_toe", 0.035),
     ("r_foot", "r_ankle", "r_toe", 0.035),
+    # The palms: the "lh"/"rh" of Table I (the paper's hand markers), spheres at the palm
+    # centres inside the hand capsules; used by leftHand, rightHand and grasp.
+    ("l_palm", "l_hand", "l_hand", 0.045),
+    ("r_palm", "r_hand", "r_hand", 0.045),
 )
 
 #: Part names in capsule order.
@@ -59,7 +63,7 @@ BODY_PARTS: tuple[str, ...] = tuple(c[0] for c in BODY_CAPSULES)
 
 #: Table I abbreviations and groups -> parts.
 PART_ALIASES: dict[str, tuple[str, ...]] = {
-    "lh": ("l_hand",), "rh": ("r_hand",), "lk": ("l_knee",), "rk": ("r_knee",),
+    "lh": ("l_palm",), "rh": ("r_palm",), "lk": ("l_knee",), "rk": ("r_knee",),
     "hands": ("l_hand", "r_hand"),
     "left_arm": ("l_upper_arm", "l_lower_arm", "l_hand"),
     "right_arm": ("r_upper_arm", "r_lower_arm", "r_hand"),

@@ -30,6 +30,7 @@ __all__ = [
     "as_shape",
     "body_clearance",
     "collision",
+    "distance_to",
     "enclose",
     "enclose_object",
     "enter",
@@ -74,6 +75,30 @@ def enter(positions: np.ndarray, region: Target, parts: str | Iterable[str] | No
         raise ValueError(f"margin must be non-negative, got {margin!r}")
     seg, rad = capsules_from_positions(positions, stature, parts)
     return np.any(as_shape(region).capsule_clearance(seg, rad) <= margin, axis=-1)
+
+
+def distance_to(positions: np.ndarray, target: Target,
+                parts: str | Iterable[str] | None = None, *,
+                stature: float = DEFAULT_STATURE) -> np.ndarray:
+    """dist(occ(x, BP), target): the smallest distance between the body and a target.
+
+    The A* heuristic of Sec. III-B uses it. Exact (no far-field bound).
+
+    Parameters
+    ----------
+    positions : array-like, shape (..., J, 3)
+    target : Region, Shape or SceneObject
+    parts : str or iterable of str, optional
+    stature : float
+
+    Returns
+    -------
+    distance : ndarray, shape (...)
+        0 when the body meets the target.
+    """
+    seg, rad = capsules_from_positions(positions, stature, parts)
+    clearance = as_shape(target).capsule_clearance(seg, rad, exact_below=np.inf)
+    return np.maximum(np.min(clearance, axis=-1), 0.0)
 
 
 def enclose(positions: np.ndarray, region: Target, parts: str | Iterable[str] | None = None, *,

@@ -566,6 +566,11 @@ class MeshShape(Shape):
     def _fcl_object(self):
         return self.to_fcl()
 
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        state.pop("_fcl_object", None)          # fcl objects cannot be pickled
+        return state
+
     def aabb(self) -> tuple[np.ndarray, np.ndarray]:
         b = np.asarray(self.mesh.bounds, dtype=np.float64)
         return b[0] + self.center_, b[1] + self.center_

@@ -158,7 +158,7 @@ def _single(task: str, args: tuple[str, ...], window: np.ndarray, cell: Cell,
         elapsed = np.arange(T) / fps
         return still & (elapsed >= duration - 1e-9)
     if task in ("leftHand", "rightHand"):
-        part = "l_hand" if task == "leftHand" else "r_hand"
+        part = "l_palm" if task == "leftHand" else "r_palm"
         return enclose(window, cell.region(args[0]), part, stature=stature)
     if task == "walk":
         return enter(window, cell.region(args[0]), stature=stature)
@@ -183,13 +183,11 @@ def _single(task: str, args: tuple[str, ...], window: np.ndarray, cell: Cell,
     if task in ("grasp", "release"):
         obj = cell.object(args[0])
         traj = obj_traj(args[0])
-        held = np.zeros(T, dtype=bool)
-        uniq, inverse = np.unique(traj, axis=0, return_inverse=True)
-        inverse = np.asarray(inverse).reshape(-1)
-        for k, p in enumerate(uniq):
-            rows = inverse == k
-            held[rows] = enter(window[rows], obj.occupancy_at(p), ("l_hand", "r_hand"),
-                               margin=eps, stature=stature)
+        # The object only translates: move the palms into its frame instead of moving the
+        # object, so one vectorized query covers every frame.
+        shift = traj - traj[0]                                           # (T, 3)
+        held = enter(window - shift[:, None, :], obj.occupancy_at(traj[0]),
+                     ("l_palm", "r_palm"), margin=eps, stature=stature)
         return held if task == "grasp" else ~held
     if task == "sit":
         obj = cell.object(args[0])

@@ -163,9 +163,13 @@ def draw_static_cell(ax, cell: Cell, lo: np.ndarray, hi: np.ndarray, labels: boo
     """
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
     z = cell.floor_z
-    floor = [[(lo[0], lo[1], z), (hi[0], lo[1], z), (hi[0], hi[1], z), (lo[0], hi[1], z)]]
-    ax.add_collection3d(Poly3DCollection(floor, facecolors="#f2f2f2", edgecolors="#cccccc",
-                                         linewidths=0.5, alpha=0.6))
+    # The floor is an outline, not a filled polygon: mplot3d sorts whole collections by
+    # depth, and a big translucent floor would be painted over the worker's legs.
+    outline = [(lo[0], lo[1], z), (hi[0], lo[1], z), (hi[0], hi[1], z), (lo[0], hi[1], z)]
+    ax.add_collection3d(Line3DCollection([outline[i:i + 2] if i < 3 else [outline[3],
+                                                                          outline[0]]
+                                          for i in range(4)], colors="#b0b0b0",
+                                         linewidths=0.8))
     if grid:
         xs = np.arange(np.ceil(lo[0] / grid), np.floor(hi[0] / grid) + 1) * grid
         ys = np.arange(np.ceil(lo[1] / grid), np.floor(hi[1] / grid) + 1) * grid

@@ -171,6 +171,7 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
     title = ax.set_title("", fontsize=9)
     canvas = fig.canvas
     images = []
+    palette = None
     for frame in frames:
         pose = synth.positions[frame]
         bones.set_segments(bone_segments(pose))
@@ -182,9 +183,10 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
                 art.set_verts(base[name] + shift)
         title.set_text(_frame_title(synth, int(frame)))
         canvas.draw()
-        rgba = np.asarray(canvas.buffer_rgba())
-        images.append(Image.fromarray(rgba[..., :3].copy()).quantize(
-            colors=128, method=Image.Quantize.MEDIANCUT))
+        rgb = Image.fromarray(np.asarray(canvas.buffer_rgba())[..., :3].copy())
+        if palette is None:          # one palette for all frames: fast and flicker-free
+            palette = rgb.quantize(colors=160, method=Image.Quantize.MEDIANCUT)
+        images.append(rgb.quantize(palette=palette, dither=Image.Dither.NONE))
     duration_ms = round(1000.0 / fps)
     with atomic_path(path) as tmp:
         images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],

@@ -1,0 +1,204 @@
+"""Goal primitives made by the body model, for every Table I task."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ltl_human_motion.motion.gait import standing_pose
+from ltl_human_motion.motion.goals import (
+    GOAL_TASKS, chest_height, knee_height, make_goal_primitive, max_reach, reach_placement,
+    seat_height_range)
+from ltl_human_motion.motion.ik import center_of_mass, two_bone_ik
+from ltl_human_motion.motion.quality import primitive_metrics
+from ltl_human_motion.motion.skeleton import JOINT_INDEX as J
+from ltl_human_motion.motion.skeleton import Skeleton
+from ltl_human_motion.motion.types import world_positions
+
+SK = Skeleton(1.75)
+STAND, STAND_Z = standing_pose(SK)
+STAND_WORLD = STAND + np.array([0.0, 0.0, STAND_Z])
+
+
+def _make(task, target=None, sk=SK, **kw):
+    mp = make_goal_primitive(task, None if target is None else np.asarray(target, float), sk,
+                             rng=np.random.default_rng(kw.pop("seed", 0)), **kw)
+    return mp, world_positions(mp)
+
+
+def _target(task: str, h: float, sk: Skeleton = SK) -> np.ndarray:
+    x, y = reach_placement(task, h, sk)
+    return np.array([x, y, h])
+
+
+@pytest.mark.parametrize("task", GOAL_TASKS)
+def test_every_task_passes_quality_and_returns_to_standing(task: str) -> None:
+    target = _target(task, 1.0) if task not in (
+        "bend", "stoop", "kneel", "sit", "standUp", "wait") else None
+    mp, w = _make(task, target)
+    m = primitive_metrics(w, mp.fps, SK)
+    assert m["passed"], m
+    assert mp.task == task and mp.fps == 120.0
+    assert {"contact_frame", "hand", "target"} <= set(mp.meta)
+    assert 0 <= mp.meta["contact_frame"] < mp.n_frames
+    assert mp.root[0, 0] == 0 and mp.root[0, 1] == 0 and mp.root[0, 3] == 0
+    if task != "standUp":
+        np.testing.assert_allclose(w[0], STAND_WORLD, atol=1e-6)
+    if task not in ("sit", "standUp"):
+        np.testing.assert_allclose(w[-1], STAND_WORLD, atol=1e-6)
+    if task == "standUp":
+        end = w[-1] - np.array([w[-1, 0, 0], w[-1, 0, 1], 0.0])
+        np.testing.assert_allclose(end, STAND_WORLD, atol=1e-6)
+
+
+@pytest.mark.parametrize("height", [0.02, 0.3, 0.75, 1.1, 1.5, 1.9])
+@pytest.mark.parametrize("stature", [1.55, 1.95])
+def test_grasp_reaches_any_height(height: float, stature: float) -> None:
+    sk = Skeleton(stature)
+    if height > max_reach("grasp", sk):
+        with pytest.raises(ValueError, match="outside"):
+            _target("grasp", height, sk)
+        return
+    target = _target("grasp", height, sk)
+    mp, w = _make("grasp", target, sk)
+    f = mp.meta["contact_frame"]
+    hand = J[mp.meta["hand"]]
+    assert np.linalg.norm(w[f, hand] - target) < 1e-3
+    assert primitive_metrics(w, mp.fps, sk)["passed"]
+    # balance: the centre of mass stays over the feet in every frame
+    com = center_of_mass(w)
+    heel = w[0, [J["l_ankle"], J["r_ankle"]], 0].min() - 0.035 * stature
+    toe = w[0, [J["l_toe"], J["r_toe"]], 0].max() + 0.01 * stature
+    assert np.all((com[:, 0] > heel) & (com[:, 0] < toe))
+
+
+def test_hand_selection_and_two_hands() -> None:
+    left, wl = _make("grasp", [0.45, 0.15, 1.0])
+    right, wr = _make("grasp", [0.45, -0.15, 1.0])
+    assert left.meta["hand"] == "l_hand" and right.meta["hand"] == "r_hand"
+    forced, _ = _make("grasp", [0.45, 0.15, 1.0], hand="r_hand")
+    assert forced.meta["hand"] == "r_hand"
+    lh, _ = _make("leftHand", [0.45, -0.05, 1.0])
+    assert lh.meta["hand"] == "l_hand"
+    target = _target("assemble", 1.0)
+    asm, w = _make("assemble", target)
+    assert asm.meta["hand"] == "both"
+    lo, hi = asm.meta["hold_frames"]
+    for hand in ("l_hand", "r_hand"):
+        # both palms stay within a few centimetres of the target while assembling
+        d = np.linalg.norm(w[lo:hi + 1, J[hand]] - target, axis=1)
+        assert d.max() < 0.06
+    # the manipulation moves the hands a little, not a lot
+    span = np.ptp(w[lo:hi + 1, J["r_hand"]], axis=0)
+    assert 0.003 < span.max() < 0.04
+
+
+def test_insert_and_extract_paths() -> None:
+    target = _target("insert", 1.0)
+    ins, w = _make("insert", target)
+    hand = J[ins.meta["hand"]]
+    f = ins.meta["contact_frame"]
+    assert np.linalg.norm(w[f, hand] - target) < 1e-3
+    before = w[ins.meta["hold_frames"][0], hand]
+    assert 0.07 < np.linalg.norm(before - target) < 0.09       # pushed the last 8 cm
+    ext, w = _make("extract", target)
+    f = ext.meta["contact_frame"]
+    assert np.linalg.norm(w[f, J[ext.meta["hand"]]] - target) == pytest.approx(0.08, abs=2e-3)
+
+
+def test_bend_and_stoop_follow_table_one() -> None:
+    chest, knee = chest_height(SK), knee_height(SK)
+    bend, w = _make("bend")
+    f = bend.meta["contact_frame"]
+    assert w[f, J["head"]][2] < chest
+    assert min(w[f, J["l_hip"], 2], w[f, J["r_hip"], 2]) > knee
+    # bend keeps the knees nearly straight
+    leg = np.linalg.norm(w[f, J["l_hip"]] - w[f, J["l_ankle"]])
+    assert leg > 0.97 * (SK.bone_lengths()[J["l_knee"]] + SK.bone_lengths()[J["l_ankle"]])
+    stoop, w = _make("stoop")
+    f = stoop.meta["contact_frame"]
+    assert w[f, J["head"]][2] < chest
+    assert max(w[f, J["l_hip"], 2], w[f, J["r_hip"], 2]) < knee
+    assert bend.meta["posture"] == "bend" and stoop.meta["posture"] == "stoop"
+
+
+def test_kneel_sit_and_stand_up() -> None:
+    kneel, w = _make("kneel")
+    f = kneel.meta["contact_frame"]
+    assert w[f, J["r_knee"], 2] < 0.06 and w[f, J["l_knee"], 2] > 0.3
+    left, w = _make("kneel", hand="l_hand")
+    assert w[left.meta["contact_frame"], J["l_knee"], 2] < 0.06
+    lo, hi = seat_height_range(SK)
+    seat = np.array([reach_placement("sit", 0.45, SK)[0], 0.0, 0.45])
+    sit, w = _make("sit", seat)
+    f = sit.meta["contact_frame"]
+    assert f == sit.n_frames - 1
+    hips = w[f, [J["l_hip"], J["r_hip"]]].mean(axis=0)
+    assert hips[2] - seat[2] == pytest.approx(0.055 * SK.stature, abs=1e-6)
+    assert np.linalg.norm(hips[:2] - seat[:2]) < 0.03
+    up, w = _make("standUp", [0.0, 0.0, 0.45])
+    assert w[0, J["l_hip"], 2] == pytest.approx(0.45 + 0.055 * SK.stature, abs=1e-6)
+    assert w[-1, 0, 2] == pytest.approx(STAND_Z, abs=1e-6)
+    with pytest.raises(ValueError, match="seat height"):
+        _make("sit", [seat[0], 0.0, hi + 0.1])
+    with pytest.raises(ValueError, match="behind the worker"):
+        _make("sit", [0.3, 0.0, 0.45])
+
+
+def test_wait_stays_within_a_small_ball() -> None:
+    mp, w = _make("wait", duration=3.0)
+    assert mp.n_frames == int(round(3.0 * 120)) + 1
+    assert np.linalg.norm(w - w[0], axis=-1).max() < 0.02
+
+
+def test_seeds_vary_the_motion_but_stay_valid() -> None:
+    target = _target("grasp", 0.9)
+    a, wa = _make("grasp", target, seed=1)
+    b, wb = _make("grasp", target, seed=2)
+    a2, wa2 = _make("grasp", target, seed=1)
+    np.testing.assert_array_equal(wa, wa2)
+    assert a.n_frames != b.n_frames or np.abs(wa - wb).max() > 1e-3
+    for mp, w in ((a, wa), (b, wb)):
+        assert np.linalg.norm(w[mp.meta["contact_frame"], J[mp.meta["hand"]]] - target) < 1e-3
+
+
+def test_duration_and_errors() -> None:
+    target = _target("assemble", 1.0)
+    mp, _ = _make("assemble", target, duration=6.0)
+    assert mp.n_frames == 721
+    with pytest.raises(ValueError, match="too short"):
+        _make("assemble", target, duration=0.5)
+    with pytest.raises(ValueError, match="unknown goal task"):
+        _make("jump", target)
+    with pytest.raises(ValueError, match="gait task"):
+        _make("walk", target)
+    with pytest.raises(ValueError, match="needs a target"):
+        _make("grasp", None)
+    with pytest.raises(ValueError, match="out of reach"):
+        _make("grasp", [3.0, 0.0, 1.0])
+    with pytest.raises(ValueError, match="outside"):
+        _make("grasp", [0.4, 0.0, max_reach("grasp", SK) + 0.05])
+    with pytest.raises(ValueError, match="shape"):
+        _make("grasp", [0.4, 0.0])
+
+
+def test_custom_start_pose_is_respected() -> None:
+    carry, _ = standing_pose(SK, carry=True)
+    target = _target("release", 0.9)
+    mp, w = _make("release", target, start_pose=carry)
+    np.testing.assert_allclose(mp.poses[0], carry, atol=1e-6)
+    np.testing.assert_allclose(mp.poses[-1], carry, atol=1e-6)
+    assert np.linalg.norm(w[mp.meta["contact_frame"], J[mp.meta["hand"]]] - target) < 2e-3
+
+
+def test_two_bone_ik_reaches_and_keeps_lengths() -> None:
+    rng = np.random.default_rng(5)
+    base = rng.normal(size=(200, 3))
+    target = base + rng.normal(size=(200, 3)) * 0.3
+    pole = rng.normal(size=(200, 3))
+    mid, end = two_bone_ik(base, target, 0.3, 0.25, pole)
+    np.testing.assert_allclose(np.linalg.norm(mid - base, axis=1), 0.3)
+    np.testing.assert_allclose(np.linalg.norm(end - mid, axis=1), 0.25)
+    reach = np.linalg.norm(target - base, axis=1)
+    ok = (reach < 0.999 * 0.55) & (reach > 0.05 + 1e-6)
+    np.testing.assert_allclose(end[ok], target[ok], atol=1e-9)

@@ -1,0 +1,133 @@
+"""Recording to MCAP (rosbag2 layout), read back with an independent reader.
+
+The files are read with ``mcap``'s reader and decoded by ``mcap_ros2``'s decoder, which
+parses the stored ``ros2msg`` schemas itself -- so the test also checks that the
+concatenated message definitions are complete.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+rclpy = pytest.importorskip("rclpy")
+
+from mcap.reader import make_reader  # noqa: E402
+from mcap_ros2.decoder import DecoderFactory  # noqa: E402
+
+from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
+from ltl_human_motion.ros.client import wait_until  # noqa: E402
+from ltl_human_motion.ros.demo_loop import run_ros_demo  # noqa: E402
+from ltl_human_motion.ros.msgdefs import SEPARATOR, message_definition  # noqa: E402
+from ltl_human_motion.ros.testing import make_test_motion, scripted_synthesize  # noqa: E402
+from ltl_human_motion.scene.occupancy import BODY_PARTS  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def read_mcap(path: Path) -> tuple[dict, list]:
+    """(channels by topic, decoded messages as (topic, message)) of an MCAP file."""
+    with open(path, "rb") as fh:
+        reader = make_reader(fh, decoder_factories=[DecoderFactory()])
+        summary = reader.get_summary()
+        channels = {c.topic: (c, summary.schemas[c.schema_id])
+                    for c in summary.channels.values()}
+        decoded = [(channel.topic, msg) for _, channel, _, msg
+                   in reader.iter_decoded_messages()]
+    return channels, decoded
+
+
+def test_message_definitions_include_every_dependency_once() -> None:
+    text = message_definition("ltl_human_motion/msg/HumanOccupancy")
+    sections = text.split(SEPARATOR + "\n")
+    names = [s.splitlines()[0] for s in sections[1:]]
+    assert names == ["MSG: std_msgs/Header", "MSG: builtin_interfaces/Time",
+                     "MSG: ltl_human_motion/Capsule", "MSG: geometry_msgs/Point",
+                     "MSG: ltl_human_motion/PredictedOccupancy"]
+    assert sections[0].startswith("# The space occupied by one human worker")
+    markers = message_definition("visualization_msgs/msg/MarkerArray")
+    for dep in ("visualization_msgs/Marker", "geometry_msgs/Pose", "std_msgs/ColorRGBA",
+                "builtin_interfaces/Duration", "visualization_msgs/MeshFile"):
+        assert markers.count(f"MSG: {dep}\n") == 1, dep
+    with pytest.raises(FileNotFoundError, match="no_such_pkg/msg/Nothing"):
+        message_definition("no_such_pkg/msg/Nothing")
+
+
+def test_bringup_records_the_node_set_atomically(tmp_path: Path) -> None:
+    target = tmp_path / "out" / "run.mcap"
+    bringup = Bringup(None, record=target, overrides={"store_dir": ""}).start()
+    try:
+        motion_id = bringup.store.add(make_test_motion(duration=1.0))
+        skeleton = bringup.node("skeleton_publisher", "1")
+        skeleton.playback.play(motion_id, bringup.store.get(motion_id),
+                               skeleton.get_clock().now().nanoseconds * 1e-9)
+        wait_until(lambda: bringup.recorder.counts.get("/human_1/occupancy", 0) >= 100, 10.0,
+                   "100 recorded occupancy messages")
+        assert not target.exists(), "the MCAP file must appear only when complete"
+        assert list(target.parent.glob(".run.mcap.*"))
+    finally:
+        path = bringup.shutdown()
+    assert path == target and target.is_file()
+    assert not list(target.parent.glob(".run.mcap.*")), "temporary file left behind"
+
+    channels, decoded = read_mcap(target)
+    counts = Counter(topic for topic, _ in decoded)
+    for topic in ("/tf", "/tf_static", "/markers", "/occupancy_markers", "/motion_catalog",
+                  "/human_1/task_state", "/human_1/occupancy"):
+        assert topic in channels, topic
+        channel, schema = channels[topic]
+        assert channel.message_encoding == "cdr" and schema.encoding == "ros2msg"
+        assert "offered_qos_profiles" in channel.metadata
+    assert channels["/tf"][1].name == "tf2_msgs/msg/TFMessage"
+    assert "durability: transient_local" in channels["/tf_static"][0].metadata[
+        "offered_qos_profiles"]
+    assert counts["/human_1/occupancy"] >= 100 and counts["/tf"] >= 20
+    assert counts == Counter(bringup.recorder.counts)
+    occupancy = next(m for t, m in decoded if t == "/human_1/occupancy")
+    assert len(occupancy.capsules) == len(occupancy.part_names) == len(BODY_PARTS)
+    tf = next(m for t, m in decoded if t == "/tf")
+    assert len(tf.transforms) == 23 and tf.transforms[0].child_frame_id == "human_1/pelvis"
+    state = [m for t, m in decoded if t == "/human_1/task_state"][-1]
+    assert state.motion_id == motion_id
+
+
+def test_cli_bringup_records_for_a_duration(tmp_path: Path) -> None:
+    target = tmp_path / "cli.mcap"
+    env = {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+    done = subprocess.run(
+        [sys.executable, "-m", "ltl_human_motion", "bringup", str(ROOT / "config" /
+                                                                  "bringup.yaml"),
+         "--record", str(target), "--duration", "1.5", "--store-dir", str(tmp_path / "m")],
+        env=env, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr[-3000:]
+    summary = json.loads(done.stdout)
+    assert summary["mcap"] == str(target)
+    assert summary["topics"]["/tf_static"]["count"] == 1
+    channels, decoded = read_mcap(target)
+    assert {"/motion_catalog", "/tf_static", "/markers", "/human_1/task_state"} <= set(channels)
+    states = [m for t, m in decoded if t == "/human_1/task_state"]
+    assert len(states) >= 20 and all(s.playback_state == "stopped" for s in states)
+
+
+def test_ros_demo_loop(tmp_path: Path) -> None:
+    summary = run_ros_demo("S2", "paper_cell", tmp_path, synthesize_fn=scripted_synthesize)
+    assert summary["success"], summary["error"]
+    assert summary["task_sequence"] == "grasp(O1)"
+    assert summary["occupancy_rate_hz"] > 80
+    assert "human_1/r_hand" in summary["tf_frames"]
+    assert {"human_1/bones", "human_1/capsules", "cell/regions"} <= set(
+        summary["markers_namespaces"])
+    recorded = summary["recorded"]
+    assert recorded["/human_1/occupancy"]["count"] >= 150
+    assert Path(summary["mcap"]).is_file()
+    assert json.loads((tmp_path / "ros_summary.json").read_text())["motion_ids"] == \
+        summary["motion_ids"]
+    assert (tmp_path / "motions" / f"{summary['motion_ids'][0]}.npz").is_file()
