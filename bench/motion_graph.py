@@ -27,8 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from ltl_human_motion.atomic import atomic_write_text  # noqa: E402
 from ltl_human_motion.motion import deepmimic, gait  # noqa: E402
-from ltl_human_motion.motion.automaton import (  # noqa: E402
-    build_transitions, largest_scc, window_positions)
+from ltl_human_motion.motion.automaton import build_transitions, largest_scc, window_positions  # noqa: E402
 from ltl_human_motion.motion.library import DEFAULT_LIBRARY_DELTA  # noqa: E402
 from ltl_human_motion.motion.skeleton import Skeleton  # noqa: E402
 from ltl_human_motion.motion.types import Motion  # noqa: E402
@@ -56,12 +55,12 @@ def primitive_pool(n: int, k_comp: int = 5) -> list:
     raise RuntimeError(f"augmentation gives only {len(pool)} primitives, asked for {n}")
 
 
-def build_graph(prims: list, delta: float, k_comp: int = 5) -> dict:
+def build_graph(prims: list, delta: float, k_comp: int = 5, dtype=np.float32) -> dict:
     t0 = time.perf_counter()
     ends = window_positions(prims, k_comp, end=True)
     begins = window_positions(prims, k_comp, end=False)
     t1 = time.perf_counter()
-    D = build_transitions(ends, begins, delta)
+    D = build_transitions(ends, begins, delta, dtype=dtype)
     t2 = time.perf_counter()
     carry = np.array([mp.task == "carry" for mp in prims])
     sizes = [largest_scc(D, np.nonzero(carry == flag)[0]).size for flag in (False, True)]

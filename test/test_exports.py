@@ -306,3 +306,23 @@ def test_save_dispatches_on_suffix_and_keeps_old_file_on_failure(synth, tmp_path
     assert target.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.bvh", "m.csv", "m.json",
                                                           "m.npz"]
+
+
+def test_bvh_translations_reproduce_non_rigid_motion(synth, tmp_path):
+    pos = synth.positions.copy()
+    e, w, h = (JOINT_NAMES.index(n) for n in ("r_elbow", "r_wrist", "r_hand"))
+    stretch = 0.04 * np.sin(np.linspace(0, np.pi, len(pos)))[:, None]    # up to 4 cm
+    fore = pos[:, w] - pos[:, e]
+    shift = stretch * fore / np.linalg.norm(fore, axis=-1, keepdims=True)
+    pos[:, w] += shift
+    pos[:, h] += shift
+    pos[:, JOINT_NAMES.index("l_hip")] += [0.0, 0.0, 0.02]           # a deforming pelvis
+    motion = Motion(pos, synth.fps, synth.motion.skeleton)
+    rigid_err = save_bvh(motion, tmp_path / "r.bvh")
+    assert rigid_err > 0.01
+    err = save_bvh(motion, tmp_path / "t.bvh", translations=True)
+    assert err < 1e-4
+    names, got, _ = _bvh_positions(tmp_path / "t.bvh")
+    got = np.stack([got[..., 2], got[..., 0], got[..., 1]], axis=-1)
+    assert names == list(JOINT_NAMES)
+    assert np.max(np.linalg.norm(got - pos, axis=-1)) < 1e-4

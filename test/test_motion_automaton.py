@@ -8,8 +8,14 @@ from scipy.optimize import minimize
 from scipy.sparse import csr_matrix
 
 from ltl_human_motion.motion.automaton import (
-    MotionAutomaton, align_windows, build_transitions, largest_scc, pair_distance,
-    transition_distances, window_positions)
+    MotionAutomaton,
+    align_windows,
+    build_transitions,
+    largest_scc,
+    pair_distance,
+    transition_distances,
+    window_positions,
+)
 from ltl_human_motion.motion.types import MotionPrimitive
 
 

@@ -7,8 +7,14 @@ import pytest
 
 from ltl_human_motion.motion.gait import standing_pose
 from ltl_human_motion.motion.goals import (
-    GOAL_TASKS, chest_height, knee_height, make_goal_primitive, max_reach, reach_placement,
-    seat_height_range)
+    GOAL_TASKS,
+    chest_height,
+    knee_height,
+    make_goal_primitive,
+    max_reach,
+    reach_placement,
+    seat_height_range,
+)
 from ltl_human_motion.motion.ik import center_of_mass, two_bone_ik
 from ltl_human_motion.motion.quality import primitive_metrics
 from ltl_human_motion.motion.skeleton import JOINT_INDEX as J
@@ -73,8 +79,8 @@ def test_grasp_reaches_any_height(height: float, stature: float) -> None:
 
 
 def test_hand_selection_and_two_hands() -> None:
-    left, wl = _make("grasp", [0.45, 0.15, 1.0])
-    right, wr = _make("grasp", [0.45, -0.15, 1.0])
+    left, _wl = _make("grasp", [0.45, 0.15, 1.0])
+    right, _wr = _make("grasp", [0.45, -0.15, 1.0])
     assert left.meta["hand"] == "l_hand" and right.meta["hand"] == "r_hand"
     forced, _ = _make("grasp", [0.45, 0.15, 1.0], hand="r_hand")
     assert forced.meta["hand"] == "r_hand"
@@ -128,7 +134,7 @@ def test_kneel_sit_and_stand_up() -> None:
     assert w[f, J["r_knee"], 2] < 0.06 and w[f, J["l_knee"], 2] > 0.3
     left, w = _make("kneel", hand="l_hand")
     assert w[left.meta["contact_frame"], J["l_knee"], 2] < 0.06
-    lo, hi = seat_height_range(SK)
+    _lo, hi = seat_height_range(SK)
     seat = np.array([reach_placement("sit", 0.45, SK)[0], 0.0, 0.45])
     sit, w = _make("sit", seat)
     f = sit.meta["contact_frame"]
@@ -136,7 +142,7 @@ def test_kneel_sit_and_stand_up() -> None:
     hips = w[f, [J["l_hip"], J["r_hip"]]].mean(axis=0)
     assert hips[2] - seat[2] == pytest.approx(0.055 * SK.stature, abs=1e-6)
     assert np.linalg.norm(hips[:2] - seat[:2]) < 0.03
-    up, w = _make("standUp", [0.0, 0.0, 0.45])
+    _up, w = _make("standUp", [0.0, 0.0, 0.45])
     assert w[0, J["l_hip"], 2] == pytest.approx(0.45 + 0.055 * SK.stature, abs=1e-6)
     assert w[-1, 0, 2] == pytest.approx(STAND_Z, abs=1e-6)
     with pytest.raises(ValueError, match="seat height"):
@@ -147,7 +153,7 @@ def test_kneel_sit_and_stand_up() -> None:
 
 def test_wait_stays_within_a_small_ball() -> None:
     mp, w = _make("wait", duration=3.0)
-    assert mp.n_frames == int(round(3.0 * 120)) + 1
+    assert mp.n_frames == round(3.0 * 120) + 1
     assert np.linalg.norm(w - w[0], axis=-1).max() < 0.02
 
 
@@ -155,7 +161,7 @@ def test_seeds_vary_the_motion_but_stay_valid() -> None:
     target = _target("grasp", 0.9)
     a, wa = _make("grasp", target, seed=1)
     b, wb = _make("grasp", target, seed=2)
-    a2, wa2 = _make("grasp", target, seed=1)
+    _a2, wa2 = _make("grasp", target, seed=1)
     np.testing.assert_array_equal(wa, wa2)
     assert a.n_frames != b.n_frames or np.abs(wa - wb).max() > 1e-3
     for mp, w in ((a, wa), (b, wb)):

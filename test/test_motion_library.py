@@ -13,7 +13,12 @@ from scipy.sparse.csgraph import connected_components
 from ltl_human_motion.motion import deepmimic, gait
 from ltl_human_motion.motion.automaton import transition_distances, window_positions
 from ltl_human_motion.motion.library import (
-    DEFAULT_LIBRARY_DELTA, MotionLibrary, cache_dir, library_key, load_library)
+    DEFAULT_LIBRARY_DELTA,
+    MotionLibrary,
+    cache_dir,
+    library_key,
+    load_library,
+)
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import world_positions
 

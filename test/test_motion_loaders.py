@@ -183,7 +183,7 @@ def test_corrupt_bvh_errors(tmp_path: Path, mutate, message: str) -> None:
 def test_binary_garbage_is_a_format_error(tmp_path: Path) -> None:
     path = tmp_path / "junk.bvh"
     path.write_bytes(bytes(range(256)) * 4)
-    with pytest.raises(MotionFormatError, match="junk.bvh"):
+    with pytest.raises(MotionFormatError, match=r"junk\.bvh"):
         bvh.load(path)
 
 

@@ -149,7 +149,7 @@ def test_predictive_separation_discounts_by_time() -> None:
 coords = arrays(np.float64, (4, 2, 3), elements=st.floats(-2.0, 2.0, allow_nan=False))
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=200, deadline=None)
 @given(P=coords, Q=coords, angle=st.floats(-np.pi, np.pi), shift=st.floats(-3.0, 3.0))
 def test_segment_distance_properties(P: np.ndarray, Q: np.ndarray, angle: float,
                                      shift: float) -> None:

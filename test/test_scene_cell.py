@@ -295,3 +295,13 @@ obstacles: {crate: {mesh: crate.stl, position: [2.0, 0.0, 0.5]}}
     np.testing.assert_allclose(before, [0.2], atol=1e-6)
     paper = pickle.loads(pickle.dumps(cell_by_name("paper_cell")))
     np.testing.assert_allclose(paper.region("R1").center, [1.0, -1.0, 1.0])
+
+
+def test_yaml_exponent_numbers_are_numbers():
+    cell = cell_from_yaml("start_region: R0\nfloor_z: 1e-3\nregions:\n"
+                          "  R0: {lo: [-3e-1, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}\n")
+    assert cell.floor_z == pytest.approx(0.001)
+    np.testing.assert_allclose(cell.region("R0").lo, [-0.3, -0.3, 0.0])
+    with pytest.raises(CellError, match=r"floor_z: expected a number, got 'abc'"):
+        cell_from_yaml("start_region: R0\nfloor_z: abc\nregions:\n"
+                       "  R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}\n")

@@ -82,13 +82,20 @@ def _plot(lib, path: Path) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ltl_human_motion.atomic import atomic_write_text
+    from ltl_human_motion.errors import LtlHumanMotionError
     from ltl_human_motion.motion.library import load_library
     from ltl_human_motion.motion.quality import check_primitives, goal_sample
 
-    lib = load_library(stature=args.stature, source=args.source, delta=args.delta,
-                       cache_dir=args.cache_dir, k_comp=args.k_comp,
-                       include_default=not args.no_default, use_cache=not args.no_cache,
-                       progress=True if args.progress else None)
+    try:
+        lib = load_library(stature=args.stature, source=args.source, delta=args.delta,
+                           cache_dir=args.cache_dir, k_comp=args.k_comp,
+                           include_default=not args.no_default, use_cache=not args.no_cache,
+                           progress=True if args.progress else None)
+    except LtlHumanMotionError:
+        raise
+    except ValueError as exc:          # bad option values: one clear line, no traceback
+        print(f"ltl-human-motion library: error: {exc}", file=sys.stderr)
+        return 2
     summary = lib.summary()
     quality = dict(lib.quality)
     if args.details or not quality:

@@ -29,7 +29,7 @@ from ltl_human_motion.motion.rotations import matrix_from_euler
 from ltl_human_motion.motion.skeleton import Skeleton
 from ltl_human_motion.motion.types import Motion
 
-__all__ = ["AsfSkeleton", "AsfBone", "parse_asf", "load_raw", "load", "NAME_CANDIDATES"]
+__all__ = ["NAME_CANDIDATES", "AsfBone", "AsfSkeleton", "load", "load_raw", "parse_asf"]
 
 NAME_CANDIDATES: dict[str, tuple[str, ...]] = {
     "pelvis": ("root",),

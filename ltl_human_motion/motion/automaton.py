@@ -36,12 +36,19 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
-from ltl_human_motion.motion.types import MotionPrimitive, world_positions
+from ltl_human_motion.motion.types import MotionPrimitive
 
 __all__ = [
-    "DEFAULT_DELTA", "DEFAULT_K_COMP", "REFERENCE_STATURE", "MotionAutomaton",
-    "window_positions", "transition_distances", "pair_distance", "align_windows",
-    "build_transitions", "largest_scc",
+    "DEFAULT_DELTA",
+    "DEFAULT_K_COMP",
+    "REFERENCE_STATURE",
+    "MotionAutomaton",
+    "align_windows",
+    "build_transitions",
+    "largest_scc",
+    "pair_distance",
+    "transition_distances",
+    "window_positions",
 ]
 
 DEFAULT_DELTA = 0.135
@@ -57,13 +64,20 @@ def window_positions(primitives: list[MotionPrimitive], k_comp: int,
     -------
     ndarray, shape (N, k_comp, J, 3)
     """
-    out = []
     for mp in primitives:
         if mp.n_frames < k_comp:
             raise ValueError(f"primitive {mp.name!r} has {mp.n_frames} frames < k_comp={k_comp}")
-        w = world_positions(mp)
-        out.append(w[-k_comp:] if end else w[:k_comp])
-    return np.asarray(out)
+    if not primitives:
+        return np.zeros((0, k_comp, 0, 3))
+    sl = slice(-k_comp, None) if end else slice(0, k_comp)
+    poses = np.stack([mp.poses[sl] for mp in primitives])            # (N, k, J, 3)
+    root = np.stack([mp.root[sl] for mp in primitives])              # (N, k, 4)
+    c, s = np.cos(root[..., 3])[..., None], np.sin(root[..., 3])[..., None]
+    out = np.empty_like(poses)
+    out[..., 0] = c * poses[..., 0] - s * poses[..., 1] + root[..., None, 0]
+    out[..., 1] = s * poses[..., 0] + c * poses[..., 1] + root[..., None, 1]
+    out[..., 2] = poses[..., 2] + root[..., None, 2]
+    return out
 
 
 def _flat(win: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -115,8 +129,8 @@ def pair_distance(a: np.ndarray, b: np.ndarray, stature: float = REFERENCE_STATU
 
 
 def transition_distances(end_windows: np.ndarray, start_windows: np.ndarray,
-                         stature: float = REFERENCE_STATURE, rows: slice | None = None
-                         ) -> np.ndarray:
+                         stature: float = REFERENCE_STATURE, rows: slice | None = None,
+                         dtype: type = np.float64) -> np.ndarray:
     """Distances d_ij for all pairs (or a block of rows), vectorized.
 
     Parameters
@@ -128,18 +142,27 @@ def transition_distances(end_windows: np.ndarray, start_windows: np.ndarray,
     stature : float
     rows : slice, optional
         Only these rows of ``end_windows``.
+    dtype : numpy dtype
+        Precision of the matrix products (float32 halves the time; the floor coordinates
+        are centred first, so the error stays below about 1e-4 in d).
 
     Returns
     -------
     D : ndarray, shape (N or len(rows), M)
     """
-    ew = end_windows if rows is None else end_windows[rows]
+    sse, k = _sse(end_windows if rows is None else end_windows[rows], start_windows, dtype)
+    return (np.sqrt(np.maximum(sse, 0.0) / k) * (REFERENCE_STATURE / stature)).astype(
+        np.float64, copy=False)
+
+
+def _sse(ew: np.ndarray, start_windows: np.ndarray, dtype: type) -> tuple[np.ndarray, int]:
+    """Minimum summed squared error of every pair (closed form), and k."""
     if ew.shape[1:] != start_windows.shape[1:]:
         raise ValueError(f"window shapes differ: {ew.shape} vs {start_windows.shape}")
     k = ew.shape[1]
-    ax, ay, az = _flat(ew)
-    bx, by, bz = _flat(start_windows)
-    # centred floor coordinates: the centring terms are rank-one corrections
+    ax, ay, az = (v.astype(dtype, copy=False) for v in _flat(ew))
+    bx, by, bz = (v.astype(dtype, copy=False) for v in _flat(start_windows))
+    # centred floor coordinates (the optimal translation matches the centroids)
     ax_c, ay_c = ax - ax.mean(1, keepdims=True), ay - ay.mean(1, keepdims=True)
     bx_c, by_c = bx - bx.mean(1, keepdims=True), by - by.mean(1, keepdims=True)
     A1 = np.concatenate([ax_c, ay_c], axis=1)               # (N, 2n)
@@ -149,14 +172,20 @@ def transition_distances(end_windows: np.ndarray, start_windows: np.ndarray,
     s = A2 @ B1.T                                           # sum a x b (centred)
     sq_a = np.einsum("ij,ij->i", A1, A1) + np.einsum("ij,ij->i", az, az)
     sq_b = np.einsum("ij,ij->i", B1, B1) + np.einsum("ij,ij->i", bz, bz)
+    sse = np.hypot(c, s, out=c)
+    del s
     zz = az @ bz.T
-    sse = sq_a[:, None] + sq_b[None, :] - 2.0 * np.hypot(c, s) - 2.0 * zz
-    return np.sqrt(np.maximum(sse, 0.0) / k) * (REFERENCE_STATURE / stature)
+    sse += zz
+    sse *= -2.0
+    del zz
+    sse += sq_a[:, None]
+    sse += sq_b[None, :]
+    return sse, k
 
 
 def build_transitions(end_windows: np.ndarray, start_windows: np.ndarray, delta: float,
                       stature: float = REFERENCE_STATURE, block: int | None = None,
-                      progress=None) -> csr_matrix:
+                      progress=None, dtype: type = np.float64) -> csr_matrix:
     """Sparse matrix of the distances of all pairs with ``d_ij < delta``.
 
     Pairs with distance exactly 0 are stored as a tiny positive number so they stay in the
@@ -173,12 +202,16 @@ def build_transitions(end_windows: np.ndarray, start_windows: np.ndarray, delta:
     if block is None:
         block = int(np.clip(4_000_000 // max(start_windows.shape[0], 1), 16, 4096))
     rows_l, cols_l, vals_l = [], [], []
+    scale = REFERENCE_STATURE / stature
+    k = end_windows.shape[1]
+    limit = (delta / scale) ** 2 * k          # d < delta  <=>  sse < limit
     for r0 in range(0, N, block):
-        D = transition_distances(end_windows, start_windows, stature, slice(r0, r0 + block))
-        r, c = np.nonzero(D < delta)
+        sse, _ = _sse(end_windows[r0:r0 + block], start_windows, dtype)
+        r, c = np.nonzero(sse < limit)
         rows_l.append(r + r0)
         cols_l.append(c)
-        vals_l.append(np.maximum(D[r, c], 1e-12))
+        d = np.sqrt(np.maximum(sse[r, c].astype(np.float64), 0.0) / k) * scale
+        vals_l.append(np.maximum(d, 1e-12))
         if progress is not None:
             progress(min(block, N - r0))
     rows = np.concatenate(rows_l) if rows_l else np.zeros(0, int)

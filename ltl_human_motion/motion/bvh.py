@@ -27,7 +27,7 @@ from ltl_human_motion.motion.rotations import matrix_from_euler
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton
 from ltl_human_motion.motion.types import Motion
 
-__all__ = ["BvhSkeleton", "load", "load_raw", "save", "NAME_CANDIDATES", "canonical_points"]
+__all__ = ["NAME_CANDIDATES", "BvhSkeleton", "canonical_points", "load", "load_raw", "save"]
 
 # Candidate source joint names per canonical joint, first match wins (case-insensitive,
 # namespace prefixes such as "mixamorig:" ignored). "<name>_End" is the End Site of <name>.

@@ -32,7 +32,7 @@ from ltl_human_motion.motion.rotations import matrix_from_axis_angle, matrix_fro
 from ltl_human_motion.motion.skeleton import Skeleton
 from ltl_human_motion.motion.types import Motion
 
-__all__ = ["load", "load_raw", "motions_dir", "urdf_path", "FRAME_SIZE", "DEFAULT_GAIT_CLIPS"]
+__all__ = ["DEFAULT_GAIT_CLIPS", "FRAME_SIZE", "load", "load_raw", "motions_dir", "urdf_path"]
 
 FRAME_SIZE = 44
 URDF_SCALE = 0.25
@@ -177,7 +177,6 @@ def load_raw(path: str | os.PathLike[str]) -> tuple[dict[str, np.ndarray], float
     path = Path(path)
     arr, loop = _read_frames(path)
     offsets = _joint_offsets(str(urdf_path()))
-    T = arr.shape[0]
     rot: dict[str, np.ndarray] = {"root": matrix_from_quaternion(arr[:, 4:8])}
     pos: dict[str, np.ndarray] = {"root": arr[:, 1:4].copy()}
     z_axis = np.array([0.0, 0.0, 1.0])
@@ -190,7 +189,6 @@ def load_raw(path: str | os.PathLike[str]) -> tuple[dict[str, np.ndarray], float
         pos[name] = pos[link] + rot[link] @ (np.asarray(local_xyz) * URDF_SCALE)
     points = {k: v @ _ZUP_FROM_YUP.T for k, v in pos.items()}
     fps = 1.0 / float(arr[0, 0])
-    assert all(v.shape == (T, 3) for v in points.values())
     return points, fps, loop
 
 

@@ -26,15 +26,29 @@ import numpy as np
 
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.ops import (
-    compose, decompose, poses_from_world, relative_root, resample_positions)
+    compose,
+    decompose,
+    poses_from_world,
+    relative_root,
+    resample_positions,
+)
 from ltl_human_motion.motion.retarget import enforce_bone_lengths, fix_feet, mirror_positions
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import Motion, MotionPrimitive, yaw_matrix
 
 __all__ = [
-    "LIBRARY_FPS", "PRIMITIVE_FRAMES", "OVERLAP", "GaitClip", "prepare_loop", "gait_primitives",
-    "prepare_clip", "carry_poses", "standing_pose", "clip_motion", "start_stop_primitives",
     "CARRY_HAND_OFFSET",
+    "LIBRARY_FPS",
+    "OVERLAP",
+    "PRIMITIVE_FRAMES",
+    "GaitClip",
+    "carry_poses",
+    "clip_motion",
+    "gait_primitives",
+    "prepare_clip",
+    "prepare_loop",
+    "standing_pose",
+    "start_stop_primitives",
 ]
 
 LIBRARY_FPS = 120.0
@@ -133,7 +147,7 @@ def prepare_loop(motion: Motion, name: str, source: str, mirror: bool = False,
     poses_r = resample_positions(poses3, motion.fps, fps)
     poses_r = enforce_bone_lengths(poses_r - poses_r[:, :1], motion.skeleton)
     root_r, poses_r = _clean(root_r, poses_r, fps, motion.skeleton)
-    period = int(round((n - 1) / motion.fps * fps))
+    period = round((n - 1) / motion.fps * fps)
     return GaitClip(name=name + ("_m" if mirror else ""), root=root_r, poses=poses_r,
                     period=period, source=source + (" (mirrored)" if mirror else ""))
 
@@ -312,7 +326,7 @@ def start_stop_primitives(clip: GaitClip, skeleton: Skeleton, n_phases: int = 4,
     list of MotionPrimitive
         ``meta["kind"]`` is ``"start"`` or ``"stop"``.
     """
-    n = max(8, int(round(duration * fps / 8.0)) * 8)
+    n = max(8, round(duration * fps / 8.0) * 8)
     out: list[MotionPrimitive] = []
     if not clip.loops:
         return out

@@ -33,6 +33,7 @@ origin, facing +x, left = +y, z = height above the floor. Every goal primitive s
 
 from __future__ import annotations
 
+import itertools
 from functools import lru_cache
 
 import numpy as np
@@ -40,12 +41,20 @@ import numpy as np
 from ltl_human_motion.motion.gait import LIBRARY_FPS
 from ltl_human_motion.motion.ik import center_of_mass, min_jerk, two_bone_ik
 from ltl_human_motion.motion.ops import relative_root
-from ltl_human_motion.motion.rotations import yaw_from_positions
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import MotionPrimitive
 
-__all__ = ["GOAL_TASKS", "HAND_TASKS", "make_goal_primitive", "reach_placement", "max_reach",
-           "min_reach_height", "chest_height", "knee_height", "seat_height_range"]
+__all__ = [
+    "GOAL_TASKS",
+    "HAND_TASKS",
+    "chest_height",
+    "knee_height",
+    "make_goal_primitive",
+    "max_reach",
+    "min_reach_height",
+    "reach_placement",
+    "seat_height_range",
+]
 
 HAND_TASKS: tuple[str, ...] = ("grasp", "release", "move", "leftHand", "rightHand", "assemble",
                                "insert", "extract")
@@ -300,7 +309,7 @@ def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tu
 def _profile(t: np.ndarray, keys: list[tuple[float, float]]) -> np.ndarray:
     """Piecewise minimum-jerk interpolation of scalar key values ``[(time, value), ...]``."""
     out = np.full_like(t, keys[0][1], dtype=np.float64)
-    for (t0, v0), (t1, v1) in zip(keys[:-1], keys[1:]):
+    for (t0, v0), (t1, v1) in itertools.pairwise(keys):
         if t1 <= t0:
             continue
         m = (t >= t0) & (t <= t1)
@@ -312,8 +321,8 @@ def _profile(t: np.ndarray, keys: list[tuple[float, float]]) -> np.ndarray:
 def _interp_keys(t: np.ndarray, keys: list[tuple[float, np.ndarray]]) -> np.ndarray:
     """Piecewise minimum-jerk interpolation of array key values (same shapes)."""
     first = np.asarray(keys[0][1], dtype=np.float64)
-    out = np.broadcast_to(first, (t.size,) + first.shape).copy()
-    for (t0, v0), (t1, v1) in zip(keys[:-1], keys[1:]):
+    out = np.broadcast_to(first, (t.size, *first.shape)).copy()
+    for (t0, v0), (t1, v1) in itertools.pairwise(keys):
         if t1 <= t0:
             continue
         m = (t >= t0) & (t <= t1)
@@ -328,8 +337,8 @@ def _arc_keys(t: np.ndarray, keys: list[tuple[float, np.ndarray]]) -> np.ndarray
     slerped and the length interpolated, so the palm swings in an arc about the shoulder
     (never through it), with the minimum-jerk timing."""
     first = np.asarray(keys[0][1], dtype=np.float64)
-    out = np.broadcast_to(first, (t.size,) + first.shape).copy()
-    for (t0, v0), (t1, v1) in zip(keys[:-1], keys[1:]):
+    out = np.broadcast_to(first, (t.size, *first.shape)).copy()
+    for (t0, v0), (t1, v1) in itertools.pairwise(keys):
         if t1 <= t0:
             continue
         m = (t >= t0) & (t <= t1)
@@ -351,7 +360,7 @@ def _arc_keys(t: np.ndarray, keys: list[tuple[float, np.ndarray]]) -> np.ndarray
 
 
 def _n_frames(total: float, fps: float) -> int:
-    return int(round(total * fps)) + 1
+    return round(total * fps) + 1
 
 
 def _finish(name: str, task: str, world: np.ndarray, st: _Start, fps: float, source: str,
@@ -443,8 +452,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     pitch = pitch1 * sb
     tr = _trunk(skeleton, pelvis, pitch)
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)   # (T,2,3)
-    f1 = min(int(round(t1 * fps)), T - 1)
-    f2 = min(int(round(t2 * fps)), T - 1)
+    f1 = min(round(t1 * fps), T - 1)
+    f2 = min(round(t2 * fps), T - 1)
     sh1 = shoulders[f1]
     # hand key positions relative to the shoulder
     rel_home = st.hand_rel
@@ -503,7 +512,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         goal_pole = np.array([-0.35, 1.0 * side, -0.45])
         elbow_pole[:, k] = (1 - s_hand)[:, None] * st.elbow_pole[k] + s_hand[:, None] * goal_pole
     world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole)
-    contact = min(int(round(contact_t * fps)), T - 1)
+    contact = min(round(contact_t * fps), T - 1)
     meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
             "hold_frames": [f1, f2], "trunk_flexion": pitch1, "pelvis_drop": drop1,
             "posture": _posture_name(world[f1], skeleton)}
@@ -559,8 +568,8 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
         pitch1 = float(np.arccos(c))
         pitch = pitch1 * s
         pelvis[:, 2] -= drop * s
-        shift = _balance_shift(skeleton, pelvis[[-1]].copy() * 0 + np.array(
-            [st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]), np.array([pitch1]), st)[0]
+        p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
+        shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
         pelvis[:, 0] += shift * s
     elif task == "stoop":
         # buttocks (hips) below knee height, trunk flexed forward
@@ -613,7 +622,7 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
             raise ValueError(f"target must have shape (3,), got {target.shape}")
         targets, active, hand_name = _hand_targets("grasp", target, hand if hand != "auto"
                                                    else "auto")
-        f1 = min(int(round(t1 * fps)), T - 1)
+        f1 = min(round(t1 * fps), T - 1)
         arm = _arm_length(skeleton)
         rel = np.broadcast_to(st.hand_rel, (T, 2, 3)).copy()
         for k in active:
@@ -626,10 +635,10 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
         hands = shoulders + rel
     world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, ankles, toes,
                     knee_pole)
-    f1 = min(int(round(t1 * fps)), T - 1)
+    f1 = min(round(t1 * fps), T - 1)
     meta = {"contact_frame": f1, "hand": hand_name,
             "target": None if target is None else np.asarray(target).tolist(),
-            "hold_frames": [f1, min(int(round(t2 * fps)), T - 1)],
+            "hold_frames": [f1, min(round(t2 * fps), T - 1)],
             "posture": "kneel" if task == "kneel" else _posture_name(world[f1], skeleton)}
     return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
                    f"goals.make_goal_primitive({task!r})", meta)
@@ -859,7 +868,3 @@ def reach_placement(task: str, target_height: float, skeleton: Skeleton,
                          f"for a {skeleton.stature:.2f} m worker")
     return _placement(task, round(h, 4), float(skeleton.stature), hand)
 
-
-def heading_of(primitive: MotionPrimitive) -> np.ndarray:  # pragma: no cover - debugging aid
-    """Body heading (T,) of a goal primitive's frames (should stay near 0)."""
-    return yaw_from_positions(primitive.poses)

@@ -6,7 +6,7 @@ import numpy as np
 
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 
-__all__ = ["two_bone_ik", "min_jerk", "center_of_mass", "SEGMENT_MASS"]
+__all__ = ["SEGMENT_MASS", "center_of_mass", "min_jerk", "two_bone_ik"]
 
 
 def two_bone_ik(base: np.ndarray, target: np.ndarray, l1: float, l2: float,

@@ -41,13 +41,28 @@ from ltl_human_motion.atomic import atomic_write_with
 from ltl_human_motion.errors import MotionFormatError
 from ltl_human_motion.motion import gait as _gait
 from ltl_human_motion.motion.automaton import (
-    DEFAULT_K_COMP, MotionAutomaton, build_transitions, largest_scc, window_positions)
+    DEFAULT_K_COMP,
+    MotionAutomaton,
+    build_transitions,
+    largest_scc,
+    window_positions,
+)
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, Skeleton
-from ltl_human_motion.motion.types import MotionPrimitive, Motion
+from ltl_human_motion.motion.types import Motion, MotionPrimitive
 
-__all__ = ["MotionLibrary", "load_library", "build_library", "cache_dir", "library_key",
-           "DEFAULT_LIBRARY_DELTA", "MIN_LIBRARY_STATURE", "MAX_LIBRARY_STATURE",
-           "LOADERS", "load_motion", "ROOT_PATH_SAMPLES"]
+__all__ = [
+    "DEFAULT_LIBRARY_DELTA",
+    "LOADERS",
+    "MAX_LIBRARY_STATURE",
+    "MIN_LIBRARY_STATURE",
+    "ROOT_PATH_SAMPLES",
+    "MotionLibrary",
+    "build_library",
+    "cache_dir",
+    "library_key",
+    "load_library",
+    "load_motion",
+]
 
 LIBRARY_FORMAT = 1
 # With our normalisation (see automaton.py) delta = 0.135 keeps the walk graph's largest
@@ -284,8 +299,9 @@ def _progress(total: int, desc: str, enabled: bool | None):
     return tqdm(total=total, desc=desc, unit="prim", file=sys.stderr, leave=False)
 
 
-def build_library(stature: float = DEFAULT_STATURE, source=None, delta: float = DEFAULT_LIBRARY_DELTA,
-                  k_comp: int = DEFAULT_K_COMP, phase_step: int = 4,
+def build_library(stature: float = DEFAULT_STATURE, source=None,
+                  delta: float = DEFAULT_LIBRARY_DELTA, k_comp: int = DEFAULT_K_COMP,
+                  phase_step: int = 4,
                   include_default: bool = True, mirror: bool = True,
                   progress: bool | None = None, quality: bool = True,
                   _files: list[Path] | None = None, key: str = "") -> MotionLibrary:

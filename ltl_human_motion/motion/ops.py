@@ -7,8 +7,14 @@ import numpy as np
 from ltl_human_motion.motion.rotations import unwrap_angles, yaw_from_positions
 from ltl_human_motion.motion.types import MotionPrimitive, yaw_matrix
 
-__all__ = ["decompose", "compose", "primitive_from_positions", "resample_positions",
-           "relative_root", "poses_from_world"]
+__all__ = [
+    "compose",
+    "decompose",
+    "poses_from_world",
+    "primitive_from_positions",
+    "relative_root",
+    "resample_positions",
+]
 
 
 def decompose(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -95,7 +101,7 @@ def resample_positions(values: np.ndarray, fps_in: float, fps_out: float,
         raise ValueError(f"frame rates must be positive, got {fps_in}, {fps_out}")
     t_in = np.arange(v.shape[0]) / fps_in
     duration = t_in[-1]
-    n_out = int(round(duration * fps_out)) + (0 if periodic else 1)
+    n_out = round(duration * fps_out) + (0 if periodic else 1)
     t_out = np.arange(n_out) / fps_out
     flat = v.reshape(v.shape[0], -1)
     if periodic:
@@ -104,4 +110,4 @@ def resample_positions(values: np.ndarray, fps_in: float, fps_out: float,
         spline = CubicSpline(t_in, flat, axis=0, bc_type="periodic")
     else:
         spline = CubicSpline(t_in, flat, axis=0)
-    return spline(np.minimum(t_out, duration)).reshape((n_out,) + v.shape[1:])
+    return spline(np.minimum(t_out, duration)).reshape((n_out, *v.shape[1:]))

@@ -26,7 +26,7 @@ import numpy as np
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, PARENTS, Skeleton
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 
-__all__ = ["QualityThresholds", "primitive_metrics", "check_primitives", "goal_sample"]
+__all__ = ["QualityThresholds", "check_primitives", "goal_sample", "primitive_metrics"]
 
 _FEET = tuple(JOINT_INDEX[n] for n in ("l_ankle", "l_toe", "r_ankle", "r_toe"))
 
@@ -138,7 +138,12 @@ def goal_sample(skeleton: Skeleton, seed: int = 0) -> list[MotionPrimitive]:
     reach; posture tasks with their defaults.
     """
     from ltl_human_motion.motion.goals import (
-        GOAL_TASKS, HAND_TASKS, make_goal_primitive, max_reach, reach_placement)
+        GOAL_TASKS,
+        HAND_TASKS,
+        make_goal_primitive,
+        max_reach,
+        reach_placement,
+    )
 
     rng = np.random.default_rng(seed)
     out: list[MotionPrimitive] = []

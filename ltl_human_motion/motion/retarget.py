@@ -18,8 +18,14 @@ import numpy as np
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, Skeleton
 from ltl_human_motion.motion.types import Motion
 
-__all__ = ["REQUIRED_POINTS", "retarget_points", "enforce_bone_lengths", "mirror_positions",
-           "frame_from_axes", "fix_feet"]
+__all__ = [
+    "REQUIRED_POINTS",
+    "enforce_bone_lengths",
+    "fix_feet",
+    "frame_from_axes",
+    "mirror_positions",
+    "retarget_points",
+]
 
 # Source points a loader must provide (the spine is taken halfway between pelvis and chest
 # when missing; head, hands and toes may be derived by the loader).
@@ -184,7 +190,7 @@ def fix_feet(positions: np.ndarray, fps: float, skeleton: Skeleton, clearance: f
             v = np.zeros(T)
         ramp = np.clip((v - swing_speed[0]) / (swing_speed[1] - swing_speed[0]), 0.0, 1.0)
         ramp = ramp * ramp * (3 - 2 * ramp)
-        width = max(1, int(round(0.03 * fps)))
+        width = max(1, round(0.03 * fps))
         ramp = uniform_filter1d(maximum_filter1d(ramp, 2 * width + 1), 4 * width + 1)
         floor_t = rest[t, 2] + clearance * ramp
         low = out[:, t, 2] < floor_t
@@ -201,7 +207,7 @@ def fix_feet(positions: np.ndarray, fps: float, skeleton: Skeleton, clearance: f
     feet = [JOINT_INDEX[n] for n in ("l_ankle", "l_toe", "r_ankle", "r_toe")]
     deficit = np.max(rest[feet, 2] - out[:, feet, 2], axis=1).clip(min=0.0)
     if np.any(deficit > 0):
-        width = max(1, int(round(0.05 * fps)))
+        width = max(1, round(0.05 * fps))
         lift = maximum_filter1d(deficit, size=2 * width + 1)
         lift = np.maximum(uniform_filter1d(lift, size=2 * width + 1), deficit)
         out[..., 2] += lift[:, None]

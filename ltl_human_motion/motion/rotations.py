@@ -5,8 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
-    "matrix_from_quaternion", "matrix_from_axis_angle", "matrix_from_euler",
-    "yaw_from_positions", "unwrap_angles",
+    "matrix_from_axis_angle",
+    "matrix_from_euler",
+    "matrix_from_quaternion",
+    "unwrap_angles",
+    "yaw_from_positions",
 ]
 
 
@@ -76,7 +79,7 @@ def matrix_from_euler(angles_deg: np.ndarray, order: str) -> np.ndarray:
     if a.shape[-1:] != (len(order),) or any(c not in _AXES for c in order):
         raise ValueError(f"angles of shape (..., {len(order)}) and axes from XYZ expected, "
                          f"got {a.shape} and {order!r}")
-    out = np.broadcast_to(np.eye(3), a.shape[:-1] + (3, 3)).copy()
+    out = np.broadcast_to(np.eye(3), (*a.shape[:-1], 3, 3)).copy()
     for k, c in enumerate(order):
         out = out @ matrix_from_axis_angle(_AXES[c], a[..., k])
     return out

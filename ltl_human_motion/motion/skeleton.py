@@ -130,7 +130,8 @@ class Skeleton:
         try:
             return JOINT_INDEX[name]
         except KeyError:
-            raise ValueError(f"unknown joint {name!r}; expected one of {', '.join(self.names)}") from None
+            raise ValueError(
+                f"unknown joint {name!r}; expected one of {', '.join(self.names)}") from None
 
     def rest_positions(self) -> np.ndarray:
         """Rest pose, shape (J, 3): standing on z = 0, facing +x, arms down."""

@@ -123,7 +123,8 @@ def yaw_matrix(yaw: np.ndarray | float) -> np.ndarray:
     yaw = np.asarray(yaw, dtype=np.float64)
     c, s = np.cos(yaw), np.sin(yaw)
     z, o = np.zeros_like(yaw), np.ones_like(yaw)
-    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
+    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1),
+                     np.stack([z, z, o], -1)], -2)
 
 
 def world_positions(primitive: MotionPrimitive, x: float = 0.0, y: float = 0.0,

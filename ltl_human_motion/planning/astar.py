@@ -25,7 +25,7 @@ class SearchBudget:
     """Limits of one search: expanded nodes and wall-clock seconds."""
 
     max_nodes: int = 20000
-    max_seconds: float = 2.0
+    max_seconds: float = 10.0
 
 
 @dataclass
@@ -92,16 +92,15 @@ def _place(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float) ->
                      yaw + d[:, 2]], axis=-1)
 
 
-def _paths_clear(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float,
-                 clearance: Callable[[np.ndarray], np.ndarray], radius: float) -> np.ndarray:
-    """True where the root path of primitive ``ids[m]`` keeps ``radius`` from obstacles."""
+def _path_clearance(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float,
+                    clearance: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """Smallest obstacle clearance along the root path of primitives ``ids``, shape (M,)."""
     c, s = np.cos(yaw), np.sin(yaw)
     p = index.path[ids]                                    # (M, S, 2)
     wx = x + c * p[..., 0] - s * p[..., 1]
     wy = y + s * p[..., 0] + c * p[..., 1]
     pts = np.stack([wx, wy], axis=-1).reshape(-1, 2)
-    ok = clearance(pts).reshape(p.shape[:2]) > radius
-    return ok.all(axis=1)
+    return clearance(pts).reshape(p.shape[:2]).min(axis=1)
 
 
 def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | None = None,
@@ -109,6 +108,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
           heuristic_speed: float = 0.7, turn_rate: float = 2.0, carry: bool = False,
           budget: SearchBudget = SearchBudget(), rng: np.random.Generator | None = None,
           body_clear: Callable[[np.ndarray], np.ndarray] | None = None,
+          near_radius: float = 0.6,
           cost_noise: float = 0.0, grid: float = 0.08, yaw_bins: int = 24
           ) -> SearchResult | SearchFailure:
     """Search a sequence of gait primitives from ``start`` until ``goal.reached``.
@@ -136,8 +136,10 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     rng, cost_noise
         Seeded multiplicative noise on primitive costs, for varied but valid paths.
     body_clear : callable, optional
-        ``body_clear(poses (M, S, J, 3)) -> bool (M,)``: whole-body obstacle test for the
-        primitives listed in ``index.body`` (turns and steps on the spot).
+        ``body_clear(poses (M, S, J, 3)) -> bool (M,)``: whole-body obstacle test, run on
+        standing primitives (turns, steps) and on primitives whose root path comes within
+        ``near_radius`` of an obstacle.
+    near_radius : float
 
     Returns
     -------
@@ -188,16 +190,17 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         if succ.size == 0:
             continue
         ends = _place(index, succ, px, py, pyaw)
-        clear = _paths_clear(index, succ, px, py, pyaw, clearance, body_radius)
+        gap = _path_clearance(index, succ, px, py, pyaw, clearance)
+        clear = gap > body_radius
         if not clear.any():
             continue
-        succ, ends = succ[clear], ends[clear]
-        if body_clear is not None and index.body:
-            exact = np.array([int(j) in index.body for j in succ])
+        succ, ends, gap = succ[clear], ends[clear], gap[clear]
+        if body_clear is not None and index.body.size:
+            exact = index.standing[succ] | (gap < near_radius)
             if exact.any():
                 c, s_ = np.cos(pyaw), np.sin(pyaw)
                 rot = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
-                sweep = np.stack([index.body[int(j)] for j in succ[exact]]) @ rot.T
+                sweep = index.body[succ[exact]] @ rot.T
                 sweep[..., 0] += px
                 sweep[..., 1] += py
                 ok = np.ones(len(succ), dtype=bool)

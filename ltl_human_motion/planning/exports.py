@@ -25,7 +25,10 @@ chest) gets the rotation that best maps its rest child offsets onto the current 
 onto the current bone, plus a twist about the bone that aligns a reference direction
 (legs: the foot, spine: the shoulder line); leaves keep their parent's rotation. With
 rigid bone lengths the BVH reproduces the joint positions exactly;
-:func:`save_bvh` returns the largest reconstruction error.
+:func:`save_bvh` returns the largest reconstruction error. Motions that are not rigid
+(stretching bones, a deforming pelvis) can be written exactly with
+``translations=True``, which adds per-joint position channels (displacements from the
+rest offsets, which Blender imports as bone locations).
 """
 
 from __future__ import annotations
@@ -81,14 +84,21 @@ def _plain(value: Any, finite_only: bool = False) -> Any:
     return str(value)
 
 
+def _is_timing(key: str) -> bool:
+    return key.endswith("_time") or key in ("real_time_factor", "seconds")
+
+
 def _meta(synth: SynthesizedMotion) -> dict[str, Any]:
+    """Metadata stored with the motion; wall-clock timings are left out so that the same
+    inputs give the same bytes (they stay in :func:`to_dict` / JSON)."""
     return {
         "format": FORMAT_NAME, "version": FORMAT_VERSION,
         "name": synth.motion.name, "fps": float(synth.fps),
         "stature": float(synth.motion.skeleton.stature),
         "joint_names": list(synth.motion.skeleton.names),
         "spec": synth.spec, "sequence": list(synth.sequence), "seed": synth.seed,
-        "stats": synth.stats, "verification": synth.verification,
+        "stats": {k: v for k, v in synth.stats.items() if not _is_timing(k)},
+        "verification": synth.verification,
         "timeline": [seg.to_dict() for seg in synth.timeline],
         "objects": sorted(synth.objects),
     }
@@ -100,6 +110,7 @@ def to_dict(synth: SynthesizedMotion, finite_only: bool = True) -> dict[str, Any
     Non-finite floats in ``stats``/``verification`` become None when ``finite_only``.
     """
     d = _meta(synth)
+    d["stats"] = dict(synth.stats)
     d["positions"] = synth.positions.tolist()
     d["root_yaw"] = synth.root_yaw.tolist()
     d["task_index"] = synth.task_index.tolist()
@@ -371,7 +382,7 @@ def _fmt(v: float) -> str:
 
 
 def save_bvh(motion: SynthesizedMotion | Motion, path: PathLike, up: str = "y",
-             scale: float = 1.0) -> float:
+             scale: float = 1.0, translations: bool = False) -> float:
     """Write a BVH file (Blender-compatible) of a motion.
 
     Parameters
@@ -382,12 +393,18 @@ def save_bvh(motion: SynthesizedMotion | Motion, path: PathLike, up: str = "y",
         ``"y"``: y up, facing +z (the mocap convention, default); ``"z"``: our frame.
     scale : float
         Unit scale (1.0 = metres, 100.0 = centimetres).
+    translations : bool
+        Also give every joint ``Xposition Yposition Zposition`` channels holding its
+        per-frame displacement from the rest offset (in the parent's frame), so that
+        motions whose bones stretch or whose pelvis/chest deform are reproduced exactly.
+        Off by default: rotation-only files are what most tools expect.
 
     Returns
     -------
     max_error : float
         Largest distance (metres) between the input joint positions and the positions
-        the written hierarchy and angles reproduce.
+        the written file reproduces (0 up to rounding with ``translations``; otherwise it
+        measures how far the motion is from rigid).
     """
     m = motion.motion if isinstance(motion, SynthesizedMotion) else motion
     if not isinstance(m, Motion):
@@ -401,29 +418,41 @@ def save_bvh(motion: SynthesizedMotion | Motion, path: PathLike, up: str = "y",
     C = _UP_FROM_Z[up]
     skel = m.skeleton
     rest = skel.rest_positions()
-    G = bvh_rotations(m.positions, skel)                            # (T, J, 3, 3)
+    pos = m.positions
+    G = bvh_rotations(pos, skel)                                    # (T, J, 3, 3)
     T, J = G.shape[:2]
     local = np.empty_like(G)
+    delta = np.zeros((T, J, 3))                  # displacement from the rest offset
     for j in range(J):
         p = PARENTS[j]
-        local[:, j] = G[:, j] if p < 0 else np.swapaxes(G[:, p], -1, -2) @ G[:, j]
+        if p < 0:
+            local[:, j] = G[:, j]
+            continue
+        local[:, j] = np.swapaxes(G[:, p], -1, -2) @ G[:, j]
+        if translations:
+            in_parent = np.einsum("tji,tj->ti", G[:, p], pos[:, j] - pos[:, p])
+            delta[:, j] = in_parent - (rest[j] - rest[p])
     local_file = C @ local @ C.T
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)         # gimbal lock is still exact
         euler = Rotation.from_matrix(local_file.reshape(-1, 3, 3)).as_euler(
             "ZYX", degrees=True).reshape(T, J, 3)
-    root = (m.positions[:, 0] @ C.T) * scale
+    euler = np.round(euler, 6)
+    root = np.round((pos[:, 0] @ C.T) * scale, 6)
+    delta_file = np.round((delta @ C.T) * scale, 6)
 
     lines = ["HIERARCHY"]
+    order: list[int] = []
 
     def emit(j: int, depth: int) -> None:
+        order.append(j)
         ind = "  " * depth
         p = PARENTS[j]
         offset = (np.zeros(3) if p < 0 else (rest[j] - rest[p]) @ C.T * scale)
         lines.append(f"{ind}{'ROOT' if p < 0 else 'JOINT'} {JOINT_NAMES[j]}")
         lines.append(f"{ind}{{")
         lines.append(f"{ind}  OFFSET {' '.join(_fmt(v) for v in offset)}")
-        if p < 0:
+        if p < 0 or translations:
             lines.append(f"{ind}  CHANNELS 6 Xposition Yposition Zposition "
                          "Zrotation Yrotation Xrotation")
         else:
@@ -445,25 +474,31 @@ def save_bvh(motion: SynthesizedMotion | Motion, path: PathLike, up: str = "y",
     lines.append(f"Frames: {T}")
     lines.append(f"Frame Time: {1.0 / m.fps:.8f}")
     for t in range(T):
-        vals = list(root[t]) + list(euler[t].reshape(-1))
+        vals: list[float] = []
+        for j in order:
+            if PARENTS[j] < 0:
+                vals.extend(root[t])
+            elif translations:
+                vals.extend(delta_file[t, j])
+            vals.extend(euler[t, j])
         lines.append(" ".join(_fmt(v) for v in vals))
     atomic_write_text(path, "\n".join(lines) + "\n")
 
-    # Reconstruction error of the written hierarchy (rounded angles included).
-    R = Rotation.from_euler("ZYX", np.round(euler.reshape(-1, 3), 6),
-                            degrees=True).as_matrix().reshape(T, J, 3, 3)
-    R = C.T @ R @ C
+    # Reconstruction error of what was written (rounded values included).
+    R = Rotation.from_euler("ZYX", euler.reshape(-1, 3), degrees=True).as_matrix()
+    R = C.T @ R.reshape(T, J, 3, 3) @ C
     world = np.empty_like(R)
     recon = np.empty((T, J, 3))
-    for j in range(J):
+    for j in order:
         p = PARENTS[j]
         if p < 0:
             world[:, j] = R[:, j]
-            recon[:, j] = np.round(root, 6) @ C / scale
+            recon[:, j] = root @ C / scale
         else:
             world[:, j] = world[:, p] @ R[:, j]
-            recon[:, j] = recon[:, p] + np.einsum("tij,j->ti", world[:, p], rest[j] - rest[p])
-    return float(np.max(np.linalg.norm(recon - m.positions, axis=-1))) if T else 0.0
+            off = rest[j] - rest[p] + delta_file[:, j] @ C / scale
+            recon[:, j] = recon[:, p] + np.einsum("tij,tj->ti", world[:, p], off)
+    return float(np.max(np.linalg.norm(recon - pos, axis=-1))) if T else 0.0
 
 
 # --------------------------------------------------------------------------- dispatch

@@ -10,6 +10,15 @@ import numpy as np
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 
 
+BODY_SAMPLES = 5
+
+
+def sample_body(mp: MotionPrimitive, samples: int = BODY_SAMPLES) -> np.ndarray:
+    """Poses of ``mp`` placed at the origin at evenly spaced frames, shape (S, J, 3)."""
+    frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
+    return world_positions(mp)[frames]
+
+
 @dataclass(frozen=True, eq=False)
 class GaitIndex:
     """Precomputed placement data of the gait primitives.
@@ -37,10 +46,12 @@ class GaitIndex:
         True for carry primitives (arms holding an object).
     nf : int
         Blend overlap between gait primitives, frames.
-    body : dict of int to ndarray, shape (S, J, 3)
-        Sampled world poses (start frame) of primitives whose whole body must be
-        checked against obstacles during the search (turns and steps on the spot, where
-        the root path says nothing about the sweeping arms).
+    body : ndarray, shape (N, B, J, 3)
+        Sampled poses of each primitive placed at the origin, for whole-body obstacle
+        checks during the search (empty when not built).
+    standing : ndarray of bool, shape (N,)
+        Standing-to-standing primitives (turns and steps on the spot): their root path
+        says nothing about the sweeping arms, so their whole body is always checked.
         Blend overlap between gait primitives, frames.
     """
 
@@ -54,7 +65,8 @@ class GaitIndex:
     stops: np.ndarray
     carry: np.ndarray
     nf: int
-    body: dict = field(default_factory=dict)
+    body: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 0, 3)))
+    standing: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
 
     @classmethod
     def from_library(cls, library) -> GaitIndex:
@@ -62,12 +74,14 @@ class GaitIndex:
         n = library.n_primitives
         stops = np.zeros(n, dtype=bool)
         stops[np.asarray(library.stops, dtype=np.int64)] = True
+        body = np.stack([sample_body(mp) for mp in library.primitives])
         return cls(list(library.primitives), np.asarray(library.displacement),
                    np.asarray(library.durations), np.asarray(library.root_paths),
                    np.asarray(library.indptr, dtype=np.int64),
                    np.asarray(library.indices, dtype=np.int64),
                    np.asarray(library.starts, dtype=np.int64), stops,
-                   np.asarray(library.is_carry, dtype=bool), int(library.overlap))
+                   np.asarray(library.is_carry, dtype=bool), int(library.overlap), body,
+                   np.zeros(n, dtype=bool))
 
     @classmethod
     def build(cls, primitives: Sequence[MotionPrimitive], successors: Sequence[Sequence[int]],
@@ -86,7 +100,7 @@ class GaitIndex:
         cost = np.zeros(n)
         path = np.zeros((n, samples, 2))
         for j, mp in enumerate(primitives):
-            k = max(mp.n_frames - nf, 1)
+            k = min(max(mp.n_frames - nf, 1), mp.n_frames - 1)
             disp[j] = (mp.root[k, 0], mp.root[k, 1], mp.root[k, 3])
             cost[j] = k / mp.fps
             idx = np.linspace(0, k, samples).round().astype(int)
@@ -96,13 +110,14 @@ class GaitIndex:
         indices = (np.concatenate([np.asarray(s, dtype=np.int64) for s in successors])
                    if lengths.sum() else np.zeros(0, dtype=np.int64))
         start_ids = np.arange(n) if starts is None else np.asarray(starts, dtype=np.int64)
+        body = np.stack([sample_body(mp) for mp in primitives])
         stop_mask = np.ones(n, dtype=bool)
         if stops is not None:
             stop_mask[:] = False
             stop_mask[np.asarray(stops, dtype=np.int64)] = True
         carry = np.array([mp.task == "carry" for mp in primitives])
         return cls(list(primitives), disp, cost, path, indptr, indices, start_ids, stop_mask,
-                   carry, nf)
+                   carry, nf, body, np.zeros(n, dtype=bool))
 
     def with_standing_primitives(self, extra: Sequence[MotionPrimitive],
                                  samples: int | None = None) -> GaitIndex:
@@ -128,16 +143,14 @@ class GaitIndex:
             succ.append(start_set[self.carry[start_set] == add.carry[k]])
         lengths = np.array([len(x) for x in succ])
         indptr = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
-        body = dict(self.body)
-        for k, mp in enumerate(extra):
-            frames = np.linspace(0, mp.n_frames - 1, 7).round().astype(int)
-            body[n0 + k] = world_positions(mp)[frames]
+        body = np.concatenate([self.body, add.body]) if self.body.size else add.body
         return GaitIndex(
             self.primitives + list(extra), np.concatenate([self.disp, add.disp]),
             np.concatenate([self.cost, add.cost]), np.concatenate([self.path, add.path]),
             indptr, np.concatenate(succ).astype(np.int64),
             np.concatenate([self.starts, new_ids]), np.concatenate([self.stops, add.stops]),
-            np.concatenate([self.carry, add.carry]), self.nf, body)
+            np.concatenate([self.carry, add.carry]), self.nf, body,
+            np.concatenate([self.standing, np.ones(n1, dtype=bool)]))
 
     def successors(self, j: int) -> np.ndarray:
         """Indices of the primitives that may follow primitive ``j``."""

@@ -97,18 +97,23 @@ class NavigationField:
 class ClearanceMap:
     """Floor clearance from obstacle footprints, sampled once on a grid.
 
-    ``Cell.floor_clearance`` is exact but slow for the thousands of queries of a search;
-    this map interpolates it bilinearly (error below the grid step). Points outside the
-    workspace get -1 (not walkable).
+    Tall obstacle parts (whose top is above ``tall_height``: walls, machine columns) count
+    ``tall_extra`` closer, because the swinging arms pass them at shoulder width; low
+    parts (bench and table tops at hip height) do not, so a worker can step up to a
+    bench. Points outside the workspace get -1 (not walkable). Values are interpolated
+    bilinearly (error below the grid step).
 
     Parameters
     ----------
     cell : Cell
     resolution : float
         Grid step in metres.
+    tall_extra, tall_height : float
+        Metres.
     """
 
-    def __init__(self, cell, resolution: float = 0.04) -> None:  # noqa: ANN001
+    def __init__(self, cell, resolution: float = 0.04, tall_extra: float = 0.25,  # noqa: ANN001
+                 tall_height: float = 1.2) -> None:
         from scipy.interpolate import RegularGridInterpolator
         lo = np.asarray(cell.workspace_lo[:2], dtype=np.float64)
         hi = np.asarray(cell.workspace_hi[:2], dtype=np.float64)
@@ -116,13 +121,97 @@ class ClearanceMap:
         ys = np.arange(lo[1], hi[1] + resolution, resolution)
         gx, gy = np.meshgrid(xs, ys, indexing="ij")
         pts = np.stack([gx.ravel(), gy.ravel()], axis=-1)
-        values = np.minimum(cell.floor_clearance(pts), 1e3).reshape(gx.shape)
+        values = np.full(len(pts), 1e3)
+        for ob in cell.obstacles:
+            for part in ob.parts:
+                extra = tall_extra if part.aabb()[1][2] > tall_height else 0.0
+                values = np.minimum(values, part.footprint().signed_distance(pts) - extra)
         self.lo, self.hi = lo, hi
-        self._interp = RegularGridInterpolator((xs, ys), values, bounds_error=False,
-                                               fill_value=-1.0)
+        self._interp = RegularGridInterpolator((xs, ys), values.reshape(gx.shape),
+                                               bounds_error=False, fill_value=-1.0)
 
     def __call__(self, xy: np.ndarray) -> np.ndarray:
         """Clearance of floor points, shape (N,) for ``xy`` of shape (N, 2)."""
         xy = np.asarray(xy, dtype=np.float64)
         inside = np.all((xy >= self.lo) & (xy <= self.hi), axis=-1)
         return np.where(inside, self._interp(xy), -1.0)
+
+
+class ObstacleField:
+    """Distance to the cell's obstacles sampled on a 3D grid, for fast whole-body checks.
+
+    The search checks thousands of body poses; the exact capsule distances of
+    :mod:`ltl_human_motion.scene.predicates` stay for the final verification. The
+    distance is 1-Lipschitz, so trilinear interpolation errs by at most
+    ``resolution * sqrt(3) / 2`` (much less away from edges); :meth:`clear` keeps
+    ``0.4 * resolution`` extra margin, and the exact verification catches the rest.
+
+    Parameters
+    ----------
+    cell : Cell
+    resolution : float
+        Grid step, metres.
+    pad : float
+        The grid covers the obstacles' bounding box grown by this much; further away
+        nothing can touch them.
+    """
+
+    def __init__(self, cell, resolution: float = 0.05, pad: float = 0.5) -> None:  # noqa: ANN001
+        self.res = float(resolution)
+        self.empty = not cell.obstacles
+        if self.empty:
+            return
+        boxes = [ob.aabb() for ob in cell.obstacles]
+        lo = np.min([b[0] for b in boxes], axis=0) - pad
+        hi = np.max([b[1] for b in boxes], axis=0) + pad
+        axes = [np.arange(lo[i], hi[i] + self.res, self.res) for i in range(3)]
+        gx, gy, gz = np.meshgrid(*axes, indexing="ij")
+        pts = np.stack([gx, gy, gz], axis=-1).reshape(-1, 3)
+        dist = np.min(np.stack([ob.distance(pts) for ob in cell.obstacles]), axis=0)
+        self.lo = lo
+        self.shape = np.array(gx.shape)
+        self.dist = dist.reshape(gx.shape)
+        self.far = pad
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Interpolated obstacle distance of points (..., 3), shape (...)."""
+        pts = np.asarray(points, dtype=np.float64)
+        if self.empty:
+            return np.full(pts.shape[:-1], np.inf)
+        u = (pts - self.lo) / self.res
+        outside = np.any((u < 0) | (u > self.shape - 1), axis=-1)
+        u = np.clip(u, 0, self.shape - 1.000001)
+        i = np.floor(u).astype(np.int64)
+        f = u - i
+        d = self.dist
+        i0, j0, k0 = i[..., 0], i[..., 1], i[..., 2]
+        fx, fy, fz = f[..., 0], f[..., 1], f[..., 2]
+        c00 = d[i0, j0, k0] * (1 - fx) + d[i0 + 1, j0, k0] * fx
+        c10 = d[i0, j0 + 1, k0] * (1 - fx) + d[i0 + 1, j0 + 1, k0] * fx
+        c01 = d[i0, j0, k0 + 1] * (1 - fx) + d[i0 + 1, j0, k0 + 1] * fx
+        c11 = d[i0, j0 + 1, k0 + 1] * (1 - fx) + d[i0 + 1, j0 + 1, k0 + 1] * fx
+        out = (c00 * (1 - fy) + c10 * fy) * (1 - fz) + (c01 * (1 - fy) + c11 * fy) * fz
+        return np.where(outside, np.maximum(out, self.far), out)
+
+    def clear(self, poses: np.ndarray, stature: float, margin: float = 0.01) -> np.ndarray:
+        """Whether body poses keep ``margin`` from every obstacle.
+
+        Parameters
+        ----------
+        poses : ndarray, shape (M, S, J, 3)
+            S sampled poses of each of M candidates.
+        stature : float
+        margin : float
+
+        Returns
+        -------
+        ok : ndarray of bool, shape (M,)
+        """
+        from ltl_human_motion.scene.occupancy import capsules_from_positions
+        if self.empty:
+            return np.ones(poses.shape[0], dtype=bool)
+        seg, rad = capsules_from_positions(poses, stature)              # (M, S, K, 2, 3)
+        pts = np.concatenate([seg, seg.mean(axis=-2, keepdims=True)], axis=-2)
+        need = rad[:, None] + margin + self.res * 0.4
+        ok = self.distance(pts) > need
+        return ok.reshape(poses.shape[0], -1).all(axis=1)

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from ltl_human_motion.errors import CellError, PlanningError
+from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
 from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.blend import concatenate
@@ -293,6 +294,8 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
 
     t0 = time.perf_counter()
     positions, root_yaw, labels, spans = concatenate(plan.segments)
+    # Linear blends of joint positions shorten bones between unlike poses; restore them.
+    positions = enforce_bone_lengths(positions, library.skeleton)
     tracks, held = _object_tracks(cell, plan, spans, positions, library.overlap)
     timeline = []
     for i, step in enumerate(plan.steps):

@@ -29,7 +29,7 @@ from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import Goal, SearchBudget, SearchFailure, astar
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.gait_index import GaitIndex
-from ltl_human_motion.planning.navigation import ClearanceMap, NavigationField
+from ltl_human_motion.planning.navigation import ClearanceMap, NavigationField, ObstacleField
 
 Pose = tuple[float, float, float]
 
@@ -61,12 +61,12 @@ class PlannerOptions:
         Cell size of the navigation field behind the heuristic, metres.
     """
 
-    heuristic_speed: float = 0.5
+    heuristic_speed: float = 0.25
     budget: SearchBudget = field(default_factory=SearchBudget)
     cost_noise: float = 0.15
     reach_tolerance: float = 0.15
     heading_tolerance: float = 0.30
-    body_radius: float = 0.18
+    body_radius: float = 0.15
     grid_resolution: float = 0.1
 
 
@@ -154,21 +154,21 @@ def gait_index(library) -> GaitIndex:  # noqa: ANN001
     return index
 
 
-_CLEARANCE_CACHE: dict[str, ClearanceMap] = {}
+_CLEARANCE_CACHE: dict[str, tuple[ClearanceMap, ObstacleField]] = {}
 
 
-def clearance_map(cell) -> ClearanceMap:  # noqa: ANN001
-    """The clearance map of ``cell``, computed once per obstacle layout."""
+def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:  # noqa: ANN001
+    """The floor clearance map and 3D obstacle field of ``cell``, once per obstacle layout."""
     import hashlib
     import pickle
     key = hashlib.sha1(pickle.dumps((np.asarray(cell.workspace_lo), np.asarray(
         cell.workspace_hi), cell.obstacles))).hexdigest()
-    cmap = _CLEARANCE_CACHE.get(key)
-    if cmap is None:
+    maps = _CLEARANCE_CACHE.get(key)
+    if maps is None:
         if len(_CLEARANCE_CACHE) > 64:
             _CLEARANCE_CACHE.clear()
-        cmap = _CLEARANCE_CACHE[key] = ClearanceMap(cell)
-    return cmap
+        maps = _CLEARANCE_CACHE[key] = (ClearanceMap(cell), ObstacleField(cell))
+    return maps
 
 
 class SequencePlanner:
@@ -189,7 +189,7 @@ class SequencePlanner:
         self.index = gait_index(library)
         self.rng = rng
         self.options = options
-        self.clearance = clearance_map(cell)
+        self.clearance, self.obstacle_field = clearance_maps(cell)
         self.overlap = int(library.overlap)
         self.segments: list[PlacedSegment] = []
         self.steps: list[StepPlan] = []
@@ -218,15 +218,15 @@ class SequencePlanner:
             return np.asarray(obj.sitting_surface_at(obj.position).center, dtype=np.float64)
         return None
 
-    def _placement(self, kind: str, target: np.ndarray) -> tuple[float, float]:
+    def _placement(self, kind: str, target: np.ndarray, task: str) -> tuple[float, float]:
         """Where the target should be in the standing root's frame: (ahead, left), metres."""
         from ltl_human_motion.motion import goals
         try:
             d, lat = goals.reach_placement(kind, float(target[2]), self.library.skeleton)
             return float(d), float(lat)
         except ValueError as exc:
-            raise PlanningError(f"{kind} target at height {target[2]:.2f} m is unreachable: "
-                                f"{exc}", task=kind, reason="unreachable") from None
+            raise PlanningError(f"task {task}: the target at height {target[2]:.2f} m is "
+                                f"unreachable: {exc}", task=task, reason="unreachable") from None
 
     def _clearance(self, xy: np.ndarray) -> np.ndarray:
         return self.clearance(xy)
@@ -321,9 +321,7 @@ class SequencePlanner:
 
     def _body_clear(self, poses: np.ndarray) -> np.ndarray:
         """Whether sampled poses (M, S, J, 3) keep 2 cm from every obstacle, shape (M,)."""
-        from ltl_human_motion.scene.predicates import body_clearance
-        d = body_clearance(poses, self.cell, stature=self.library.skeleton.stature)
-        return np.all(d > 0.02, axis=-1)
+        return self.obstacle_field.clear(poses, self.library.skeleton.stature)
 
     def _stance(self, carrying: bool) -> np.ndarray:
         lib = self.library
@@ -434,7 +432,7 @@ class SequencePlanner:
             self.consumed.discard(args[0])           # a fresh part from the supply
         walked = 0
         if target is not None and kind != "release":
-            goal = self._reach_goal(target, self._placement(kind, target), f"reach {text} at "
+            goal = self._reach_goal(target, self._placement(kind, target, text), f"reach {text} at "
                                     f"({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})", text)
             walked = self._walk(goal, text, -1, carry=bool(self.held))
         if kind == "release":

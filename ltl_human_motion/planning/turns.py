@@ -62,8 +62,11 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
     s_root = _progress(t, 0.05, 0.95)
     heading = angle * s_root
     root_xy = np.stack([dx * s_root, dy * s_root], axis=-1)
+    # The pelvis dips a little mid-step so the straight standing legs can reach.
+    dip = (0.02 + 0.08 * np.hypot(dx, dy)) * np.sin(np.pi * s_root)
     body = np.einsum("tij,kj->tki", yaw_matrix(heading), stand)        # (T, J, 3)
     body[:, :, :2] += root_xy[:, None, :]
+    body[:, :, 2] -= dip[:, None]
     lead = "l" if (angle > 0 or (angle == 0 and dy > 0)) else "r"
     first, second = (lead, "r" if lead == "l" else "l")
     windows = {first: (0.05, 0.55), second: (0.45, 0.95)}
@@ -83,10 +86,11 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
         body[:, knee], body[:, ankle] = two_bone_ik(body[:, hip], body[:, ankle], l1, l2,
                                                      pole, max_stretch=1.0)
     body[:, :, :2] -= root_xy[:, None, :]
+    body[:, :, 2] += dip[:, None]
     poses = np.einsum("tji,tkj->tki", yaw_matrix(heading), body)     # back to heading frame
     root = np.zeros((n, 4))
     root[:, :2] = root_xy
-    root[:, 2] = height
+    root[:, 2] = height - dip
     root[:, 3] = heading
     deg = int(round(np.degrees(angle)))
     name = (f"{task}_turn_{deg:+d}" if dx == 0 and dy == 0 else

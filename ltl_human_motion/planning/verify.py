@@ -221,6 +221,8 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
 
     report["passed"] = all(c["passed"] for c in report.values() if isinstance(c, dict))
     if raise_on_failure and not report["passed"]:
-        name = next(k for k, c in report.items() if isinstance(c, dict) and not c["passed"])
-        raise VerificationError(f"verification failed ({name}): {report[name]['detail']}", name)
+        failed = [k for k, c in report.items() if isinstance(c, dict) and not c["passed"]]
+        details = "; ".join(f"{k}: {report[k]['detail']}" for k in failed)
+        raise VerificationError(f"verification failed ({', '.join(failed)}): {details}",
+                                failed[0])
     return report

@@ -31,6 +31,7 @@ from ltl_human_motion.robot.metrics import (
     plot_commissioning,
     write_commissioning_report,
 )
+from ltl_human_motion.robot.rtde_server import ControllerServer
 from ltl_human_motion.robot.separation import (
     Separation,
     check_capsules,
@@ -66,6 +67,7 @@ __all__ = [
     "CoexistenceConfig",
     "CoexistenceController",
     "ControlDecision",
+    "ControllerServer",
     "DecisionRecorder",
     "IOLike",
     "JointTrajectory",

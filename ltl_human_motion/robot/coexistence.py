@@ -17,6 +17,14 @@ Fail-safe behaviour
   rejected and logged; until the next valid occupancy the command cannot rise above the
   one in force when the rejection happened.
 
+Usage (what the ROS node does)::
+
+    receive_factory, io_factory = ur_rtde_factories("127.0.0.1")
+    ctl = CoexistenceController(receive_factory, io_factory, "ur5e", base=world_from_base)
+    ctl.update_occupancy(segments, radii, stamp)    # occupancy callback, any thread
+    decision = ctl.step()                           # 125 Hz timer
+    ctl.close()                                     # on shutdown
+
 ur_rtde 1.6.5 caveat: an ``RTDEIOInterface`` whose connection broke throws from its
 destructor (``std::terminate``). The controller therefore repairs broken interfaces with
 ``reconnect()`` instead of replacing them, and :meth:`CoexistenceController.close` keeps a

@@ -37,7 +37,8 @@ __all__ = ["ControllerServer", "listen_socket"]
 
 log = logging.getLogger(__name__)
 
-_MAX_BACKLOG = 64 * 1024
+_MAX_BACKLOG = 64 * 1024      # skip data packages beyond this unsent backlog
+_MAX_UNREAD = 1024 * 1024     # drop a client that leaves this much unread
 _SAFETY_NAMES = {1: "NORMAL", 2: "REDUCED", 3: "PROTECTIVE_STOP", 4: "RECOVERY",
                  5: "SAFEGUARD_STOP", 6: "SYSTEM_EMERGENCY_STOP", 7: "ROBOT_EMERGENCY_STOP",
                  8: "VIOLATION", 9: "FAULT"}
@@ -226,6 +227,10 @@ class ControllerServer:
             self._drop(client)
 
     def _send(self, client: _Client, data: bytes) -> None:
+        if len(client.out) > _MAX_UNREAD:
+            log.info("client %d reads nothing back; disconnecting", client.cid)
+            self._drop(client)
+            return
         client.out += data
         self._flush(client)
 

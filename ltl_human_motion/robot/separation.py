@@ -28,7 +28,7 @@ __all__ = [
 
 #: Coordinates beyond this (m) are rejected as nonsense by :func:`check_capsules`.
 MAX_COORDINATE = 1.0e3
-_EPS = 1e-12
+_EPS = 1e-30   # squared length (m^2) below which a segment counts as a point
 _TINY = 1e-300
 
 

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ltl_human_motion.robot.kinematics import URModel, tcp_pose, ur_model
 from ltl_human_motion.robot.trajectory import JointTrajectory, default_pick_and_place
@@ -57,6 +57,9 @@ class SimulatedUR:
     zero_slider_protective_stop : bool
         Model the controller's behaviour that a speed slider set to 0 raises a protective
         stop at the next slider change (so clients keep the slider at >= 1 %).
+    base : array-like, shape (4, 4), optional
+        World-from-base pose of the arm in the cell (reported by :meth:`status`; the RTDE
+        outputs are in the base frame, as on a real controller).
 
     Notes
     -----
@@ -67,10 +70,14 @@ class SimulatedUR:
 
     def __init__(self, model: str | URModel = "ur5e", trajectory: JointTrajectory | None = None,
                  clock: Callable[[], float] | None = None,
-                 zero_slider_protective_stop: bool = True) -> None:
+                 zero_slider_protective_stop: bool = True,
+                 base: ArrayLike | None = None) -> None:
         import time
 
         self.model = ur_model(model)
+        self.base = np.eye(4) if base is None else np.asarray(base, dtype=np.float64)
+        if self.base.shape != (4, 4) or not np.all(np.isfinite(self.base)):
+            raise ValueError(f"base: expected a finite (4, 4) transform, got {self.base.shape}")
         self.trajectory = trajectory if trajectory is not None else default_pick_and_place()
         self.clock = clock if clock is not None else time.monotonic
         self.zero_slider_protective_stop = zero_slider_protective_stop
@@ -168,6 +175,7 @@ class SimulatedUR:
         return {
             "time": self.clock() - self.start_time,
             "model": self.model.name,
+            "base_pose": self.base.tolist(),
             "q": [float(v) for v in self.q],
             "tcp_pose": [float(v) for v in self.tcp],
             "speed_slider": self.speed_slider,

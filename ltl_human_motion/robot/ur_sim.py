@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ltl_human_motion.robot.kinematics import ur_model
+from ltl_human_motion.robot.kinematics import pose_from_xyz_rpy, ur_model
 from ltl_human_motion.robot.rtde_server import ControllerServer
 from ltl_human_motion.robot.sim_state import SimulatedUR
 from ltl_human_motion.robot.trajectory import load_robot_config
@@ -64,7 +64,8 @@ def build_controller(config: URSimConfig) -> ControllerServer:
     model = ur_model(config.model or cfg["model"])
     if cfg["tool_length"] is not None:
         model = model.with_tool(cfg["tool_length"], cfg["tool_radius"])
-    sim = SimulatedUR(model, cfg["trajectory"])
+    sim = SimulatedUR(model, cfg["trajectory"],
+                      base=pose_from_xyz_rpy(cfg["base_xyz"], cfg["base_rpy"]))
     if not sim.set_speed_slider(config.initial_speed_slider):
         raise ValueError(f"initial speed slider must be finite, got {config.initial_speed_slider}")
     dash = None if config.dashboard_port < 0 else config.dashboard_port

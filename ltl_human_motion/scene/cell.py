@@ -387,7 +387,7 @@ class _Parser:
     def error(self, key: str, message: str) -> CellError:
         return CellError(f"{self.source}: {key}: {message}" if key else f"{self.source}: {message}")
 
-    def mapping(self, value: Any, key: str, allowed: set[str],
+    def mapping(self, value: Any, key: str, allowed: set[str] | frozenset[str],
                 required: tuple[str, ...] = ()) -> Mapping[str, Any]:
         if not isinstance(value, Mapping):
             raise self.error(key, f"expected a mapping, got {type(value).__name__}")
@@ -403,6 +403,12 @@ class _Parser:
         return value
 
     def number(self, value: Any, key: str) -> float:
+        if isinstance(value, str):
+            # YAML 1.1 reads "1e-3" (no dot) as a string; accept numeric strings.
+            try:
+                value = float(value)
+            except ValueError:
+                raise self.error(key, f"expected a number, got {value!r}") from None
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.error(key, f"expected a number, got {value!r}")
         if not math.isfinite(float(value)):

@@ -1,0 +1,247 @@
+"""The work of one item, run in a worker process (process pool or Dask worker).
+
+A :class:`BatchJob` holds what every item of a run shares (the cell as YAML text, the
+synthesis options); it is small and picklable. Each worker process keeps the parsed cell
+and the motion libraries in a module-level cache (:func:`prepare_worker`), so they are
+loaded once per process, not once per item.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import socket
+import time
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from ltl_human_motion.batch.items import ItemParams, cell_for_item
+
+__all__ = ["ARRAY_NAMES", "BatchJob", "ItemResult", "motion_sha256", "prepare_worker",
+           "run_item"]
+
+#: Per-item arrays, in the order they are hashed and stored.
+ARRAY_NAMES = ("positions", "root_yaw", "task_index", "objects")
+DTYPES = ("float32", "float64")
+#: Libraries kept preloaded per worker (each is ~80 MB in memory).
+PRELOAD_LIMIT = 8
+
+
+@dataclass(frozen=True)
+class BatchJob:
+    """What every item of a run shares.
+
+    Attributes
+    ----------
+    cell_yaml : str
+        The cell description (YAML text).
+    cell_source : str
+        Its file (for messages and ``Cell.source``).
+    cell_base_dir : str or None
+        Folder that relative mesh paths of the cell are resolved against.
+    options : dict
+        :meth:`SynthesisOptions.from_dict` keys (``verify`` is always off: the worker
+        decides from the report).
+    sequence_mode : str
+    keep_unverified : bool
+    dtype : {"float32", "float64"}
+        Storage type of positions, yaw and object tracks.
+    statures : tuple of float
+        The stature grid (libraries are preloaded when it is small).
+    """
+
+    cell_yaml: str
+    cell_source: str = "<inline>"
+    cell_base_dir: str | None = None
+    options: dict[str, Any] = field(default_factory=dict)
+    sequence_mode: str = "random"
+    keep_unverified: bool = False
+    dtype: str = "float32"
+    statures: tuple[float, ...] = (1.75,)
+
+    def __post_init__(self) -> None:
+        if self.dtype not in DTYPES:
+            raise ValueError(f"dtype must be one of {DTYPES}, got {self.dtype!r}")
+
+    def fingerprint(self) -> str:
+        """SHA-256 (hex) of everything that changes the produced data."""
+        data = {"cell_sha256": hashlib.sha256(self.cell_yaml.encode("utf-8")).hexdigest(),
+                "options": self.options, "sequence_mode": self.sequence_mode,
+                "keep_unverified": self.keep_unverified, "dtype": self.dtype}
+        return hashlib.sha256(json.dumps(data, sort_keys=True).encode("utf-8")).hexdigest()
+
+    def synthesis_options(self):
+        """The options used for every item: deterministic search limits, no raising.
+
+        Unless the specs set ``max_seconds``, the wall-clock budget of each search is
+        lifted (only ``max_nodes`` bounds it), so results do not depend on machine load.
+        """
+        from ltl_human_motion.planning.astar import SearchBudget
+        from ltl_human_motion.planning.pipeline import SynthesisOptions
+        opts = SynthesisOptions.from_dict(dict(self.options))
+        planner = opts.planner
+        if "max_seconds" not in self.options:
+            planner = replace(planner, budget=SearchBudget(planner.budget.max_nodes, math.inf))
+        return replace(opts, planner=planner, verify=False, sequence_mode=self.sequence_mode)
+
+
+@dataclass
+class ItemResult:
+    """The outcome of one item.
+
+    Attributes
+    ----------
+    record : dict
+        Deterministic metadata (the manifest entry without shard placement).
+    timing : dict
+        Compute times and the worker (differ between runs).
+    arrays : dict of str to ndarray or None
+        ``positions`` (T, J, 3), ``root_yaw`` (T,), ``task_index`` (T,) int16,
+        ``objects`` (T, N, 3) with N = objects of the cell sorted by name; None when
+        the item failed.
+    """
+
+    record: dict[str, Any]
+    timing: dict[str, Any]
+    arrays: dict[str, np.ndarray] | None = None
+
+    @property
+    def index(self) -> int:
+        return int(self.record["index"])
+
+
+# --------------------------------------------------------------------------- worker state
+
+_CELLS: dict[str, Any] = {}
+_OPTIONS: dict[str, Any] = {}
+
+
+def _cell_and_options(job: BatchJob) -> tuple[Any, Any]:
+    key = job.fingerprint()
+    if key not in _CELLS:
+        from ltl_human_motion.scene.cell import cell_from_yaml
+        if len(_CELLS) > 4:
+            _CELLS.clear()
+            _OPTIONS.clear()
+        _CELLS[key] = cell_from_yaml(job.cell_yaml, source=job.cell_source,
+                                     base_dir=job.cell_base_dir)
+        _OPTIONS[key] = job.synthesis_options()
+    return _CELLS[key], _OPTIONS[key]
+
+
+def prepare_worker(job: BatchJob) -> None:
+    """Parse the cell and load the libraries of a small stature grid in this process.
+
+    Called once per worker process (pool initializer, Dask worker plugin); items also
+    call it implicitly, so it is an optimization, not a requirement.
+    """
+    from ltl_human_motion.planning.pipeline import get_library
+    _, options = _cell_and_options(job)
+    if len(job.statures) <= PRELOAD_LIMIT:
+        for stature in job.statures:
+            get_library(float(stature), options.library_source)
+
+
+# --------------------------------------------------------------------------- one item
+
+def _plain(value: Any) -> Any:
+    """JSON-ready plain Python; non-finite floats become None."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return v if math.isfinite(v) else None
+    if value is None or isinstance(value, str):
+        return value
+    return str(value)
+
+
+def motion_sha256(arrays: dict[str, np.ndarray]) -> str:
+    """SHA-256 (hex) over the item arrays: names, dtypes, shapes and bytes, in order."""
+    h = hashlib.sha256()
+    for name in ARRAY_NAMES:
+        arr = np.ascontiguousarray(arrays[name])
+        h.update(f"{name}|{arr.dtype.str}|{arr.shape}|".encode())
+        h.update(arr.tobytes())
+    return h.hexdigest()
+
+
+def _arrays(synth, dtype: str) -> dict[str, np.ndarray]:
+    names = sorted(synth.objects)
+    T = synth.n_frames
+    objects = (np.stack([synth.objects[n] for n in names], axis=1) if names
+               else np.zeros((T, 0, 3)))
+    return {"positions": np.ascontiguousarray(synth.positions, dtype=dtype),
+            "root_yaw": np.ascontiguousarray(synth.root_yaw, dtype=dtype),
+            "task_index": synth.task_index.astype(np.int16),
+            "objects": np.ascontiguousarray(objects, dtype=dtype)}
+
+
+def _first_failure(report: dict) -> tuple[str | None, str]:
+    for name, check in report.items():
+        if isinstance(check, dict) and not check.get("passed", True):
+            return name, str(check.get("detail", ""))
+    return None, ""
+
+
+def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
+    """Synthesize and verify one item; errors of the item become a ``failed`` record.
+
+    Returns
+    -------
+    ItemResult
+        ``record["status"]`` is ``"ok"`` (verified), ``"unverified"`` (a check failed
+        and ``job.keep_unverified``) or ``"failed"`` (``record["error"]`` says why).
+    """
+    from ltl_human_motion.planning.pipeline import get_library, synthesize
+
+    t0 = time.perf_counter()
+    record: dict[str, Any] = {
+        "index": item.index, "spec_name": item.spec_name, "spec": item.spec,
+        "seed": item.seed, "params": item.params_dict(), "status": "failed",
+        "sequence": None, "lasso": None, "duration": None, "n_frames": None, "fps": None,
+        "verified": False, "verification": None, "motion_sha256": None, "error": None}
+    timing: dict[str, Any] = {"worker": f"{socket.gethostname()}:{os.getpid()}"}
+    arrays = None
+    try:
+        base_cell, options = _cell_and_options(job)
+        cell = cell_for_item(base_cell, item)
+        library = get_library(float(item.stature), options.library_source)
+        synth = synthesize(item.spec, cell, library=library, variants=1, seed=item.seed,
+                           cycles=item.cycles, stature=item.stature, options=options)[0]
+    except Exception as exc:
+        record["error"] = {"type": type(exc).__name__, "message": str(exc),
+                           "check": getattr(exc, "check", None),
+                           "task": getattr(exc, "task", None)}
+        timing["compute_time"] = time.perf_counter() - t0
+        return ItemResult(record, timing, None)
+    report = _plain(synth.verification)
+    failed_check, detail = _first_failure(report)
+    verified = failed_check is None
+    record.update({"sequence": list(synth.sequence), "lasso": str(synth.stats.get("lasso")),
+                   "duration": float(synth.duration), "n_frames": int(synth.n_frames),
+                   "fps": float(synth.fps), "verified": verified, "verification": report,
+                   "nodes_expanded": int(synth.stats.get("nodes_expanded", 0))})
+    if verified or job.keep_unverified:
+        arrays = _arrays(synth, job.dtype)
+        record["motion_sha256"] = motion_sha256(arrays)
+        record["status"] = "ok" if verified else "unverified"
+    if not verified:
+        record["error"] = {"type": "VerificationError", "message": detail,
+                           "check": failed_check, "task": None}
+    timing.update({k: float(v) for k, v in synth.stats.items()
+                   if k.endswith("_time") and k != "batch_total_time"})
+    timing["compute_time"] = time.perf_counter() - t0
+    return ItemResult(record, timing, arrays)

@@ -1,0 +1,51 @@
+"""``ltl-human-motion library``: builds the library, writes the report and the plot."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from ltl_human_motion.cli import build_parser, main
+
+
+def test_library_command_writes_report_and_plot(tmp_path: Path, capsys) -> None:
+    report, plot = tmp_path / "report.json", tmp_path / "graph.png"
+    rc = main(["library", "--cache-dir", str(tmp_path / "cache"), "--report", str(report),
+               "--plot", str(plot)])
+    assert rc == 0
+    out = capsys.readouterr().out
+    assert "gait primitives" in out and "quality gait" in out
+    data = json.loads(report.read_text())
+    assert data["quality"]["ok"] is True
+    s = data["summary"]
+    assert s["primitives"] == s["walk"] + s["carry"] and s["edges"] > s["primitives"]
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # second run: from the cache, JSON summary on stdout
+    rc = main(["library", "--cache-dir", str(tmp_path / "cache"), "--json"])
+    assert rc == 0
+    assert json.loads(capsys.readouterr().out)["key"] == s["key"]
+
+
+def test_library_command_reports_user_errors(tmp_path: Path, capsys) -> None:
+    rc = main(["library", "--cache-dir", str(tmp_path), "--source", str(tmp_path / "none")])
+    assert rc == 2
+    assert "does not exist" in capsys.readouterr().err
+    rc = main(["library", "--cache-dir", str(tmp_path), "--stature", "2.5"])
+    assert rc == 2
+    assert "stature must be between" in capsys.readouterr().err
+    bad = tmp_path / "broken"
+    bad.mkdir()
+    (bad / "walk.bvh").write_text("HIERARCHY\nROOT Hips\n{\n")
+    rc = main(["library", "--cache-dir", str(tmp_path), "--source", str(bad), "--no-cache"])
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert "walk.bvh" in err and "MOTION" in err
+
+
+def test_library_parser_has_options() -> None:
+    args = build_parser().parse_args(["library", "--stature", "1.6", "--delta", "0.3"])
+    assert args.stature == 1.6 and args.delta == 0.3
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["library", "--stature", "tall"])

@@ -1,0 +1,151 @@
+"""Unit tests of the planning building blocks: blending, navigation field, A*, turns."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
+from ltl_human_motion.motion.types import MotionPrimitive
+from ltl_human_motion.planning.astar import Goal, SearchBudget, SearchFailure, SearchResult, astar
+from ltl_human_motion.planning.blend import PlacedSegment, blend_weights, concatenate
+from ltl_human_motion.planning.gait_index import GaitIndex
+from ltl_human_motion.planning.navigation import NavigationField
+from ltl_human_motion.planning.turns import make_step_primitive, make_turn_primitive
+
+
+def test_blend_weights_are_cubic_c1_from_one_to_zero() -> None:
+    w = blend_weights(9)
+    assert w.shape == (9,)
+    assert np.all(np.diff(w) < 0)
+    assert 0.0 < w[-1] < w[0] < 1.0
+    s = np.array([0.0, 1.0])
+    # The polynomial itself: w(0) = 1, w(1) = 0 and zero slope at both ends.
+    poly = 1 - 3 * s**2 + 2 * s**3
+    slope = -6 * s + 6 * s**2
+    np.testing.assert_allclose(poly, [1.0, 0.0])
+    np.testing.assert_allclose(slope, [0.0, 0.0])
+    # Symmetry w(s) + w(1 - s) = 1.
+    np.testing.assert_allclose(w + w[::-1], 1.0)
+    with pytest.raises(ValueError, match="nf must be >= 0"):
+        blend_weights(-1)
+
+
+def test_concatenate_overlaps_and_blends_positions_and_heading() -> None:
+    rng = np.random.default_rng(3)
+    a = PlacedSegment(rng.normal(size=(20, 4, 3)), np.linspace(3.0, 3.1, 20), label=0)
+    b = PlacedSegment(rng.normal(size=(15, 4, 3)), np.linspace(-3.1, -3.0, 15) , label=1,
+                      blend_in=5)
+    pos, yaw, labels, spans = concatenate([a, b])
+    assert pos.shape == (30, 4, 3) and yaw.shape == (30,) and labels.shape == (30,)
+    assert spans == [(0, 20), (15, 30)]
+    np.testing.assert_array_equal(pos[:15], a.positions[:15])
+    np.testing.assert_array_equal(pos[20:], b.positions[5:])
+    w = blend_weights(5)[:, None, None]
+    np.testing.assert_allclose(pos[15:20], w * a.positions[15:] + (1 - w) * b.positions[:5])
+    # Heading crosses +-pi without a jump of 2 pi.
+    assert np.max(np.abs(np.diff(yaw))) < 0.1
+    assert labels[0] == 0 and labels[-1] == 1
+
+
+def _wall_free(xy: np.ndarray) -> np.ndarray:
+    """Free floor: everything except a wall x in [0.9, 1.1], y in [-1, 3]."""
+    inside = (np.abs(xy[:, 0] - 1.0) <= 0.1) & (xy[:, 1] >= -1.0) & (xy[:, 1] <= 3.0)
+    return ~inside
+
+
+def test_navigation_field_measures_the_way_around_a_wall() -> None:
+    goal = (2.0, 1.0)
+    field = NavigationField(np.array([-3.0, -3.0]), np.array([3.0, 3.0]), _wall_free,
+                            lambda xy: np.hypot(xy[:, 0] - goal[0], xy[:, 1] - goal[1]) < 0.2)
+    d = float(field.distance(np.array([0.0]), np.array([1.0]))[0])
+    straight = 2.0
+    # Around the wall's end at y = -1: down 2 m, across, and up again.
+    assert d > straight + 2.5
+    assert field.reachable_from(0.0, 1.0)
+    # In front of the wall the way leads away from the straight line (towards -y).
+    heading = float(field.heading(np.array([0.6]), np.array([1.0]))[0])
+    assert np.sin(heading) < 0
+
+
+def test_navigation_field_knows_an_enclosed_goal_is_unreachable() -> None:
+    def free(xy: np.ndarray) -> np.ndarray:
+        ring = np.abs(np.hypot(xy[:, 0] - 2.0, xy[:, 1]) - 0.6) < 0.15
+        return ~ring
+
+    field = NavigationField(np.array([-3.0, -3.0]), np.array([3.0, 3.0]), free,
+                            lambda xy: np.hypot(xy[:, 0] - 2.0, xy[:, 1]) < 0.2)
+    assert field.has_goal
+    assert not field.reachable_from(0.0, 0.0)
+
+
+def _straight_and_turning_gait() -> GaitIndex:
+    """A toy gait: 0.3 m forward, or forward while turning +-30 degrees (10 frames, 60 Hz)."""
+    prims = []
+    for k, turn in enumerate((0.0, np.radians(30), -np.radians(30))):
+        t = np.linspace(0, 1, 11)
+        yaw = turn * t
+        root = np.stack([0.3 * t * np.cos(yaw / 2), 0.3 * t * np.sin(yaw / 2),
+                         np.full(11, 0.9), yaw], axis=-1)
+        prims.append(MotionPrimitive(f"p{k}", "walk", np.zeros((11, 23, 3)), root, 60.0))
+    succ = [[0, 1, 2]] * 3
+    return GaitIndex.build(prims, succ, nf=0)
+
+
+def _point_goal(x: float, y: float, radius: float = 0.2) -> Goal:
+    return Goal(lambda px, py, yaw: np.hypot(px - x, py - y) <= radius,
+                lambda px, py: np.maximum(np.hypot(px - x, py - y) - radius, 0.0),
+                lambda px, py: np.arctan2(y - py, x - px), "point")
+
+
+def test_astar_reaches_a_goal_behind_the_start_with_a_chain_of_primitives() -> None:
+    index = _straight_and_turning_gait()
+    res = astar(index, (0.0, 0.0, 0.0), _point_goal(-1.5, 0.5),
+                clearance=lambda xy: np.full(len(xy), np.inf), heuristic_speed=0.5)
+    assert isinstance(res, SearchResult)
+    assert len(res.primitives) == len(res.poses) > 3
+    assert np.hypot(res.end_pose[0] + 1.5, res.end_pose[1] - 0.5) <= 0.2
+    # Replaying the chain from the poses gives the reported end pose.
+    x, y, yaw = res.poses[-1]
+    d = index.disp[res.primitives[-1]]
+    end = (x + np.cos(yaw) * d[0] - np.sin(yaw) * d[1], y + np.sin(yaw) * d[0] + np.cos(yaw) * d[1])
+    np.testing.assert_allclose(end, res.end_pose[:2], atol=1e-9)
+
+
+def test_astar_reports_blocked_and_budget_failures() -> None:
+    index = _straight_and_turning_gait()
+    walls = astar(index, (0.0, 0.0, 0.0), _point_goal(3.0, 0.0),
+                  clearance=lambda xy: np.where(np.hypot(xy[:, 0], xy[:, 1]) > 0.8, -1.0, 1.0),
+                  body_radius=0.1)
+    assert isinstance(walls, SearchFailure) and walls.reason == "blocked"
+    tiny = astar(index, (0.0, 0.0, 0.0), _point_goal(30.0, 0.0),
+                 clearance=lambda xy: np.full(len(xy), np.inf),
+                 budget=SearchBudget(max_nodes=5, max_seconds=10.0))
+    assert isinstance(tiny, SearchFailure) and tiny.reason == "budget"
+
+
+@pytest.mark.parametrize("angle", [np.pi / 2, -np.pi, np.radians(45)])
+def test_turn_primitive_turns_on_the_spot_with_feet_on_the_floor(angle: float) -> None:
+    sk = Skeleton()
+    rest = sk.rest_positions()
+    stand = rest - rest[0]
+    mp = make_turn_primitive(stand, float(rest[0, 2]), angle, sk, 120.0)
+    assert mp.root[-1, 3] == pytest.approx(angle)
+    np.testing.assert_allclose(mp.root[:, :2], 0.0)
+    np.testing.assert_allclose(mp.poses[0], stand, atol=1e-6)
+    np.testing.assert_allclose(mp.poses[-1], stand, atol=1e-6)
+    feet = mp.poses[:, [JOINT_INDEX[j] for j in ("l_ankle", "r_ankle")], 2] + mp.root[:, None, 2]
+    assert feet.min() >= rest[JOINT_INDEX["l_ankle"], 2] - 1e-6
+    lengths = np.linalg.norm(mp.poses[:, JOINT_INDEX["l_knee"]] - mp.poses[:, JOINT_INDEX["l_hip"]],
+                             axis=-1)
+    np.testing.assert_allclose(lengths, lengths[0], atol=1e-6)
+
+
+def test_step_back_moves_the_root_back() -> None:
+    sk = Skeleton(1.6)
+    rest = sk.rest_positions()
+    mp = make_step_primitive(rest - rest[0], float(rest[0, 2]), -0.3, 0.0, 0.0, sk, 120.0)
+    np.testing.assert_allclose(mp.root[-1, :2], [-0.3, 0.0], atol=1e-9)
+    speeds = np.linalg.norm(np.diff(mp.poses + mp.root[:, None, :3] * [1, 1, 0], axis=0),
+                            axis=-1) * 120
+    assert speeds.max() < 3.0
