@@ -198,7 +198,7 @@ def test_user_source_folder_adds_primitives(tmp_path: Path) -> None:
     folder.mkdir()
     m = bvh.load(src)
     bvh.save(type(m)(m.positions[:360], m.fps, m.skeleton, "part"), folder / "part.bvh")
-    lib = load_library(source=folder, include_default=False, use_cache=False, phase_step=10)
+    lib = load_library(source=folder, include_default=False, use_cache=False)
     assert lib.stats["candidates"] > 0
     assert all("part.bvh" in mp.source for mp in lib.primitives)
 

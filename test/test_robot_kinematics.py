@@ -174,3 +174,17 @@ def test_simulated_ur_zero_slider_then_change_is_a_protective_stop() -> None:
     assert sim.safety_mode == 1
     sim.set_speed_slider(0.5)
     assert sim.safety_mode == 3
+
+
+@pytest.mark.parametrize(("text", "match"), [
+    ("trajectory: {units: grad, waypoints: [{q: [0, 0, 0, 0, 0, 0]}]}", "units"),
+    ("trajectory: {waypoints: [{name: a}]}", "needs a mapping with 'q'"),
+    ("trajectory: {waypoints: [{q: [0, 0, 0]}, {q: [0, 0, 0]}]}", "6"),
+    ("base: [1, 2, 3]", "base"),
+    ("- just a list", "mapping"),
+])
+def test_robot_config_errors_name_the_problem(tmp_path: Path, text: str, match: str) -> None:
+    path = tmp_path / "robot.yaml"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=match):
+        load_robot_config(path)

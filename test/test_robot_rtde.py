@@ -249,6 +249,12 @@ def test_second_writer_of_an_input_is_in_use(sim: URSimHandle, io: object) -> No
         raw.close()
 
 
+def test_second_controller_on_a_busy_port_fails_clearly(sim: URSimHandle) -> None:
+    with pytest.raises(OSError, match="failed to start"):
+        start_ur_sim_process(host=HOST, dashboard_port=-1)
+    assert sim.is_alive()
+
+
 def test_dashboard_sim_status_over_tcp(sim: URSimHandle) -> None:
     with socket.create_connection((HOST, 29999), timeout=2.0) as s:
         f = s.makefile("rwb")

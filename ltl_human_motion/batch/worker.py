@@ -12,6 +12,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import socket
 import time
 from dataclasses import dataclass, field, replace
@@ -29,6 +30,9 @@ ARRAY_NAMES = ("positions", "root_yaw", "task_index", "objects")
 DTYPES = ("float32", "float64")
 #: Libraries kept preloaded per worker (each is ~80 MB in memory).
 PRELOAD_LIMIT = 8
+# Wall-clock seconds inside error messages (planner budget); moved to the timing part so
+# records of failed items stay identical between runs.
+_SECONDS_IN_MESSAGE = re.compile(r"(\d+ nodes), \d+(?:\.\d+)? s\b")
 
 
 @dataclass(frozen=True)
@@ -222,7 +226,11 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
         synth = synthesize(item.spec, cell, library=library, variants=1, seed=item.seed,
                            cycles=item.cycles, stature=item.stature, options=options)[0]
     except Exception as exc:
-        record["error"] = {"type": type(exc).__name__, "message": str(exc),
+        message = str(exc)
+        if _SECONDS_IN_MESSAGE.search(message):
+            timing["error_message"] = message
+            message = _SECONDS_IN_MESSAGE.sub(r"\1", message)
+        record["error"] = {"type": type(exc).__name__, "message": message,
                            "check": getattr(exc, "check", None),
                            "task": getattr(exc, "task", None)}
         timing["compute_time"] = time.perf_counter() - t0

@@ -24,7 +24,7 @@ Sec. 3.1) the exact minimizer, in closed form:
 (scaled by 1.75 / stature so one threshold fits every body size). ``delta`` is therefore a
 bound on the root-mean-square over frames of the whole-body position error (23 joints
 stacked); ``delta = 0.135`` allows an average of about 0.135 / sqrt(23) = 2.8 cm per joint.
-All pairs are evaluated with a few matrix products in row blocks (no loops over pairs, no
+All pairs are evaluated with a few matrix products in tiles (no loops over pairs, no
 numeric optimizer).
 """
 
@@ -155,32 +155,37 @@ def transition_distances(end_windows: np.ndarray, start_windows: np.ndarray,
         np.float64, copy=False)
 
 
+def _prepare(windows: np.ndarray, dtype: type) -> tuple[np.ndarray, ...]:
+    """Per-primitive terms of the closed form: centred floor coordinates (x | y), the
+    rotated ones (y | -x), heights, and the squared norm of everything."""
+    x, y, z = (v.astype(dtype, copy=False) for v in _flat(windows))
+    x_c, y_c = x - x.mean(1, keepdims=True), y - y.mean(1, keepdims=True)
+    P = np.concatenate([x_c, y_c], axis=1)                   # (N, 2n)
+    Q = np.concatenate([y_c, -x_c], axis=1)
+    sq = np.einsum("ij,ij->i", P, P) + np.einsum("ij,ij->i", z, z)
+    return P, Q, np.ascontiguousarray(z), sq
+
+
+def _sse_tile(a: tuple[np.ndarray, ...], b: tuple[np.ndarray, ...]) -> np.ndarray:
+    """Minimum summed squared error of every pair of two prepared blocks (closed form)."""
+    A1, A2, az, sq_a = a
+    B1, _, bz, sq_b = b
+    c = A1 @ B1.T                                           # sum a.b (centred)
+    s = A2 @ B1.T                                           # sum a x b (centred)
+    sse = np.hypot(c, s, out=c)
+    del s
+    sse += az @ bz.T
+    sse *= -2.0
+    sse += sq_a[:, None]
+    sse += sq_b[None, :]
+    return sse
+
+
 def _sse(ew: np.ndarray, start_windows: np.ndarray, dtype: type) -> tuple[np.ndarray, int]:
     """Minimum summed squared error of every pair (closed form), and k."""
     if ew.shape[1:] != start_windows.shape[1:]:
         raise ValueError(f"window shapes differ: {ew.shape} vs {start_windows.shape}")
-    k = ew.shape[1]
-    ax, ay, az = (v.astype(dtype, copy=False) for v in _flat(ew))
-    bx, by, bz = (v.astype(dtype, copy=False) for v in _flat(start_windows))
-    # centred floor coordinates (the optimal translation matches the centroids)
-    ax_c, ay_c = ax - ax.mean(1, keepdims=True), ay - ay.mean(1, keepdims=True)
-    bx_c, by_c = bx - bx.mean(1, keepdims=True), by - by.mean(1, keepdims=True)
-    A1 = np.concatenate([ax_c, ay_c], axis=1)               # (N, 2n)
-    B1 = np.concatenate([bx_c, by_c], axis=1)               # (M, 2n)
-    A2 = np.concatenate([ay_c, -ax_c], axis=1)
-    c = A1 @ B1.T                                           # sum a.b (centred)
-    s = A2 @ B1.T                                           # sum a x b (centred)
-    sq_a = np.einsum("ij,ij->i", A1, A1) + np.einsum("ij,ij->i", az, az)
-    sq_b = np.einsum("ij,ij->i", B1, B1) + np.einsum("ij,ij->i", bz, bz)
-    sse = np.hypot(c, s, out=c)
-    del s
-    zz = az @ bz.T
-    sse += zz
-    sse *= -2.0
-    del zz
-    sse += sq_a[:, None]
-    sse += sq_b[None, :]
-    return sse, k
+    return _sse_tile(_prepare(ew, dtype), _prepare(start_windows, dtype)), ew.shape[1]
 
 
 def build_transitions(end_windows: np.ndarray, start_windows: np.ndarray, delta: float,
@@ -189,8 +194,9 @@ def build_transitions(end_windows: np.ndarray, start_windows: np.ndarray, delta:
     """Sparse matrix of the distances of all pairs with ``d_ij < delta``.
 
     Pairs with distance exactly 0 are stored as a tiny positive number so they stay in the
-    sparsity pattern. Rows are processed in blocks (default: about 4 million pairs, i.e.
-    some 30 MB per temporary array) so memory stays bounded for large libraries.
+    sparsity pattern. Pairs are processed in tiles of ``block`` rows by about 4 million /
+    ``block`` columns (some 16 to 32 MB per temporary array), so memory stays bounded and
+    the operands stay in cache for large libraries.
 
     Returns
     -------
@@ -198,20 +204,27 @@ def build_transitions(end_windows: np.ndarray, start_windows: np.ndarray, delta:
     """
     if not delta > 0:
         raise ValueError(f"delta must be positive, got {delta!r}")
-    N = end_windows.shape[0]
+    if end_windows.shape[1:] != start_windows.shape[1:]:
+        raise ValueError(f"window shapes differ: {end_windows.shape} vs "
+                         f"{start_windows.shape}")
+    N, M = end_windows.shape[0], start_windows.shape[0]
     if block is None:
-        block = int(np.clip(4_000_000 // max(start_windows.shape[0], 1), 16, 4096))
+        block = 1024
+    col_block = max(1, 4_000_000 // max(block, 1))
     rows_l, cols_l, vals_l = [], [], []
     scale = REFERENCE_STATURE / stature
     k = end_windows.shape[1]
     limit = (delta / scale) ** 2 * k          # d < delta  <=>  sse < limit
+    B = _prepare(start_windows, dtype)
     for r0 in range(0, N, block):
-        sse, _ = _sse(end_windows[r0:r0 + block], start_windows, dtype)
-        r, c = np.nonzero(sse < limit)
-        rows_l.append(r + r0)
-        cols_l.append(c)
-        d = np.sqrt(np.maximum(sse[r, c].astype(np.float64), 0.0) / k) * scale
-        vals_l.append(np.maximum(d, 1e-12))
+        A = _prepare(end_windows[r0:r0 + block], dtype)
+        for c0 in range(0, M, col_block):
+            sse = _sse_tile(A, tuple(v[c0:c0 + col_block] for v in B))
+            r, c = np.nonzero(sse < limit)
+            rows_l.append(r + r0)
+            cols_l.append(c + c0)
+            d = np.sqrt(np.maximum(sse[r, c].astype(np.float64), 0.0) / k) * scale
+            vals_l.append(np.maximum(d, 1e-12))
         if progress is not None:
             progress(min(block, N - r0))
     rows = np.concatenate(rows_l) if rows_l else np.zeros(0, int)

@@ -304,8 +304,15 @@ def build_library(stature: float = DEFAULT_STATURE, source=None,
                   phase_step: int = 4,
                   include_default: bool = True, mirror: bool = True,
                   progress: bool | None = None, quality: bool = True,
-                  _files: list[Path] | None = None, key: str = "") -> MotionLibrary:
-    """Build the library without touching the cache (see :func:`load_library`)."""
+                  _files: list[Path] | None = None, key: str = "",
+                  user_step: int = _gait.PRIMITIVE_FRAMES) -> MotionLibrary:
+    """Build the library without touching the cache (see :func:`load_library`).
+
+    ``user_step``: frames between primitive starts in non-looping (user) clips; the default
+    20 splits them like the paper. The graph build is quadratic in the number of primitives
+    (about 15 to 40 s for 20 000 on two cores, see ``bench/motion_graph.py``), so point
+    ``source`` at walking clips rather than at a whole database.
+    """
     import time
 
     t0 = time.perf_counter()
@@ -328,10 +335,14 @@ def build_library(stature: float = DEFAULT_STATURE, source=None,
             if looping:
                 clip = _gait.prepare_loop(motion, name, str(f), mirror=m)
                 prims += _gait.start_stop_primitives(clip, skeleton, overlap=k_comp)
+                prims += _gait.gait_primitives(clip, skeleton, phase_step=phase_step,
+                                               overlap=k_comp)
             else:
+                # user clips are cut every 20 frames as in the paper (they are long)
                 clip = _gait.prepare_clip(motion, name, str(f), mirror=m)
-            prims += _gait.gait_primitives(clip, skeleton, phase_step=phase_step,
-                                           overlap=k_comp)
+                prims += _gait.gait_primitives(clip, skeleton,
+                                               phase_step=max(phase_step, user_step),
+                                               overlap=k_comp)
         if bar is not None:
             bar.update(1)
     if bar is not None:
@@ -491,7 +502,8 @@ def load_library(stature: float = DEFAULT_STATURE, source=None,
     source : path-like or list of path-like, optional
         Extra motion files or folders (BVH, DeepMimic, npz) of walking, e.g. a user's CMU
         BVH database; added to the default DeepMimic loops. Non-looping clips are cut
-        along their whole length; primitives that do not connect are pruned.
+        every 20 frames along their whole length (as in the paper); primitives that do
+        not connect to the largest strongly connected component are pruned.
     delta : float
         Transition threshold on d_ij (see :mod:`.automaton` for its meaning).
     cache_dir : path-like, optional

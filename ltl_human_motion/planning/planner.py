@@ -65,7 +65,7 @@ class PlannerOptions:
     budget: SearchBudget = field(default_factory=SearchBudget)
     cost_noise: float = 0.15
     reach_tolerance: float = 0.15
-    heading_tolerance: float = 0.30
+    heading_tolerance: float = 0.35
     body_radius: float = 0.15
     grid_resolution: float = 0.1
 

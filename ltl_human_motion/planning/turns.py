@@ -14,10 +14,12 @@ from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import MotionPrimitive, yaw_matrix
 
-TURN_ANGLES_DEG = (-180.0, -135.0, -90.0, -45.0, 45.0, 90.0, 135.0)
-#: Steps on the spot: (back, left, turn in degrees).
+TURN_ANGLES_DEG = (-180.0, -135.0, -90.0, -45.0, -20.0, 20.0, 45.0, 90.0, 135.0)
+#: Steps on the spot: (forward, left, turn in degrees). The short ones let a walk end
+#: exactly where a goal primitive can reach its target.
 STEPS = ((-0.3, 0.0, 0.0), (-0.3, 0.0, 90.0), (-0.3, 0.0, -90.0), (0.0, 0.25, 0.0),
-         (0.0, -0.25, 0.0))
+         (0.0, -0.25, 0.0), (0.15, 0.0, 0.0), (-0.15, 0.0, 0.0), (0.0, 0.12, 0.0),
+         (0.0, -0.12, 0.0))
 _FOOT = {"l": ("l_ankle", "l_toe"), "r": ("r_ankle", "r_toe")}
 
 

@@ -164,8 +164,11 @@ def plot_commissioning(decisions: Sequence[ControlDecision], path: str | os.Path
             ax1.plot(t, c["effective_separation"], "--", label="effective (predicted)")
         ax1.plot(t, c["protective_distance"], "r:", label="S_p")
         below = np.isfinite(c["separation"]) & (c["separation"] < c["protective_distance"])
-        if below.any():
-            ax1.plot(t[below], c["separation"][below], "rx", label="below S_p")
+        dt = _durations(t)
+        for i, (a, b) in enumerate(_intervals(below)):
+            for ax in (ax1, ax2):
+                ax.axvspan(t[a], t[b - 1] + dt[b - 1], color="red", alpha=0.15, lw=0,
+                           label="below S_p" if i == 0 and ax is ax1 else None)
         ax1.set_ylabel("separation [m]")
         ax1.legend(loc="upper right", fontsize="small")
         ax1.set_title(title)

@@ -66,6 +66,10 @@ class SimulatedUR:
     The trajectory time advances at ``speed_slider`` times wall time while the robot runs
     (normal safety mode, program playing); a protective stop freezes it. ``speed_scaling``
     reports that effective rate (0 while stopped); ``target_speed_fraction`` the slider.
+    A real controller reports the slider only in ``target_speed_fraction`` (its
+    ``speed_scaling`` is the trajectory limiter's), so ur_rtde's
+    ``getSpeedScalingCombined()`` (their product) reads slider squared here; clients should
+    read the slider with ``getTargetSpeedFraction()``.
     """
 
     def __init__(self, model: str | URModel = "ur5e", trajectory: JointTrajectory | None = None,
