@@ -349,6 +349,7 @@ def build_library(stature: float = DEFAULT_STATURE, source=None,
         bar.close()
     t_prims = time.perf_counter() - t0
     dropped: list[str] = []
+    generated = len(prims)
     if quality:
         from ltl_human_motion.motion.quality import check_primitives
         pre = check_primitives(prims, skeleton, kind="gait candidates")
@@ -356,6 +357,7 @@ def build_library(stature: float = DEFAULT_STATURE, source=None,
         dropped = sorted(bad)
         prims = [mp for mp in prims if mp.name not in bad]
     auto, stats = _automaton(prims, skeleton, delta, k_comp, progress)
+    stats["generated"] = generated
     stats["dropped_quality"] = dropped
     stats["time_primitives_s"] = round(t_prims, 3)
     stats["time_total_s"] = round(time.perf_counter() - t0, 3)

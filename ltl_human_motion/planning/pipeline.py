@@ -318,7 +318,7 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     t0 = time.perf_counter()
     report = verify_motion(synth, cell, specification, seq, [(s[1], s[2]) for s in steps],
                            options.verification, held=held, stature=stature,
-                           raise_on_failure=options.verify)
+                           blend_frames=library.overlap, raise_on_failure=options.verify)
     t_verify = time.perf_counter() - t0
     compute = time.perf_counter() - t_start + t_automaton + t_sequence
     synth.verification = report

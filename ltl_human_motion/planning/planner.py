@@ -59,6 +59,8 @@ class PlannerOptions:
         Clearance the walking root keeps from obstacle footprints, metres.
     grid_resolution : float
         Cell size of the navigation field behind the heuristic, metres.
+    goal_attempts : int
+        Seeded goal primitives tried before a reach blocked by obstacles fails.
     """
 
     heuristic_speed: float = 0.25
@@ -67,6 +69,7 @@ class PlannerOptions:
     reach_tolerance: float = 0.15
     heading_tolerance: float = 0.35
     body_radius: float = 0.15
+    goal_attempts: int = 6
     grid_resolution: float = 0.1
 
 
@@ -198,6 +201,8 @@ class SequencePlanner:
         self.seated = False
         self.held: dict[str, str] = {}               # object -> hand joint
         self.consumed: set[str] = set()
+        self._wait_seconds: float | None = None
+        self.grasp_object: str | None = None
         self.expanded = 0
         self.search_seconds = 0.0
 
@@ -444,6 +449,8 @@ class SequencePlanner:
                 raise PlanningError(f"task {text}: {obj} is not held, so it cannot be "
                                     "released", task=text, reason="precondition")
         carrying_before = bool(self.held)
+        self._wait_seconds = float(args[0]) if kind == "wait" and args else None
+        self.grasp_object = args[0] if kind == "grasp" else None
         seg, mp = self._goal_segment(kind, target, i, text)
         hand = mp.meta.get("hand")
         effect = self._apply_effects(kind, args, hand)
@@ -468,15 +475,56 @@ class SequencePlanner:
         kwargs = {"rng": self.rng, "start_pose": self._stance(bool(self.held))}
         if kind in ("move", "insert", "extract", "release") and hold_hand:
             kwargs["hand"] = hold_hand
-        try:
-            mp = self.library.goal(kind, local, **kwargs)
-        except ValueError as exc:
-            raise PlanningError(f"task {text}: cannot make a {kind} motion for the target: "
-                                f"{exc}", task=text, reason="unreachable") from None
+        if kind == "wait" and target is None and self._wait_seconds is not None:
+            # Longer than asked by the blends at both ends, so the stillness lasts.
+            kwargs["duration"] = self._wait_seconds + (2 * self.overlap + 6) / self.library.fps
+        mp = None
+        for attempt in range(self.options.goal_attempts):
+            try:
+                candidate = self.library.goal(kind, local, **kwargs)
+            except ValueError as exc:
+                raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
+                                    f"target: {exc}", task=text, reason="unreachable") from None
+            if self._goal_clear(candidate, kind):
+                mp = candidate
+                break
+            if attempt == 1 and kind in ("grasp", "leftHand", "rightHand", "release"):
+                other = {"l_hand": "r_hand", "r_hand": "l_hand"}.get(
+                    candidate.meta.get("hand"), None)
+                if other and kind not in ("leftHand", "rightHand"):
+                    kwargs["hand"] = other
+        if mp is None:
+            raise PlanningError(f"task {text}: every {kind} motion tried "
+                                f"({self.options.goal_attempts}) runs into an obstacle; "
+                                "an obstacle blocks the reach", task=text, reason="blocked")
         seg = self._add(mp, self.pose, label, self.overlap)
         self.pose = self._hand_over_pose(mp, self.pose)
         self.gait_state = None
         return seg, mp
+
+    def _goal_clear(self, mp: MotionPrimitive, kind: str) -> bool:
+        """Whether the body, and any object in the hands, keep clear of obstacles."""
+        world = world_positions(mp, *self.pose)
+        frames = np.linspace(0, mp.n_frames - 1, 24).round().astype(int)
+        if not bool(self._body_clear(world[frames][None])[0]):
+            return False
+        contact = int(mp.meta.get("contact_frame", 0))
+        carried = dict(self.held)
+        if kind == "grasp" and self.grasp_object is not None:
+            carried[self.grasp_object] = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(
+                mp.meta.get("hand"), "r_hand")
+        for name, joint in carried.items():
+            obj = self.cell.object(name)
+            lo, hi = obj.occupancy.aabb()
+            half = 0.5 * float(np.linalg.norm(hi - lo))
+            j = JOINT_INDEX[joint]
+            start = contact if name == self.grasp_object else 0
+            hand = world[start:, j]
+            offset = (obj.position - hand[0]) if name == self.grasp_object else np.zeros(3)
+            centre = hand[::6] + offset
+            if np.any(self.obstacle_field.distance(centre) <= half + 0.005):
+                return False
+        return True
 
     def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None) -> dict:
         """Update which objects are held; return the effect for the object tracks."""
