@@ -21,6 +21,7 @@ import pytest
 
 from ltl_human_motion.batch import (
     BatchConfigError,
+    BatchSummary,
     CorruptDatasetError,
     deterministic_record,
     open_dataset,
@@ -55,7 +56,7 @@ def specs_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
-def _run(specs_file: Path, out: Path, **kw):  # noqa: ANN202 - BatchSummary
+def _run(specs_file: Path, out: Path, **kw: object) -> BatchSummary:
     return run_batch("paper_cell", specs_file, COUNT, out, seed=SEED, shard_size=SHARD,
                      progress=False, **kw)
 
@@ -214,7 +215,7 @@ def test_failed_items_are_listed_with_reasons(tmp_path: Path) -> None:
 def test_a_different_job_does_not_touch_an_existing_dataset(reference: Path,
                                                             specs_file: Path) -> None:
     before = (reference / "manifest.jsonl").read_bytes()
-    with pytest.raises(BatchConfigError, match="holds a different dataset.*seed"):
+    with pytest.raises(BatchConfigError, match=r"holds a different dataset.*seed"):
         run_batch("paper_cell", specs_file, COUNT, reference, seed=SEED + 1,
                   shard_size=SHARD, progress=False, workers=0)
     assert (reference / "manifest.jsonl").read_bytes() == before

@@ -113,7 +113,7 @@ def test_specs_are_checked_against_the_cell(cell) -> None:
 
 
 def test_missing_specs_file_is_named(tmp_path: Path) -> None:
-    with pytest.raises(BatchConfigError, match="nope.yaml: cannot read specs file"):
+    with pytest.raises(BatchConfigError, match=r"nope\.yaml: cannot read specs file"):
         load_specs(tmp_path / "nope.yaml")
     with pytest.raises(ValueError, match="index must be an integer >= 0"):
         derive_item(specs_from_yaml("specs: [S1]"), 0, -1)

@@ -270,8 +270,8 @@ def run_batch(cell: str | os.PathLike[str], specs: BatchSpecs | str | os.PathLik
             summary.compute_time += float(result.timing.get("compute_time", 0.0))
             tally[result.record["status"]] += 1
             summary.verified_this_run += int(result.record["status"] == "ok")
-            bar.update(1)
             bar.set_postfix(tally, refresh=False)
+            bar.update(1)
             if on_item is not None:
                 on_item(result)
     finally:

@@ -66,6 +66,7 @@ _SIDES = ("l", "r")
 _REACH_FRACTION = 0.93          # hand never further than this fraction of the arm length
 _ASSEMBLE_HALF_GAP = 0.035      # m, hands either side of an assembly target
 _INSERT_TRAVEL = 0.08           # m, straight push of insert / pull of extract
+_APPROACH_LIFT = 0.08           # m, grasp/release/move come down onto low targets
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -475,6 +476,17 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     else:
         keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
         contact_t = t1
+        if task in ("grasp", "release", "move"):
+            # Parts rest on surfaces: come down onto a target below the shoulder from
+            # _APPROACH_LIFT above it, and lift off the same way.
+            lift = np.zeros_like(rel_goal)
+            for k in active:
+                if targets[k][2] < sh1[k][2] - 0.1:
+                    lift[k, 2] = _APPROACH_LIFT
+            if np.any(lift):
+                rel_above = rel_goal + lift
+                keys = [(0.0, rel_home), (0.7 * t1, rel_above), (t1, rel_goal), (t2, rel_goal),
+                        (t2 + 0.3 * (total - t2), rel_above), (total, rel_home)]
     rel = _arc_keys(t, keys)
     # a small seeded bow of the hand path (outward and up), zero at every key pose
     s_out = _profile(t, [(0.0, 0.0), (t1, 1.0)])
@@ -496,6 +508,12 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
             wob = amp * np.sin(2 * np.pi * f * t[:, None] + ph)
             rel[:, k] += env[:, None] * wob
     hands = shoulders + rel
+    # A free hand stays by the hip while the trunk leans (it does not swing forward into
+    # the furniture the other hand reaches over).
+    for k in range(2):
+        if k not in active:
+            hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04]) * \
+                sb[:, None]
     # palm direction and elbow pole blend from the start pose to the reaching posture
     s_hand = _interp_keys(t, [(0.0, 0.0), (t1, 1.0), (t2, 1.0), (total, 0.0)])
     hand_dir = np.broadcast_to(st.hand_dir, (T, 2, 3)).copy()

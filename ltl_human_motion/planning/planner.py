@@ -203,6 +203,8 @@ class SequencePlanner:
         self.consumed: set[str] = set()
         self._wait_seconds: float | None = None
         self.grasp_object: str | None = None
+        self.held_offsets: dict[str, np.ndarray] = {}
+        self._carry_stance = False
         self.expanded = 0
         self.search_seconds = 0.0
 
@@ -449,9 +451,16 @@ class SequencePlanner:
                 raise PlanningError(f"task {text}: {obj} is not held, so it cannot be "
                                     "released", task=text, reason="precondition")
         carrying_before = bool(self.held)
+        if kind == "grasp" and not carrying_before:
+            # Raise the arms to the carry stance first: the part then comes up to the chest
+            # instead of swinging down past the surface it rested on.
+            self._arm_transition(False, -1)
+            carrying_before = True
+            self._carry_stance = True
         self._wait_seconds = float(args[0]) if kind == "wait" and args else None
         self.grasp_object = args[0] if kind == "grasp" else None
         seg, mp = self._goal_segment(kind, target, i, text)
+        self._carry_stance = False
         hand = mp.meta.get("hand")
         effect = self._apply_effects(kind, args, hand)
         if bool(self.held) != carrying_before:
@@ -472,7 +481,8 @@ class SequencePlanner:
             dx, dy = target[0] - x, target[1] - y
             local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
         hold_hand = next(iter(self.held.values()), None)
-        kwargs = {"rng": self.rng, "start_pose": self._stance(bool(self.held))}
+        kwargs = {"rng": self.rng,
+                  "start_pose": self._stance(bool(self.held) or self._carry_stance)}
         if kind in ("move", "insert", "extract", "release") and hold_hand:
             kwargs["hand"] = hold_hand
         if kind == "wait" and target is None and self._wait_seconds is not None:
@@ -506,23 +516,25 @@ class SequencePlanner:
         """Whether the body, and any object in the hands, keep clear of obstacles."""
         world = world_positions(mp, *self.pose)
         frames = np.linspace(0, mp.n_frames - 1, 24).round().astype(int)
-        if not bool(self._body_clear(world[frames][None])[0]):
+        if not bool(self.obstacle_field.clear(world[frames][None],
+                                              self.library.skeleton.stature, margin=0.0)[0]):
             return False
         contact = int(mp.meta.get("contact_frame", 0))
         carried = dict(self.held)
         if kind == "grasp" and self.grasp_object is not None:
             carried[self.grasp_object] = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(
                 mp.meta.get("hand"), "r_hand")
+        from ltl_human_motion.scene.predicates import object_clearance
         for name, joint in carried.items():
-            obj = self.cell.object(name)
-            lo, hi = obj.occupancy.aabb()
-            half = 0.5 * float(np.linalg.norm(hi - lo))
             j = JOINT_INDEX[joint]
             start = contact if name == self.grasp_object else 0
             hand = world[start:, j]
-            offset = (obj.position - hand[0]) if name == self.grasp_object else np.zeros(3)
-            centre = hand[::6] + offset
-            if np.any(self.obstacle_field.distance(centre) <= half + 0.005):
+            if name == self.grasp_object:
+                offset = self.cell.object(name).position - hand[0]
+            else:
+                offset = self.held_offsets.get(name, np.zeros(3))
+            centre = hand[::4] + offset
+            if centre.size and np.any(object_clearance(self.cell, name, centre) <= 0.0):
                 return False
         return True
 

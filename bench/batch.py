@@ -1,0 +1,145 @@
+"""Benchmark of dataset generation: verified S2 motions per minute, 1 vs 2 workers.
+
+Runs ``run_batch`` on the paper cell with S2 (shortest task sequence: grasp O1, grasp O2,
+assemble R1; object and start jitter; stature 1.75 m) on a local process pool with 1 and
+with 2 workers, ``--repeat`` times each into fresh folders, and reports medians:
+throughput (verified motions per wall-clock minute, worker start-up included),
+throughput per core, scaling efficiency ``T2 / (2 T1)`` and the median per-item compute
+time. Then it profiles an in-process run (``workers=0``, after a warm-up) with cProfile
+and reports the top functions by cumulative time and the time per pipeline stage.
+Prints a summary and writes ``bench/results/batch.json``. Not a test: run
+``python bench/batch.py`` (about 2-3 minutes on 2 cores).
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import io
+import json
+import os
+import platform
+import pstats
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from ltl_human_motion.atomic import atomic_write_text  # noqa: E402
+from ltl_human_motion.batch import open_dataset, run_batch, specs_from_yaml  # noqa: E402
+
+SPECS = """
+version: 1
+specs:
+  - {name: S2, spec: S2}
+stature: 1.75
+objects: {O1: [0.05, 0.05, 0.0], O2: [0.05, 0.05, 0.0]}
+regions: {R0: [0.05, 0.05, 0.0]}
+sequence_mode: all
+"""
+TARGET_PER_CORE = 1000.0       # verified S2 motions per minute per core (issue 8)
+STAGES = ("automaton_time", "sequence_time", "planning_time", "blending_time",
+          "verification_time")
+
+
+def _throughput(specs, count: int, workers: int, folder: Path, seed: int) -> dict:
+    out = folder / f"w{workers}-s{seed}"
+    summary = run_batch("paper_cell", specs, count, out, seed=seed, workers=workers,
+                        shard_size=max(count // 4, 1), progress=False)
+    records = open_dataset(out, verify_checksums=False).records
+    compute = [r["timing"]["compute_time"] for r in records if r["status"] == "ok"]
+    return {"workers": workers, "count": count, "verified": summary.verified_this_run,
+            "failed": summary.counts.get("failed", 0), "elapsed_s": summary.elapsed,
+            "verified_per_minute": summary.verified_per_minute,
+            "median_compute_s": statistics.median(compute) if compute else None}
+
+
+def _profile(specs, count: int, folder: Path, top: int) -> dict:
+    run_batch("paper_cell", specs, 2, folder / "warm", seed=999, workers=0, progress=False)
+    prof = cProfile.Profile()
+    t0 = time.perf_counter()
+    prof.enable()
+    run_batch("paper_cell", specs, count, folder / "prof", seed=123, workers=0,
+              progress=False)
+    prof.disable()
+    wall = time.perf_counter() - t0
+    stats = pstats.Stats(prof)
+    rows = []
+    for (file, line, func), (_cc, nc, tt, ct, _callers) in stats.stats.items():
+        rows.append({"function": f"{Path(file).name}:{line}({func})", "calls": nc,
+                     "tottime_s": round(tt, 4), "cumtime_s": round(ct, 4),
+                     "cum_share": round(ct / wall, 4)})
+    rows.sort(key=lambda r: -r["cumtime_s"])
+    by_self = sorted(rows, key=lambda r: -r["tottime_s"])[:top]
+    records = open_dataset(folder / "prof", verify_checksums=False).records
+    stage = {s: statistics.median(r["timing"].get(s, 0.0) for r in records) for s in STAGES}
+    compute = statistics.median(r["timing"]["compute_time"] for r in records)
+    stage["other_time"] = max(compute - sum(stage.values()), 0.0)
+    text = io.StringIO()
+    pstats.Stats(prof, stream=text).sort_stats("cumulative").print_stats(top)
+    return {"items": count, "wall_s": wall, "per_item_s": wall / count,
+            "median_item_compute_s": compute,
+            "stage_median_s": stage,
+            "stage_share": {k: v / compute for k, v in stage.items()},
+            "top_cumulative": rows[:top],
+            "top_self": by_self}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=20, help="items per run (default 20)")
+    parser.add_argument("--repeat", type=int, default=3, help="runs per setting (default 3)")
+    parser.add_argument("--profile-items", type=int, default=10)
+    parser.add_argument("--top", type=int, default=15)
+    parser.add_argument("--out", default=str(ROOT / "bench" / "results" / "batch.json"))
+    args = parser.parse_args(argv)
+    specs = specs_from_yaml(SPECS, "bench/batch.py:SPECS")
+    runs: dict[int, list[dict]] = {1: [], 2: []}
+    with tempfile.TemporaryDirectory(prefix="lhm-bench-batch-") as tmp:
+        folder = Path(tmp)
+        for rep in range(args.repeat):
+            for workers in (1, 2):
+                r = _throughput(specs, args.count, workers, folder, seed=rep)
+                runs[workers].append(r)
+                print(f"  {workers} worker(s), run {rep + 1}: {r['verified']}/{args.count} "
+                      f"verified in {r['elapsed_s']:.1f} s = "
+                      f"{r['verified_per_minute']:.0f}/min", file=sys.stderr)
+        profile = _profile(specs, args.profile_items, folder, args.top)
+    med = {w: statistics.median(r["verified_per_minute"] for r in rs) for w, rs in runs.items()}
+    compute = statistics.median(r["median_compute_s"] for r in runs[1] if r["median_compute_s"])
+    result = {
+        "benchmark": "batch", "spec": "S2 (sequence_mode all: grasp O1, grasp O2, assemble)",
+        "cell": "paper_cell", "count_per_run": args.count, "repeat": args.repeat,
+        "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
+                    "platform": platform.platform(),
+                    "load_average": list(os.getloadavg())},
+        "verified_per_minute_1_worker": med[1],
+        "verified_per_minute_2_workers": med[2],
+        "per_core_verified_per_minute": med[2] / 2.0,
+        "scaling_efficiency": med[2] / (2.0 * med[1]) if med[1] else None,
+        "median_item_compute_s": compute,
+        "steady_state_per_core_per_minute": 60.0 / compute if compute else None,
+        "target_per_core_per_minute": TARGET_PER_CORE,
+        "meets_target": med[2] / 2.0 >= TARGET_PER_CORE,
+        "runs": runs, "profile": profile,
+    }
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(args.out, json.dumps(result, indent=1) + "\n")
+    print(json.dumps({k: v for k, v in result.items() if k not in ("runs", "profile")},
+                     indent=1))
+    print("\nwhere the time goes (median per item, in-process):")
+    for stage, secs in profile["stage_median_s"].items():
+        print(f"  {stage:<18} {secs * 1000:8.1f} ms  {profile['stage_share'][stage]:6.1%}")
+    print("top functions by cumulative time:")
+    for row in profile["top_cumulative"]:
+        print(f"  {row['cumtime_s']:8.3f} s {row['cum_share']:6.1%}  {row['function']}")
+    print(f"written to {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
