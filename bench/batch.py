@@ -5,7 +5,8 @@ assemble R1; object and start jitter; stature 1.75 m) on a local process pool wi
 with 2 workers, ``--repeat`` times each into fresh folders, and reports medians:
 throughput (verified motions per wall-clock minute, worker start-up included),
 throughput per core, scaling efficiency ``T2 / (2 T1)`` and the median per-item compute
-time. Then it profiles an in-process run (``workers=0``, after a warm-up) with cProfile
+time; from the workers' CPU time (robust to other load on the machine) the CPU-bound
+per-core rate ``60 / mean item CPU seconds``. Then it profiles an in-process run (``workers=0``, after a warm-up) with cProfile
 and reports the top functions by cumulative time and the time per pipeline stage.
 Prints a summary and writes ``bench/results/batch.json``. Not a test: run
 ``python bench/batch.py`` (about 2-3 minutes on 2 cores).
@@ -48,14 +49,21 @@ STAGES = ("automaton_time", "sequence_time", "planning_time", "blending_time",
 
 def _throughput(specs, count: int, workers: int, folder: Path, seed: int) -> dict:
     out = folder / f"w{workers}-s{seed}"
+    first: list[float] = []
+    t0 = time.perf_counter()
     summary = run_batch("paper_cell", specs, count, out, seed=seed, workers=workers,
-                        shard_size=max(count // 4, 1), progress=False)
+                        shard_size=max(count // 4, 1), progress=False,
+                        on_item=lambda _: first or first.append(time.perf_counter() - t0))
     records = open_dataset(out, verify_checksums=False).records
     compute = [r["timing"]["compute_time"] for r in records if r["status"] == "ok"]
     return {"workers": workers, "count": count, "verified": summary.verified_this_run,
             "failed": summary.counts.get("failed", 0), "elapsed_s": summary.elapsed,
             "verified_per_minute": summary.verified_per_minute,
-            "median_compute_s": statistics.median(compute) if compute else None}
+            "median_compute_s": statistics.median(compute) if compute else None,
+            "mean_compute_s": statistics.fmean(compute) if compute else None,
+            "mean_cpu_s": statistics.fmean(r["timing"]["cpu_time"] for r in records
+                                           if r["status"] == "ok") if compute else None,
+            "first_result_s": first[0] if first else None}
 
 
 def _profile(specs, count: int, folder: Path, top: int) -> dict:
@@ -98,6 +106,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", default=str(ROOT / "bench" / "results" / "batch.json"))
     args = parser.parse_args(argv)
     specs = specs_from_yaml(SPECS, "bench/batch.py:SPECS")
+    load_before = list(os.getloadavg())
     runs: dict[int, list[dict]] = {1: [], 2: []}
     with tempfile.TemporaryDirectory(prefix="lhm-bench-batch-") as tmp:
         folder = Path(tmp)
@@ -111,18 +120,23 @@ def main(argv: list[str] | None = None) -> int:
         profile = _profile(specs, args.profile_items, folder, args.top)
     med = {w: statistics.median(r["verified_per_minute"] for r in rs) for w, rs in runs.items()}
     compute = statistics.median(r["median_compute_s"] for r in runs[1] if r["median_compute_s"])
+    cpu = statistics.median(r["mean_cpu_s"] for rs in runs.values() for r in rs
+                            if r["mean_cpu_s"])
     result = {
         "benchmark": "batch", "spec": "S2 (sequence_mode all: grasp O1, grasp O2, assemble)",
         "cell": "paper_cell", "count_per_run": args.count, "repeat": args.repeat,
         "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                     "platform": platform.platform(),
-                    "load_average": list(os.getloadavg())},
+                    "load_average_before": load_before,
+                    "load_average_after": list(os.getloadavg())},
         "verified_per_minute_1_worker": med[1],
         "verified_per_minute_2_workers": med[2],
         "per_core_verified_per_minute": med[2] / 2.0,
         "scaling_efficiency": med[2] / (2.0 * med[1]) if med[1] else None,
         "median_item_compute_s": compute,
         "steady_state_per_core_per_minute": 60.0 / compute if compute else None,
+        "median_of_mean_item_cpu_s": cpu,
+        "cpu_bound_per_core_per_minute": 60.0 / cpu if cpu else None,
         "target_per_core_per_minute": TARGET_PER_CORE,
         "meets_target": med[2] / 2.0 >= TARGET_PER_CORE,
         "runs": runs, "profile": profile,

@@ -38,7 +38,7 @@ def cell():
 def test_example_file_parses_and_fits_the_paper_cell(cell) -> None:
     specs = load_specs(EXAMPLE)
     assert [s.name for s in specs.specs] == ["S1", "S2"]
-    assert specs.statures == (1.6, 1.65, 1.7, 1.75, 1.8, 1.85, 1.9)
+    assert specs.statures == (1.6, 1.65, 1.7, 1.75, 1.8)
     assert specs.objects["O1"].lo == (-0.1, -0.1, 0.0)
     validate_against_cell(specs, cell)
 

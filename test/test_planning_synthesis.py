@@ -191,3 +191,33 @@ def test_options_from_service_json_are_checked() -> None:
     assert opts.sequence_mode == "coverage" and opts.planner.budget.max_nodes == 500
     with pytest.raises(ValueError, match="unknown synthesis options"):
         SynthesisOptions.from_dict({"speed": 3})
+
+
+TASK_CELL = """
+name: tasks
+start_region: R0
+objects:
+  O1: {position: [1.2, 0.8, 0.8], shape: box, size: [0.08, 0.08, 0.08],
+       grasp_points: [[0, 0, 0.04]]}
+  stool: {position: [-1.2, 0.0, 0.225], shape: cylinder, size: [0.18, 0.45], movable: false,
+          sitting_surface: {lo: [-0.18, -0.18, 0.2], hi: [0.18, 0.18, 0.225]}}
+regions:
+  R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}
+  R1: {lo: [1.1, -1.1, 0.9], hi: [1.3, -0.9, 1.1]}
+  R2: {lo: [-1.5, 1.2, 0.0], hi: [-0.9, 1.8, 2.0]}
+obstacles:
+  table: {shape: box, position: [1.4, 0.8, 0.375], size: [0.6, 0.6, 0.75]}
+"""
+
+
+@pytest.mark.parametrize("spec", [
+    "grasp(O1) & X move(O1, R1) & X X release(O1)",
+    "grasp(O1) & X carry(O1, R2) & X X release(O1)",
+    "wait(1.0) & X bend & X X stoop & X X X kneel",
+    "sit(stool) & X standUp & X X walk(R2)",
+    "grasp(O1) & X rightHand(R1) & X X leftHand(R1)",
+])
+def test_every_table_i_task_plans_and_verifies(spec: str, library) -> None:
+    synth = synthesize(spec, TASK_CELL, library=library, seed=0)[0]
+    assert synth.verification["passed"], synth.verification
+    assert len(synth.timeline) == len(synth.sequence) >= 3

@@ -22,7 +22,6 @@ from rclpy.serialization import deserialize_message  # noqa: E402
 from ltl_human_motion.ros import conversions as cv  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.bringup_config import load_bringup_config  # noqa: E402
-from ltl_human_motion.ros.entry_points import coexistence_node  # noqa: E402
 from ltl_human_motion.ros.motion_store import MotionStore, check_motion_id  # noqa: E402
 from ltl_human_motion.ros.occupancy_cdr import encode_human_occupancy  # noqa: E402
 from ltl_human_motion.ros.playback import Playback  # noqa: E402
@@ -129,11 +128,6 @@ def test_bad_bringup_files_are_rejected(tmp_path: Path) -> None:
         load_bringup_config(path)
     with pytest.raises(FileNotFoundError):
         load_bringup_config(tmp_path / "missing.yaml")
-
-
-def test_coexistence_node_is_not_available_yet() -> None:
-    with pytest.raises(SystemExit, match="not available yet"):
-        coexistence_node([])
 
 
 def test_rviz_config_shows_tf_markers_and_occupancy() -> None:

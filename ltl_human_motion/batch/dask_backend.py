@@ -14,6 +14,7 @@ import contextlib
 from collections.abc import Iterator
 
 from ltl_human_motion.batch.items import ItemParams
+from ltl_human_motion.batch.specs import BatchConfigError
 from ltl_human_motion.batch.worker import BatchJob, ItemResult, prepare_worker, run_item
 from ltl_human_motion.errors import MissingDependencyError
 
@@ -52,7 +53,12 @@ def open_client(scheduler: str, workers: int) -> Iterator[Client]:
         finally:
             cluster.close()
     else:
-        with Client(scheduler) as client:
+        try:
+            client = Client(scheduler)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise BatchConfigError(f"cannot connect to the Dask scheduler {scheduler!r}: "
+                                   f"{exc}") from exc
+        with client:
             yield client
 
 

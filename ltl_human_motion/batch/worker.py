@@ -211,7 +211,7 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
     """
     from ltl_human_motion.planning.pipeline import get_library, synthesize
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     record: dict[str, Any] = {
         "index": item.index, "spec_name": item.spec_name, "spec": item.spec,
         "seed": item.seed, "params": item.params_dict(), "status": "failed",
@@ -234,6 +234,7 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
                            "check": getattr(exc, "check", None),
                            "task": getattr(exc, "task", None)}
         timing["compute_time"] = time.perf_counter() - t0
+        timing["cpu_time"] = time.process_time() - c0
         return ItemResult(record, timing, None)
     report = _plain(synth.verification)
     failed_check, detail = _first_failure(report)
@@ -252,4 +253,5 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
     timing.update({k: float(v) for k, v in synth.stats.items()
                    if k.endswith("_time") and k != "batch_total_time"})
     timing["compute_time"] = time.perf_counter() - t0
+    timing["cpu_time"] = time.process_time() - c0
     return ItemResult(record, timing, arrays)

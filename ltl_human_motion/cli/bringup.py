@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 from pathlib import Path
 
@@ -48,9 +49,13 @@ def run(args: argparse.Namespace) -> int:
     names = ", ".join(n.get_fully_qualified_name() for n in node_set.nodes)
     print(f"bringup: {names}" + (f"; recording to {args.record}" if args.record else ""),
           file=sys.stderr)
+    # SIGTERM (e.g. from a process manager) ends the run like Ctrl-C: the recording is
+    # finished and moved into place.
+    previous = signal.signal(signal.SIGTERM, node_set.request_stop)
     try:
         node_set.spin(args.duration)
     finally:
+        signal.signal(signal.SIGTERM, previous)
         path = node_set.shutdown()
     if path is not None:
         summary = {"mcap": str(path), "topics": node_set.recorder.summary()}

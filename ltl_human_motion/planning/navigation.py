@@ -194,7 +194,8 @@ class ObstacleField:
         return np.where(outside, np.maximum(out, self.far), out)
 
     def clear(self, poses: np.ndarray, stature: float, margin: float = 0.01) -> np.ndarray:
-        """Whether body poses keep ``margin`` from every obstacle.
+        """Whether body poses keep ``margin`` from every obstacle, or, for body parts
+        already closer at the first sample, get no closer.
 
         Parameters
         ----------
@@ -212,6 +213,9 @@ class ObstacleField:
             return np.ones(poses.shape[0], dtype=bool)
         seg, rad = capsules_from_positions(poses, stature)              # (M, S, K, 2, 3)
         pts = np.concatenate([seg, seg.mean(axis=-2, keepdims=True)], axis=-2)
-        need = rad[:, None] + margin + self.res * 0.4
-        ok = self.distance(pts) > need
-        return ok.reshape(poses.shape[0], -1).all(axis=1)
+        gap = self.distance(pts) - (rad[:, None] + margin + self.res * 0.4)   # (M, S, K, 3)
+        gap = gap.min(axis=-1)                                              # (M, S, K)
+        # A body part that starts closer than the margin (a worker standing at a bench)
+        # may stay there; it must not get closer.
+        allowed = np.minimum(gap[:, :1], 0.0) - 0.005
+        return np.all(gap >= allowed, axis=(1, 2))

@@ -61,6 +61,9 @@ class PlannerOptions:
         Cell size of the navigation field behind the heuristic, metres.
     goal_attempts : int
         Seeded goal primitives tried before a reach blocked by obstacles fails.
+    adjust_radius : float
+        A walk may end this far from the ideal placement; a model-made step and turn on
+        the spot covers the rest (like the analytic expansion of hybrid A*).
     """
 
     heuristic_speed: float = 0.25
@@ -70,6 +73,7 @@ class PlannerOptions:
     heading_tolerance: float = 0.35
     body_radius: float = 0.15
     goal_attempts: int = 6
+    adjust_radius: float = 0.3
     grid_resolution: float = 0.1
 
 
@@ -261,21 +265,44 @@ class SequencePlanner:
 
         return Goal(reached, distance, field.heading, desc)
 
+    def _ideal_placement(self, target: np.ndarray, placement: tuple[float, float],
+                         x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray,
+                                                                np.ndarray, np.ndarray]:
+        """Root pose (x*, y*, yaw*) from which the goal primitive reaches ``target``,
+        facing it from the side of (x, y), and whether that spot is free.
+
+        Where the ideal spot is too close to an obstacle (a bench in front), the worker
+        stands up to ``reach_tolerance`` further back. Arrays shaped like ``x``.
+        """
+        d, lat = placement
+        yaw = np.arctan2(target[1] - y, target[0] - x) - np.arctan2(lat, d)
+        c, s = np.cos(yaw), np.sin(yaw)
+        back = np.linspace(0.0, self.options.reach_tolerance, 6)
+        px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)
+        py = target[1] - (s[..., None] * (d + back) + c[..., None] * lat)
+        free = self._clearance(np.stack([px, py], axis=-1).reshape(-1, 2)).reshape(px.shape)
+        free = free > self.options.body_radius + 0.03    # the hips are wider than the legs
+        k = np.argmax(free, axis=-1)
+        pick = np.take_along_axis
+        return (pick(px, k[..., None], -1)[..., 0], pick(py, k[..., None], -1)[..., 0], yaw,
+                free.any(axis=-1))
+
     def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
                     task: str) -> Goal:
+        """Walk until a standing adjustment (a step of at most ``adjust_radius`` and a
+        turn) puts the worker where the goal primitive reaches the target."""
         tx, ty = float(target[0]), float(target[1])
-        tol, htol = self.options.reach_tolerance, self.options.heading_tolerance
+        tol = self.options.reach_tolerance
         dist = float(np.hypot(*placement))
         offset = float(np.arctan2(placement[1], placement[0]))
+        adjust = self.options.adjust_radius
 
         def ring(xy: np.ndarray) -> np.ndarray:
             return np.abs(np.hypot(tx - xy[:, 0], ty - xy[:, 1]) - dist) <= tol
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-            dx, dy = tx - x, ty - y
-            r = np.hypot(dx, dy)
-            bearing = np.arctan2(dy, dx)
-            return (np.abs(r - dist) <= tol) & (np.abs(wrap_angle(bearing - yaw - offset)) <= htol)
+            px, py, _, free = self._ideal_placement(target, placement, x, y)
+            return free & (np.hypot(px - x, py - y) <= adjust)
 
         field = self._field(ring)
         goal = self._goal_from_field(field, reached, desc, task)
@@ -287,6 +314,26 @@ class SequencePlanner:
 
         goal.heading = heading
         return goal
+
+    def _adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str) -> None:
+        """Step and turn on the spot to the ideal placement for ``target`` (if needed)."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        x, y, yaw = self.pose
+        px, py, pyaw, _ = (float(v[0]) for v in self._ideal_placement(
+            target, placement, np.array([x]), np.array([y])))
+        c, s = math.cos(yaw), math.sin(yaw)
+        dx, dy = c * (px - x) + s * (py - y), -s * (px - x) + c * (py - y)
+        dyaw = float(wrap_angle(pyaw - yaw))
+        if math.hypot(dx, dy) < 0.02 and abs(dyaw) < 0.05:
+            return
+        carrying = bool(self.held) or self._carry_stance
+        mp = make_step_primitive(self._stance(carrying), self.library.standing_height, dx, dy,
+                                 dyaw, self.library.skeleton, self.library.fps,
+                                 "carry" if carrying else "walk")
+        if not self._placed_clear(mp, self.pose):
+            return            # keep the pose the walk reached; the goal IK absorbs the rest
+        self._add(mp, self.pose, -1, self.overlap)
+        self.pose = self._hand_over_pose(mp, self.pose)
 
     def _region_goal(self, region, desc: str, task: str) -> Goal:  # noqa: ANN001
         lo, hi = np.asarray(region.lo, dtype=float), np.asarray(region.hi, dtype=float)
@@ -364,8 +411,9 @@ class SequencePlanner:
 
     def _placed_clear(self, mp: MotionPrimitive, pose: Pose) -> bool:
         """Whether ``mp`` placed at ``pose`` keeps clear of every obstacle (sampled)."""
-        frames = np.linspace(0, mp.n_frames - 1, 9).round().astype(int)
-        return bool(self._body_clear(world_positions(mp, *pose)[frames][None])[0])
+        frames = np.linspace(0, mp.n_frames - 1, 12).round().astype(int)
+        return bool(self.obstacle_field.clear(world_positions(mp, *pose)[frames][None],
+                                              self.library.skeleton.stature, margin=0.0)[0])
 
     def _step_back(self, carrying: bool, label: int) -> None:
         """Step back from an obstacle in front (a step primitive of the gait index)."""
@@ -439,9 +487,11 @@ class SequencePlanner:
             self.consumed.discard(args[0])           # a fresh part from the supply
         walked = 0
         if target is not None and kind != "release":
-            goal = self._reach_goal(target, self._placement(kind, target, text), f"reach {text} at "
+            placement = self._placement(kind, target, text)
+            goal = self._reach_goal(target, placement, f"reach {text} at "
                                     f"({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})", text)
             walked = self._walk(goal, text, -1, carry=bool(self.held))
+            self._adjust_to(target, placement, text)
         if kind == "release":
             obj = args[0]
             c, s = math.cos(self.pose[2]), math.sin(self.pose[2])

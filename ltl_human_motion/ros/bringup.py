@@ -9,6 +9,7 @@ publisher and occupancy node share one :class:`Playback` clock.
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -27,15 +28,6 @@ from ltl_human_motion.ros.playback import Playback
 from ltl_human_motion.ros.recorder import Recorder
 from ltl_human_motion.ros.skeleton_publisher import SkeletonPublisher
 from ltl_human_motion.ros.synthesis_node import SynthesisNode
-
-COEXISTENCE_UNAVAILABLE = (
-    "coexistence_node is not available yet: the robot part (ltl_human_motion.robot) is "
-    "being written; remove it from bringup.nodes for now")
-
-
-def coexistence_unavailable() -> SystemExit:
-    """The error for the node set's robot part, which does not exist yet."""
-    return SystemExit(COEXISTENCE_UNAVAILABLE)
 
 
 class Bringup:
@@ -61,8 +53,6 @@ class Bringup:
                  context: Context | None = None) -> None:
         self.config = config if isinstance(config, BringupConfig) \
             else load_bringup_config(config)
-        if "coexistence_node" in self.config.nodes:
-            raise coexistence_unavailable()
         self._owns_context = context is None
         if context is None:
             context = Context()
@@ -76,6 +66,7 @@ class Bringup:
         self._spinner: SpinThread | None = None
         self._record_spinner: SpinThread | None = None
         self._shut_down = False
+        self._stop = threading.Event()
         self.mcap_path: Path | None = None
         try:
             if record is not None:
@@ -99,6 +90,10 @@ class Bringup:
             node = SynthesisNode(synthesize_fn=synthesize_fn, node_name=spec.name, **kwargs)
             self.store = node.store
             return node
+        if spec.executable == "coexistence_node":
+            from ltl_human_motion.ros.coexistence_node import CoexistenceNode
+
+            return CoexistenceNode(node_name=spec.name, **kwargs)
         human = spec.parameters["human_id"]
         playback = self.playbacks.setdefault(human, Playback())
         if spec.executable == "skeleton_publisher":
@@ -107,14 +102,15 @@ class Bringup:
         if spec.executable == "occupancy_node":
             return OccupancyNode(store=self.store, playback=playback, node_name=spec.name,
                                  **kwargs)
-        raise coexistence_unavailable()
+        raise ValueError(f"unknown node kind {spec.executable!r}")
 
     def node(self, executable: str, human_id: str | None = None) -> Node:
         """The first node of kind ``executable`` (for human ``human_id``)."""
         for node in self.nodes:
             kind = type(node).__name__
             wanted = {"synthesis_node": "SynthesisNode", "skeleton_publisher":
-                      "SkeletonPublisher", "occupancy_node": "OccupancyNode"}[executable]
+                      "SkeletonPublisher", "occupancy_node": "OccupancyNode",
+                      "coexistence_node": "CoexistenceNode"}[executable]
             if kind == wanted and (human_id is None
                                    or getattr(node, "human_id", None) == human_id):
                 return node
@@ -133,14 +129,20 @@ class Bringup:
         return self
 
     def spin(self, duration: float | None = None) -> None:
-        """Run until Ctrl-C, context shutdown or ``duration`` seconds (in this thread)."""
+        """Run until Ctrl-C, SIGTERM, :meth:`request_stop`, context shutdown or
+        ``duration`` seconds (blocks this thread; the nodes spin on background threads)."""
         self.start()
         stop_at = None if duration is None else time.monotonic() + duration
         try:
-            while self.context.ok() and (stop_at is None or time.monotonic() < stop_at):
-                time.sleep(0.05)
+            while self.context.ok() and not self._stop.is_set() and (
+                    stop_at is None or time.monotonic() < stop_at):
+                self._stop.wait(0.05)
         except KeyboardInterrupt:
             pass
+
+    def request_stop(self, *_: object) -> None:
+        """Make :meth:`spin` return (usable as a signal handler)."""
+        self._stop.set()
 
     def shutdown(self) -> Path | None:
         """Stop spinning, close the recording, destroy the nodes; returns the MCAP path.

@@ -103,6 +103,13 @@ class BringupConfig:
                 if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
                     out[self.parameter(spec, "markers_topic", "/occupancy_markers")] = \
                         "visualization_msgs/msg/MarkerArray"
+            elif spec.executable == "coexistence_node":
+                out["/tf"] = out["/tf_static"] = "tf2_msgs/msg/TFMessage"
+                out["/joint_states"] = "sensor_msgs/msg/JointState"
+                out["/safety_status"] = f"{PACKAGE}/msg/SafetyStatus"
+                if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
+                    out[self.parameter(spec, "markers_topic", "/robot_markers")] = \
+                        "visualization_msgs/msg/MarkerArray"
         return out
 
 

@@ -130,6 +130,11 @@ class SpinThread:
         """Stop spinning, wait for the thread and the running callbacks."""
         self._stop.set()
         self._thread.join(timeout=timeout)
+        # Executor.shutdown() destroys its guard condition before the callbacks queued on
+        # its thread pool have run (rclpy 9.1), and they then fail on it; drain them first.
+        pool = getattr(self.executor, "_executor", None)
+        if pool is not None:
+            pool.shutdown(wait=True)
         for node in list(self.executor.get_nodes()):
             self.executor.remove_node(node)
         self.executor.shutdown(timeout_sec=timeout)

@@ -58,10 +58,11 @@ def occupancy_node(args: list[str] | None = None) -> int:
 
 
 def coexistence_node(args: list[str] | None = None) -> int:
-    """The robot-coexistence node (not available yet)."""
-    from ltl_human_motion.ros.bringup import coexistence_unavailable
+    """Speed and separation monitoring of a UR arm (``robot_host``) against every human's
+    ``occupancy``: reads the arm over RTDE, writes its speed slider."""
+    from ltl_human_motion.ros.coexistence_node import CoexistenceNode
 
-    raise coexistence_unavailable()
+    return _run_node(CoexistenceNode, args)
 
 
 def bringup(args: list[str] | None = None) -> int:

@@ -1,0 +1,586 @@
+"""The coexistence node: human occupancy in, UR speed slider out (ISO/TS 15066 SSM).
+
+A thin rclpy layer over :class:`~ltl_human_motion.robot.coexistence.CoexistenceController`.
+The control loop runs on a thread of its own at ``rate`` Hz (125 by default, the rate of
+a UR e-Series' RTDE interface); it reads the arm's joint positions through ``ur_rtde``,
+computes the separation between the arm's capsules and every human's capsules and writes
+the speed slider. Running it outside the executor keeps its timing independent of the
+other callbacks of the process (a one-process bringup spins a dozen of them).
+
+Subscribes to ``ltl_human_motion/msg/HumanOccupancy``: with ``occupancy_topic: auto``
+(default) every topic of that type is found and followed (checked once per second), so
+the node guards the arm against all humans at once; otherwise only the named topic. The
+separation is the minimum over all humans, and the occupancy counts as fresh only while
+every known human's stream is fresh (a human whose stream stops holds the arm at the
+slider minimum). Predicted occupancy is used when ``use_prediction`` is true.
+
+Publishes (at ``publish_rate``):
+
+* ``/joint_states`` (sensor_msgs/JointState): the six UR joints
+  (``<joint_prefix>shoulder_pan_joint`` ... ``wrist_3_joint``) as read over RTDE.
+* ``/tf``: ``<tf_prefix>base`` -> ``<tf_prefix>link_1`` ... ``link_6`` (the DH frames
+  after each joint; ``link_6`` is the flange) -> ``<tf_prefix>tool_tip``;
+  ``/tf_static``: ``<world_frame>`` -> ``<tf_prefix>base`` (the base pose parameters).
+* ``safety_status`` (ltl_human_motion/msg/SafetyStatus): separation, effective
+  separation, S_p, slider command, mode and connection of the latest control step.
+* ``markers_topic`` (``/robot_markers``, at ``marker_rate``): the arm's collision capsules
+  (namespace ``robot/capsules``, coloured by mode) and a label with mode and slider.
+
+Fail-safe behaviour comes from the controller: no or stale occupancy, a lost connection
+or a rejected occupancy never raise the speed (see :mod:`ltl_human_motion.robot.coexistence`).
+With ``metrics_out`` set, the node keeps every control decision and writes the
+commissioning report (``coexistence.json`` and ``coexistence.png``) there when destroyed.
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from geometry_msgs.msg import TransformStamped
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.node import Node
+from rclpy.serialization import deserialize_message
+from sensor_msgs.msg import JointState
+from tf2_msgs.msg import TFMessage
+from visualization_msgs.msg import MarkerArray
+
+from ltl_human_motion.msg import HumanOccupancy, SafetyStatus
+from ltl_human_motion.robot.coexistence import (
+    CoexistenceConfig,
+    CoexistenceController,
+    ControlDecision,
+    IOLike,
+    ReceiveLike,
+    ur_rtde_factories,
+)
+from ltl_human_motion.robot.kinematics import (
+    UR_MODELS,
+    forward_kinematics,
+    pose_from_xyz_rpy,
+    robot_capsules,
+    ur_model,
+)
+from ltl_human_motion.robot.metrics import DecisionRecorder, write_commissioning_report
+from ltl_human_motion.robot.ssm import SLIDER_MIN, SSMParameters
+from ltl_human_motion.ros import conversions as cv
+from ltl_human_motion.ros.common import STREAM_QOS, TF_QOS, TF_STATIC_QOS, stamp_seconds
+from ltl_human_motion.ros.params import (
+    ParamSpec,
+    declare_parameters,
+    frame_id,
+    in_range,
+    non_negative,
+    positive,
+    topic_name,
+)
+
+__all__ = ["OCCUPANCY_TYPE", "UR_JOINT_NAMES", "CoexistenceNode", "OccupancySample",
+           "coexistence_parameters", "decode_human_occupancy"]
+
+#: Joint names of Universal Robots' ROS 2 driver and description.
+UR_JOINT_NAMES = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
+                  "wrist_1_joint", "wrist_2_joint", "wrist_3_joint")
+OCCUPANCY_TYPE = "ltl_human_motion/msg/HumanOccupancy"
+_MODE_COLORS = {"full": (0.2, 0.8, 0.2), "reduced": (1.0, 0.8, 0.0), "stop": (0.9, 0.1, 0.1),
+                "stale": (0.5, 0.5, 0.5), "disconnected": (0.3, 0.3, 0.3)}
+
+# Parameter name -> SSMParameters field.
+_SSM_FIELDS = {
+    "human_speed": "human_speed", "robot_speed": "robot_speed",
+    "reaction_time": "reaction_time", "stopping_time": "stopping_time",
+    "stopping_distance": "stopping_distance", "intrusion_distance": "intrusion_distance",
+    "sensor_uncertainty": "sensor_uncertainty", "robot_uncertainty": "robot_uncertainty",
+    "margin": "margin", "min_slider": "min_slider", "max_slider": "max_slider",
+    "prediction_discount_speed": "prediction_discount_speed",
+}
+
+
+def _model_name(value: Any) -> str | None:
+    ok = isinstance(value, str) and value.lower() in UR_MODELS
+    return None if ok else f"expected one of {sorted(UR_MODELS)}, got {value!r}"
+
+
+def _host(value: Any) -> str | None:
+    ok = isinstance(value, str) and bool(value.strip()) and " " not in value.strip()
+    return None if ok else f"expected a host name or IP address, got {value!r}"
+
+
+def _finite(value: Any) -> str | None:
+    ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    return None if ok else f"expected a finite number, got {value!r}"
+
+
+def _occupancy_topic(value: Any) -> str | None:
+    return None if value == "auto" else topic_name(value)
+
+
+def _tf_prefix(value: Any) -> str | None:
+    ok = isinstance(value, str) and (value == "" or frame_id(value + "x") is None)
+    return None if ok else f"expected a TF frame prefix such as 'ur/', got {value!r}"
+
+
+def coexistence_parameters() -> list[ParamSpec]:
+    """The coexistence node's parameters (defaults: the UR5e of config/ur_pick_place.yaml
+    and the SSM defaults of :class:`~ltl_human_motion.robot.ssm.SSMParameters`)."""
+    ssm = SSMParameters()
+    spec = ParamSpec
+    return [
+        spec("robot_host", "127.0.0.1", "Robot controller (or URSim / simulator) address; "
+             "ur_rtde uses TCP 30004", _host, read_only=True),
+        spec("model", "ur5e", "UR model (ur3e, ur5e, ur10e, ur16e)", _model_name,
+             read_only=True),
+        spec("tool_length", 0.15, "Tool capsule length along the flange z axis (m)",
+             non_negative, read_only=True),
+        spec("tool_radius", 0.05, "Tool capsule radius (m)", non_negative, read_only=True),
+        spec("base_x", 1.45, "Robot base x in the world frame (m)", _finite, read_only=True),
+        spec("base_y", -1.3, "Robot base y in the world frame (m)", _finite, read_only=True),
+        spec("base_z", 0.85, "Robot base z in the world frame (m)", _finite, read_only=True),
+        spec("base_yaw", 2.62, "Robot base yaw about world z (rad)", _finite, read_only=True),
+        spec("rate", 125.0, "Control loop rate (Hz)", in_range(1.0, 1000.0), read_only=True),
+        spec("occupancy_topic", "auto", "HumanOccupancy topic, or 'auto' for every topic of "
+             "that type (all humans)", _occupancy_topic, read_only=True),
+        spec("stale_after", 0.25, "Occupancy older than this (s) is stale: slider minimum",
+             positive, read_only=True),
+        spec("robot_stale_after", 0.5, "Robot data frozen this long (s) = connection lost",
+             positive, read_only=True),
+        spec("human_speed", ssm.human_speed, "v_h: human approach speed (m/s)",
+             non_negative, read_only=True),
+        spec("robot_speed", ssm.robot_speed, "v_r: robot speed towards the human (m/s)",
+             non_negative, read_only=True),
+        spec("reaction_time", ssm.reaction_time, "T_r: sensing+processing latency (s)",
+             non_negative, read_only=True),
+        spec("stopping_time", ssm.stopping_time, "T_s: robot stopping time (s)",
+             non_negative, read_only=True),
+        spec("stopping_distance", ssm.stopping_distance, "S_s: robot stopping distance (m)",
+             non_negative, read_only=True),
+        spec("intrusion_distance", ssm.intrusion_distance, "C: intrusion distance (m)",
+             non_negative, read_only=True),
+        spec("sensor_uncertainty", ssm.sensor_uncertainty, "Z_d: sensing uncertainty (m)",
+             non_negative, read_only=True),
+        spec("robot_uncertainty", ssm.robot_uncertainty, "Z_r: robot position uncertainty (m)",
+             non_negative, read_only=True),
+        spec("margin", ssm.margin, "Band above S_p with linearly reduced speed (m)", positive,
+             read_only=True),
+        spec("min_slider", ssm.min_slider, "Slider minimum, standing for 'stop' (>= 0.01)",
+             in_range(SLIDER_MIN, 1.0), read_only=True),
+        spec("max_slider", ssm.max_slider, "Slider at full speed", in_range(SLIDER_MIN, 1.0),
+             read_only=True),
+        spec("prediction_discount_speed", ssm.prediction_discount_speed,
+             "m/s: a predicted separation dt s ahead counts as d + v dt", non_negative,
+             read_only=True),
+        spec("use_prediction", True, "Use predicted occupancy (predictive SSM)",
+             read_only=True),
+        spec("metrics_out", "", "Folder for the commissioning report written at shutdown "
+             "('' = none)", read_only=True),
+        spec("world_frame", "world", "Fixed frame of the cell", frame_id, read_only=True),
+        spec("tf_prefix", "ur/", "Prefix of the robot's TF frames", _tf_prefix,
+             read_only=True),
+        spec("joint_prefix", "", "Prefix of the joint names in /joint_states", read_only=True),
+        spec("publish_rate", 50.0, "joint_states, TF and safety_status rate (Hz)",
+             in_range(1.0, 500.0), read_only=True),
+        spec("marker_rate", 10.0, "Robot marker rate (Hz; 0 = none)", non_negative,
+             read_only=True),
+        spec("markers_topic", "/robot_markers", "MarkerArray topic", topic_name,
+             read_only=True),
+    ]
+
+
+# ---------------------------------------------------------------------- occupancy decoding
+@dataclass
+class OccupancySample:
+    """One decoded HumanOccupancy: stamp (s, ROS time), capsules and predictions."""
+
+    human_id: str
+    stamp: float
+    segments: np.ndarray                                  # (K, 2, 3)
+    radii: np.ndarray                                     # (K,)
+    predicted: list[tuple[float, np.ndarray, np.ndarray]]
+
+
+class _Reader:
+    """Reads plain little-endian CDR, aligning relative to the payload start."""
+
+    def __init__(self, data: bytes) -> None:
+        self.data = data
+        self.pos = 4                                      # after the encapsulation header
+
+    def _align(self, n: int) -> None:
+        self.pos += (-(self.pos - 4)) % n
+
+    def uint32(self) -> int:
+        self._align(4)
+        (value,) = struct.unpack_from("<I", self.data, self.pos)
+        self.pos += 4
+        return value
+
+    def int32(self) -> int:
+        self._align(4)
+        (value,) = struct.unpack_from("<i", self.data, self.pos)
+        self.pos += 4
+        return value
+
+    def float64(self) -> float:
+        self._align(8)
+        (value,) = struct.unpack_from("<d", self.data, self.pos)
+        self.pos += 8
+        return value
+
+    def string(self) -> str:
+        n = self.uint32()
+        if n == 0 or self.pos + n > len(self.data):
+            raise ValueError("bad string length")
+        text = self.data[self.pos:self.pos + n - 1].decode("utf-8")
+        self.pos += n
+        return text
+
+    def capsules(self) -> np.ndarray:
+        k = self.uint32()
+        if k == 0:
+            return np.zeros((0, 7))
+        self._align(8)
+        end = self.pos + 56 * k
+        if end > len(self.data):
+            raise ValueError("capsule sequence runs past the message")
+        rows = np.frombuffer(self.data, dtype="<f8", count=7 * k, offset=self.pos)
+        self.pos = end
+        return rows.reshape(k, 7).astype(np.float64)
+
+
+def _split(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return rows[:, :6].reshape(-1, 2, 3), rows[:, 6].copy()
+
+
+def decode_human_occupancy(data: bytes) -> OccupancySample:
+    """Decode serialized ``HumanOccupancy`` bytes straight into numpy arrays.
+
+    Plain little-endian CDR (what rclpy and Fast DDS send) is read with numpy, a few
+    microseconds for a message of 250 capsules; anything else goes through rclpy's
+    deserializer. Raises ValueError on malformed data.
+    """
+    data = bytes(data)
+    if data[:2] == b"\x00\x01":
+        try:
+            r = _Reader(data)
+            sec, nanosec = r.int32(), r.uint32()
+            r.string()                                    # frame_id
+            human_id = r.string()
+            for _ in range(r.uint32()):
+                r.string()                                # part names
+            segments, radii = _split(r.capsules())
+            r.float64()                                   # prediction_horizon
+            predicted = []
+            for _ in range(r.uint32()):
+                horizon = r.float64()
+                predicted.append((horizon, *_split(r.capsules())))
+            return OccupancySample(human_id, sec + nanosec * 1e-9, segments, radii, predicted)
+        except (struct.error, ValueError, UnicodeDecodeError):
+            pass                                          # let rclpy decide below
+    try:
+        msg = deserialize_message(data, HumanOccupancy)
+    except Exception as exc:  # rclpy raises several types for garbage
+        raise ValueError(f"cannot deserialize HumanOccupancy: {exc}") from None
+    return occupancy_from_message(msg)
+
+
+def _capsule_rows(capsules: Any) -> np.ndarray:
+    return np.array([[c.a.x, c.a.y, c.a.z, c.b.x, c.b.y, c.b.z, c.radius] for c in capsules],
+                    dtype=np.float64).reshape(-1, 7)
+
+
+def occupancy_from_message(msg: Any) -> OccupancySample:
+    """An :class:`OccupancySample` from a ``HumanOccupancy`` message object."""
+    segments, radii = _split(_capsule_rows(msg.capsules))
+    predicted = [(float(p.time_from_now), *_split(_capsule_rows(p.capsules)))
+                 for p in msg.predicted]
+    return OccupancySample(msg.human_id, stamp_seconds(msg.header.stamp), segments, radii,
+                           predicted)
+
+
+# ---------------------------------------------------------------------- small helpers
+def _quaternion_from_matrix(R: np.ndarray) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of a rotation matrix (3, 3)."""
+    m = R
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    if trace > 0:
+        s = 2.0 * math.sqrt(trace + 1.0)
+        w, x = 0.25 * s, (m[2, 1] - m[1, 2]) / s
+        y, z = (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        w, x = (m[2, 1] - m[1, 2]) / s, 0.25 * s
+        y, z = (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        w, x = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s
+        y, z = 0.25 * s, (m[1, 2] + m[2, 1]) / s
+    else:
+        s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        w, x = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s
+        y, z = (m[1, 2] + m[2, 1]) / s, 0.25 * s
+    return float(x), float(y), float(z), float(w)
+
+
+def _transform(parent: str, child: str, T: np.ndarray, stamp: Any) -> TransformStamped:
+    tf = TransformStamped()
+    tf.header.stamp = stamp
+    tf.header.frame_id = parent
+    tf.child_frame_id = child
+    t = tf.transform.translation
+    t.x, t.y, t.z = (float(v) for v in T[:3, 3])
+    q = tf.transform.rotation
+    q.x, q.y, q.z, q.w = _quaternion_from_matrix(T[:3, :3])
+    return tf
+
+
+# ---------------------------------------------------------------------- the node
+class CoexistenceNode(Node):
+    """Speed and separation monitoring of one UR arm against every human in the cell.
+
+    Parameters
+    ----------
+    receive_factory, io_factory : callable, optional
+        Connection factories (default: the real ``ur_rtde`` interfaces to ``robot_host``).
+    record : bool, optional
+        Keep every control decision in :attr:`recorder` (default: when ``metrics_out`` is
+        set).
+    on_decision : callable, optional
+        Also called with every :class:`~ltl_human_motion.robot.coexistence.ControlDecision`
+        (on the control thread).
+    """
+
+    def __init__(self, *, receive_factory: Callable[[], ReceiveLike] | None = None,
+                 io_factory: Callable[[], IOLike] | None = None, record: bool | None = None,
+                 on_decision: Callable[[ControlDecision], None] | None = None,
+                 node_name: str = "coexistence_node", **node_kwargs: Any) -> None:
+        super().__init__(node_name, **node_kwargs)
+        declare_parameters(self, coexistence_parameters())
+        p = self.param
+        try:
+            self.params = SSMParameters(**{f: float(p(n)) for n, f in _SSM_FIELDS.items()})
+            self.config = CoexistenceConfig(
+                stale_after=float(p("stale_after")),
+                robot_stale_after=float(p("robot_stale_after")),
+                use_prediction=bool(p("use_prediction")))
+        except ValueError as exc:
+            raise ValueError(f"{self.get_fully_qualified_name()}: invalid parameters: {exc}") \
+                from None
+        self.model = ur_model(p("model")).with_tool(float(p("tool_length")),
+                                                    float(p("tool_radius")))
+        self.base = pose_from_xyz_rpy((p("base_x"), p("base_y"), p("base_z")),
+                                      (0.0, 0.0, p("base_yaw")))
+        self.world_frame: str = p("world_frame")
+        self.prefix: str = p("tf_prefix")
+        self.joint_names = [p("joint_prefix") + name for name in UR_JOINT_NAMES]
+        self.use_prediction = bool(p("use_prediction"))
+        self.rate = float(p("rate"))
+        metrics_out = p("metrics_out")
+        self.metrics_out = Path(metrics_out) if metrics_out else None
+        self.recorder = DecisionRecorder() \
+            if (record if record is not None else self.metrics_out is not None) else None
+        self._extra_on_decision = on_decision
+        if receive_factory is None or io_factory is None:
+            default_receive, default_io = ur_rtde_factories(p("robot_host"))
+            receive_factory = receive_factory or default_receive
+            io_factory = io_factory or default_io
+        self.controller = CoexistenceController(
+            receive_factory, io_factory, self.model, self.base, self.params, self.config,
+            on_decision=self._on_decision)
+
+        self._humans: dict[str, tuple[float, OccupancySample]] = {}   # key -> (ctl stamp, s)
+        self._humans_lock = threading.Lock()
+        self._subscribed: set[str] = set()
+        self._latest: ControlDecision | None = None
+        self.steps = 0
+        self.messages_received = 0
+        self.messages_rejected = 0
+
+        self._joint_pub = self.create_publisher(JointState, "/joint_states", STREAM_QOS)
+        self._tf_pub = self.create_publisher(TFMessage, "/tf", TF_QOS)
+        self._tf_static_pub = self.create_publisher(TFMessage, "/tf_static", TF_STATIC_QOS)
+        self._status_pub = self.create_publisher(SafetyStatus, "safety_status", STREAM_QOS)
+        self._marker_pub = self.create_publisher(MarkerArray, p("markers_topic"), STREAM_QOS)
+        self._occ_group = MutuallyExclusiveCallbackGroup()
+        if p("occupancy_topic") == "auto":
+            self._discover()
+            self.create_timer(1.0, self._discover)
+        else:
+            self._subscribe(p("occupancy_topic"))
+        pub_group = MutuallyExclusiveCallbackGroup()
+        self.create_timer(1.0 / p("publish_rate"), self._publish_state, callback_group=pub_group)
+        if p("marker_rate") > 0:
+            self.create_timer(1.0 / p("marker_rate"), self._publish_markers,
+                              callback_group=pub_group)
+        self._publish_static()
+
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._control_loop, name="coexistence-control",
+                                        daemon=True)
+        self._thread.start()
+        mode = "predictive" if self.use_prediction else "reactive"
+        self.get_logger().info(
+            f"{self.model.name} at {p('robot_host')}: {mode} SSM at {self.rate:g} Hz, "
+            f"S_p = {self.params.protective_distance:.3f} m, occupancy from "
+            f"{p('occupancy_topic')}")
+
+    def param(self, name: str) -> Any:
+        return self.get_parameter(name).value
+
+    # ------------------------------------------------------------------ occupancy input
+    def _discover(self) -> None:
+        for topic, types in self.get_topic_names_and_types():
+            if OCCUPANCY_TYPE in types and topic not in self._subscribed:
+                self._subscribe(topic)
+
+    def _subscribe(self, topic: str) -> None:
+        self._subscribed.add(topic)
+        self.create_subscription(HumanOccupancy, topic,
+                                 lambda data, t=topic: self._on_occupancy(t, data), STREAM_QOS,
+                                 callback_group=self._occ_group, raw=True)
+        self.get_logger().info(f"following human occupancy on {topic}")
+
+    @property
+    def humans(self) -> list[str]:
+        """Keys of the humans whose occupancy the node holds."""
+        with self._humans_lock:
+            return sorted(self._humans)
+
+    def _on_occupancy(self, topic: str, data: bytes) -> None:
+        self.messages_received += 1
+        ctl_now = self.controller.clock()
+        try:
+            sample = decode_human_occupancy(data)
+        except ValueError as exc:
+            self.messages_rejected += 1
+            self.get_logger().warning(f"{topic}: {exc}", throttle_duration_sec=2.0)
+            return
+        age = self.get_clock().now().nanoseconds * 1e-9 - sample.stamp
+        key = sample.human_id or topic
+        with self._humans_lock:
+            self._humans[key] = (ctl_now - age, sample)
+            entries = list(self._humans.values())
+        stamp = min(s for s, _ in entries)
+        if len(entries) == 1:
+            segments, radii = sample.segments, sample.radii
+        else:
+            segments = np.concatenate([e.segments for _, e in entries])
+            radii = np.concatenate([e.radii for _, e in entries])
+        predicted = None
+        if self.use_prediction:
+            predicted = [(h + (s - stamp), ps, pr) for s, e in entries
+                         for h, ps, pr in e.predicted] or None
+        if not self.controller.update_occupancy(segments, radii, stamp, predicted):
+            self.messages_rejected += 1
+
+    # ------------------------------------------------------------------ control
+    def _on_decision(self, decision: ControlDecision) -> None:
+        self._latest = decision
+        self.steps += 1
+        if self.recorder is not None:
+            self.recorder(decision)
+        if self._extra_on_decision is not None:
+            self._extra_on_decision(decision)
+
+    def _control_loop(self) -> None:
+        try:
+            self.controller.run(self.rate, should_stop=self._stop.is_set)
+        except Exception as exc:  # never die silently: the slider stays where it was
+            self.get_logger().fatal(f"control loop failed: {type(exc).__name__}: {exc}")
+            raise
+
+    @property
+    def latest(self) -> ControlDecision | None:
+        """The latest control decision."""
+        return self._latest
+
+    @property
+    def control_alive(self) -> bool:
+        """True while the control thread runs."""
+        return self._thread.is_alive()
+
+    # ------------------------------------------------------------------ outputs
+    def _publish_static(self) -> None:
+        stamp = self.get_clock().now().to_msg()
+        self._tf_static_pub.publish(TFMessage(transforms=[
+            _transform(self.world_frame, f"{self.prefix}base", self.base, stamp)]))
+
+    def _publish_state(self) -> None:
+        d = self._latest
+        if d is None:
+            return
+        stamp = self.get_clock().now().to_msg()
+        status = SafetyStatus(separation=d.separation,
+                              effective_separation=d.effective_separation,
+                              protective_distance=d.protective_distance, slider=d.slider,
+                              mode=d.mode, connected=d.connected, humans=len(self.humans))
+        status.header.stamp = stamp
+        status.header.frame_id = self.world_frame
+        self._status_pub.publish(status)
+        if d.q is None:
+            return
+        joints = JointState(name=self.joint_names, position=list(d.q))
+        joints.header.stamp = stamp
+        self._joint_pub.publish(joints)
+        frames = forward_kinematics(np.asarray(d.q), self.model)
+        names = [f"{self.prefix}base"] + [f"{self.prefix}link_{i}" for i in range(1, 7)]
+        transforms = [_transform(names[i], names[i + 1],
+                                 np.linalg.solve(frames[i], frames[i + 1]), stamp)
+                      for i in range(6)]
+        tip = np.eye(4)
+        tip[2, 3] = self.model.tool_length
+        transforms.append(_transform(names[6], f"{self.prefix}tool_tip", tip, stamp))
+        self._tf_pub.publish(TFMessage(transforms=transforms))
+
+    def _publish_markers(self) -> None:
+        d = self._latest
+        if d is None or d.q is None:
+            return
+        segments, radii = robot_capsules(np.asarray(d.q), self.model, self.base)
+        f = cv.MarkerFactory(self.world_frame, self.get_clock().now().to_msg(),
+                             2.0 / max(self.param("marker_rate"), 1e-3))
+        rgba = cv.color(*_MODE_COLORS.get(d.mode, (0.5, 0.5, 0.5)), 0.6)
+        markers = f.capsules("robot/capsules", segments, radii, rgba)
+        sep = "?" if math.isnan(d.separation) else f"{d.separation:.2f} m"
+        label = f"{d.mode} {100 * d.slider:.0f}% sep {sep}"
+        markers.append(f.text("robot/status", 0, self.base[:3, 3] + [0.0, 0.0, 1.2], label,
+                              0.08, cv.color(1.0, 1.0, 1.0)))
+        self._marker_pub.publish(MarkerArray(markers=markers))
+
+    # ------------------------------------------------------------------ shutdown
+    def stop_control(self, timeout: float = 5.0) -> None:
+        """Stop the control loop and disconnect from the robot (idempotent)."""
+        if not self._stop.is_set():
+            self._stop.set()
+            self._thread.join(timeout)
+            self.controller.close()
+
+    def write_report(self, out_dir: str | Path, name: str = "coexistence",
+                     cycle_times: tuple[float, ...] | list[float] = (),
+                     baseline_cycle_time: float | None = None,
+                     extra: dict[str, Any] | None = None) -> tuple[Path, Path] | None:
+        """Write the commissioning report of the recorded decisions (None without any)."""
+        if self.recorder is None or not self.recorder.decisions:
+            return None
+        info = {"use_prediction": self.use_prediction, "rate_target_hz": self.rate,
+                "ssm_terms": self.params.terms(), **(extra or {})}
+        return write_commissioning_report(
+            list(self.recorder.decisions), out_dir, name, cycle_times, baseline_cycle_time,
+            self.params.max_slider, self.params.min_slider, info)
+
+    def destroy_node(self) -> None:
+        self.stop_control()
+        if self.metrics_out is not None:
+            try:
+                paths = self.write_report(self.metrics_out)
+                if paths is not None:
+                    self.get_logger().info(f"commissioning report: {paths[0]}, {paths[1]}")
+            except (OSError, ValueError) as exc:
+                self.get_logger().error(f"cannot write the commissioning report: {exc}")
+        super().destroy_node()
+
