@@ -6,8 +6,9 @@ with 2 workers, ``--repeat`` times each into fresh folders, and reports medians:
 throughput (verified motions per wall-clock minute, worker start-up included),
 throughput per core, scaling efficiency ``T2 / (2 T1)`` and the median per-item compute
 time; from the workers' CPU time (robust to other load on the machine) the CPU-bound
-per-core rate ``60 / mean item CPU seconds``. Then it profiles an in-process run (``workers=0``, after a warm-up) with cProfile
-and reports the top functions by cumulative time and the time per pipeline stage.
+per-core rate ``60 / mean item CPU seconds``. Then it profiles an in-process run
+(``workers=0``, after a warm-up) with cProfile and reports the top functions by
+cumulative time and the time per pipeline stage.
 Prints a summary and writes ``bench/results/batch.json``. Not a test: run
 ``python bench/batch.py`` (about 2-3 minutes on 2 cores).
 """

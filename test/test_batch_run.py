@@ -7,6 +7,7 @@ same manifest (timing aside) and byte-identical shards.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -17,6 +18,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import psutil
 import pytest
 
 from ltl_human_motion.batch import (
@@ -137,10 +139,16 @@ def test_killed_run_resumes_without_loss_or_duplicates(reference: Path, specs_fi
             assert proc.poll() is None, proc.stderr.read().decode()
             assert time.monotonic() < deadline, "the batch run made no progress"
             time.sleep(0.02)
-    finally:
-        os.killpg(proc.pid, signal.SIGKILL)             # the run and its workers
+        workers = psutil.Process(proc.pid).children(recursive=True)
+        proc.send_signal(signal.SIGKILL)                # the driver only
         proc.wait()
-    done_at_kill = _done_items(out)
+        done_at_kill = _done_items(out)
+        _, alive = psutil.wait_procs(workers, timeout=15)
+        assert not alive, "pool workers outlived the killed driver"
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)         # clean up whatever is left
+        proc.wait()
     assert 2 <= done_at_kill < COUNT
     assert not (out / "manifest.jsonl").exists()
     with pytest.raises(CorruptDatasetError, match="unfinished"):

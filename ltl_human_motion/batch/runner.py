@@ -25,7 +25,13 @@ from typing import TYPE_CHECKING, Any
 from ltl_human_motion.batch.items import ItemParams, derive_item, validate_against_cell
 from ltl_human_motion.batch.specs import BatchConfigError, BatchSpecs, load_specs
 from ltl_human_motion.batch.store import DATASET_FORMAT, DATASET_VERSION, DatasetStore
-from ltl_human_motion.batch.worker import BatchJob, ItemResult, prepare_worker, run_item
+from ltl_human_motion.batch.worker import (
+    BatchJob,
+    ItemResult,
+    pool_initializer,
+    prepare_worker,
+    run_item,
+)
 
 if TYPE_CHECKING:
     from ltl_human_motion.scene.cell import Cell
@@ -140,7 +146,7 @@ def _run_pool(job: BatchJob, items: list[ItemParams], workers: int) -> Iterator[
     window = 2 * workers + 2
     pending: dict[Future, ItemParams] = {}
     queue = iter(items)
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=prepare_worker,
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=pool_initializer,
                              initargs=(job,)) as pool:
         broken: str | None = None
         while True:

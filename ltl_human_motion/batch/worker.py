@@ -14,6 +14,7 @@ import math
 import os
 import re
 import socket
+import threading
 import time
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -22,8 +23,8 @@ import numpy as np
 
 from ltl_human_motion.batch.items import ItemParams, cell_for_item
 
-__all__ = ["ARRAY_NAMES", "BatchJob", "ItemResult", "motion_sha256", "prepare_worker",
-           "run_item"]
+__all__ = ["ARRAY_NAMES", "BatchJob", "ItemResult", "motion_sha256", "pool_initializer",
+           "prepare_worker", "run_item"]
 
 #: Per-item arrays, in the order they are hashed and stored.
 ARRAY_NAMES = ("positions", "root_yaw", "task_index", "objects")
@@ -148,6 +149,22 @@ def prepare_worker(job: BatchJob) -> None:
     if len(job.statures) <= PRELOAD_LIMIT:
         for stature in job.statures:
             get_library(float(stature), options.library_source)
+
+
+def _exit_with_parent(parent: int, period: float) -> None:
+    while os.getppid() == parent:
+        time.sleep(period)
+    os._exit(1)                     # the driver is gone: stop, do not finish the item
+
+
+def pool_initializer(job: BatchJob, period: float = 1.0) -> None:
+    """Initializer of process-pool workers: :func:`prepare_worker`, and exit with the driver.
+
+    A killed driver would otherwise leave its workers computing their current items.
+    """
+    threading.Thread(target=_exit_with_parent, args=(os.getppid(), period), daemon=True,
+                     name="lhm-exit-with-parent").start()
+    prepare_worker(job)
 
 
 # --------------------------------------------------------------------------- one item

@@ -136,7 +136,8 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     rng, cost_noise
         Seeded multiplicative noise on primitive costs, for varied but valid paths.
     body_clear : callable, optional
-        ``body_clear(poses (M, S, J, 3)) -> bool (M,)``: whole-body obstacle test, run on
+        ``body_clear(poses (M, S, J, 3), standing (M,)) -> bool (M,)``: whole-body obstacle
+        test (``standing``: the primitive starts where the last one ended), run on
         standing primitives (turns, steps) and on primitives whose root path comes within
         ``near_radius`` of an obstacle.
     near_radius : float
@@ -204,7 +205,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
                 sweep[..., 0] += px
                 sweep[..., 1] += py
                 ok = np.ones(len(succ), dtype=bool)
-                ok[exact] = body_clear(sweep)
+                ok[exact] = body_clear(sweep, index.standing[succ[exact]])
                 if not ok.any():
                     continue
                 succ, ends = succ[ok], ends[ok]

@@ -193,7 +193,8 @@ class ObstacleField:
         out = (c00 * (1 - fy) + c10 * fy) * (1 - fz) + (c01 * (1 - fy) + c11 * fy) * fz
         return np.where(outside, np.maximum(out, self.far), out)
 
-    def clear(self, poses: np.ndarray, stature: float, margin: float = 0.01) -> np.ndarray:
+    def clear(self, poses: np.ndarray, stature: float, margin: float = 0.01,
+              relative: bool = False) -> np.ndarray:
         """Whether body poses keep ``margin`` from every obstacle, or, for body parts
         already closer at the first sample, get no closer.
 
@@ -203,6 +204,8 @@ class ObstacleField:
             S sampled poses of each of M candidates.
         stature : float
         margin : float
+        relative : bool
+            For standing primitives that start where the last motion ended.
 
         Returns
         -------
@@ -215,7 +218,7 @@ class ObstacleField:
         pts = np.concatenate([seg, seg.mean(axis=-2, keepdims=True)], axis=-2)
         gap = self.distance(pts) - (rad[:, None] + margin + self.res * 0.4)   # (M, S, K, 3)
         gap = gap.min(axis=-1)                                              # (M, S, K)
-        # A body part that starts closer than the margin (a worker standing at a bench)
-        # may stay there; it must not get closer.
-        allowed = np.minimum(gap[:, :1], 0.0) - 0.005
+        # With ``relative``, a body part that starts closer than the margin (a worker
+        # standing at a bench) may stay there; it must not get closer.
+        allowed = np.minimum(gap[:, :1], 0.0) - 0.005 if relative else 0.0
         return np.all(gap >= allowed, axis=(1, 2))

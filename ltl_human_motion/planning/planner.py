@@ -373,9 +373,16 @@ class SequencePlanner:
         mp = MotionPrimitive("stand", "wait", rel, root, self.library.fps, "planner: stand")
         self._add(mp, self.pose, label, self.overlap)
 
-    def _body_clear(self, poses: np.ndarray) -> np.ndarray:
-        """Whether sampled poses (M, S, J, 3) keep 2 cm from every obstacle, shape (M,)."""
-        return self.obstacle_field.clear(poses, self.library.skeleton.stature)
+    def _body_clear(self, poses: np.ndarray, standing: np.ndarray) -> np.ndarray:
+        """Whether sampled poses (M, S, J, 3) keep 1 cm from every obstacle, shape (M,);
+        standing primitives (``standing`` (M,)) need only not come closer."""
+        out = np.ones(len(poses), dtype=bool)
+        stature = self.library.skeleton.stature
+        for rel in (False, True):
+            sel = standing == rel
+            if sel.any():
+                out[sel] = self.obstacle_field.clear(poses[sel], stature, relative=rel)
+        return out
 
     def _stance(self, carrying: bool) -> np.ndarray:
         lib = self.library
@@ -413,7 +420,8 @@ class SequencePlanner:
         """Whether ``mp`` placed at ``pose`` keeps clear of every obstacle (sampled)."""
         frames = np.linspace(0, mp.n_frames - 1, 12).round().astype(int)
         return bool(self.obstacle_field.clear(world_positions(mp, *pose)[frames][None],
-                                              self.library.skeleton.stature, margin=0.0)[0])
+                                              self.library.skeleton.stature, margin=0.0,
+                                              relative=True)[0])
 
     def _step_back(self, carrying: bool, label: int) -> None:
         """Step back from an obstacle in front (a step primitive of the gait index)."""

@@ -11,8 +11,8 @@ Subscribes to ``ltl_human_motion/msg/HumanOccupancy``: with ``occupancy_topic: a
 (default) every topic of that type is found and followed (checked once per second), so
 the node guards the arm against all humans at once; otherwise only the named topic. The
 separation is the minimum over all humans, and the occupancy counts as fresh only while
-every known human's stream is fresh (a human whose stream stops holds the arm at the
-slider minimum). Predicted occupancy is used when ``use_prediction`` is true.
+every known human's stream is fresh: a human whose stream stops holds the arm at the
+slider minimum (until ``forget_after`` s of silence, when set, drop them). Predicted occupancy is used when ``use_prediction`` is true.
 
 Publishes (at ``publish_rate``):
 
@@ -148,6 +148,9 @@ def coexistence_parameters() -> list[ParamSpec]:
              "that type (all humans)", _occupancy_topic, read_only=True),
         spec("stale_after", 0.25, "Occupancy older than this (s) is stale: slider minimum",
              positive, read_only=True),
+        spec("forget_after", 0.0, "A human whose stream has been silent this long (s) is "
+             "dropped, so the others decide again (0 = never; until then: minimum)",
+             non_negative, read_only=True),
         spec("robot_stale_after", 0.5, "Robot data frozen this long (s) = connection lost",
              positive, read_only=True),
         spec("human_speed", ssm.human_speed, "v_h: human approach speed (m/s)",
@@ -380,6 +383,7 @@ class CoexistenceNode(Node):
         self.joint_names = [p("joint_prefix") + name for name in UR_JOINT_NAMES]
         self.use_prediction = bool(p("use_prediction"))
         self.rate = float(p("rate"))
+        self.forget_after = float(p("forget_after"))
         metrics_out = p("metrics_out")
         self.metrics_out = Path(metrics_out) if metrics_out else None
         self.recorder = DecisionRecorder() \
@@ -464,6 +468,12 @@ class CoexistenceNode(Node):
         key = sample.human_id or topic
         with self._humans_lock:
             self._humans[key] = (ctl_now - age, sample)
+            if self.forget_after > 0:
+                for k in [k for k, (s, _) in self._humans.items()
+                          if ctl_now - s > self.forget_after]:
+                    del self._humans[k]
+                    self.get_logger().warning(f"human {k!r} silent for over "
+                                              f"{self.forget_after:g} s: forgotten")
             entries = list(self._humans.values())
         stamp = min(s for s, _ in entries)
         if len(entries) == 1:

@@ -92,9 +92,22 @@ def spin_nodes(nodes: Sequence[Node], num_threads: int = DEFAULT_EXECUTOR_THREAD
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        for node in nodes:
-            executor.remove_node(node)
-        executor.shutdown()
+        shutdown_executor(executor)
+
+
+def shutdown_executor(executor: Executor, timeout: float = 5.0) -> None:
+    """Remove the nodes and shut ``executor`` down after its queued callbacks ran.
+
+    ``Executor.shutdown()`` destroys its guard condition before the callbacks queued on a
+    MultiThreadedExecutor's pool have run (rclpy 9.1), and they then fail on it ("cannot
+    use Destroyable"); so the pool is drained first.
+    """
+    pool = getattr(executor, "_executor", None)
+    if pool is not None:
+        pool.shutdown(wait=True)
+    for node in list(executor.get_nodes()):
+        executor.remove_node(node)
+    executor.shutdown(timeout_sec=timeout)
 
 
 class SpinThread:
@@ -130,11 +143,4 @@ class SpinThread:
         """Stop spinning, wait for the thread and the running callbacks."""
         self._stop.set()
         self._thread.join(timeout=timeout)
-        # Executor.shutdown() destroys its guard condition before the callbacks queued on
-        # its thread pool have run (rclpy 9.1), and they then fail on it; drain them first.
-        pool = getattr(self.executor, "_executor", None)
-        if pool is not None:
-            pool.shutdown(wait=True)
-        for node in list(self.executor.get_nodes()):
-            self.executor.remove_node(node)
-        self.executor.shutdown(timeout_sec=timeout)
+        shutdown_executor(self.executor, timeout)

@@ -1,0 +1,365 @@
+"""The coexistence loop end to end: real DDS (loopback) and real RTDE (ur_rtde 1.6.5).
+
+One module-wide stack: the simulated UR5e of config/ur_pick_place.yaml in its own process
+on 127.0.0.1:30004, and the node set of config/bringup_coexistence.yaml (synthesis node,
+worker 1's skeleton publisher and occupancy node, coexistence node) in this process.
+Requests and observations go through a client node in its own rclpy context (DDS); the
+robot's speed slider is read back over RTDE by a separate ``RTDEReceiveInterface``, as any
+client of the controller would see it. No mocks of ROS or ur_rtde.
+
+ur_rtde cannot use another port than 30004, so the tests wait (bounded) for the port to be
+free and never run two simulated controllers at once.
+"""
+
+from __future__ import annotations
+
+import ast
+import math
+import runpy
+import sys
+import time
+import types
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+rclpy = pytest.importorskip("rclpy")
+rtde_receive = pytest.importorskip("rtde_receive")
+pytest.importorskip("rtde_io")
+
+from ltl_human_motion.msg import HumanOccupancy, SafetyStatus, TaskState  # noqa: E402
+from rclpy.parameter import Parameter  # noqa: E402
+from rclpy.serialization import serialize_message  # noqa: E402
+from sensor_msgs.msg import JointState  # noqa: E402
+from tf2_msgs.msg import TFMessage  # noqa: E402
+from visualization_msgs.msg import MarkerArray  # noqa: E402
+
+from ltl_human_motion.robot.ur_sim import URSimHandle  # noqa: E402
+from ltl_human_motion.ros import conversions as cv  # noqa: E402
+from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
+from ltl_human_motion.ros.bringup_config import load_bringup_config  # noqa: E402
+from ltl_human_motion.ros.client import ClientSession  # noqa: E402
+from ltl_human_motion.ros.coexistence_demo import start_sim_when_free  # noqa: E402
+from ltl_human_motion.ros.coexistence_node import (  # noqa: E402
+    UR_JOINT_NAMES,
+    CoexistenceNode,
+    decode_human_occupancy,
+)
+from ltl_human_motion.ros.entry_points import coexistence_node  # noqa: E402
+from ltl_human_motion.ros.occupancy_cdr import encode_human_occupancy  # noqa: E402
+from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = ROOT / "config" / "bringup_coexistence.yaml"
+LAUNCH_FILE = ROOT / "launch" / "coexistence.launch.py"
+HOST = "127.0.0.1"
+MIN = 0.01
+S_P = 1.06                       # the SSM defaults of the config
+# The worker grasps O1, assembles at R1 (on the robot's workbench), then walks to O2,
+# about 3 m from the robot: in, then out of the robot's workspace.
+SPEC = "grasp(O1) & F(assemble(R1) & F grasp(O2))"
+RATE = 2.5                       # playback rate (22.8 s of motion in about 9 s)
+
+
+def wait_for(predicate: Callable[[], Any], timeout: float, what: str,
+             period: float = 0.02) -> Any:
+    """Poll until ``predicate()`` is truthy; fail naming ``what`` after ``timeout`` s."""
+    end = time.monotonic() + timeout
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() > end:
+            pytest.fail(f"timed out after {timeout:g} s waiting for {what}")
+        time.sleep(period)
+
+
+class Stack:
+    """The simulated robot, the node set and a client session."""
+
+    def __init__(self, tmp: Path) -> None:
+        self.sim: URSimHandle = start_sim_when_free(timeout=60.0)
+        try:
+            self.bringup = Bringup(CONFIG, overrides={
+                "store_dir": str(tmp / "motions"), "forget_after": 1.5}).start()
+        except BaseException:
+            self.sim.stop()
+            raise
+        self.node: CoexistenceNode = self.bringup.node("coexistence_node")  # type: ignore
+        self.session = ClientSession("coexistence_test_client")
+        self.status = self.session.watch(SafetyStatus, "/safety_status", keep=1)
+        self.task = self.session.watch(TaskState, "/human_1/task_state", keep=1)
+        self.joints = self.session.watch(JointState, "/joint_states", keep=1)
+        self.tf = self.session.watch(TFMessage, "/tf", keep=20)
+        self.markers = self.session.watch(MarkerArray, "/robot_markers", keep=1)
+        self.readback: Any = None
+
+    def connect_readback(self) -> Any:
+        """A separate RTDE client reading the controller's state."""
+        if self.readback is None:
+            self.readback = rtde_receive.RTDEReceiveInterface(HOST)
+        return self.readback
+
+    def drop_readback(self) -> None:
+        if self.readback is not None:
+            self.readback.disconnect()
+            self.readback = None
+
+    def slider(self) -> float:
+        """The speed slider as the controller reports it over RTDE."""
+        return float(self.connect_readback().getTargetSpeedFraction())
+
+    def play(self, motion_id: str, command: str = "play", rate: float = RATE) -> None:
+        response = self.session.call(PlayMotion, "/human_1/play_motion", PlayMotion.Request(
+            command=command, motion_id=motion_id if command == "play" else "", rate=rate))
+        assert response.success, response.message
+
+    def close(self) -> None:
+        self.session.close()
+        self.bringup.shutdown()                  # closes the RTDE clients: robot reachable
+        self.drop_readback()
+        self.sim.stop()
+
+
+@pytest.fixture(scope="module")
+def stack(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Stack]:
+    s = Stack(tmp_path_factory.mktemp("coexistence"))
+    try:
+        wait_for(lambda: s.node.latest is not None and s.node.latest.connected, 15.0,
+                 "the coexistence node to connect to the simulated UR over RTDE")
+        yield s
+    finally:
+        s.close()
+
+
+@pytest.fixture(scope="module")
+def motion_id(stack: Stack) -> str:
+    response = stack.session.call(SynthesizeMotion, "/synthesize_motion",
+                                  SynthesizeMotion.Request(spec=SPEC, cell="paper_cell"),
+                                  timeout=120.0)
+    assert response.success, response.error_message
+    assert "assemble(R1)" in response.task_sequences[0]
+    return response.motion_ids[0]
+
+
+def hold_worker_at_start(stack: Stack, motion_id: str) -> None:
+    """Worker 1 stands at the start of the motion (R0, ~1.2 m from the arm)."""
+    stack.play(motion_id)
+    stack.play(motion_id, "pause")
+
+
+# ------------------------------------------------------------------ end to end
+def test_worker_in_robot_workspace_slows_the_robot_which_resumes_after(
+        stack: Stack, motion_id: str) -> None:
+    stack.slider()                               # readback connected before the run
+    stack.play(motion_id)
+    samples = []                                 # (task, slider over RTDE, status mode)
+    end = time.monotonic() + 22.8 / RATE + 1.5
+    while time.monotonic() < end:
+        task, status = stack.task.last, stack.status.last
+        if task is not None and task.motion_id == motion_id and status is not None:
+            samples.append((task.current_task or task.next_task, stack.slider(), status.mode,
+                            status.separation))
+        time.sleep(0.02)
+    assert len(samples) > 100, f"too few samples ({len(samples)}): no task state/status?"
+    at_bench = [s for s in samples if s[0] == "assemble(R1)"]
+    after = [s for s in samples if s[0] == "grasp(O2)"]
+    assert at_bench and after, sorted({s[0] for s in samples})
+    # In the robot's workspace: the controller slows the arm down to the minimum ("stop").
+    assert min(s[1] for s in at_bench) == pytest.approx(MIN, abs=1e-6), at_bench[::10]
+    assert "stop" in {s[2] for s in at_bench}
+    assert min(s[3] for s in at_bench) < S_P
+    # Before reaching the bench the arm moved faster than the minimum ...
+    before = samples[:samples.index(at_bench[0])]
+    assert max(s[1] for s in before) > 0.5
+    # ... and after the worker has walked away to O2 (about 3 m) it is back at full speed.
+    tail = after[-10:]
+    assert all(s[1] == pytest.approx(1.0) for s in tail), tail
+    assert {s[2] for s in tail} == {"full"}
+    # The ROS side shows the robot: joint states, TF of the links, capsule markers.
+    joints = stack.joints.last
+    assert list(joints.name) == list(UR_JOINT_NAMES) and len(joints.position) == 6
+    frames = {t.child_frame_id for m in stack.tf.messages for t in m.transforms}
+    assert {"ur/link_1", "ur/link_6", "ur/tool_tip"} <= frames
+    assert {m.ns for m in stack.markers.last.markers} >= {"robot/capsules", "robot/status"}
+    assert stack.status.last.protective_distance == pytest.approx(S_P)
+    assert stack.node.control_alive
+
+
+def test_stale_occupancy_commands_the_minimum_and_recovers(stack: Stack,
+                                                           motion_id: str) -> None:
+    hold_worker_at_start(stack, motion_id)
+    wait_for(lambda: stack.status.last.mode in ("reduced", "full") and stack.slider() > MIN,
+             5.0, "the arm to move with the worker held at the start")
+    stack.play(motion_id, "stop")                # the occupancy stream stops
+    t0 = time.monotonic()
+    wait_for(lambda: stack.slider() == pytest.approx(MIN), 2.0,
+             "the slider minimum over RTDE after the occupancy stream stopped")
+    assert time.monotonic() - t0 < 1.0           # stale_after is 0.25 s
+    wait_for(lambda: stack.status.last.mode == "stale", 1.0, "safety_status mode 'stale'")
+    hold_worker_at_start(stack, motion_id)       # the stream returns
+    wait_for(lambda: stack.slider() > MIN + 0.05, 5.0,
+             "the arm to speed up again once occupancy returned")
+    assert stack.node.control_alive
+
+
+def test_every_human_counts(stack: Stack, motion_id: str) -> None:
+    """A second worker (published here over DDS) next to the arm stops it, although
+    worker 1 stands away; once their stream has been silent for forget_after, worker 1
+    decides again."""
+    hold_worker_at_start(stack, motion_id)
+    wait_for(lambda: stack.slider() > MIN + 0.05, 5.0, "the arm to move (worker 1 away)")
+    publisher = stack.session.node.create_publisher(HumanOccupancy, "/human_2/occupancy", 10)
+    base = np.array([1.45, -1.3, 0.85])
+    segments = np.array([[[*(base + [-0.3, 0.3, -0.85])], [*(base + [-0.3, 0.3, 0.6])]]])
+    clock = stack.session.node.get_clock()
+
+    def publish_close_worker() -> bool:
+        sec, nanosec = divmod(clock.now().nanoseconds, 1_000_000_000)
+        publisher.publish(encode_human_occupancy(sec, nanosec, "world", "2", ["torso"],
+                                                 segments[None], np.array([0.2]),
+                                                 np.zeros(1)))
+        return stack.slider() == pytest.approx(MIN) and stack.status.last.humans == 2
+
+    wait_for(publish_close_worker, 8.0, "the arm to stop for worker 2 (found by 'auto')")
+    assert stack.status.last.separation < S_P
+    stack.session.node.destroy_publisher(publisher)
+    wait_for(lambda: stack.slider() > MIN + 0.05, 5.0,
+             "worker 1 alone to decide again after worker 2 was forgotten")
+    assert stack.status.last.humans == 1
+
+
+def test_dropped_robot_connection_is_survived(stack: Stack, motion_id: str) -> None:
+    hold_worker_at_start(stack, motion_id)
+    wait_for(lambda: stack.status.last.connected and stack.slider() > MIN, 5.0,
+             "a connected, moving arm")
+    stack.drop_readback()
+    stack.sim.kill()                             # controller crash / cable pulled
+    status = wait_for(lambda: (s := stack.status.last) is not None and s.mode == "disconnected"
+                      and s, 3.0, "safety_status 'disconnected' after the controller died")
+    assert not status.connected and status.slider == pytest.approx(MIN)
+    count = stack.status.count
+    time.sleep(0.5)
+    assert stack.status.count > count + 5, "the node stopped publishing without a robot"
+    assert stack.node.control_alive
+    # The controller comes back with a slider of 100 %; the node must reconnect by itself
+    # and command the (lower) slider the separation from worker 1 calls for.
+    stack.sim = start_sim_when_free(timeout=30.0, initial_speed_slider=1.0)
+    wait_for(lambda: stack.status.last.connected and stack.status.last.mode in (
+        "reduced", "stop"), 10.0, "the node to reconnect to the restarted controller")
+    wait_for(lambda: abs(stack.slider() - stack.status.last.slider) < 0.05
+             and stack.slider() < 0.9, 5.0, "the restarted controller to follow the node")
+    assert stack.node.controller.reconnects >= 2
+
+
+# ------------------------------------------------------------------ pieces
+def test_occupancy_decoder_matches_rclpy() -> None:
+    rng = np.random.default_rng(3)
+    for n, k in [(11, 23), (1, 23), (3, 0)]:
+        segments = rng.normal(size=(n, k, 2, 3))
+        radii = rng.uniform(0.01, 0.2, k)
+        msg = HumanOccupancy(human_id="h7", part_names=[f"p{i}" for i in range(k)],
+                             capsules=cv.capsule_messages(segments[0], radii))
+        msg.header.stamp.sec, msg.header.stamp.nanosec = 12, 250_000_000
+        msg.header.frame_id = "world"
+        msg.predicted = [_predicted(0.1 * i, segments[i], radii) for i in range(1, n)]
+        decoded = decode_human_occupancy(serialize_message(msg))   # rclpy's serializer
+        assert decoded.human_id == "h7" and decoded.stamp == pytest.approx(12.25)
+        np.testing.assert_array_equal(decoded.segments, segments[0])
+        np.testing.assert_array_equal(decoded.radii, radii)
+        assert [h for h, _, _ in decoded.predicted] == pytest.approx(
+            [0.1 * i for i in range(1, n)])
+        for i, (_, s, r) in enumerate(decoded.predicted, start=1):
+            np.testing.assert_array_equal(s, segments[i])
+    with pytest.raises(ValueError, match="HumanOccupancy"):
+        decode_human_occupancy(b"\x00\x01\x00\x00\x05")
+
+
+def _predicted(t: float, segments: np.ndarray, radii: np.ndarray) -> Any:
+    from ltl_human_motion.msg import PredictedOccupancy
+
+    return PredictedOccupancy(time_from_now=t, capsules=cv.capsule_messages(segments, radii))
+
+
+def test_invalid_parameters_are_rejected() -> None:
+    context = rclpy.context.Context()
+    rclpy.init(context=context)
+    try:
+        for name, value, match in [("rate", -5.0, "rate"), ("model", "ur99", "model"),
+                                   ("min_slider", 0.0, "min_slider"),
+                                   ("stale_after", 0.0, "stale_after"),
+                                   ("occupancy_topic", "not a topic", "occupancy_topic"),
+                                   ("base_x", math.inf, "base_x")]:
+            with pytest.raises(ValueError, match=match):
+                CoexistenceNode(context=context,
+                                parameter_overrides=[Parameter(name, value=value)])
+        with pytest.raises(ValueError, match="min_slider <= max_slider"):
+            CoexistenceNode(context=context, parameter_overrides=[
+                Parameter("min_slider", value=0.5), Parameter("max_slider", value=0.2)])
+    finally:
+        rclpy.try_shutdown(context=context)
+    assert coexistence_node(["--ros-args", "-p", "rate:=-5.0"]) == 2
+
+
+def _launch_nodes(monkeypatch: pytest.MonkeyPatch, config: Path, host: str) -> list[dict]:
+    """Run the launch file against recording stand-ins of launch/launch_ros (absent)."""
+    def module(name: str, **attrs: Any) -> None:
+        mod = types.ModuleType(name)
+        mod.__dict__.update(attrs)
+        monkeypatch.setitem(sys.modules, name, mod)
+
+    class LaunchConfiguration:
+        def __init__(self, name: str) -> None:
+            self.name = name
+
+        def perform(self, context: dict[str, str]) -> str:
+            return context[self.name]
+
+    class OpaqueFunction:
+        def __init__(self, function: Any) -> None:
+            self.function = function
+
+    module("launch", LaunchDescription=list)
+    module("launch.actions", OpaqueFunction=OpaqueFunction,
+           DeclareLaunchArgument=lambda name, **kw: ("arg", name, kw))
+    module("launch.substitutions", LaunchConfiguration=LaunchConfiguration)
+    module("launch_ros")
+    module("launch_ros.actions", Node=lambda **kw: kw)
+    description = runpy.run_path(str(LAUNCH_FILE))["generate_launch_description"]()
+    opaque = next(a for a in description if isinstance(a, OpaqueFunction))
+    return opaque.function({"config": str(config), "robot_host": host})
+
+
+def test_launch_file_and_bringup_start_the_same_nodes(monkeypatch: pytest.MonkeyPatch,
+                                                      tmp_path: Path) -> None:
+    # 127.0.0.2: loopback, but nothing serves RTDE there, so this bringup's coexistence
+    # node cannot reach (and command) a simulated controller of another test.
+    launched = _launch_nodes(monkeypatch, CONFIG, "127.0.0.2")
+    bringup = Bringup(CONFIG, overrides={"store_dir": str(tmp_path), "robot_host": "127.0.0.2"})
+    try:
+        started = {(n.get_namespace(), n.get_name()): n for n in bringup.nodes}
+        assert {("/" + (kw["namespace"] or "").strip("/"), kw["name"]) for kw in launched} \
+            == set(started)
+        kinds = {kw["name"]: kw["executable"] for kw in launched}
+        assert kinds["coexistence_node"] == "coexistence_node"
+        coexistence = started[("/", "coexistence_node")]
+        assert isinstance(coexistence, CoexistenceNode)
+        spec = next(s for s in load_bringup_config(CONFIG).node_specs()
+                    if s.executable == "coexistence_node")
+        for name in ("rate", "stale_after", "human_speed", "base_yaw", "use_prediction"):
+            assert coexistence.get_parameter(name).value == \
+                load_bringup_config(CONFIG).parameter(spec, name)
+        launched_coex = next(kw for kw in launched if kw["name"] == "coexistence_node")
+        assert launched_coex["parameters"] == [str(CONFIG.resolve()),
+                                               {"robot_host": "127.0.0.2"}]
+    finally:
+        bringup.shutdown()
+    tree = ast.parse(LAUNCH_FILE.read_text())
+    assert not any(isinstance(n, ast.Import | ast.ImportFrom) and any(
+        (a.name if isinstance(n, ast.Import) else (n.module or "")).startswith("launch")
+        for a in n.names) for n in tree.body)
