@@ -241,3 +241,34 @@ def test_cli_reports_bad_arguments(specs_file: Path, tmp_path: Path,
     assert main(["batch", "--cell", "paper_cell", "--specs", str(bad), "--count", "1",
                  "--out", str(tmp_path / "y")]) == 2
     assert "bad.yaml: specs[0].weight: expected a positive number" in capsys.readouterr().err
+
+
+def test_unverified_motions_are_kept_on_request_and_filtered(tmp_path: Path) -> None:
+    specs = tmp_path / "strict.yaml"
+    specs.write_text("specs: [S1]\nsequence_mode: all\nkeep_unverified: true\n"
+                     "options: {max_joint_speed: 0.5}\n")    # no walk is that slow
+    summary = run_batch("paper_cell", specs, 2, tmp_path / "ds", workers=0, progress=False)
+    assert summary.counts == {"ok": 0, "unverified": 2, "failed": 0}
+    ds = open_dataset(tmp_path / "ds")
+    assert list(ds.items()) == []                        # verified only, by default
+    kept = list(ds.items(verified_only=False))
+    assert [it.index for it in kept] == [0, 1]
+    for it in kept:
+        assert not it.verified
+        assert it.record["error"]["check"] == "smoothness"
+        assert not it.record["verification"]["smoothness"]["passed"]
+        assert it.record["verification"]["collision"]["passed"]
+        assert it.positions.shape[0] == it.record["n_frames"]
+
+
+def test_two_runs_cannot_write_one_folder(reference: Path, specs_file: Path) -> None:
+    from ltl_human_motion.batch import DatasetStore
+
+    header = json.loads((reference / "dataset.json").read_text())
+    holder = DatasetStore(reference, header)           # as if another run were active
+    try:
+        with pytest.raises(BatchConfigError, match="another batch run is writing"):
+            _run(specs_file, reference, workers=0)
+    finally:
+        holder.close()
+    assert _run(specs_file, reference, workers=0).skipped == COUNT

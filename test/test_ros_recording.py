@@ -131,3 +131,27 @@ def test_ros_demo_loop(tmp_path: Path) -> None:
     assert json.loads((tmp_path / "ros_summary.json").read_text())["motion_ids"] == \
         summary["motion_ids"]
     assert (tmp_path / "motions" / f"{summary['motion_ids'][0]}.npz").is_file()
+
+
+def _pipeline_available() -> bool:
+    """True once the lead exports ``planning.synthesize`` (the contract's name)."""
+    try:
+        from ltl_human_motion import planning
+    except ImportError:
+        return False
+    return callable(getattr(planning, "synthesize", None))
+
+
+@pytest.mark.pipeline
+@pytest.mark.slow
+@pytest.mark.skipif(not _pipeline_available(), reason="planning.synthesize is not available yet")
+def test_ros_demo_loop_with_the_pipeline_s2(tmp_path: Path) -> None:
+    summary = run_ros_demo("S2", "paper_cell", tmp_path, playback_rate=10.0)
+    assert summary["success"], summary["error"]
+    for task in ("grasp(O1)", "grasp(O2)", "assemble(R1)"):
+        assert task in summary["task_sequence"]
+    assert summary["motion_duration"] > 1.0
+    assert summary["recorded"]["/human_1/occupancy"]["count"] > 100
+    _, decoded = read_mcap(Path(summary["mcap"]))
+    states = [m for t, m in decoded if t == "/human_1/task_state"]
+    assert {s.current_task for s in states} >= {"grasp(O1)", "grasp(O2)", "assemble(R1)"}

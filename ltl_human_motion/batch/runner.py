@@ -240,7 +240,17 @@ def run_batch(cell: str | os.PathLike[str], specs: BatchSpecs | str | os.PathLik
         specs = load_specs(specs)
     job, parsed_cell = make_job(cell, specs, dtype)
     store = DatasetStore(out, _header(job, specs, parsed_cell, seed, count, shard_size))
-    summary = BatchSummary(out=Path(out), count=count)
+    try:
+        return _run_store(store, job, specs, seed, count, workers, scheduler, progress,
+                          on_item)
+    finally:
+        store.close()
+
+
+def _run_store(store: DatasetStore, job: BatchJob, specs: BatchSpecs, seed: int, count: int,
+               workers: int, scheduler: str | None, progress: bool,
+               on_item: Callable[[ItemResult], None] | None) -> BatchSummary:
+    summary = BatchSummary(out=store.root, count=count)
     done = store.recover()
     summary.skipped = len(done)
     todo = [derive_item(specs, seed, i) for i in range(count) if i not in done]

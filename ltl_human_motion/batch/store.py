@@ -129,16 +129,36 @@ class DatasetStore:
                     f"{self.root}: holds a different dataset (differs in {', '.join(diff)}); "
                     "resuming needs the same cell, specs, seed, count, shard size and dtype. "
                     "Use another --out folder.")
-        elif self.root.exists() and any(p.name != ".gitkeep" for p in self.root.iterdir()):
+        elif self.root.exists() and any(p.name not in (".gitkeep", ".lock")
+                                        for p in self.root.iterdir()):
             raise BatchConfigError(f"{self.root}: exists, is not empty and is not a dataset "
                                    "(no dataset.json); use an empty or new --out folder")
         self.staging.mkdir(parents=True, exist_ok=True)
         self.shards.mkdir(parents=True, exist_ok=True)
+        self._lock()
         if not self.header_path.is_file():
             self._write_header(self.header)
         for folder in (self.staging, self.shards, self.root):
             for tmp in folder.glob(".*.tmp"):          # left by a killed atomic write
                 tmp.unlink(missing_ok=True)
+
+    def _lock(self) -> None:
+        """Hold an exclusive lock on ``out/.lock`` (released when the process ends)."""
+        import fcntl
+        # Held (not a context manager) until close() or the end of the process.
+        self._lock_fh = open(self.root / ".lock", "a+b")
+        try:
+            fcntl.flock(self._lock_fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self._lock_fh.close()
+            raise BatchConfigError(f"{self.root}: another batch run is writing to this "
+                                   "folder") from None
+
+    def close(self) -> None:
+        """Release the folder lock."""
+        fh = getattr(self, "_lock_fh", None)
+        if fh is not None and not fh.closed:
+            fh.close()
 
     def _write_header(self, header: dict[str, Any]) -> None:
         atomic_write_text(self.header_path, json.dumps(header, sort_keys=True, indent=1)

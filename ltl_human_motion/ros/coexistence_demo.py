@@ -25,10 +25,15 @@ time) and needs ``baseline_cycle_time``.
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import json
 import math
+import os
 import socket
+import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -48,12 +53,40 @@ from ltl_human_motion.ros.common import SpinThread
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 
 __all__ = ["RTDE_PORT", "ROBOT_CONFIG", "node_parameters_from_robot_config",
-           "run_coexistence_demo", "start_sim_when_free", "wait_port_free"]
+           "rtde_port_lock", "run_coexistence_demo", "start_sim_when_free", "wait_port_free"]
 
 ROOT = Path(__file__).resolve().parents[2]
 ROBOT_CONFIG = ROOT / "config" / "ur_pick_place.yaml"
 #: ur_rtde always connects to this port: only one simulated controller per machine.
 RTDE_PORT = 30004
+
+
+@contextlib.contextmanager
+def rtde_port_lock(timeout: float = 120.0) -> Iterator[None]:
+    """Hold the machine-wide lock of the simulated controller's port 30004.
+
+    ur_rtde always connects to 30004, so a second simulated controller (another test
+    session, demo or benchmark on the machine) would serve, or steal, the first one's
+    clients. Everything here that starts one takes this lock (an ``flock`` on a file in
+    the temporary folder) for as long as its controller runs. TimeoutError after
+    ``timeout`` s.
+    """
+    path = Path(tempfile.gettempdir()) / f"ltl_human_motion-rtde-{RTDE_PORT}.lock"
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+    try:
+        end = time.monotonic() + timeout
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if time.monotonic() > end:
+                    raise TimeoutError(f"another simulated UR run holds {path} for over "
+                                       f"{timeout:g} s") from None
+                time.sleep(0.2)
+        yield
+    finally:
+        os.close(fd)                              # releases the lock
 
 
 def wait_port_free(host: str = "127.0.0.1", port: int = RTDE_PORT,
@@ -258,10 +291,15 @@ def run_coexistence_demo(out_dir: str | Path, spec: str = "S1", duration: float 
     summary: dict[str, Any] = {"spec": spec, "cell": cell, "robot_host": node_params[
         "robot_host"], "simulated_robot": robot_host is None, "playback_rate": playback_rate,
         "success": False, "error": ""}
-    sim = start_sim_when_free(robot_config, port_timeout) if robot_host is None else None
+    stack = contextlib.ExitStack()
+    sim: URSimHandle | None = None
     node_set: Bringup | None = None
     session: ClientSession | None = None
     try:
+        if robot_host is None:
+            stack.enter_context(rtde_port_lock(port_timeout))
+            sim = start_sim_when_free(robot_config, port_timeout)
+            stack.callback(sim.stop)
         node_set = Bringup(None, overrides={"store_dir": str(out / "motions"), "cell": cell})
         node_set.start()
         session = ClientSession("coexistence_demo_client")
@@ -305,8 +343,7 @@ def run_coexistence_demo(out_dir: str | Path, spec: str = "S1", duration: float 
             session.close()
         if node_set is not None:
             node_set.shutdown()
-        if sim is not None:
-            sim.stop()
+        stack.close()                             # stops the simulated UR, then unlocks
         summary["wall_time"] = round(time.monotonic() - started, 2)
         atomic_write_text(out / "coexistence_summary.json",
                           json.dumps(summary, indent=2, allow_nan=False, default=_json_default)

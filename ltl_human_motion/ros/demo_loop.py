@@ -74,7 +74,7 @@ def run_ros_demo(spec: str, cell: str, out_dir: str | Path, duration: float | No
         node_set.start()
         session = ClientSession("demo_client")
         tf_log = session.watch(TFMessage, "/tf", keep=1)
-        marker_log = session.watch(MarkerArray, "/markers", keep=50)
+        marker_log = session.watch(MarkerArray, "/markers", keep=300)
         state_log = session.watch(TaskState, f"{ns}/task_state", keep=1)
         occ_log = session.watch(HumanOccupancy, f"{ns}/occupancy", keep=0)
 

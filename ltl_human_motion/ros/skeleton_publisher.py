@@ -39,6 +39,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from geometry_msgs.msg import TransformStamped
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -79,8 +80,9 @@ def skeleton_parameters() -> list[ParamSpec]:
                   read_only=True, dynamic_typing=True),
         ParamSpec("world_frame", "world", "Fixed frame of the cell", frame_id, read_only=True),
         ParamSpec("publish_rate", 30.0, "TF, marker and task state rate (Hz)", positive),
-        ParamSpec("cell", "paper_cell", "Cell shown as markers ('' for none)"),
-        ParamSpec("scene_period", 2.0, "Seconds between cell marker messages", positive),
+        ParamSpec("cell", "paper_cell", "Cell shown as markers ('' for none)", read_only=True),
+        ParamSpec("scene_period", 2.0, "Seconds between cell marker messages", positive,
+                  read_only=True),
         ParamSpec("motion_id", "", "Motion played as soon as it is known ('' for none)",
                   lambda v: None if v == "" else _id_error(v)),
         ParamSpec("autoplay", False, "Play every newly announced motion"),
@@ -147,8 +149,12 @@ class SkeletonPublisher(Node):
         self.add_post_set_parameters_callback(self._on_parameters_set)
         self._publish_static_frames()
         self._publish_scene()
-        if self.param("motion_id") and self.param("motion_id") in self.source.known():
-            self._play(self.param("motion_id"), self.param("loop"), self.param("playback_rate"))
+        wanted = self.param("motion_id")
+        if wanted and wanted in self.source.known():
+            try:
+                self._play(wanted, self.param("loop"), self.param("playback_rate"))
+            except (KeyError, ValueError, OSError) as exc:
+                self.get_logger().error(f"cannot play {wanted!r}: {exc}")
 
     def param(self, name: str) -> Any:
         return self.get_parameter(name).value
@@ -225,6 +231,11 @@ class SkeletonPublisher(Node):
                                                 callback_group=self._timer_group)
             elif p.name == "playback_rate" and self.playback.state(now_seconds(self)) != STOPPED:
                 self.playback.set_rate(now_seconds(self), p.value)
+            elif p.name == "motion_id" and p.value and p.value in self.source.known():
+                try:
+                    self._play(p.value, self.param("loop"), self.param("playback_rate"))
+                except (KeyError, ValueError, OSError) as exc:
+                    self.get_logger().error(f"cannot play {p.value!r}: {exc}")
 
     # -- outputs --------------------------------------------------------------------------
     def _tick(self) -> None:
@@ -317,7 +328,7 @@ class SkeletonPublisher(Node):
             if lo is None or hi is None:
                 continue
             centre = (np.asarray(lo, dtype=np.float64) + np.asarray(hi, dtype=np.float64)) / 2
-            tf = cv.TransformStamped()
+            tf = TransformStamped()
             tf.header.stamp, tf.header.frame_id = stamp, self.world_frame
             tf.child_frame_id = f"cell/{name}"
             tf.transform.translation.x, tf.transform.translation.y, \
