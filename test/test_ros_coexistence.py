@@ -31,6 +31,7 @@ rtde_receive = pytest.importorskip("rtde_receive")
 pytest.importorskip("rtde_io")
 
 from ltl_human_motion.msg import HumanOccupancy, SafetyStatus, TaskState  # noqa: E402
+from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 from rclpy.serialization import serialize_message  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
@@ -53,7 +54,6 @@ from ltl_human_motion.ros.coexistence_node import (  # noqa: E402
 )
 from ltl_human_motion.ros.entry_points import coexistence_node  # noqa: E402
 from ltl_human_motion.ros.occupancy_cdr import encode_human_occupancy  # noqa: E402
-from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -225,8 +225,8 @@ def test_every_human_counts(stack: Stack, motion: tuple[str, float]) -> None:
     decides again."""
     worker_away(stack, motion[0])
     publisher = stack.session.node.create_publisher(HumanOccupancy, "/human_2/occupancy", 10)
-    base = np.array([1.45, -1.3, 0.85])
-    segments = np.array([[[*(base + [-0.3, 0.3, -0.85])], [*(base + [-0.3, 0.3, 0.6])]]])
+    # A standing torso 0.42 m from the robot's base (1.45, -1.3) on the workbench.
+    segments = np.array([[[1.15, -1.0, 0.0], [1.15, -1.0, 1.45]]])
     clock = stack.session.node.get_clock()
 
     def publish_close_worker() -> Any:
@@ -290,7 +290,7 @@ def test_occupancy_decoder_matches_rclpy() -> None:
         np.testing.assert_array_equal(decoded.radii, radii)
         assert [h for h, _, _ in decoded.predicted] == pytest.approx(
             [0.1 * i for i in range(1, n)])
-        for i, (_, s, r) in enumerate(decoded.predicted, start=1):
+        for i, (_, s, _r) in enumerate(decoded.predicted, start=1):
             np.testing.assert_array_equal(s, segments[i])
     with pytest.raises(ValueError, match="HumanOccupancy"):
         decode_human_occupancy(b"\x00\x01\x00\x00\x05")

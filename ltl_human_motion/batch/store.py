@@ -24,10 +24,10 @@ rows ``frame_offsets[k]:frame_offsets[k + 1]``. Failed items have records but no
 
 A record holds ``index``, ``status`` (ok | unverified | failed), ``spec_name``, ``spec``,
 ``seed``, ``params`` (cycles, stature, object/region offsets), ``sequence``, ``lasso``,
-``duration``, ``n_frames``, ``fps``, ``verified``, ``verification`` (every check),
-``motion_sha256``, ``error`` (type, message, check, task), ``shard``, ``row``,
-``shard_sha256`` and ``timing`` (compute times and worker: the only part that differs
-between runs).
+``duration``, ``n_frames``, ``fps``, ``start_pose`` (x, y, yaw), ``nodes_expanded``,
+``verified``, ``verification`` (every check), ``motion_sha256``, ``error`` (type,
+message, check, task), ``shard``, ``row``, ``shard_sha256`` and ``timing`` (compute and
+CPU times, worker: the only part that differs between runs).
 """
 
 from __future__ import annotations

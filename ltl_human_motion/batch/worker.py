@@ -233,7 +233,8 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
         "index": item.index, "spec_name": item.spec_name, "spec": item.spec,
         "seed": item.seed, "params": item.params_dict(), "status": "failed",
         "sequence": None, "lasso": None, "duration": None, "n_frames": None, "fps": None,
-        "verified": False, "verification": None, "motion_sha256": None, "error": None}
+        "verified": False, "verification": None, "motion_sha256": None, "error": None,
+        "nodes_expanded": None, "start_pose": None}
     timing: dict[str, Any] = {"worker": f"{socket.gethostname()}:{os.getpid()}"}
     arrays = None
     try:
@@ -255,11 +256,14 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
         return ItemResult(record, timing, None)
     report = _plain(synth.verification)
     failed_check, detail = _first_failure(report)
+    if failed_check is None and report.get("passed", True) is False:
+        failed_check, detail = "passed", "the verification report did not pass"
     verified = failed_check is None
     record.update({"sequence": list(synth.sequence), "lasso": str(synth.stats.get("lasso")),
                    "duration": float(synth.duration), "n_frames": int(synth.n_frames),
                    "fps": float(synth.fps), "verified": verified, "verification": report,
-                   "nodes_expanded": int(synth.stats.get("nodes_expanded", 0))})
+                   "nodes_expanded": int(synth.stats.get("nodes_expanded", 0)),
+                   "start_pose": _plain(synth.stats.get("start_pose"))})
     if verified or job.keep_unverified:
         arrays = _arrays(synth, job.dtype)
         record["motion_sha256"] = motion_sha256(arrays)

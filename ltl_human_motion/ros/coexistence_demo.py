@@ -52,8 +52,15 @@ from ltl_human_motion.ros.coexistence_node import CoexistenceNode
 from ltl_human_motion.ros.common import SpinThread
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 
-__all__ = ["RTDE_PORT", "ROBOT_CONFIG", "node_parameters_from_robot_config",
-           "rtde_port_lock", "run_coexistence_demo", "start_sim_when_free", "wait_port_free"]
+__all__ = [
+    "ROBOT_CONFIG",
+    "RTDE_PORT",
+    "node_parameters_from_robot_config",
+    "rtde_port_lock",
+    "run_coexistence_demo",
+    "start_sim_when_free",
+    "wait_port_free",
+]
 
 ROOT = Path(__file__).resolve().parents[2]
 ROBOT_CONFIG = ROOT / "config" / "ur_pick_place.yaml"

@@ -12,7 +12,8 @@ Subscribes to ``ltl_human_motion/msg/HumanOccupancy``: with ``occupancy_topic: a
 the node guards the arm against all humans at once; otherwise only the named topic. The
 separation is the minimum over all humans, and the occupancy counts as fresh only while
 every known human's stream is fresh: a human whose stream stops holds the arm at the
-slider minimum (until ``forget_after`` s of silence, when set, drop them). Predicted occupancy is used when ``use_prediction`` is true.
+slider minimum (until ``forget_after`` s of silence, when set, drop them). Predicted
+occupancy is used when ``use_prediction`` is true.
 
 Publishes (at ``publish_rate``):
 
