@@ -38,7 +38,7 @@ from ltl_human_motion.atomic import atomic_write_text  # noqa: E402
 def _periods(times: np.ndarray, rate: float) -> dict[str, float]:
     dt = np.diff(times)
     return {
-        "steps": int(len(times)),
+        "steps": len(times),
         "rate_hz": float((len(times) - 1) / (times[-1] - times[0])),
         "period_median_ms": float(np.median(dt) * 1e3),
         "period_p99_ms": float(np.percentile(dt, 99) * 1e3),
@@ -83,23 +83,29 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=10.0, help="seconds per mode")
     parser.add_argument("--rate", type=float, default=125.0, help="target loop rate (Hz)")
+    parser.add_argument("--switch-interval", type=float, default=None, metavar="S",
+                        help="sys.setswitchinterval for the process (default: Python's "
+                             "5 ms); the node's entry point and `coexist` use 0.001")
     parser.add_argument("--out", type=Path, default=ROOT / "bench" / "results"
                         / "coexistence_loop.json")
     args = parser.parse_args(argv)
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    if args.switch_interval is not None:
+        sys.setswitchinterval(args.switch_interval)
 
     import rtde_receive
+    from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 
     from ltl_human_motion.ros.bringup import Bringup
     from ltl_human_motion.ros.client import ClientSession
     from ltl_human_motion.ros.coexistence_demo import rtde_port_lock, start_sim_when_free
     from ltl_human_motion.ros.testing import scripted_synthesize
-    from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 
     results: dict[str, Any] = {
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
                     "load_avg_1min": os.getloadavg()[0]},
         "target_rate_hz": args.rate, "duration_s": args.duration,
+        "switch_interval_s": sys.getswitchinterval(),
         "setup": "one process: skeleton publisher (30 Hz) + occupancy node (100 Hz, 1 s "
                  "prediction) + coexistence node; simulated UR5e in its own process; "
                  "ur_rtde 1.6.5 over loopback",

@@ -146,7 +146,7 @@ def reproduce_paper(out_dir: str | Path, seed: int = 1, cycles: int = 2,
         "sequences": {n: s.sequence for n, s in results.items()},
         "verification": {n: {k: v["passed"] for k, v in s.verification.items()
                              if isinstance(v, dict)} for n, s in results.items()},
-        "files": files + ["tab2_goal_primitives.md", "tab3_times.md", "times.json"],
+        "files": [*files, "tab2_goal_primitives.md", "tab3_times.md", "times.json"],
     }
     atomic_write_text(out / "times.json", json.dumps(summary, indent=2, default=str))
     summary["tables"] = {"tab2": _tab2(results), "tab3": tab3}

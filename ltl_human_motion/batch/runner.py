@@ -10,6 +10,7 @@ needs the package and, for mesh cells, the mesh files).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import multiprocessing
@@ -141,13 +142,32 @@ def _run_inline(job: BatchJob, items: list[ItemParams], workers: int) -> Iterato
         yield item, run_item(job, item), None
 
 
+#: Thread pools of numeric libraries in worker processes: one thread each (as Dask's
+#: worker processes do), so N workers on N cores do not oversubscribe them.
+_SINGLE_THREAD_ENV = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+@contextlib.contextmanager
+def _worker_environment() -> Iterator[None]:
+    """Set the single-thread variables the spawned workers inherit (unless already set)."""
+    added = [k for k in _SINGLE_THREAD_ENV if k not in os.environ]
+    for key in added:
+        os.environ[key] = "1"
+    try:
+        yield
+    finally:
+        for key in added:
+            os.environ.pop(key, None)
+
+
 def _run_pool(job: BatchJob, items: list[ItemParams], workers: int) -> Iterator[Outcome]:
     ctx = multiprocessing.get_context("spawn")
     window = 2 * workers + 2
     pending: dict[Future, ItemParams] = {}
     queue = iter(items)
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=pool_initializer,
-                             initargs=(job,)) as pool:
+    with _worker_environment(), ProcessPoolExecutor(
+            max_workers=workers, mp_context=ctx, initializer=pool_initializer,
+            initargs=(job,)) as pool:
         broken: str | None = None
         while True:
             while broken is None and len(pending) < window:

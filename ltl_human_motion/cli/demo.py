@@ -57,8 +57,8 @@ def _paper(args: argparse.Namespace) -> dict:
 
 
 def _ros(args: argparse.Namespace) -> dict:
-    from ltl_human_motion.ros.demo_loop import run_ros_demo
     from ltl_human_motion.ltl.spec import PAPER_SPECS
+    from ltl_human_motion.ros.demo_loop import run_ros_demo
     _say("bringing up the ROS 2 nodes and calling the synthesis service for S2")
     summary = run_ros_demo(PAPER_SPECS["S2"], "paper_cell", args.out / "ros", seed=args.seed,
                            playback_rate=args.playback_rate)

@@ -9,7 +9,6 @@ import numpy as np
 
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 
-
 BODY_SAMPLES = 5
 
 

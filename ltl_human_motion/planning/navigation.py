@@ -112,7 +112,7 @@ class ClearanceMap:
         Metres.
     """
 
-    def __init__(self, cell, resolution: float = 0.04, tall_extra: float = 0.25,  # noqa: ANN001
+    def __init__(self, cell, resolution: float = 0.04, tall_extra: float = 0.25,
                  tall_height: float = 1.2) -> None:
         from scipy.interpolate import RegularGridInterpolator
         lo = np.asarray(cell.workspace_lo[:2], dtype=np.float64)
@@ -156,7 +156,7 @@ class ObstacleField:
         nothing can touch them.
     """
 
-    def __init__(self, cell, resolution: float = 0.05, pad: float = 0.5) -> None:  # noqa: ANN001
+    def __init__(self, cell, resolution: float = 0.05, pad: float = 0.5) -> None:
         self.res = float(resolution)
         self.empty = not cell.obstacles
         if self.empty:
@@ -178,20 +178,12 @@ class ObstacleField:
         pts = np.asarray(points, dtype=np.float64)
         if self.empty:
             return np.full(pts.shape[:-1], np.inf)
-        u = (pts - self.lo) / self.res
+        from scipy.ndimage import map_coordinates
+        u = (pts.reshape(-1, 3) - self.lo) / self.res
         outside = np.any((u < 0) | (u > self.shape - 1), axis=-1)
-        u = np.clip(u, 0, self.shape - 1.000001)
-        i = np.floor(u).astype(np.int64)
-        f = u - i
-        d = self.dist
-        i0, j0, k0 = i[..., 0], i[..., 1], i[..., 2]
-        fx, fy, fz = f[..., 0], f[..., 1], f[..., 2]
-        c00 = d[i0, j0, k0] * (1 - fx) + d[i0 + 1, j0, k0] * fx
-        c10 = d[i0, j0 + 1, k0] * (1 - fx) + d[i0 + 1, j0 + 1, k0] * fx
-        c01 = d[i0, j0, k0 + 1] * (1 - fx) + d[i0 + 1, j0, k0 + 1] * fx
-        c11 = d[i0, j0 + 1, k0 + 1] * (1 - fx) + d[i0 + 1, j0 + 1, k0 + 1] * fx
-        out = (c00 * (1 - fy) + c10 * fy) * (1 - fz) + (c01 * (1 - fy) + c11 * fy) * fz
-        return np.where(outside, np.maximum(out, self.far), out)
+        out = map_coordinates(self.dist, u.T, order=1, mode="nearest")
+        out = np.where(outside, np.maximum(out, self.far), out)
+        return out.reshape(pts.shape[:-1])
 
     def clear(self, poses: np.ndarray, stature: float, margin: float = 0.01,
               relative: bool = False) -> np.ndarray:

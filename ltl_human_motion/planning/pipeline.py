@@ -29,7 +29,7 @@ from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlan
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, verify_motion
 
-__all__ = ["SynthesisOptions", "resolve_cell", "synthesize", "get_library"]
+__all__ = ["SynthesisOptions", "get_library", "resolve_cell", "synthesize"]
 
 
 @dataclass(frozen=True)
@@ -92,7 +92,7 @@ class SynthesisOptions:
                    library_source=data.get("library_source"))
 
 
-def resolve_cell(cell):  # noqa: ANN001, ANN201 - Cell | str | Path
+def resolve_cell(cell):
     """A :class:`~ltl_human_motion.scene.cell.Cell` from a Cell, a name, a path or YAML text."""
     from ltl_human_motion.scene.cell import Cell, cell_by_name, cell_from_yaml, load_cell
     if isinstance(cell, Cell):
@@ -111,7 +111,7 @@ def resolve_cell(cell):  # noqa: ANN001, ANN201 - Cell | str | Path
 
 
 @functools.lru_cache(maxsize=8)
-def get_library(stature: float = DEFAULT_STATURE, source: str | None = None):  # noqa: ANN201
+def get_library(stature: float = DEFAULT_STATURE, source: str | None = None):
     """The motion library for one body size, cached in memory and on disk."""
     from ltl_human_motion.motion.library import load_library
     return load_library(stature=stature, source=source)
@@ -191,7 +191,7 @@ def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np
     return tracks, held
 
 
-def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,  # noqa: ANN001
+def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
                cycles: int = 1, stature: float = DEFAULT_STATURE,
                options: SynthesisOptions | None = None) -> list[SynthesizedMotion]:
     """Synthesize ``variants`` verified full-body motions satisfying ``spec`` in ``cell``.
@@ -271,7 +271,7 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0, 
     return results
 
 
-def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, variant,  # noqa: ANN001
+def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, variant,
                     options, t_automaton, t_sequence, t_library, stature
                     ) -> SynthesizedMotion:
     t_start = time.perf_counter()
@@ -293,12 +293,12 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     t_planning = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    positions, root_yaw, labels, spans = concatenate(plan.segments)
+    positions, root_yaw, _labels, spans = concatenate(plan.segments)
     # Linear blends of joint positions shorten bones between unlike poses; restore them.
     positions = enforce_bone_lengths(positions, library.skeleton)
     tracks, held = _object_tracks(cell, plan, spans, positions, library.overlap)
     timeline = []
-    for i, step in enumerate(plan.steps):
+    for step in plan.steps:
         if step.goal_segment is not None:
             a, b = spans[step.goal_segment]
         else:

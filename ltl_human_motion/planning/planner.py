@@ -17,6 +17,7 @@ where every grasp picks a new part from the floor.
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import dataclass, field
@@ -148,7 +149,7 @@ def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, 
 _INDEX_CACHE: dict[int, tuple[object, GaitIndex]] = {}
 
 
-def gait_index(library) -> GaitIndex:  # noqa: ANN001
+def gait_index(library) -> GaitIndex:
     """The library's gait index extended with turns on the spot, built once per library."""
     hit = _INDEX_CACHE.get(id(library))
     if hit is not None and hit[0] is library:
@@ -165,7 +166,7 @@ _CLEARANCE_CACHE: dict[str, tuple[ClearanceMap, ObstacleField]] = {}
 _FIELDS_FORMAT = 1
 
 
-def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:  # noqa: ANN001
+def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
     """The floor clearance map and 3D obstacle field of ``cell``, once per obstacle layout.
 
     Cached in memory and on disk (next to the motion library cache), keyed by a hash of
@@ -214,7 +215,7 @@ class SequencePlanner:
     options : PlannerOptions
     """
 
-    def __init__(self, cell, library, rng: np.random.Generator,  # noqa: ANN001
+    def __init__(self, cell, library, rng: np.random.Generator,
                  options: PlannerOptions = PlannerOptions()) -> None:
         self.cell = cell
         self.library = library
@@ -267,13 +268,13 @@ class SequencePlanner:
     def _clearance(self, xy: np.ndarray) -> np.ndarray:
         return self.clearance(xy)
 
-    def _field(self, goal_cells) -> NavigationField:  # noqa: ANN001
+    def _field(self, goal_cells) -> NavigationField:
         lo, hi = self.cell.workspace_lo[:2], self.cell.workspace_hi[:2]
         radius = self.options.body_radius
         return NavigationField(lo, hi, lambda xy: self._clearance(xy) > radius, goal_cells,
                                self.options.grid_resolution)
 
-    def _goal_from_field(self, field: NavigationField, reached, desc: str,  # noqa: ANN001
+    def _goal_from_field(self, field: NavigationField, reached, desc: str,
                          task: str) -> Goal:
         if not field.has_goal:
             raise PlanningError(f"task {task}: {desc}: every place to stand there is blocked "
@@ -360,7 +361,7 @@ class SequencePlanner:
         self._add(mp, self.pose, -1, self.overlap)
         self.pose = self._hand_over_pose(mp, self.pose)
 
-    def _region_goal(self, region, desc: str, task: str) -> Goal:  # noqa: ANN001
+    def _region_goal(self, region, desc: str, task: str) -> Goal:
         lo, hi = np.asarray(region.lo, dtype=float), np.asarray(region.hi, dtype=float)
         margin = 0.15
 
@@ -391,7 +392,7 @@ class SequencePlanner:
 
     def _stand_still(self, label: int, seconds: float) -> None:
         """A short standing segment (start of the motion, end of a walk task)."""
-        n = max(int(round(seconds * self.library.fps)), self.overlap + 2)
+        n = max(round(seconds * self.library.fps), self.overlap + 2)
         rel = np.repeat(self._stance(bool(self.held))[None], n, axis=0)
         root = np.zeros((n, 4))
         root[:, 2] = self.library.standing_height
@@ -428,8 +429,8 @@ class SequencePlanner:
         tucked[arms, 0] = np.minimum(carry[arms, 0], free[arms, 0] + 0.08)
         waypoints = [a, tucked, b]
         legs = []
-        for p, q in zip(waypoints[:-1], waypoints[1:]):
-            n = max(int(round(0.3 * self.library.fps)), self.overlap + 2)
+        for p, q in itertools.pairwise(waypoints):
+            n = max(round(0.3 * self.library.fps), self.overlap + 2)
             s = min_jerk(np.linspace(0.0, 1.0, n))[:, None, None]
             legs.append(p[None] + s * (q - p)[None])
         rel = np.concatenate([legs[0], legs[1][1:]])
@@ -451,7 +452,7 @@ class SequencePlanner:
     def _step_back(self, carrying: bool, label: int) -> None:
         """Step back from an obstacle in front (a step primitive of the gait index)."""
         task = "carry" if carrying else "walk"
-        for j, mp in enumerate(self.index.primitives):
+        for _j, mp in enumerate(self.index.primitives):
             if mp.task == task and mp.meta.get("step") == [-0.3, 0.0] and not mp.meta.get("turn"):
                 self._add(mp, self.pose, label, self.overlap)
                 self.pose = self._hand_over_pose(mp, self.pose)

@@ -59,7 +59,7 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
     """
     stand = np.asarray(stand, dtype=np.float64)
     duration = 0.5 + 0.45 * abs(angle) / (np.pi / 2) + 1.2 * np.hypot(dx, dy)
-    n = int(round(duration * fps)) + 1
+    n = round(duration * fps) + 1
     t = np.linspace(0.0, 1.0, n)
     s_root = _progress(t, 0.05, 0.95)
     heading = angle * s_root
@@ -94,7 +94,7 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
     root[:, :2] = root_xy
     root[:, 2] = height - dip
     root[:, 3] = heading
-    deg = int(round(np.degrees(angle)))
+    deg = round(np.degrees(angle))
     name = (f"{task}_turn_{deg:+d}" if dx == 0 and dy == 0 else
             f"{task}_step_{dx:+.2f}_{dy:+.2f}_{deg:+d}")
     return MotionPrimitive(name=name, task=task, poses=poses, root=root, fps=fps,
@@ -108,7 +108,7 @@ def make_turn_primitive(stand: np.ndarray, height: float, angle: float, skeleton
     return make_step_primitive(stand, height, 0.0, 0.0, angle, skeleton, fps, task, lift)
 
 
-def turn_primitives(library) -> list[MotionPrimitive]:  # noqa: ANN001 - MotionLibrary
+def turn_primitives(library) -> list[MotionPrimitive]:
     """Turns and steps on the spot for walking and carrying on the library's body."""
     out = []
     for task, stand in (("walk", library.standing_pose), ("carry", library.carry_standing_pose)):

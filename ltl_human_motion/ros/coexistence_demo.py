@@ -31,6 +31,7 @@ import json
 import math
 import os
 import socket
+import sys
 import tempfile
 import time
 from collections.abc import Iterator
@@ -48,7 +49,7 @@ from ltl_human_motion.robot.trajectory import load_robot_config
 from ltl_human_motion.robot.ur_sim import URSimHandle, start_ur_sim_process
 from ltl_human_motion.ros.bringup import Bringup
 from ltl_human_motion.ros.client import ClientSession, wait_until
-from ltl_human_motion.ros.coexistence_node import CoexistenceNode
+from ltl_human_motion.ros.coexistence_node import CONTROL_SWITCH_INTERVAL, CoexistenceNode
 from ltl_human_motion.ros.common import SpinThread
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 
@@ -299,6 +300,8 @@ def run_coexistence_demo(out_dir: str | Path, spec: str = "S1", duration: float 
         "robot_host"], "simulated_robot": robot_host is None, "playback_rate": playback_rate,
         "success": False, "error": ""}
     stack = contextlib.ExitStack()
+    stack.callback(sys.setswitchinterval, sys.getswitchinterval())
+    sys.setswitchinterval(CONTROL_SWITCH_INTERVAL)     # restored at the end
     sim: URSimHandle | None = None
     node_set: Bringup | None = None
     session: ClientSession | None = None

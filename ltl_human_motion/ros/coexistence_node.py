@@ -82,13 +82,18 @@ from ltl_human_motion.ros.params import (
     topic_name,
 )
 
-__all__ = ["OCCUPANCY_TYPE", "UR_JOINT_NAMES", "CoexistenceNode", "OccupancySample",
-           "coexistence_parameters", "decode_human_occupancy"]
+__all__ = ["CONTROL_SWITCH_INTERVAL", "OCCUPANCY_TYPE", "UR_JOINT_NAMES", "CoexistenceNode",
+           "OccupancySample", "coexistence_parameters", "decode_human_occupancy",
+           "occupancy_from_message"]
 
 #: Joint names of Universal Robots' ROS 2 driver and description.
 UR_JOINT_NAMES = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
                   "wrist_1_joint", "wrist_2_joint", "wrist_3_joint")
 OCCUPANCY_TYPE = "ltl_human_motion/msg/HumanOccupancy"
+#: ``sys.setswitchinterval`` for processes running the control loop (Python's default is
+#: 5 ms, the longest a thread waiting for the GIL may wait for a busy one): with 1 ms the
+#: loop keeps closer to 125 Hz next to other busy nodes (bench/coexistence_loop.py).
+CONTROL_SWITCH_INTERVAL = 0.001
 _MODE_COLORS = {"full": (0.2, 0.8, 0.2), "reduced": (1.0, 0.8, 0.0), "stop": (0.9, 0.1, 0.1),
                 "stale": (0.5, 0.5, 0.5), "disconnected": (0.3, 0.3, 0.3)}
 

@@ -60,8 +60,9 @@ def occupancy_node(args: list[str] | None = None) -> int:
 def coexistence_node(args: list[str] | None = None) -> int:
     """Speed and separation monitoring of a UR arm (``robot_host``) against every human's
     ``occupancy``: reads the arm over RTDE, writes its speed slider."""
-    from ltl_human_motion.ros.coexistence_node import CoexistenceNode
+    from ltl_human_motion.ros.coexistence_node import CONTROL_SWITCH_INTERVAL, CoexistenceNode
 
+    sys.setswitchinterval(CONTROL_SWITCH_INTERVAL)   # the 125 Hz loop waits less for the GIL
     return _run_node(CoexistenceNode, args)
 
 
