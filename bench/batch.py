@@ -5,10 +5,11 @@ assemble R1; object and start jitter; stature 1.75 m) on a local process pool wi
 with 2 workers, ``--repeat`` times each into fresh folders, and reports medians:
 throughput (verified motions per wall-clock minute, worker start-up included),
 throughput per core, scaling efficiency ``T2 / (2 T1)`` and the median per-item compute
-time; from the workers' CPU time (robust to other load on the machine) the CPU-bound
-per-core rate ``60 / mean item CPU seconds``. Then it profiles an in-process run
-(``workers=0``, after a warm-up) with cProfile and reports the top functions by
-cumulative time and the time per pipeline stage.
+time, next to the scaling efficiency of a pure-CPU loop measured before and after (what
+a machine shared with other jobs actually offers). From the workers' CPU time (robust
+to other load) it gives the CPU-bound per-core rate ``60 / mean item CPU seconds``.
+Then it profiles an in-process run (``workers=0``, after a warm-up) with cProfile and
+reports the top functions by cumulative time and the time per pipeline stage.
 Prints a summary and writes ``bench/results/batch.json``. Not a test: run
 ``python bench/batch.py`` (about 2-3 minutes on 2 cores).
 """
@@ -46,6 +47,27 @@ sequence_mode: all
 TARGET_PER_CORE = 1000.0       # verified S2 motions per minute per core (issue 8)
 STAGES = ("automaton_time", "sequence_time", "planning_time", "blending_time",
           "verification_time")
+
+
+def _spin(n: int) -> float:
+    t0 = time.perf_counter()
+    sum(range(n))
+    return time.perf_counter() - t0
+
+
+def _spin_efficiency(n: int = 30_000_000) -> float:
+    """Scaling efficiency of a pure-CPU loop in 1 vs 2 processes: what the machine gives.
+
+    On a machine shared with other jobs this is well below 1; the batch efficiency should
+    be read relative to it.
+    """
+    import multiprocessing
+    ctx = multiprocessing.get_context("spawn")
+    with ctx.Pool(2) as pool:
+        pool.map(_spin, [1000, 1000])                       # start both processes
+        single = min(pool.map(_spin, [n]) for _ in range(3))[0]
+        pair = min(max(pool.map(_spin, [n, n])) for _ in range(3))
+    return single / pair
 
 
 def _throughput(specs, count: int, workers: int, folder: Path, seed: int) -> dict:
@@ -108,6 +130,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     specs = specs_from_yaml(SPECS, "bench/batch.py:SPECS")
     load_before = list(os.getloadavg())
+    spin = [_spin_efficiency()]
     runs: dict[int, list[dict]] = {1: [], 2: []}
     with tempfile.TemporaryDirectory(prefix="lhm-bench-batch-") as tmp:
         folder = Path(tmp)
@@ -118,6 +141,7 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"  {workers} worker(s), run {rep + 1}: {r['verified']}/{args.count} "
                       f"verified in {r['elapsed_s']:.1f} s = "
                       f"{r['verified_per_minute']:.0f}/min", file=sys.stderr)
+        spin.append(_spin_efficiency())
         profile = _profile(specs, args.profile_items, folder, args.top)
     med = {w: statistics.median(r["verified_per_minute"] for r in rs) for w, rs in runs.items()}
     compute = statistics.median(r["median_compute_s"] for r in runs[1] if r["median_compute_s"])
@@ -134,6 +158,7 @@ def main(argv: list[str] | None = None) -> int:
         "verified_per_minute_2_workers": med[2],
         "per_core_verified_per_minute": med[2] / 2.0,
         "scaling_efficiency": med[2] / (2.0 * med[1]) if med[1] else None,
+        "machine_spin_efficiency_before_after": spin,
         "median_item_compute_s": compute,
         "steady_state_per_core_per_minute": 60.0 / compute if compute else None,
         "median_of_mean_item_cpu_s": cpu,

@@ -272,3 +272,25 @@ def test_two_runs_cannot_write_one_folder(reference: Path, specs_file: Path) -> 
     finally:
         holder.close()
     assert _run(specs_file, reference, workers=0).skipped == COUNT
+
+
+def test_an_item_is_reproducible_from_its_manifest_record(reference: Path) -> None:
+    from ltl_human_motion.batch import ItemParams, cell_for_item
+    from ltl_human_motion.batch.worker import BatchJob
+    from ltl_human_motion.planning.pipeline import synthesize
+    from ltl_human_motion.scene.cell import cell_by_name
+
+    item = next(iter(open_dataset(reference).items()))
+    r = item.record
+    params = ItemParams(index=r["index"], spec_name=r["spec_name"], spec=r["spec"],
+                        seed=r["seed"], cycles=r["params"]["cycles"],
+                        stature=r["params"]["stature"],
+                        object_offsets={k: tuple(v) for k, v in r["params"]["objects"].items()},
+                        region_offsets={k: tuple(v) for k, v in r["params"]["regions"].items()})
+    options = BatchJob(cell_yaml="", sequence_mode="all").synthesis_options()
+    synth = synthesize(r["spec"], cell_for_item(cell_by_name("paper_cell"), params),
+                       seed=r["seed"], cycles=params.cycles, stature=params.stature,
+                       options=options)[0]
+    assert synth.sequence == r["sequence"]
+    np.testing.assert_array_equal(synth.positions.astype(np.float32), item.positions)
+    np.testing.assert_array_equal(synth.task_index, item.task_index)

@@ -77,7 +77,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"{mode:>10}: min separation {_fmt(r['min_separation'], ' m')} "
               f"(S_p {r['protective_distance']:.2f} m), reduced speed "
               f"{r['time_reduced_speed']:.1f} s, at minimum {r['time_min_speed']:.1f} s, "
-              f"{r['violations']} violation(s) ({r['violation_time']:.2f} s), effective cycle "
+              f"{r['violations']} violation(s) ({r['violation_time']:.2f} s), mean slider "
+              f"{_fmt(r['mean_slider_1s_before'])} in the 1 s before S_p, effective cycle "
               f"{_fmt(r['effective_cycle_time'], ' s')}, loop {_fmt(r['loop_rate_hz'], ' Hz', 1)}")
     print(f"metrics: {args.out}/coexistence_*.json, .png; total {summary['wall_time']:.0f} s")
     return 0

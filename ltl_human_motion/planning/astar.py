@@ -209,8 +209,27 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
                 if not ok.any():
                     continue
                 succ, ends = succ[ok], ends[ok]
-        done = goal.reached(ends[:, 0], ends[:, 1], ends[:, 2]) & index.stops[succ]
+        near = goal.reached(ends[:, 0], ends[:, 1], ends[:, 2])
+        done = near & index.stops[succ]
         g_new = g_cost[node] + step_cost[succ]
+        tail: list[tuple[int, Pose]] = []
+        if not done.any() and near.any():
+            # Reached while still walking: finish with a stop primitive if one lands there.
+            for m in np.flatnonzero(near):
+                stop_ids = index.successors(int(succ[m]))
+                stop_ids = stop_ids[index.stops[stop_ids] & allowed[stop_ids]]
+                if stop_ids.size == 0:
+                    continue
+                mx, my, myaw = (float(v) for v in ends[m])
+                stop_ends = _place(index, stop_ids, mx, my, myaw)
+                stop_ok = goal.reached(stop_ends[:, 0], stop_ends[:, 1], stop_ends[:, 2])
+                stop_ok &= _path_clearance(index, stop_ids, mx, my, myaw, clearance) > body_radius
+                if stop_ok.any():
+                    k = int(np.flatnonzero(stop_ok)[0])
+                    tail = [(int(stop_ids[k]), (mx, my, myaw))]
+                    done[m] = True
+                    ends[m] = stop_ends[k]
+                    break
         if done.any():
             best = int(np.argmin(np.where(done, g_new, np.inf)))
             chain = [int(succ[best])]
@@ -222,6 +241,9 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
                 n = parents[n]
             chain.reverse()
             chain_poses.reverse()
+            for prim_id, pose in tail:
+                chain.append(prim_id)
+                chain_poses.append(pose)
             end = tuple(float(v) for v in ends[best])
             return SearchResult(chain, chain_poses, end, expanded, time.perf_counter() - t0)
         h_new = heuristic(ends[:, 0], ends[:, 1], ends[:, 2])

@@ -48,6 +48,8 @@ class PlannerOptions:
     ----------
     heuristic_speed : float
         Relaxed speed of the A* heuristic, m/s (paper Sec. III-B).
+    turn_rate : float
+        Relaxed turning speed of the heuristic's heading term, rad/s.
     budget : SearchBudget
         Node and time limits of each search.
     cost_noise : float
@@ -65,9 +67,16 @@ class PlannerOptions:
     adjust_radius : float
         A walk may end this far from the ideal placement; a model-made step and turn on
         the spot covers the rest (like the analytic expansion of hybrid A*).
+    turn_clearance : float
+        Floor clearance a walk must end with to turn there by more than the heading
+        tolerance, metres.
+    stand_clearance : float
+        Floor clearance of the spot a goal primitive starts from (hips and a slight
+        forward lean need more room than the walking legs), metres.
     """
 
     heuristic_speed: float = 0.25
+    turn_rate: float = 0.8
     budget: SearchBudget = field(default_factory=SearchBudget)
     cost_noise: float = 0.15
     reach_tolerance: float = 0.15
@@ -75,6 +84,8 @@ class PlannerOptions:
     body_radius: float = 0.15
     goal_attempts: int = 6
     adjust_radius: float = 0.3
+    turn_clearance: float = 0.26
+    stand_clearance: float = 0.22
     grid_resolution: float = 0.1
 
 
@@ -307,7 +318,7 @@ class SequencePlanner:
         px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)
         py = target[1] - (s[..., None] * (d + back) + c[..., None] * lat)
         free = self._clearance(np.stack([px, py], axis=-1).reshape(-1, 2)).reshape(px.shape)
-        free = free > self.options.body_radius + 0.03    # the hips are wider than the legs
+        free = free > self.options.stand_clearance
         k = np.argmax(free, axis=-1)
         pick = np.take_along_axis
         return (pick(px, k[..., None], -1)[..., 0], pick(py, k[..., None], -1)[..., 0], yaw,
@@ -327,8 +338,11 @@ class SequencePlanner:
             return np.abs(np.hypot(tx - xy[:, 0], ty - xy[:, 1]) - dist) <= tol
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-            px, py, _, free = self._ideal_placement(target, placement, x, y)
-            return free & (np.hypot(px - x, py - y) <= adjust)
+            px, py, pyaw, free = self._ideal_placement(target, placement, x, y)
+            # Turning on the spot needs room for the hips; facing nearly right needs none.
+            room = self._clearance(np.stack([x, y], axis=-1)) > self.options.turn_clearance
+            facing = np.abs(wrap_angle(pyaw - yaw)) <= self.options.heading_tolerance
+            return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing)
 
         field = self._field(ring)
         goal = self._goal_from_field(field, reached, desc, task)
@@ -342,24 +356,49 @@ class SequencePlanner:
         return goal
 
     def _adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str) -> None:
-        """Step and turn on the spot to the ideal placement for ``target`` (if needed)."""
+        """Step and turn on the spot to the ideal placement for ``target`` (if needed).
+
+        If that step would touch an obstacle, stand a little further back (up to 15 cm);
+        if none is clear, stay where the walk ended (the goal's IK absorbs small errors).
+        """
         from ltl_human_motion.planning.turns import make_step_primitive
         x, y, yaw = self.pose
         px, py, pyaw, _ = (float(v[0]) for v in self._ideal_placement(
             target, placement, np.array([x]), np.array([y])))
-        c, s = math.cos(yaw), math.sin(yaw)
-        dx, dy = c * (px - x) + s * (py - y), -s * (px - x) + c * (py - y)
-        dyaw = float(wrap_angle(pyaw - yaw))
-        if math.hypot(dx, dy) < 0.02 and abs(dyaw) < 0.05:
-            return
         carrying = bool(self.held) or self._carry_stance
-        mp = make_step_primitive(self._stance(carrying), self.library.standing_height, dx, dy,
-                                 dyaw, self.library.skeleton, self.library.fps,
-                                 "carry" if carrying else "walk")
-        if not self._placed_clear(mp, self.pose):
-            return            # keep the pose the walk reached; the goal IK absorbs the rest
-        self._add(mp, self.pose, -1, self.overlap)
-        self.pose = self._hand_over_pose(mp, self.pose)
+        back_dir = np.array([math.cos(pyaw), math.sin(pyaw)])
+        c, s = math.cos(yaw), math.sin(yaw)
+        stance = self._stance(carrying)
+        task_name = "carry" if carrying else "walk"
+        lib = self.library
+
+        def step(dx: float, dy: float, dyaw: float) -> MotionPrimitive:
+            return make_step_primitive(stance, lib.standing_height, dx, dy, dyaw, lib.skeleton,
+                                       lib.fps, task_name)
+
+        for back in (0.0, 0.05, 0.1, 0.15):
+            qx, qy = px - back * back_dir[0], py - back * back_dir[1]
+            dx, dy = c * (qx - x) + s * (qy - y), -s * (qx - x) + c * (qy - y)
+            dyaw = float(wrap_angle(pyaw - yaw))
+            if math.hypot(dx, dy) < 0.02 and abs(dyaw) < 0.05:
+                return
+            # Step and turn at once; or turn where the walk ended, then step in.
+            cp, sp = math.cos(dyaw), math.sin(dyaw)
+            plans = [[step(dx, dy, dyaw)],
+                     [step(0.0, 0.0, dyaw), step(cp * dx + sp * dy, -sp * dx + cp * dy, 0.0)]]
+            for plan in plans:
+                pose = self.pose
+                ok = True
+                for mp in plan:
+                    if not self._placed_clear(mp, pose):
+                        ok = False
+                        break
+                    pose = self._hand_over_pose(mp, pose)
+                if ok:
+                    for mp in plan:
+                        self._add(mp, self.pose, -1, self.overlap)
+                        self.pose = self._hand_over_pose(mp, self.pose)
+                    return
 
     def _region_goal(self, region, desc: str, task: str) -> Goal:
         lo, hi = np.asarray(region.lo, dtype=float), np.asarray(region.hi, dtype=float)
@@ -442,12 +481,16 @@ class SequencePlanner:
             self._step_back(carrying_before, label)
         self._add(mp, self.pose, label, self.overlap)
 
-    def _placed_clear(self, mp: MotionPrimitive, pose: Pose) -> bool:
-        """Whether ``mp`` placed at ``pose`` keeps clear of every obstacle (sampled)."""
-        frames = np.linspace(0, mp.n_frames - 1, 12).round().astype(int)
-        return bool(self.obstacle_field.clear(world_positions(mp, *pose)[frames][None],
-                                              self.library.skeleton.stature, margin=0.0,
-                                              relative=True)[0])
+    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int = 16) -> bool:
+        """Whether ``mp`` placed at ``pose`` keeps clear of every obstacle, checked with
+        the exact capsule distances on ``samples`` frames (these checks are few)."""
+        from ltl_human_motion.scene.predicates import body_clearance
+        if not self.cell.obstacles:
+            return True
+        frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
+        world = world_positions(mp, *pose)[frames]
+        d = body_clearance(world, self.cell, stature=self.library.skeleton.stature)
+        return bool(np.min(d) > 0.003)
 
     def _step_back(self, carrying: bool, label: int) -> None:
         """Step back from an obstacle in front (a step primitive of the gait index)."""
@@ -462,7 +505,8 @@ class SequencePlanner:
         """A* from the current pose; appends the gait segments; returns their count."""
         res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
                     clearance=self._clearance, body_radius=self.options.body_radius,
-                    heuristic_speed=self.options.heuristic_speed, carry=carry,
+                    heuristic_speed=self.options.heuristic_speed,
+                    turn_rate=self.options.turn_rate, carry=carry,
                     budget=self.options.budget, rng=self.rng,
                     cost_noise=self.options.cost_noise, body_clear=self._body_clear)
         self.expanded += res.expanded
@@ -599,9 +643,7 @@ class SequencePlanner:
     def _goal_clear(self, mp: MotionPrimitive, kind: str) -> bool:
         """Whether the body, and any object in the hands, keep clear of obstacles."""
         world = world_positions(mp, *self.pose)
-        frames = np.linspace(0, mp.n_frames - 1, 24).round().astype(int)
-        if not bool(self.obstacle_field.clear(world[frames][None],
-                                              self.library.skeleton.stature, margin=0.0)[0]):
+        if not self._placed_clear(mp, self.pose, samples=24):
             return False
         contact = int(mp.meta.get("contact_frame", 0))
         carried = dict(self.held)

@@ -223,6 +223,7 @@ def _run_mode(session: ClientSession, context: Any, *, mode: str, motion_id: str
     progress["effective_cycle_time"] = (nominal / ratio) if nominal and ratio > 0 else None
     if baseline and progress["effective_cycle_time"]:
         progress["effective_cycle_time_ratio"] = progress["effective_cycle_time"] / baseline
+    progress.update(_approach(decisions, node.params.min_slider))
     statuses = session.watcher.logs.get("/safety_status")
     info = {"mode": mode, "progress": progress, "ssm_terms": node.params.terms(),
             "safety_status_messages": statuses.count if statuses else 0, **extra}
@@ -232,6 +233,33 @@ def _run_mode(session: ClientSession, context: Any, *, mode: str, motion_id: str
     metrics = json.loads(json_path.read_text())
     metrics["json"], metrics["png"] = str(json_path), str(png_path)
     return metrics
+
+
+def _approach(decisions: list[ControlDecision], min_slider: float) -> dict[str, float | None]:
+    """How the arm met the worker's first approach within S_p lasting over 0.5 s:
+    ``stop_lead_time``, seconds the arm was already at the slider minimum when the
+    separation fell below S_p (0 for a purely reactive reaction), and
+    ``mean_slider_1s_before``, the mean command in the second before (lower = slowed
+    earlier). None without such an approach."""
+    t = np.array([d.time for d in decisions])
+    sliders = np.array([d.slider for d in decisions])
+    below = np.array([d.separation < d.protective_distance for d in decisions])
+    at_min = np.array([d.slider <= min_slider + 1e-9 for d in decisions])
+    starts = np.flatnonzero(below & ~np.concatenate([[False], below[:-1]]))
+    for i in starts:
+        j = i
+        while j < len(below) and below[j]:
+            j += 1
+        if t[j - 1] - t[i] < 0.5:
+            continue
+        k = i
+        while k > 0 and at_min[k - 1]:
+            k -= 1
+        window = (t >= t[i] - 1.0) & (t < t[i])
+        return {"stop_lead_time": float(t[i] - t[k]) if at_min[i] else 0.0,
+                "mean_slider_1s_before": float(sliders[window].mean()) if window.any()
+                else None}
+    return {"stop_lead_time": None, "mean_slider_1s_before": None}
 
 
 def _mode_summary(m: dict[str, Any]) -> dict[str, Any]:
@@ -246,6 +274,8 @@ def _mode_summary(m: dict[str, Any]) -> dict[str, Any]:
         "violation_time": float(sum(v["end"] - v["start"] for v in violations)),
         "violations_not_slowed_to_min": sum(not v["slowed_to_min"] for v in violations),
         "effective_cycle_time": m["extra"]["progress"]["effective_cycle_time"],
+        "stop_lead_time": m["extra"]["progress"]["stop_lead_time"],
+        "mean_slider_1s_before": m["extra"]["progress"]["mean_slider_1s_before"],
         "cycle_times": m["cycle_times"],
         "loop_rate_hz": m["rate_hz"],
         "json": m["json"], "png": m["png"],
@@ -345,7 +375,7 @@ def run_coexistence_demo(out_dir: str | Path, spec: str = "S1", duration: float 
             r, p = runs["reactive"], runs["predictive"]
             summary["comparison"] = {k: {"reactive": r[k], "predictive": p[k]} for k in (
                 "min_separation", "time_reduced_speed", "time_min_speed", "violation_time",
-                "effective_cycle_time")}
+                "stop_lead_time", "mean_slider_1s_before", "effective_cycle_time")}
         summary["success"] = True
         return summary
     finally:
