@@ -47,7 +47,7 @@ def machine() -> dict:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
-    parser.add_argument("--cycles", type=int, default=2)
+    parser.add_argument("--cycles", type=int, default=1)
     parser.add_argument("--out", type=Path, default=ROOT / "bench" / "results" /
                         "paper_specs.json")
     args = parser.parse_args(argv)

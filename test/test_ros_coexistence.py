@@ -43,6 +43,7 @@ from ltl_human_motion.ros import conversions as cv  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.bringup_config import load_bringup_config  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession  # noqa: E402
+from ltl_human_motion.ros.common import TF_STATIC_QOS  # noqa: E402
 from ltl_human_motion.ros.coexistence_demo import (  # noqa: E402
     rtde_port_lock,
     start_sim_when_free,
@@ -100,6 +101,7 @@ class Stack:
         self.task = self.session.watch(TaskState, "/human_1/task_state", keep=1)
         self.joints = self.session.watch(JointState, "/joint_states", keep=1)
         self.tf = self.session.watch(TFMessage, "/tf", keep=20)
+        self.tf_static = self.session.watch(TFMessage, "/tf_static", keep=5, qos=TF_STATIC_QOS)
         self.markers = self.session.watch(MarkerArray, "/robot_markers", keep=1)
         self.readback: Any = None
 
@@ -211,6 +213,9 @@ def test_worker_in_robot_workspace_slows_the_robot_which_resumes_after(
     assert list(joints.name) == list(UR_JOINT_NAMES) and len(joints.position) == 6
     frames = {t.child_frame_id for m in stack.tf.messages for t in m.transforms}
     assert {"ur/link_1", "ur/link_6", "ur/tool_tip"} <= frames
+    static = {(t.header.frame_id, t.child_frame_id) for m in stack.tf_static.messages
+              for t in m.transforms}
+    assert ("world", "ur/base") in static
     assert {m.ns for m in stack.markers.last.markers} >= {"robot/capsules", "robot/status"}
     assert stack.status.last.protective_distance == pytest.approx(S_P)
     assert stack.node.control_alive
