@@ -7,8 +7,12 @@ export PATH="$VIRTUAL_ENV/bin:$PATH"
 export AMENT_PREFIX_PATH="$VIRTUAL_ENV${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}"
 export CMAKE_PREFIX_PATH="$VIRTUAL_ENV${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
 if [ -f "$_LHM_ROOT/.build/install/setup.bash" ]; then
+  # colcon's setup scripts read unset variables: relax `set -u` while sourcing them.
+  case $- in *u*) _LHM_NOUNSET=1; set +u ;; *) _LHM_NOUNSET= ;; esac
   # shellcheck disable=SC1091
   . "$_LHM_ROOT/.build/install/setup.bash"
+  [ -n "$_LHM_NOUNSET" ] && set -u
+  unset _LHM_NOUNSET
 fi
 # The source tree comes first so edits take effect without a rebuild; the generated
 # msg/srv modules are found in the install space through pkgutil.extend_path.

@@ -111,6 +111,40 @@ def _complement(f: Formula) -> Formula | None:
     return None
 
 
+def _operands(f: Formula, kind: type) -> tuple[Formula, ...]:
+    return f.args if isinstance(f, kind) else (f,)
+
+
+def _has_operand(f: Formula, g: Formula, kind: type) -> bool:
+    """True if ``g`` is ``f`` or one of the operands of ``f`` (a ``kind`` node)."""
+    return g in _operands(f, kind)
+
+
+def _without(f: Formula, g: Formula, kind: type) -> Formula:
+    """``f`` (an ``And``/``Or`` node or a single operand) without the operand ``g``."""
+    rest = [h for h in _operands(f, kind) if h != g]
+    return conj(*rest) if kind is And else disj(*rest)
+
+
+def _drop_disjuncts(a: Formula, b: Formula) -> Formula | None:
+    """``a`` without the disjuncts that are also disjuncts of ``b``; None if there are none
+    or if nothing would remain. In ``a U b`` and ``a W b`` such a disjunct only matters
+    where ``b`` holds already."""
+    common = set(_operands(a, Or)) & set(_operands(b, Or))
+    if not common or not isinstance(a, Or) or common >= set(a.args):
+        return None
+    return disj(*(g for g in a.args if g not in common))
+
+
+def _drop_conjuncts(a: Formula, b: Formula) -> Formula | None:
+    """The dual of :func:`_drop_disjuncts` for ``a R b`` and ``a M b``: conjuncts of ``a``
+    that are conjuncts of ``b`` hold wherever ``a & b`` is needed."""
+    common = set(_operands(a, And)) & set(_operands(b, And))
+    if not common or not isinstance(a, And) or common >= set(a.args):
+        return None
+    return conj(*(g for g in a.args if g not in common))
+
+
 @lru_cache(maxsize=4096)
 def simplify(f: Formula) -> Formula:
     """A simpler formula in NNF with the same models (input need not be in NNF)."""
@@ -134,6 +168,13 @@ def _simp(f: Formula) -> Formula:
             merged = _merge_weak(out.args, items, is_and)
             if merged is not None:
                 return _simp(merged)
+            nexts = [g for g in out.args if isinstance(g, Next)]
+            if len(nexts) > 1 and is_and:  # X a & X b = X(a & b), X a | X b = X(a | b)
+                inner = conj(*(g.arg for g in nexts)) if is_and else \
+                    disj(*(g.arg for g in nexts))
+                rest = [g for g in out.args if not isinstance(g, Next)]
+                joined = Next(inner)
+                return _simp(conj(joined, *rest) if is_and else disj(joined, *rest))
         return out
     if isinstance(f, Next):
         a = _simp(f.arg)
@@ -165,17 +206,33 @@ def _simp(f: Formula) -> Formula:
             return a
         return Globally(a)
     a, b = _simp(f.left), _simp(f.right)
+    if isinstance(f, (Until, WeakUntil)):
+        trimmed = _drop_disjuncts(a, b)
+        if trimmed is not None:  # (c | a) U (c | b) = a U (c | b), the same for W
+            return _simp(type(f)(trimmed, b))
+    if isinstance(f, (Release, StrongRelease)):
+        trimmed = _drop_conjuncts(a, b)
+        if trimmed is not None:  # (c & a) R (c & b) = a R (c & b), the same for M
+            return _simp(type(f)(trimmed, b))
     if isinstance(f, Until):
         if b == TRUE or b == FALSE or a == FALSE or a == b:
             return b
         if a == TRUE:
             return _simp(Finally(b))
+        if _has_operand(b, Globally(a), Or):  # a U (b | G a) = a W b
+            return _simp(WeakUntil(a, _without(b, Globally(a), Or)))
+        if _has_operand(b, a, And):  # a U (a & b) = b M a
+            return _simp(StrongRelease(_without(b, a, And), a))
         return Until(a, b)
     if isinstance(f, Release):
         if b == TRUE or b == FALSE or a == TRUE or a == b:
             return b
         if a == FALSE:
             return _simp(Globally(b))
+        if _has_operand(b, Finally(a), And):  # a R (b & F a) = a M b
+            return _simp(StrongRelease(a, _without(b, Finally(a), And)))
+        if _has_operand(b, a, Or):  # a R (a | b) = b W a
+            return _simp(WeakUntil(_without(b, a, Or), a))
         return Release(a, b)
     if isinstance(f, WeakUntil):
         if b == TRUE or a == b or a == FALSE:

@@ -9,6 +9,7 @@ publisher and occupancy node share one :class:`Playback` clock.
 
 from __future__ import annotations
 
+import sys
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -91,8 +92,12 @@ class Bringup:
             self.store = node.store
             return node
         if spec.executable == "coexistence_node":
-            from ltl_human_motion.ros.coexistence_node import CoexistenceNode
+            from ltl_human_motion.ros.coexistence_node import (
+                CONTROL_SWITCH_INTERVAL,
+                CoexistenceNode,
+            )
 
+            sys.setswitchinterval(CONTROL_SWITCH_INTERVAL)   # its 125 Hz loop shares the GIL
             return CoexistenceNode(node_name=spec.name, **kwargs)
         human = spec.parameters["human_id"]
         playback = self.playbacks.setdefault(human, Playback())
