@@ -1,8 +1,8 @@
 """CoexistenceController with the REAL ur_rtde client against the simulated controller.
 
 No mocks of ur_rtde here: every test that claims RTDE behaviour starts the simulated
-controller in its own process on 127.0.0.1:30004 (ur_rtde cannot use another port) and
-skips with a clear message if that port is taken by another program.
+controller in its own process on 127.0.0.1:30004 (ur_rtde cannot use another port),
+waiting until no other simulator holds that port (test/robot_sim.py).
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from robot_sim import start_sim
 
 from ltl_human_motion.robot import (
     CoexistenceConfig,
@@ -24,7 +25,6 @@ from ltl_human_motion.robot import (
     URSimHandle,
     min_distance,
     slider_from_separation,
-    start_ur_sim_process,
     ur_rtde_factories,
     write_commissioning_report,
 )
@@ -45,14 +45,6 @@ class FakeClock:
         return self.t
 
 
-def start_sim_or_skip() -> URSimHandle:
-    try:
-        return start_ur_sim_process(host=HOST)
-    except OSError as exc:
-        pytest.skip(f"cannot run the simulated UR controller on {HOST}:30004/29999 (another "
-                    f"program holds the port?): {exc}")
-
-
 def human_at(x: float, y: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """A standing worker (legs, torso, head, one arm reaching towards -x) at (x, y)."""
     segments = np.array([
@@ -66,7 +58,7 @@ def human_at(x: float, y: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
 
 @pytest.fixture(scope="module")
 def sim() -> Iterator[URSimHandle]:
-    handle = start_sim_or_skip()
+    handle = start_sim()
     yield handle
     handle.stop()
 

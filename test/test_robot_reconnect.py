@@ -8,13 +8,13 @@ from collections.abc import Iterator
 
 import numpy as np
 import pytest
+from robot_sim import start_sim
 
 from ltl_human_motion.robot import (
     CoexistenceConfig,
     CoexistenceController,
     SSMParameters,
     URSimHandle,
-    start_ur_sim_process,
     ur_rtde_factories,
 )
 
@@ -24,14 +24,6 @@ pytest.importorskip("rtde_io")
 HOST = "127.0.0.1"
 PARAMS = SSMParameters()
 MIN = PARAMS.min_slider
-
-
-def start_sim_or_skip() -> URSimHandle:
-    try:
-        return start_ur_sim_process(host=HOST)
-    except OSError as exc:
-        pytest.skip(f"cannot run the simulated UR controller on {HOST}:30004/29999 (another "
-                    f"program holds the port?): {exc}")
 
 
 def human_at(x: float, y: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -57,7 +49,7 @@ def feed_and_step(ctl: CoexistenceController, occupancy: tuple[np.ndarray, np.nd
 
 @pytest.fixture
 def sim() -> Iterator[URSimHandle]:
-    handle = start_sim_or_skip()
+    handle = start_sim()
     yield handle
     handle.stop()
 
@@ -76,7 +68,7 @@ def test_dropped_connection_goes_to_minimum_and_reconnects(sim: URSimHandle) -> 
         assert modes[-1] == "disconnected"
         lost = [d for d in feed_and_step(ctl, human_at(1.9), steps=5)]
         assert all(x.slider == MIN and not x.connected for x in lost)
-        new_sim = start_sim_or_skip()                     # the controller comes back
+        new_sim = start_sim()                     # the controller comes back
         deadline = time.monotonic() + 5.0
         while time.monotonic() < deadline:
             d = feed_and_step(ctl, human_at(1.9), steps=1)[0]

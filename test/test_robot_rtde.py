@@ -1,7 +1,7 @@
 """The simulated UR controller against the REAL ur_rtde client (pip ur-rtde), on loopback.
 
 ur_rtde always connects to TCP 30004, so these tests run one controller process at a time
-on 127.0.0.1:30004 and skip with a clear message if something else already listens there.
+on 127.0.0.1:30004; they wait until no other simulator holds the port (test/robot_sim.py).
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from robot_sim import start_sim
 
 from ltl_human_motion.robot import URSimHandle, start_ur_sim_process, tcp_pose
 from ltl_human_motion.robot import rtde_protocol as rp
@@ -30,14 +31,6 @@ dashboard_client = pytest.importorskip("dashboard_client")
 
 REPO = Path(__file__).resolve().parents[1]
 HOST = "127.0.0.1"
-
-
-def start_sim_or_skip(**kwargs: object) -> URSimHandle:
-    try:
-        return start_ur_sim_process(host=HOST, **kwargs)  # type: ignore[arg-type]
-    except OSError as exc:
-        pytest.skip(f"cannot run the simulated UR controller on {HOST}:30004/29999 (another "
-                    f"program holds the port?): {exc}")
 
 
 def wait_for(predicate, timeout: float = 3.0, period: float = 0.01) -> bool:
@@ -51,7 +44,7 @@ def wait_for(predicate, timeout: float = 3.0, period: float = 0.01) -> bool:
 
 @pytest.fixture(scope="module")
 def sim() -> Iterator[URSimHandle]:
-    handle = start_sim_or_skip()
+    handle = start_sim()
     yield handle
     handle.stop()
 

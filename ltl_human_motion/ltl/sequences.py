@@ -274,26 +274,35 @@ class _Synth:
 
     def add(self, prefix: list[_Arc], cycle: list[_Arc]) -> bool:
         """Turn a lasso of arcs into a checked TaskSequence; False if a duplicate."""
-        pre = [a.letter for a in prefix if a.letter >= 0]
-        cyc = [a.letter for a in cycle if a.letter >= 0]
+        return self.add_letters([a.letter for a in prefix], [a.letter for a in cycle])
+
+    def add_letters(self, prefix: Sequence[int], cycle: Sequence[int],
+                    pending: list[tuple[int, int]] | None = None) -> bool:
+        """:meth:`add` for letter indices (-1 = empty letter).
+
+        With ``pending``, a lasso whose check can only confirm it (no empty step dropped,
+        automaton made from the specification) is added unchecked and recorded as
+        ``(position in out, -1)`` in ``pending``; the caller checks the ones it emits
+        (:meth:`check_pending`).
+        """
+        pre = [x for x in prefix if x >= 0]
+        cyc = [x for x in cycle if x >= 0]
         dropped = len(pre) + len(cyc) != len(prefix) + len(cycle)
         if not cyc:
             return False
         key = _canonical(pre, cyc)
         if key in self.seen:
             return False
-        tasks, letters = self.spec.tasks, self.spec.letters
-        ok = evaluate_lasso(self.spec.formula, [letters[i] for i in key[0]],
-                            [letters[i] for i in key[1]])
-        if not ok:
+        if pending is not None and not dropped and self.strict:
+            pending.append((len(self.out), -1))
+        elif not self._satisfies(key):
             if dropped or not self.strict:
                 # the word without its empty steps (or a run of an automaton given by the
                 # caller) does not satisfy the full specification: not emitted
                 return False
-            raise VerificationError(
-                f"internal error: lasso {key} of '{self.spec.text}' is accepted by the "
-                "automaton but violates the specification", check="ltl")
+            self._fail(key)
         self.seen.add(key)
+        tasks, letters = self.spec.tasks, self.spec.letters
         reps = self.cycles
         if self.min_steps:
             reps = max(reps, math.ceil((self.min_steps - len(key[0])) / len(key[1])))
@@ -302,6 +311,23 @@ class _Synth:
                                      tuple(tasks[i] for i in key[1]), reps,
                                      tuple((tasks[i], letters[i]) for i in used)))
         return True
+
+    def _satisfies(self, key: tuple[tuple[int, ...], tuple[int, ...]]) -> bool:
+        letters = self.spec.letters
+        return evaluate_lasso(self.spec.formula, [letters[i] for i in key[0]],
+                              [letters[i] for i in key[1]])
+
+    def _fail(self, key: tuple[tuple[int, ...], tuple[int, ...]]) -> None:
+        raise VerificationError(
+            f"internal error: lasso {key} of '{self.spec.text}' is accepted by the "
+            "automaton but violates the specification", check="ltl")
+
+    def check(self, seq: TaskSequence) -> None:
+        """Check an unchecked sequence of :meth:`add_letters` with the evaluator."""
+        index = {t: i for i, t in enumerate(self.spec.tasks)}
+        key = (tuple(index[t] for t in seq.prefix), tuple(index[t] for t in seq.cycle))
+        if not self._satisfies(key):
+            self._fail(key)
 
     # ----------------------------------------------------------------- modes
     def lasso_through(self, arc: _Arc) -> tuple[list[_Arc], list[_Arc]]:
@@ -347,32 +373,143 @@ class _Synth:
             self.add(prefix, g.accepting_cycle(here, rng))
 
     def all(self, n: int | None, max_length: int) -> None:
+        """All lassos of ``1..max_length`` arcs, by length, then letters, then prefix length.
+
+        Same result as a depth-first enumeration of every path from the initial state
+        (stopped after ``_WORK_LIMIT`` path nodes), but computed from the distinct letter
+        words of prefixes and of accepting cycles (:class:`_LassoWords`); only the
+        sequences that are returned are checked with the evaluator.
+        """
         g = self.graph
+        words = _LassoWords(g)
+        pending: list[tuple[int, int]] = []
         work = 0
         for length in range(1, max_length + 1):
-            found: list[tuple[list[_Arc], list[_Arc]]] = []
-            stack: list[tuple[list[_Arc], list[int]]] = [([], [g.aut.initial])]
-            while stack and work < _WORK_LIMIT:
-                path, states = stack.pop()
-                work += 1
-                if len(path) == length:
-                    for j in range(length):
-                        if states[j] == states[-1]:
-                            marks = set().union(*(a.acc for a in path[j:]))
-                            if len(marks) >= g.aut.num_sets:
-                                found.append((path[:j], path[j:]))
-                    continue
-                for a in reversed(g.out[states[-1]]):
-                    stack.append(([*path, a], [*states, a.dst]))
-            found.sort(key=lambda pc: (len(pc[0]) + len(pc[1]),
-                                       [a.letter for a in pc[0] + pc[1]], len(pc[0])))
+            nodes = words.path_count(length)
+            if work + nodes > _WORK_LIMIT:  # the work limit cuts this length short
+                found = _dfs_lassos(g, length, _WORK_LIMIT - work)
+                work = _WORK_LIMIT
+            else:
+                found = words.lassos(length)
+                work += nodes
             for prefix, cycle in found:
-                self.add(prefix, cycle)
-            if n is not None and len(self.out) >= n:
+                self.add_letters(prefix, cycle, pending)
+            if work >= _WORK_LIMIT or (n is not None and len(self.out) >= n):
                 break
+        unchecked = {id(self.out[i]) for i, _ in pending}
         self.out.sort(key=lambda s: (len(s.prefix) + len(s.cycle), list(map(str, s.tasks))))
         if n is not None:
             del self.out[n:]
+        for seq in self.out:
+            if id(seq) in unchecked:
+                self.check(seq)
+
+
+_Lasso = tuple[tuple[int, ...], tuple[int, ...]]
+
+
+def _dfs_lassos(g: _LetterGraph, length: int, budget: int) -> list[_Lasso]:
+    """Lassos of ``length`` arcs found by a depth-first search of at most ``budget`` path
+    nodes, sorted by letters and prefix length."""
+    found: list[tuple[list[_Arc], list[_Arc]]] = []
+    stack: list[tuple[list[_Arc], list[int]]] = [([], [g.aut.initial])]
+    work = 0
+    while stack and work < budget:
+        path, states = stack.pop()
+        work += 1
+        if len(path) == length:
+            for j in range(length):
+                if states[j] == states[-1]:
+                    marks = set().union(*(a.acc for a in path[j:]))
+                    if len(marks) >= g.aut.num_sets:
+                        found.append((path[:j], path[j:]))
+            continue
+        for a in reversed(g.out[states[-1]]):
+            stack.append(([*path, a], [*states, a.dst]))
+    out = sorted({(tuple(a.letter for a in p + c), len(p)) for p, c in found})
+    return [(w[:j], w[j:]) for w, j in out]
+
+
+class _LassoWords:
+    """Letter words of the lassos of a letter graph, by length.
+
+    A lasso of ``L`` arcs with a prefix of ``j`` arcs is a path of ``j`` arcs from the
+    initial state to a state ``s`` and a cycle of ``L - j`` arcs from ``s`` back to ``s``
+    whose arcs carry every mark. Prefix words are kept per state and length; cycle words
+    are found by a search that only enters states that can still return to ``s`` in the
+    remaining number of arcs.
+    """
+
+    def __init__(self, g: _LetterGraph) -> None:
+        self.g = g
+        n = g.aut.num_states
+        self.full = (1 << g.aut.num_sets) - 1
+        moves: list[set[tuple[int, int, int]]] = [set() for _ in range(n)]
+        for q in range(n):
+            for a in g.out[q]:
+                moves[q].add((a.letter, a.dst, sum(1 << m for m in a.acc)))
+        self.moves = [sorted(m) for m in moves]
+        self.prefix_words: list[dict[int, set[tuple[int, ...]]]] = [{g.aut.initial: {()}}]
+        self.back: dict[int, list[set[int]]] = {}
+        self.cycle_words: dict[tuple[int, int], set[tuple[int, ...]]] = {}
+        self.paths: list[int] = [1]        # paths with t arcs from the initial state
+        self.ends: dict[int, int] = {g.aut.initial: 1}
+
+    def path_count(self, length: int) -> int:
+        """Nodes of a depth-first enumeration of all paths of at most ``length`` arcs."""
+        while len(self.paths) <= length:
+            ends: dict[int, int] = {}
+            for q, c in self.ends.items():
+                for a in self.g.out[q]:
+                    ends[a.dst] = ends.get(a.dst, 0) + c
+            self.ends = ends
+            self.paths.append(sum(ends.values()))
+        return sum(self.paths[:length + 1])
+
+    def _prefixes(self, j: int) -> dict[int, set[tuple[int, ...]]]:
+        while len(self.prefix_words) <= j:
+            last = self.prefix_words[-1]
+            layer: dict[int, set[tuple[int, ...]]] = {}
+            for q, ws in last.items():
+                for letter, dst, _ in self.moves[q]:
+                    target = layer.setdefault(dst, set())
+                    for w in ws:
+                        target.add((*w, letter))
+            self.prefix_words.append(layer)
+        return self.prefix_words[j]
+
+    def _returning(self, s: int, k: int) -> set[int]:
+        """States with a path of exactly ``k`` arcs to ``s``."""
+        levels = self.back.setdefault(s, [{s}])
+        while len(levels) <= k:
+            prev = levels[-1]
+            levels.append({q for q in range(len(self.moves))
+                           if any(dst in prev for _, dst, _ in self.moves[q])})
+        return levels[k]
+
+    def _cycles(self, s: int, k: int) -> set[tuple[int, ...]]:
+        """Words of the cycles of ``k`` arcs from ``s`` to ``s`` that carry every mark."""
+        key = (s, k)
+        if key not in self.cycle_words:
+            layer: set[tuple[int, int, tuple[int, ...]]] = {(s, 0, ())}
+            for left in range(k - 1, -1, -1):
+                ok = self._returning(s, left)
+                layer = {(dst, marks | acc, (*w, letter)) for q, marks, w in layer
+                         for letter, dst, acc in self.moves[q] if dst in ok}
+            self.cycle_words[key] = {w for q, marks, w in layer if marks == self.full}
+        return self.cycle_words[key]
+
+    def lassos(self, length: int) -> list[_Lasso]:
+        """Distinct (prefix word, cycle word) of ``length`` letters, sorted by the whole
+        word and then by the prefix length."""
+        out: set[tuple[tuple[int, ...], int]] = set()
+        for j in range(length):
+            for s, prefixes in self._prefixes(j).items():
+                cycles = self._cycles(s, length - j)
+                for c in cycles:
+                    for p in prefixes:
+                        out.add(((*p, *c), j))
+        return [(w[:j], w[j:]) for w, j in sorted(out)]
 
 
 def synthesize_sequences(spec: str | Specification, cell: object = None, n: int | None = 5,

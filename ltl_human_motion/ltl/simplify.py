@@ -3,7 +3,8 @@
 :func:`nnf` pushes negations down to atoms and removes ``->``, ``<->`` and ``xor``; the
 result uses only atoms, negated atoms, ``& | X F G U R W M`` and constants.
 :func:`simplify` then applies rules such as ``F F a = F a``, ``G(a & b) = G a & G b``,
-``true U a = F a``, ``a & !a = false``; each rule is an LTL equivalence, and the
+``true U a = F a``, ``a & !a = false``, ``a U (b | G a) = a W b``,
+``a R (a | b) = b W a``; each rule is an LTL equivalence, and the
 property tests check the translator (which runs both) against the evaluator.
 """
 
@@ -169,12 +170,10 @@ def _simp(f: Formula) -> Formula:
             if merged is not None:
                 return _simp(merged)
             nexts = [g for g in out.args if isinstance(g, Next)]
-            if len(nexts) > 1 and is_and:  # X a & X b = X(a & b), X a | X b = X(a | b)
-                inner = conj(*(g.arg for g in nexts)) if is_and else \
-                    disj(*(g.arg for g in nexts))
+            if is_and and len(nexts) > 1:  # X a & X b = X(a & b); not for "|", where
+                # X a | X b gives two smaller successor states instead of one
                 rest = [g for g in out.args if not isinstance(g, Next)]
-                joined = Next(inner)
-                return _simp(conj(joined, *rest) if is_and else disj(joined, *rest))
+                return _simp(conj(Next(conj(*(g.arg for g in nexts))), *rest))
         return out
     if isinstance(f, Next):
         a = _simp(f.arg)

@@ -43,6 +43,7 @@ from ltl_human_motion.ltl.formula import (
     atoms,
 )
 from ltl_human_motion.ltl.simplify import simplify
+from ltl_human_motion.ltl.wdba import minimize_obligation
 
 __all__ = ["translate_builtin"]
 
@@ -154,8 +155,23 @@ def translate_builtin(formula: Formula, name: str | None = None) -> Automaton:
     -------
     Automaton
         Trimmed (only states on some accepting run, or one state for an empty language)
-        and reduced by bisimulation.
+        and reduced by bisimulation and direct simulation. If the property is an
+        obligation and its minimal weak deterministic Büchi automaton
+        (:func:`~ltl_human_motion.ltl.wdba.minimize_obligation`) has fewer states, or as
+        many states and the tableau automaton has acceptance sets, that one is returned
+        (state-based, one acceptance set).
     """
+    aut = _tableau_automaton(formula, name)
+    if aut.num_states == 1 and aut.num_sets == 0:
+        return aut
+    wdba = minimize_obligation(aut, lambda: _tableau_automaton(Not(formula), name))
+    if wdba is not None and (wdba.num_states < aut.num_states or (
+            wdba.num_states == aut.num_states and aut.num_sets > 0)):
+        return wdba
+    return aut
+
+
+def _tableau_automaton(formula: Formula, name: str | None) -> Automaton:
     f = simplify(formula)
     tableau = _Tableau()
     init = _state_key(frozenset({f}))

@@ -26,15 +26,10 @@ time) and needs ``baseline_cycle_time``.
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import json
 import math
-import os
-import socket
 import sys
-import tempfile
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -45,6 +40,7 @@ from ltl_human_motion.atomic import atomic_write_text
 from ltl_human_motion.msg import SafetyStatus
 from ltl_human_motion.robot.coexistence import ControlDecision
 from ltl_human_motion.robot.metrics import write_commissioning_report
+from ltl_human_motion.robot.port_lock import RTDE_PORT, rtde_port_lock, wait_port_free
 from ltl_human_motion.robot.trajectory import load_robot_config
 from ltl_human_motion.robot.ur_sim import URSimHandle, start_ur_sim_process
 from ltl_human_motion.ros.bringup import Bringup
@@ -66,59 +62,6 @@ __all__ = [
 ROOT = Path(__file__).resolve().parents[2]
 ROBOT_CONFIG = ROOT / "config" / "ur_pick_place.yaml"
 #: ur_rtde always connects to this port: only one simulated controller per machine.
-RTDE_PORT = 30004
-
-
-@contextlib.contextmanager
-def rtde_port_lock(timeout: float = 120.0) -> Iterator[None]:
-    """Hold the machine-wide lock of the simulated controller's port 30004.
-
-    ur_rtde always connects to 30004, so a second simulated controller (another test
-    session, demo or benchmark on the machine) would serve, or steal, the first one's
-    clients. Everything here that starts one takes this lock (an ``flock`` on a file in
-    the temporary folder) for as long as its controller runs. TimeoutError after
-    ``timeout`` s.
-    """
-    path = Path(tempfile.gettempdir()) / f"ltl_human_motion-rtde-{RTDE_PORT}.lock"
-    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
-    try:
-        end = time.monotonic() + timeout
-        while True:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                break
-            except BlockingIOError:
-                if time.monotonic() > end:
-                    raise TimeoutError(f"another simulated UR run holds {path} for over "
-                                       f"{timeout:g} s") from None
-                time.sleep(0.2)
-        yield
-    finally:
-        os.close(fd)                              # releases the lock
-
-
-def wait_port_free(host: str = "127.0.0.1", port: int = RTDE_PORT,
-                   timeout: float = 60.0) -> None:
-    """Wait until nothing listens on ``host:port`` (e.g. another test's simulated UR).
-
-    Raises
-    ------
-    TimeoutError
-        Naming the port, if it stays taken for ``timeout`` s.
-    """
-    end = time.monotonic() + timeout
-    while True:
-        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            try:
-                sock.bind((host, port))
-                return
-            except OSError:
-                pass
-        if time.monotonic() > end:
-            raise TimeoutError(f"{host}:{port} is still in use after {timeout:g} s (another "
-                               f"simulated UR controller?); only one can run at a time")
-        time.sleep(0.2)
 
 
 def start_sim_when_free(robot_config: str | Path | None = ROBOT_CONFIG, timeout: float = 60.0,
