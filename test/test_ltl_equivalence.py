@@ -94,7 +94,10 @@ def test_print_parse_round_trip_and_simplify_preserve_meaning(formula, word):
 _RULES = ["F F a", "G G a", "F(a U b)", "F(a M b)", "G(a R b)", "G(a W b)", "F G F a",
           "G F G a", "(a U b) | G a", "(a M b) | G b", "(a W b) & F b", "(a R b) & F a",
           "true U a", "false R a", "a W false", "a M true", "F(a | b)", "G(a & b)",
-          "a & !a | b", "X true U a", "!(a <-> b) xor (a -> b)"]
+          "a & !a | b", "X true U a", "!(a <-> b) xor (a -> b)", "a U (b | G a)",
+          "a U (a & b)", "a R (b & F a)", "a R (a | b)", "(b | X a) U (b | a)",
+          "(b | X a) W b", "(b & X a) R (b & a)", "(b & X a) M b", "X a & X b & a",
+          "a U (X b | G a) | X a"]
 
 
 def _all_lassos(max_prefix: int = 2, max_cycle: int = 2):

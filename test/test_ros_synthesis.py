@@ -2,8 +2,9 @@
 
 The service mechanics (errors, concurrency, clients that die) are tested with a
 scripted synthesizer that checks the spec with the real LTL parser and sleeps
-``seed`` milliseconds to stand in for a long synthesis. The tests marked ``pipeline``
-call the real ``planning.synthesize`` with the paper's S2.
+``seed`` milliseconds to stand in for a long synthesis. test_ros_pipeline.py calls the
+real ``planning.synthesize`` over the service (in a module of its own, so that no
+scripted server answers on the same service name at the same time).
 """
 
 from __future__ import annotations
@@ -26,7 +27,6 @@ from ltl_human_motion.msg import MotionCatalog  # noqa: E402
 from ltl_human_motion.srv import SynthesizeMotion  # noqa: E402
 
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
-from ltl_human_motion.ros.bringup_config import load_bringup_config  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
 from ltl_human_motion.ros.common import LATCHED_QOS  # noqa: E402
 from ltl_human_motion.ros.testing import scripted_synthesize  # noqa: E402
@@ -226,45 +226,3 @@ def test_killed_and_restarted_client_does_not_disturb_the_server(
     assert result["success"] and len(result["ids"]) == 1
     wait_until(lambda: server.in_flight == 0, 10.0, "the orphaned request to finish")
     assert call(client, request()).success
-
-
-# ---------------------------------------------------------------- the real pipeline
-def _pipeline_available() -> bool:
-    """True once the lead exports ``planning.synthesize`` (the contract's name)."""
-    try:
-        from ltl_human_motion import planning
-    except ImportError:
-        return False
-    return callable(getattr(planning, "synthesize", None))
-
-
-pipeline = pytest.mark.skipif(not _pipeline_available(),
-                              reason="planning.synthesize is not available yet")
-
-
-@pytest.fixture(scope="module")
-def real_server(synthesis_only: Path):
-    config = load_bringup_config(synthesis_only)
-    bringup = Bringup(config, overrides={"store_dir": ""}).start()
-    with ClientSession("test_pipeline_client") as session:
-        yield session
-    bringup.shutdown()
-
-
-@pytest.mark.pipeline
-@pytest.mark.slow
-@pipeline
-def test_pipeline_s2_over_the_service(real_server: ClientSession) -> None:
-    reply = call(real_server, request(spec="S2", seed=0), timeout=600.0)
-    assert reply.success, reply.error_message
-    tasks = reply.task_sequences[0]
-    for task in ("grasp(O1)", "grasp(O2)", "assemble(R1)"):
-        assert task in tasks
-    assert reply.durations[0] > 1.0 and reply.stats[0].total_time > 0
-
-
-@pytest.mark.pipeline
-@pipeline
-def test_pipeline_bad_spec_over_the_service(real_server: ClientSession) -> None:
-    reply = call(real_server, request(spec=BAD_SPEC), timeout=120.0)
-    assert not reply.success and (reply.error_line, reply.error_column) == (1, 28)

@@ -490,6 +490,8 @@ class _LassoWords:
     def _cycles(self, s: int, k: int) -> set[tuple[int, ...]]:
         """Words of the cycles of ``k`` arcs from ``s`` to ``s`` that carry every mark."""
         key = (s, k)
+        if not self.g.in_good_scc(s):  # no cycle through s carries every mark
+            return set()
         if key not in self.cycle_words:
             layer: set[tuple[int, int, tuple[int, ...]]] = {(s, 0, ())}
             for left in range(k - 1, -1, -1):

@@ -16,6 +16,8 @@ The formula is simplified first (:func:`~ltl_human_motion.ltl.simplify.simplify`
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 from ltl_human_motion.ltl.automaton import (
     TRUE_CUBE,
     Automaton,
@@ -52,11 +54,17 @@ _EMPTY: frozenset = frozenset()
 _TRUE_TERM: _Term = (TRUE_CUBE, _EMPTY, _EMPTY)
 
 
+@lru_cache(maxsize=8192)
+def _names(formulas: frozenset[Formula]) -> tuple[str, ...]:
+    """The sorted texts of ``formulas`` (a hash-seed independent sort key)."""
+    return tuple(sorted(map(str, formulas)))
+
+
 def _prune(terms: list[_Term]) -> list[_Term]:
     """Remove duplicate terms and terms implied by a weaker one."""
     unique = sorted(set(terms), key=lambda t: (len(t[0].pos) + len(t[0].neg) + len(t[1])
                                                + len(t[2]), t[0].sort_key(),
-                                               sorted(map(str, t[1])), sorted(map(str, t[2]))))
+                                               _names(t[1]), _names(t[2])))
     kept: list[_Term] = []
     for t in unique:
         c, nx, pr = t
@@ -86,7 +94,8 @@ def _state_key(formulas: frozenset[Formula]) -> frozenset[Formula]:
             stack.extend(f.args)
         elif f != Const(True):
             flat.add(f)
-    return frozenset(f for f in flat if Globally(f) not in flat)
+    always = {f.arg for f in flat if isinstance(f, Globally)}
+    return frozenset(f for f in flat if f not in always)
 
 
 class _Tableau:

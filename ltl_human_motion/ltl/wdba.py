@@ -42,6 +42,7 @@ __all__ = ["cube_cover", "minimize_obligation"]
 
 MAX_APS = 8
 MAX_STATES = 64
+MAX_WORK = 8192  # bound on letters x states of the input and of the powerset automaton
 
 _Cover = list[tuple[frozenset[int], frozenset[int]]]
 
@@ -336,12 +337,15 @@ def minimize_obligation(aut: Automaton, negation: Callable[[], Automaton],
     Automaton or None
         A state-based Büchi automaton with the language of ``aut``, or None if the
         property is no obligation, the automaton has more than ``MAX_APS``
-        propositions, or the powerset is too large.
+        propositions, or the automaton or its powerset is too large (``MAX_WORK``).
     """
-    if len(aut.aps) > MAX_APS or aut.aps != tuple(sorted(aut.aps)):
+    if len(aut.aps) > MAX_APS:
+        return None
+    num_letters = 1 << len(aut.aps)
+    if num_letters * aut.num_states > MAX_WORK:
         return None
     edge_letters = [_letters_of(e.guard, aut.aps) for e in aut.edges]
-    dba = _Powerset(aut, edge_letters, max_states)
+    dba = _Powerset(aut, edge_letters, min(max_states, MAX_WORK // num_letters))
     if not dba.complete:
         return None
     masks = [sum(1 << m for m in ms) for ms in edge_letters]

@@ -81,7 +81,8 @@ class SynthesisOptions:
         if "max_nodes" in data or "max_seconds" in data:
             planner = replace(planner, budget=SearchBudget(
                 int(data.get("max_nodes", planner.budget.max_nodes)),
-                float(data.get("max_seconds", planner.budget.max_seconds))))
+                None if data.get("max_seconds", planner.budget.max_seconds) is None
+                else float(data.get("max_seconds", planner.budget.max_seconds))))
         ver = base.verification
         if "eps" in data or "max_joint_speed" in data:
             ver = replace(ver, eps=float(data.get("eps", ver.eps)),
@@ -115,6 +116,38 @@ def get_library(stature: float = DEFAULT_STATURE, source: str | None = None):
     """The motion library for one body size, cached in memory and on disk."""
     from ltl_human_motion.motion.library import load_library
     return load_library(stature=stature, source=source)
+
+
+_SEQUENCE_CACHE: dict = {}
+
+
+def _task_sequences(specification, cell, n: int, seed: int, mode: str, cycles: int,  # noqa: ANN001
+                    backend: str) -> tuple[list, float, float]:
+    """Task sequences (memoized: they depend only on the formula, the candidate task
+    steps and these arguments) and the seconds spent on the automaton and the sequences.
+
+    Returns
+    -------
+    sequences, automaton_seconds, sequence_seconds
+        The times are those of the call that computed the entry (0 on a cache hit).
+    """
+    from ltl_human_motion.ltl.sequences import synthesize_sequences, task_automaton
+    key = (specification.formula, specification.letters, n, seed, mode, cycles, backend)
+    hit = _SEQUENCE_CACHE.get(key)
+    if hit is not None:
+        return hit, 0.0, 0.0
+    t0 = time.perf_counter()
+    task_automaton(specification, backend=backend)
+    t_automaton = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    sequences = synthesize_sequences(specification, cell, n=n, seed=seed, mode=mode,
+                                     cycles=cycles, backend=backend)
+    # synthesize_sequences translates again; count only its own work as sequence time.
+    t_sequence = max(time.perf_counter() - t0 - t_automaton, 0.0)
+    if len(_SEQUENCE_CACHE) > 256:
+        _SEQUENCE_CACHE.clear()
+    _SEQUENCE_CACHE[key] = sequences
+    return sequences, t_automaton, t_sequence
 
 
 def _start_pose(cell, first_target: np.ndarray | None, rng: np.random.Generator
@@ -232,7 +265,6 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     VerificationError
         A motion failed a check (the message names it).
     """
-    from ltl_human_motion.ltl.sequences import synthesize_sequences
     from ltl_human_motion.ltl.spec import build_specification
 
     if variants < 1:
@@ -242,16 +274,9 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     options = options or SynthesisOptions()
     t_all = time.perf_counter()
     cell = resolve_cell(cell)
-    t0 = time.perf_counter()
     specification = build_specification(spec, cell)
-    from ltl_human_motion.ltl.sequences import task_automaton
-    task_automaton(specification, backend=options.backend)
-    t_automaton = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    sequences = synthesize_sequences(specification, cell, n=variants, seed=seed,
-                                     mode=options.sequence_mode, cycles=cycles,
-                                     backend=options.backend)
-    t_sequence = time.perf_counter() - t0
+    sequences, t_automaton, t_sequence = _task_sequences(
+        specification, cell, variants, seed, options.sequence_mode, cycles, options.backend)
     if library is None:
         t0 = time.perf_counter()
         library = get_library(float(stature), options.library_source)

@@ -513,8 +513,8 @@ class SequencePlanner:
         self.search_seconds += res.seconds
         if isinstance(res, SearchFailure):
             if res.reason == "budget":
-                why = (f"the search budget ran out ({res.expanded} nodes, {res.seconds:.2f} s; "
-                       f"closest approach {res.closest:.2f} m)")
+                why = (f"the search budget ran out ({res.expanded} nodes; closest approach "
+                       f"{res.closest:.2f} m)")
             else:
                 why = (f"obstacles block every way to the target (searched {res.expanded} "
                        f"placements; closest approach {res.closest:.2f} m)")
