@@ -277,13 +277,13 @@ class _Synth:
         return self.add_letters([a.letter for a in prefix], [a.letter for a in cycle])
 
     def add_letters(self, prefix: Sequence[int], cycle: Sequence[int],
-                    pending: list[tuple[int, int]] | None = None) -> bool:
+                    pending: list[int] | None = None) -> bool:
         """:meth:`add` for letter indices (-1 = empty letter).
 
         With ``pending``, a lasso whose check can only confirm it (no empty step dropped,
-        automaton made from the specification) is added unchecked and recorded as
-        ``(position in out, -1)`` in ``pending``; the caller checks the ones it emits
-        (:meth:`check_pending`).
+        automaton made from the specification) is added unchecked and its position in
+        ``out`` is recorded in ``pending``; the caller checks the ones it emits
+        (:meth:`check`).
         """
         pre = [x for x in prefix if x >= 0]
         cyc = [x for x in cycle if x >= 0]
@@ -294,7 +294,7 @@ class _Synth:
         if key in self.seen:
             return False
         if pending is not None and not dropped and self.strict:
-            pending.append((len(self.out), -1))
+            pending.append(len(self.out))
         elif not self._satisfies(key):
             if dropped or not self.strict:
                 # the word without its empty steps (or a run of an automaton given by the
@@ -382,7 +382,7 @@ class _Synth:
         """
         g = self.graph
         words = _LassoWords(g)
-        pending: list[tuple[int, int]] = []
+        pending: list[int] = []
         work = 0
         for length in range(1, max_length + 1):
             nodes = words.path_count(length)
@@ -396,7 +396,7 @@ class _Synth:
                 self.add_letters(prefix, cycle, pending)
             if work >= _WORK_LIMIT or (n is not None and len(self.out) >= n):
                 break
-        unchecked = {id(self.out[i]) for i, _ in pending}
+        unchecked = {id(self.out[i]) for i in pending}
         self.out.sort(key=lambda s: (len(s.prefix) + len(s.cycle), list(map(str, s.tasks))))
         if n is not None:
             del self.out[n:]

@@ -10,6 +10,9 @@ The construction follows Couvreur's on-the-fly tableau (FM'99), the one behind S
 * An edge is in the acceptance set of eventuality ``e`` iff it does not promise ``e``,
   so an accepting run cannot postpone ``e`` forever.
 * Terms implied by a weaker term are dropped, and bisimilar states are merged afterwards.
+* For obligation properties, the minimal weak deterministic Büchi automaton
+  (:func:`~ltl_human_motion.ltl.wdba.minimize_obligation`, checked against the
+  automaton of the negated formula) replaces the tableau automaton when it is smaller.
 
 The formula is simplified first (:func:`~ltl_human_motion.ltl.simplify.simplify`).
 """

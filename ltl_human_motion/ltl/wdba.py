@@ -83,6 +83,7 @@ def _isop(lower: frozenset[int], upper: frozenset[int], var: int, n: int) -> _Co
 
 
 def _covered(cover: _Cover, var: int, n: int) -> frozenset[int]:
+    """The minterms over the variables ``var..n-1`` that satisfy some cube of ``cover``."""
     out: set[int] = set()
     for pos, neg in cover:
         free = [j for j in range(var, n) if j not in pos and j not in neg]

@@ -73,6 +73,9 @@ class PlannerOptions:
     stand_clearance : float
         Floor clearance of the spot a goal primitive starts from (hips and a slight
         forward lean need more room than the walking legs), metres.
+    max_step_back : float
+        How much further from the target than the preferred reach the worker may stand
+        when an obstacle (a bench) is in the way; the goal primitive leans further.
     """
 
     heuristic_speed: float = 0.25
@@ -86,6 +89,7 @@ class PlannerOptions:
     adjust_radius: float = 0.3
     turn_clearance: float = 0.26
     stand_clearance: float = 0.22
+    max_step_back: float = 0.35
     grid_resolution: float = 0.1
 
 
@@ -309,12 +313,12 @@ class SequencePlanner:
         facing it from the side of (x, y), and whether that spot is free.
 
         Where the ideal spot is too close to an obstacle (a bench in front), the worker
-        stands up to ``reach_tolerance`` further back. Arrays shaped like ``x``.
+        stands up to ``max_step_back`` further back. Arrays shaped like ``x``.
         """
         d, lat = placement
         yaw = np.arctan2(target[1] - y, target[0] - x) - np.arctan2(lat, d)
         c, s = np.cos(yaw), np.sin(yaw)
-        back = np.linspace(0.0, self.options.reach_tolerance, 6)
+        back = np.linspace(0.0, self.options.max_step_back, 8)
         px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)
         py = target[1] - (s[..., None] * (d + back) + c[..., None] * lat)
         free = self._clearance(np.stack([px, py], axis=-1).reshape(-1, 2)).reshape(px.shape)
@@ -334,8 +338,11 @@ class SequencePlanner:
         offset = float(np.arctan2(placement[1], placement[0]))
         adjust = self.options.adjust_radius
 
+        back = self.options.max_step_back
+
         def ring(xy: np.ndarray) -> np.ndarray:
-            return np.abs(np.hypot(tx - xy[:, 0], ty - xy[:, 1]) - dist) <= tol
+            r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
+            return (r >= dist - tol) & (r <= dist + back)
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             px, py, pyaw, free = self._ideal_placement(target, placement, x, y)
