@@ -98,6 +98,8 @@ def main(argv: list[str] | None = None) -> int:
         "max_translate_ms": max(r["translate_ms_median"] for r in results),
         "median_ba_ratio": statistics.median(ratios), "max_ba_ratio": max(ratios),
         "within_2x_of_spot": sum(x <= 2.0 for x in ratios),
+        "over_2x_of_spot": [r["name"] for r in results if r["ba_ratio"] > 2.0],
+        "smaller_than_spot": sum(x < 1.0 for x in ratios),
         "total_ba_states": sum(r["ba_states"] for r in results),
         "total_spot_states": sum(r["spot_ba_states"] for r in results),
     }

@@ -121,7 +121,7 @@ def get_library(stature: float = DEFAULT_STATURE, source: str | None = None):
 _SEQUENCE_CACHE: dict = {}
 
 
-def _task_sequences(specification, cell, n: int, seed: int, mode: str, cycles: int,  # noqa: ANN001
+def _task_sequences(specification, cell, n: int, seed: int, mode: str, cycles: int,
                     backend: str) -> tuple[list, float, float]:
     """Task sequences (memoized: they depend only on the formula, the candidate task
     steps and these arguments) and the seconds spent on the automaton and the sequences.

@@ -20,7 +20,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -90,7 +90,7 @@ class PlannerOptions:
     turn_clearance: float = 0.26
     stand_clearance: float = 0.22
     max_step_back: float = 0.35
-    grid_resolution: float = 0.1
+    grid_resolution: float = 0.05
 
 
 @dataclass
@@ -250,6 +250,7 @@ class SequencePlanner:
         self.grasp_object: str | None = None
         self.held_offsets: dict[str, np.ndarray] = {}
         self._carry_stance = False
+        self._back_limit = options.reach_tolerance
         self.expanded = 0
         self.search_seconds = 0.0
 
@@ -318,7 +319,7 @@ class SequencePlanner:
         d, lat = placement
         yaw = np.arctan2(target[1] - y, target[0] - x) - np.arctan2(lat, d)
         c, s = np.cos(yaw), np.sin(yaw)
-        back = np.linspace(0.0, self.options.max_step_back, 8)
+        back = np.linspace(0.0, self._back_limit, 8)
         px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)
         py = target[1] - (s[..., None] * (d + back) + c[..., None] * lat)
         free = self._clearance(np.stack([px, py], axis=-1).reshape(-1, 2)).reshape(px.shape)
@@ -338,11 +339,10 @@ class SequencePlanner:
         offset = float(np.arctan2(placement[1], placement[0]))
         adjust = self.options.adjust_radius
 
-        back = self.options.max_step_back
-
         def ring(xy: np.ndarray) -> np.ndarray:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
-            return (r >= dist - tol) & (r <= dist + back)
+            return ((r >= dist - tol) & (r <= dist + self._back_limit)
+                    & (self._clearance(xy) > self.options.stand_clearance))
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             px, py, pyaw, free = self._ideal_placement(target, placement, x, y)
@@ -351,7 +351,13 @@ class SequencePlanner:
             facing = np.abs(wrap_angle(pyaw - yaw)) <= self.options.heading_tolerance
             return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing)
 
+        # Stand within the reach tolerance where possible; only where an obstacle leaves
+        # no such place (a tall worker at a bench) stand up to max_step_back further.
+        self._back_limit = tol
         field = self._field(ring)
+        if not field.has_goal:
+            self._back_limit = self.options.max_step_back
+            field = self._field(ring)
         goal = self._goal_from_field(field, reached, desc, task)
         base_heading = field.heading
 
@@ -362,11 +368,11 @@ class SequencePlanner:
         goal.heading = heading
         return goal
 
-    def _adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str) -> None:
+    def _adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str) -> bool:
         """Step and turn on the spot to the ideal placement for ``target`` (if needed).
 
-        If that step would touch an obstacle, stand a little further back (up to 15 cm);
-        if none is clear, stay where the walk ended (the goal's IK absorbs small errors).
+        If that step would touch an obstacle, stand a little further back (up to 15 cm).
+        Returns False if no adjustment is clear (the worker stays where the walk ended).
         """
         from ltl_human_motion.planning.turns import make_step_primitive
         x, y, yaw = self.pose
@@ -388,7 +394,7 @@ class SequencePlanner:
             dx, dy = c * (qx - x) + s * (qy - y), -s * (qx - x) + c * (qy - y)
             dyaw = float(wrap_angle(pyaw - yaw))
             if math.hypot(dx, dy) < 0.02 and abs(dyaw) < 0.05:
-                return
+                return True
             # Step and turn at once; or turn where the walk ended, then step in.
             cp, sp = math.cos(dyaw), math.sin(dyaw)
             plans = [[step(dx, dy, dyaw)],
@@ -405,7 +411,8 @@ class SequencePlanner:
                     for mp in plan:
                         self._add(mp, self.pose, -1, self.overlap)
                         self.pose = self._hand_over_pose(mp, self.pose)
-                    return
+                    return True
+        return False
 
     def _region_goal(self, region, desc: str, task: str) -> Goal:
         lo, hi = np.asarray(region.lo, dtype=float), np.asarray(region.hi, dtype=float)
@@ -576,7 +583,17 @@ class SequencePlanner:
             goal = self._reach_goal(target, placement, f"reach {text} at "
                                     f"({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})", text)
             walked = self._walk(goal, text, -1, carry=bool(self.held))
-            self._adjust_to(target, placement, text)
+            if not self._adjust_to(target, placement, text):
+                # No clear step from where the walk ended: walk on to a spot that needs
+                # (almost) none.
+                adjust = self.options.adjust_radius
+                self.options = replace(self.options, adjust_radius=0.05)
+                try:
+                    goal = self._reach_goal(target, placement, goal.description, text)
+                    walked += self._walk(goal, text, -1, carry=bool(self.held))
+                finally:
+                    self.options = replace(self.options, adjust_radius=adjust)
+                self._adjust_to(target, placement, text)
         if kind == "release":
             obj = args[0]
             c, s = math.cos(self.pose[2]), math.sin(self.pose[2])
