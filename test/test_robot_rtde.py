@@ -265,10 +265,11 @@ def test_cli_runs_the_controller_until_interrupted(tmp_path: Path) -> None:
         probe.bind((HOST, 0))
         port = probe.getsockname()[1]
     env = {**os.environ, "PYTHONPATH": str(REPO)}
+    log = (tmp_path / "ur-sim.log").open("wb")     # a file: a full pipe would block exit
     proc = subprocess.Popen([sys.executable, "-m", "ltl_human_motion", "ur-sim", "--model",
                              "ur10e", "--trajectory", str(REPO / "config" / "ur_pick_place.yaml"),
                              "--rtde-port", str(port), "--dashboard-port", "-1"],
-                            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+                            env=env, stdout=log, stderr=subprocess.STDOUT)
     try:
         raw = None
         for _ in range(200):
@@ -276,17 +277,16 @@ def test_cli_runs_the_controller_until_interrupted(tmp_path: Path) -> None:
                 raw = RawClient(port)
                 break
             time.sleep(0.05)
-        assert raw is not None, proc.stdout.read().decode() if proc.poll() is not None else ""
+        assert raw is not None, (tmp_path / "ur-sim.log").read_text(errors="replace")
         raw.send(rp.RTDE_REQUEST_PROTOCOL_VERSION, struct.pack(">H", 2))
         assert raw.recv(rp.RTDE_REQUEST_PROTOCOL_VERSION).payload == b"\x01"
         raw.send(rp.RTDE_GET_URCONTROL_VERSION)
         assert struct.unpack(">IIII", raw.recv(rp.RTDE_GET_URCONTROL_VERSION).payload)[0] == 5
         raw.close()
         proc.send_signal(signal.SIGINT)
-        assert proc.wait(timeout=10) == 0
+        assert proc.wait(timeout=30) == 0, (tmp_path / "ur-sim.log").read_text(errors="replace")
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
-        if proc.stdout is not None:
-            proc.stdout.close()
+        log.close()

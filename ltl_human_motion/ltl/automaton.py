@@ -374,8 +374,9 @@ def degeneralize(aut: Automaton) -> Automaton:
     a full round of marks was just completed (accepting). Levels are only tracked inside
     accepting SCCs: entering an SCC resets the level, SCCs whose every edge carries every
     mark are accepting throughout, and SCCs without accepting cycles stay at level 0.
-    The result is trimmed and reduced; for up to three marks every order of the marks is
-    tried and the smallest result kept.
+    The result is trimmed and reduced (states on no cycle may be made accepting when that
+    lets them merge, see :func:`_reduce_state_based`); for up to three marks every order
+    of the marks is tried and the smallest result kept.
     """
     if aut.num_sets > 3 or (aut.state_based and aut.num_sets <= 1):
         return _degeneralize(aut, tuple(range(aut.num_sets)))
@@ -420,8 +421,31 @@ def _degeneralize(aut: Automaton, order: tuple[int, ...]) -> Automaton:
     accepting_states = {i for (q, level), i in index.items() if level == k}
     edges = tuple(Edge(s, d, g, frozenset({0}) if s in accepting_states else frozenset())
                   for s, d, g in raw)
-    sba = Automaton(aut.aps, len(index), 0, edges, 1, True, aut.name)
-    return simulation_reduce(reduce(trim(sba)))
+    return _reduce_state_based(Automaton(aut.aps, len(index), 0, edges, 1, True, aut.name))
+
+
+def _reduce_state_based(sba: Automaton) -> Automaton:
+    """Trim and reduce a state-based Büchi automaton.
+
+    A state on no cycle is visited at most once by a run, so whether it is accepting does
+    not matter; the automaton is reduced both with such states rejecting and with them
+    accepting (which lets them merge with accepting states), and the smaller result kept.
+    """
+    plain = simulation_reduce(reduce(trim(sba)))
+    adj = [[(e.dst, e.acc) for e in sba.successors(q)] for q in sba.states]
+    comp = strongly_connected_components(adj)
+    size: dict[int, int] = {}
+    for c in comp:
+        size[c] = size.get(c, 0) + 1
+    transient = {q for q in sba.states if size[comp[q]] == 1
+                 and all(e.dst != q for e in sba.successors(q))}
+    if not any(e.src in transient and not e.acc for e in sba.edges):
+        return plain
+    edges = tuple(Edge(e.src, e.dst, e.guard, frozenset({0})) if e.src in transient else e
+                  for e in sba.edges)
+    marked = simulation_reduce(reduce(trim(Automaton(sba.aps, sba.num_states, sba.initial,
+                                                     edges, 1, True, sba.name))))
+    return min((plain, marked), key=lambda a: (a.num_states, len(a.edges)))
 
 
 def _implies(c1: Cube, c2: Cube) -> bool:

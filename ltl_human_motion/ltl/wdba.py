@@ -7,13 +7,15 @@ which has a unique minimal form and is often much smaller than a tableau automat
 ``minimize_obligation`` does:
 
 1. The powerset construction over explicit letters gives a deterministic automaton ``D``.
-2. A strongly connected component of ``D`` is accepting iff one of its cycles, read as a
-   lasso from the initial state, is accepted by the original automaton. For an
-   obligation property every cycle of a component gives the same answer; a self-loop
-   that disagrees proves the property is no obligation and stops early.
-3. ``D`` is checked against the formula: ``L(D) & L(!f)`` and ``L(f) & !L(D)`` must be
-   empty (the second uses the original automaton and the complement of the weak ``D``,
-   which swaps accepting and rejecting components). For a safety automaton (no
+2. A strongly connected component of ``D`` is accepting iff the original automaton
+   accepts a word whose run in ``D`` ends in it. For an obligation property every cycle
+   of a component gives the same answer; a shortest cycle through some state of an
+   accepting component that is rejected proves the property is no obligation and stops
+   early (before an automaton of the negation is built).
+3. ``D`` is checked against the formula: ``L(f) & !L(D)`` and ``L(D) & L(!f)`` must be
+   empty (the first uses the original automaton and the complement of the weak ``D``,
+   which swaps accepting and rejecting components; only the second needs an automaton
+   of ``!f``). For a safety automaton (no
    acceptance sets, every infinite run accepting) ``D`` is exact by König's lemma and
    the check is skipped.
 4. Components are colored as in Löding's minimization of weak automata (colors never
@@ -181,8 +183,8 @@ def _accepting_components(aut: Automaton, dba: _Powerset,
     A component is accepting iff ``aut`` accepts some word whose deterministic run ends
     in it: iff the product of ``aut`` with the component has an accepting cycle. Every
     cycle of a rejecting component is then rejected; in an accepting component, the
-    shortest cycle and the self-loops of each state are tried (for an obligation property
-    all are accepted).
+    shortest cycle through each state is tried (for an obligation property all are
+    accepted).
     """
     index: dict[tuple[int, int], int] = {}
     nodes: list[tuple[int, int]] = []
@@ -212,21 +214,9 @@ def _accepting_components(aut: Automaton, dba: _Powerset,
             accepting[dba.comp[s]] = True
     words = dba.prefixes()
     letters = dba.letter_sets
-    for s in range(len(dba.sets)):
-        if not accepting.get(dba.comp[s], False):
-            continue
+    checked = [s for s in range(len(dba.sets)) if accepting.get(dba.comp[s], False)]
+    for s in checked:
         prefix = [letters[m] for m in words[s]]
-        edges = [i for i, e in enumerate(aut.edges) if dba.sets[s] >> e.src & 1]
-        seen_loops: set[frozenset[int]] = set()
-        for m, d in enumerate(dba.delta[s]):
-            if d != s:
-                continue
-            # letters that take the same original edges behave alike
-            key = frozenset(i for i in edges if masks[i] >> m & 1)
-            if key not in seen_loops:
-                seen_loops.add(key)
-                if not aut.accepts_lasso(prefix, [letters[m]]):
-                    return None
         if not aut.accepts_lasso(prefix, [letters[m] for m in dba.cycle(s)]):
             return None
     return accepting
@@ -355,11 +345,10 @@ def minimize_obligation(aut: Automaton, negation: Callable[[], Automaton],
         return None
     color = _colors(dba, accepting)
     if aut.num_sets > 0:
-        neg = _aligned(negation(), aut.aps)
-        if neg is None:
-            return None
-        if not _intersection_empty(neg, dba, [c % 2 == 0 for c in color]):
-            return None
+        # L(aut) within L(D) first: it needs no automaton of the negation
         if not _intersection_empty(aut, dba, [c % 2 == 1 for c in color]):
+            return None
+        neg = _aligned(negation(), aut.aps)
+        if neg is None or not _intersection_empty(neg, dba, [c % 2 == 0 for c in color]):
             return None
     return _quotient(aut, dba, color)
