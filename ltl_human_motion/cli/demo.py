@@ -97,7 +97,11 @@ def run(args: argparse.Namespace) -> int:
             line += (f"  -> {res.get('mcap')}; occupancy {res.get('occupancy_rate_hz', 0):.0f} Hz"
                      f", {len(res.get('tf_frames', []))} TF frames")
         elif name == "robot" and res["ok"]:
-            line += f"  -> {res.get('metrics_json', res.get('folder', ''))}"
+            runs = res.get("runs", {})
+            parts = [f"{mode}: min separation {r.get('min_separation', float('nan')):.2f} m, "
+                     f"{r.get('time_reduced_speed', 0.0):.1f} s slowed"
+                     for mode, r in runs.items()]
+            line += f"  -> {args.out / 'coexistence'} ({'; '.join(parts)})"
         elif not res["ok"]:
             line += f"  {res.get('error', '')}"
         print(line)
