@@ -214,3 +214,45 @@ class ObstacleField:
         # standing at a bench) may stay there; it must not get closer.
         allowed = np.minimum(gap[:, :1], 0.0) - 0.005 if relative else 0.0
         return np.all(gap >= allowed, axis=(1, 2))
+
+
+_CLEARANCE_CACHE: dict[str, tuple[ClearanceMap, ObstacleField]] = {}
+_FIELDS_FORMAT = 1
+
+
+def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
+    """The floor clearance map and 3D obstacle field of ``cell``, once per obstacle layout.
+
+    Cached in memory and on disk (next to the motion library cache), keyed by a hash of
+    the workspace and the obstacles; an unreadable cache file is rebuilt.
+    """
+    import hashlib
+    import pickle
+    import zipfile
+
+    from ltl_human_motion.atomic import atomic_write_with
+    from ltl_human_motion.motion.library import cache_dir
+    key = hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, np.asarray(cell.workspace_lo),
+                                     np.asarray(cell.workspace_hi), cell.obstacles))).hexdigest()
+    maps = _CLEARANCE_CACHE.get(key)
+    if maps is not None:
+        return maps
+    path = cache_dir() / f"fields-{key[:24]}.pkl"
+    try:
+        with open(path, "rb") as fh:
+            maps = pickle.load(fh)
+        if not (isinstance(maps, tuple) and isinstance(maps[0], ClearanceMap)):
+            maps = None
+    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ValueError,
+            zipfile.BadZipFile):
+        maps = None
+    if maps is None:
+        maps = (ClearanceMap(cell), ObstacleField(cell))
+        try:
+            atomic_write_with(path, lambda fh: pickle.dump(maps, fh, protocol=5))
+        except OSError:
+            pass            # a read-only cache folder must not stop synthesis
+    if len(_CLEARANCE_CACHE) > 64:
+        _CLEARANCE_CACHE.clear()
+    _CLEARANCE_CACHE[key] = maps
+    return maps

@@ -29,8 +29,8 @@ from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import Goal, SearchBudget, SearchFailure, astar
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
-from ltl_human_motion.planning.gait_index import GaitIndex
-from ltl_human_motion.planning.navigation import ClearanceMap, NavigationField, ObstacleField
+from ltl_human_motion.planning.gait_index import gait_index
+from ltl_human_motion.planning.navigation import NavigationField, clearance_maps
 
 Pose = tuple[float, float, float]
 
@@ -159,64 +159,6 @@ def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, 
                             "two-hand shorthands like leftHand(R) & rightHand(R) can be "
                             "planned as one step", task=name, reason="unsupported")
     return name, args
-
-
-_INDEX_CACHE: dict[int, tuple[object, GaitIndex]] = {}
-
-
-def gait_index(library) -> GaitIndex:
-    """The library's gait index extended with turns on the spot, built once per library."""
-    hit = _INDEX_CACHE.get(id(library))
-    if hit is not None and hit[0] is library:
-        return hit[1]
-    from ltl_human_motion.planning.turns import turn_primitives
-    index = GaitIndex.from_library(library).with_standing_primitives(turn_primitives(library))
-    if len(_INDEX_CACHE) > 8:
-        _INDEX_CACHE.clear()
-    _INDEX_CACHE[id(library)] = (library, index)
-    return index
-
-
-_CLEARANCE_CACHE: dict[str, tuple[ClearanceMap, ObstacleField]] = {}
-_FIELDS_FORMAT = 1
-
-
-def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
-    """The floor clearance map and 3D obstacle field of ``cell``, once per obstacle layout.
-
-    Cached in memory and on disk (next to the motion library cache), keyed by a hash of
-    the workspace and the obstacles; an unreadable cache file is rebuilt.
-    """
-    import hashlib
-    import pickle
-    import zipfile
-
-    from ltl_human_motion.atomic import atomic_write_with
-    from ltl_human_motion.motion.library import cache_dir
-    key = hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, np.asarray(cell.workspace_lo),
-                                     np.asarray(cell.workspace_hi), cell.obstacles))).hexdigest()
-    maps = _CLEARANCE_CACHE.get(key)
-    if maps is not None:
-        return maps
-    path = cache_dir() / f"fields-{key[:24]}.pkl"
-    try:
-        with open(path, "rb") as fh:
-            maps = pickle.load(fh)
-        if not (isinstance(maps, tuple) and isinstance(maps[0], ClearanceMap)):
-            maps = None
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ValueError,
-            zipfile.BadZipFile):
-        maps = None
-    if maps is None:
-        maps = (ClearanceMap(cell), ObstacleField(cell))
-        try:
-            atomic_write_with(path, lambda fh: pickle.dump(maps, fh, protocol=5))
-        except OSError:
-            pass            # a read-only cache folder must not stop synthesis
-    if len(_CLEARANCE_CACHE) > 64:
-        _CLEARANCE_CACHE.clear()
-    _CLEARANCE_CACHE[key] = maps
-    return maps
 
 
 class SequencePlanner:

@@ -86,7 +86,7 @@ def _collision_candidates(pos: np.ndarray, cell, carried: dict[str, np.ndarray],
     -------
     frames : ndarray of int
     """
-    from ltl_human_motion.planning.planner import clearance_maps
+    from ltl_human_motion.planning.navigation import clearance_maps
     from ltl_human_motion.scene.occupancy import capsules_from_positions
     field = clearance_maps(cell)[1]
     seg, rad = capsules_from_positions(pos, stature)                   # (T, K, 2, 3)
