@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import signal
 import sys
 
 NAME = "ur-sim"
@@ -47,6 +48,9 @@ def run(args: argparse.Namespace) -> int:
               f"{server.rtde_port}, dashboard port {server.dashboard_port}; Ctrl-C to stop",
               flush=True)
 
+    # Ctrl-C stops the server even when this process was started with SIGINT ignored
+    # (a background job of a non-interactive shell inherits SIG_IGN).
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         return run_ur_sim(config, announce)
     except OSError as exc:
