@@ -15,10 +15,7 @@ from __future__ import annotations
 
 import ast
 import math
-import runpy
-import sys
 import time
-import types
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -30,6 +27,7 @@ rclpy = pytest.importorskip("rclpy")
 rtde_receive = pytest.importorskip("rtde_receive")
 pytest.importorskip("rtde_io")
 
+from launch_stand_ins import launch_description, launched_nodes  # noqa: E402
 from ltl_human_motion.msg import HumanOccupancy, SafetyStatus, TaskState  # noqa: E402
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
@@ -339,31 +337,8 @@ def test_invalid_parameters_are_rejected() -> None:
 
 def _launch_nodes(monkeypatch: pytest.MonkeyPatch, config: Path, host: str) -> list[dict]:
     """Run the launch file against recording stand-ins of launch/launch_ros (absent)."""
-    def module(name: str, **attrs: Any) -> None:
-        mod = types.ModuleType(name)
-        mod.__dict__.update(attrs)
-        monkeypatch.setitem(sys.modules, name, mod)
-
-    class LaunchConfiguration:
-        def __init__(self, name: str) -> None:
-            self.name = name
-
-        def perform(self, context: dict[str, str]) -> str:
-            return context[self.name]
-
-    class OpaqueFunction:
-        def __init__(self, function: Any) -> None:
-            self.function = function
-
-    module("launch", LaunchDescription=list)
-    module("launch.actions", OpaqueFunction=OpaqueFunction,
-           DeclareLaunchArgument=lambda name, **kw: ("arg", name, kw))
-    module("launch.substitutions", LaunchConfiguration=LaunchConfiguration)
-    module("launch_ros")
-    module("launch_ros.actions", Node=lambda **kw: kw)
-    description = runpy.run_path(str(LAUNCH_FILE))["generate_launch_description"]()
-    opaque = next(a for a in description if isinstance(a, OpaqueFunction))
-    return opaque.function({"config": str(config), "robot_host": host})
+    return launched_nodes(launch_description(monkeypatch, LAUNCH_FILE),
+                          {"config": str(config), "robot_host": host})
 
 
 def test_launch_file_and_bringup_start_the_same_nodes(monkeypatch: pytest.MonkeyPatch,

@@ -4,9 +4,6 @@ plain-Python pieces (playback clock, motion store, CDR encoder, message definiti
 from __future__ import annotations
 
 import ast
-import runpy
-import sys
-import types
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +13,7 @@ import yaml
 
 rclpy = pytest.importorskip("rclpy")
 
+from launch_stand_ins import launch_description, launched_nodes  # noqa: E402
 from ltl_human_motion.msg import HumanOccupancy, PredictedOccupancy  # noqa: E402
 from rclpy.serialization import deserialize_message  # noqa: E402
 
@@ -40,35 +38,11 @@ KIND = {"SynthesisNode": "synthesis_node", "SkeletonPublisher": "skeleton_publis
 def _launch_nodes(monkeypatch: pytest.MonkeyPatch, config: Path) -> list[dict[str, Any]]:
     """Run the launch file against recording stand-ins of launch/launch_ros (absent
     here) and return the keyword arguments of every launch_ros Node it creates."""
-    def module(name: str, **attrs: Any) -> types.ModuleType:
-        mod = types.ModuleType(name)
-        mod.__dict__.update(attrs)
-        monkeypatch.setitem(sys.modules, name, mod)
-        return mod
-
-    class LaunchConfiguration:
-        def __init__(self, name: str) -> None:
-            self.name = name
-
-        def perform(self, context: dict[str, str]) -> str:
-            return context[self.name]
-
-    class OpaqueFunction:
-        def __init__(self, function: Any) -> None:
-            self.function = function
-
-    module("launch", LaunchDescription=list)
-    module("launch.actions", OpaqueFunction=OpaqueFunction,
-           DeclareLaunchArgument=lambda name, **kw: ("arg", name, kw))
-    module("launch.substitutions", LaunchConfiguration=LaunchConfiguration)
-    module("launch_ros")
-    module("launch_ros.actions", Node=lambda **kw: kw)
-    description = runpy.run_path(str(LAUNCH_FILE))["generate_launch_description"]()
+    description = launch_description(monkeypatch, LAUNCH_FILE)
     declared = [a for a in description if isinstance(a, tuple)]
     assert declared[0][1] == "config" and declared[0][2]["default_value"].endswith(
         "bringup.yaml")
-    opaque = next(a for a in description if isinstance(a, OpaqueFunction))
-    return opaque.function({"config": str(config)})
+    return launched_nodes(description, {"config": str(config)})
 
 
 def _yaml_parameters(data: dict, namespace: str, name: str) -> dict[str, Any]:
