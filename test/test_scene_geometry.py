@@ -174,3 +174,20 @@ def test_shapes_validate_their_input():
         Cylinder([0, 0, 0], -1.0, 1.0)
     with pytest.raises(ValueError, match=r"segments must have shape"):
         Box([0, 0, 0], [1, 1, 1]).capsule_clearance(np.zeros((3, 3)), 0.1)
+
+
+def test_closed_form_segment_box_distance_matches_dense_sampling() -> None:
+    from ltl_human_motion.scene.geometry import point_box_distance, segment_aabb_distance
+    rng = np.random.default_rng(42)
+    lo, hi = np.array([-0.3, -0.2, -0.5]), np.array([0.4, 0.1, 0.2])
+    a = rng.uniform(-1.5, 1.5, (500, 3))
+    b = a + rng.normal(0.0, 0.8, (500, 3))
+    b[:50] = a[:50]                                     # degenerate segments (points)
+    b[50:100, 1] = a[50:100, 1]                         # parallel to a face
+    exact = segment_aabb_distance(a, b, lo, hi)
+    t = np.linspace(0.0, 1.0, 4001)
+    dense = point_box_distance(a[:, None] + t[None, :, None] * (b - a)[:, None], lo, hi).min(1)
+    assert np.all(exact <= dense + 1e-12)               # never above a point of the segment
+    np.testing.assert_allclose(exact, dense, atol=2e-4)
+    inside = segment_aabb_distance(np.zeros((1, 3)), np.ones((1, 3)) * 0.05, lo, hi)
+    assert inside[0] == 0.0

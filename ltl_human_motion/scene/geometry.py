@@ -201,6 +201,51 @@ def min_along_segment(f: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: n
     return np.minimum(best, np.minimum(f(a), f(b)))
 
 
+def segment_aabb_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,
+                          hi: np.ndarray) -> np.ndarray:
+    """Exact distance between segments ``[a, b]`` and axis-aligned boxes, in closed form.
+
+    Along the segment ``p(t) = a + t (b - a)`` the squared distance to the box is a convex
+    piecewise quadratic whose pieces change where a coordinate crosses a face plane. Its
+    minimum is at ``t = 0``, ``t = 1``, a crossing, or the (clipped) stationary point of a
+    piece, so evaluating those 15 candidates is exact.
+
+    Parameters
+    ----------
+    a, b : array-like, shape (..., 3)
+    lo, hi : array-like, shape (3,)
+
+    Returns
+    -------
+    d : ndarray, shape (...)
+    """
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    a, b = np.broadcast_arrays(a, b)
+    lo = np.asarray(lo, dtype=np.float64)
+    hi = np.asarray(hi, dtype=np.float64)
+    d = b - a
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cross = np.concatenate([(lo - a) / d, (hi - a) / d], axis=-1)      # (..., 6)
+    cross = np.where(np.isfinite(cross), np.clip(cross, 0.0, 1.0), 0.0)
+    ends = np.zeros((*a.shape[:-1], 2))
+    ends[..., 1] = 1.0
+    knots = np.sort(np.concatenate([ends, cross], axis=-1), axis=-1)          # (..., 8)
+    t0, t1 = knots[..., :-1], knots[..., 1:]                                  # (..., 7)
+    mid = a[..., None, :] + 0.5 * (t0 + t1)[..., None] * d[..., None, :]      # (..., 7, 3)
+    below, above = mid < lo, mid > hi
+    offset = np.where(below, a[..., None, :] - lo, np.where(above, a[..., None, :] - hi, 0.0))
+    slope = np.where(below | above, d[..., None, :], 0.0)
+    num = -np.sum(offset * slope, axis=-1)
+    den = np.sum(slope * slope, axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        stat = np.where(den > 0, num / den, t0)
+    stat = np.clip(stat, t0, t1)
+    ts = np.concatenate([knots, stat], axis=-1)                               # (..., 15)
+    pts = a[..., None, :] + ts[..., None] * d[..., None, :]
+    return point_box_distance(pts, lo, hi).min(axis=-1)
+
+
 def segment_box_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,
                          hi: np.ndarray) -> np.ndarray:
     """Distance between segments ``[a, b]`` and axis-aligned boxes (0 if they meet).
@@ -214,6 +259,8 @@ def segment_box_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,
     -------
     d : ndarray, shape (...)
     """
+    if np.ndim(lo) == 1 and np.ndim(hi) == 1:
+        return segment_aabb_distance(a, b, lo, hi)
     lo = np.asarray(lo, dtype=np.float64)
     hi = np.asarray(hi, dtype=np.float64)
     return min_along_segment(lambda p: point_box_distance(p, lo, hi), a, b)

@@ -27,6 +27,7 @@ from ltl_human_motion.scene.geometry import (
     point_cylinder_signed_distance,
     point_polygon_signed_distance,
     point_segment_distance,
+    segment_aabb_distance,
 )
 
 __all__ = [
@@ -299,9 +300,7 @@ class Box(Shape):
         return point_box_signed_distance(self.to_local(points), -self.half, self.half)
 
     def segment_distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        h = self.half
-        return min_along_segment(lambda p: np.maximum(point_box_signed_distance(p, -h, h), 0.0),
-                                 self.to_local(a), self.to_local(b))
+        return segment_aabb_distance(self.to_local(a), self.to_local(b), -self.half, self.half)
 
     def aabb(self) -> tuple[np.ndarray, np.ndarray]:
         v = self.vertices()
