@@ -132,7 +132,8 @@ def _task_sequences(specification, cell, n: int, seed: int, mode: str, cycles: i
         The times are those of the call that computed the entry (0 on a cache hit).
     """
     from ltl_human_motion.ltl.sequences import synthesize_sequences, task_automaton
-    key = (specification.formula, specification.letters, n, seed, mode, cycles, backend)
+    key = (specification.formula, specification.letters, n,
+           seed if mode == "random" else None, mode, cycles, backend)   # only random is seeded
     hit = _SEQUENCE_CACHE.get(key)
     if hit is not None:
         return hit, 0.0, 0.0
