@@ -545,9 +545,10 @@ class SequencePlanner:
                 raise PlanningError(f"task {text}: {obj} is not held, so it cannot be "
                                     "released", task=text, reason="precondition")
         carrying_before = bool(self.held)
-        if kind == "grasp" and not carrying_before:
-            # Raise the arms to the carry stance first: the part then comes up to the chest
-            # instead of swinging down past the surface it rested on.
+        if kind in HAND_TASKS and not carrying_before:
+            # Raise the arms to the carry stance first: hands then reach from the chest
+            # (and a grasped part comes up to it) instead of swinging up from the thighs
+            # past the edge of the surface in front.
             self._arm_transition(False, -1)
             carrying_before = True
             self._carry_stance = True
