@@ -39,8 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``tasks``."""
     parser.add_argument("spec", help="LTL specification, e.g. \"grasp(O1) & G F walk(R1)\", "
                         f"or a paper specification name ({', '.join(PAPER_SPECS)})")
-    parser.add_argument("--cell", help="cell description (YAML) naming objects, regions, "
-                        "shorthands and the final region")
+    parser.add_argument("--cell", help="cell name (config/<name>.yaml, e.g. paper_cell) or "
+                        "YAML file naming objects, regions, shorthands and the final region")
     parser.add_argument("-n", type=_positive, default=None,
                         help="number of sequences (default 5; coverage/all: the full set)")
     parser.add_argument("--seed", type=int, default=0, help="seed of --mode random")
@@ -67,7 +67,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``tasks``; errors derive from LtlHumanMotionError (printed by the dispatcher)."""
-    spec = build_specification(args.spec, args.cell)
+    cell = args.cell
+    if cell is not None:
+        from ltl_human_motion.planning.pipeline import resolve_cell
+        cell = resolve_cell(cell)
+    spec = build_specification(args.spec, cell)
     given = _read_hoa(args.hoa) if args.hoa else None
     if args.automaton:
         aut = given if given is not None else task_automaton(spec, args.backend)

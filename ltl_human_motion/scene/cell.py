@@ -763,5 +763,7 @@ def cell_by_name(name: str) -> Cell:
         if candidate.is_file():
             return load_cell(candidate)
         if folder.is_dir():
-            found.update(p.stem for p in folder.glob("*.yaml"))
+            # Other YAML files live there too (bringup parameters, batch specs, robots).
+            found.update(p.stem for p in folder.glob("*.yaml")
+                         if "start_region:" in p.read_text(encoding="utf-8", errors="replace"))
     raise CellError(f"no cell named {stem!r}; known cells: {', '.join(sorted(found)) or '(none)'}")
