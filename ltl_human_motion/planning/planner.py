@@ -3,11 +3,13 @@
 For each task step the planner
 
 1. works out the target point (object grasp point, region centre, ...);
-2. searches gait primitives with A* (:mod:`.astar`) until the worker stands where a
-   goal primitive can reach the target, facing it (walk/carry tasks: until the body
-   enters the region);
-3. makes the goal primitive for the exact target (:mod:`ltl_human_motion.motion.goals`)
-   and places it at the pose where the walk hands over.
+2. searches gait primitives, turns and steps on the spot with A* (:mod:`.astar`) until
+   the worker stands within a short step of a place from which a goal primitive
+   reaches the target (walk/carry tasks: until the body enters the region), then takes
+   that step (a model-made step and turn, :mod:`.turns`);
+3. raises the arms for hand tasks, makes the goal primitive for the exact target
+   (:mod:`ltl_human_motion.motion.goals`), checks it against the obstacles (other seeds,
+   the other hand) and places it at the pose where the walk hands over.
 
 Objects follow the hand that grasped them until they are released, placed (move,
 insert, extract) or assembled. A part that was assembled is replenished at its supply
@@ -34,10 +36,9 @@ from ltl_human_motion.planning.navigation import NavigationField, clearance_maps
 
 Pose = tuple[float, float, float]
 
-#: Goal-primitive generator used for each Table I task (shorthand expansions map below).
+#: Tasks done with the hands: the arms are raised to the carry stance before them.
 HAND_TASKS = {"grasp", "release", "move", "insert", "extract", "leftHand", "rightHand",
               "assemble"}
-IN_PLACE_TASKS = {"wait", "standUp", "bend", "stoop", "kneel"}
 
 
 @dataclass(frozen=True)
