@@ -68,7 +68,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``tasks``; errors derive from LtlHumanMotionError (printed by the dispatcher)."""
     cell = args.cell
-    if cell is not None:
+    if cell is not None and not (cell.endswith((".yaml", ".yml")) or "/" in cell
+                                 or Path(cell).is_file()):
+        # A cell name or inline YAML needs the scene module; a file path does not.
         from ltl_human_motion.planning.pipeline import resolve_cell
         cell = resolve_cell(cell)
     spec = build_specification(args.spec, cell)

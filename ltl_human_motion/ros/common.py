@@ -91,6 +91,11 @@ def spin_nodes(nodes: Sequence[Node], num_threads: int = DEFAULT_EXECUTOR_THREAD
                 break
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except Exception:
+        # Ctrl-C shuts the context down from rclpy's signal handler; a wait that was under
+        # way then fails ("context is not valid"). Anything else is a real error.
+        if (context or rclpy.get_default_context()).ok():
+            raise
     finally:
         shutdown_executor(executor)
 
