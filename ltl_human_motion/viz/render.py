@@ -33,7 +33,7 @@ __all__ = ["render_animation", "render_snapshots"]
 
 def _frame_title(synth: SynthesizedMotion, frame: int) -> str:
     task = synth.active_task(frame)
-    return f"t = {frame / synth.fps:.2f} s  " + (task if task else "(walking)")
+    return f"t = {frame / synth.fps:.2f} s  " + (task if task else "(between tasks)")
 
 
 def _draw_worker(ax, synth: SynthesizedMotion, frame: int, capsules: bool) -> None:
