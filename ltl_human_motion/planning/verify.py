@@ -89,10 +89,18 @@ def _collision_candidates(pos: np.ndarray, cell, carried: dict[str, np.ndarray],
     from ltl_human_motion.planning.navigation import clearance_maps
     from ltl_human_motion.scene.occupancy import capsules_from_positions
     field = clearance_maps(cell)[1]
-    seg, rad = capsules_from_positions(pos, stature)                   # (T, K, 2, 3)
-    pts = np.concatenate([seg, seg.mean(axis=-2, keepdims=True)], axis=-2)
-    gap = (field.distance(pts) - rad[:, None]).min(axis=(1, 2))        # (T,)
-    near = gap < slack + field.res
+    near = np.zeros(len(pos), dtype=bool)
+    if field.empty:
+        return np.flatnonzero(near)
+    # Only frames whose body box meets the grid can come near an obstacle (the grid
+    # covers the obstacles grown by more than the slack).
+    grid_hi = field.lo + (field.shape - 1) * field.res
+    frames = near_frames(pos, field.lo, grid_hi)
+    if frames.size:
+        seg, rad = capsules_from_positions(pos[frames], stature)        # (F, K, 2, 3)
+        pts = np.concatenate([seg, seg.mean(axis=-2, keepdims=True)], axis=-2)
+        gap = (field.distance(pts) - rad[:, None]).min(axis=(1, 2))     # (F,)
+        near[frames] = gap < slack + field.res
     for name, traj in carried.items():
         lo, hi = cell.object(name).occupancy.aabb()
         reach = 0.5 * float(np.linalg.norm(hi - lo))
