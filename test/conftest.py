@@ -1,8 +1,11 @@
-"""Shared pytest set-up: isolate DDS traffic of this test session.
+"""Shared pytest set-up: isolate DDS traffic of this test session; repeatable hypothesis.
 
 Every session gets its own ROS_DOMAIN_ID (random in 100..200, unless the caller set one)
 and keeps discovery on loopback, before any test initializes rclpy; subprocesses inherit
 both through ``os.environ``.
+
+Property-based tests draw the same examples on every run (profile ``deterministic``), so
+CI is repeatable; ``HYPOTHESIS_PROFILE=explore`` draws new ones to hunt for bugs.
 """
 
 from __future__ import annotations
@@ -11,6 +14,11 @@ import os
 import random
 
 import pytest
+from hypothesis import settings
+
+settings.register_profile("deterministic", derandomize=True, database=None, deadline=None)
+settings.register_profile("explore", deadline=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 os.environ.setdefault("ROS_DOMAIN_ID", str(random.SystemRandom().randint(100, 200)))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"

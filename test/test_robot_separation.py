@@ -162,3 +162,11 @@ def test_segment_distance_properties(P: np.ndarray, Q: np.ndarray, angle: float,
     R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
     moved = segment_distances(P @ R.T + shift, Q @ R.T + shift)
     assert np.allclose(d, moved, atol=1e-6)                              # rigid invariance
+
+
+def test_nearly_parallel_segments_sharing_an_end_point_touch() -> None:
+    """Found by hypothesis: rounding of nearly parallel pairs once gave 6e-5 m, not 0."""
+    e = 6.10351562e-05
+    P = np.array([[[0.0, e, e], [e, 7.86905002e-01, e]]])
+    Q = np.array([[[0.0, 0.0, e], [e, 7.86905002e-01, e]]])
+    assert segment_distances(P, Q)[0, 0] == pytest.approx(0.0, abs=1e-12)

@@ -136,7 +136,26 @@ def segment_distances(P: NDArray[np.float64], Q: NDArray[np.float64]) -> NDArray
     # precision to cancellation when the segments nearly touch).
     gap = (p0[:, None, :] - q0[None, :, :]) + s[..., None] * d1[:, None, :] \
         - t[..., None] * d2[None, :, :]
-    return np.sqrt((gap * gap).sum(axis=-1))
+    dist = np.sqrt((gap * gap).sum(axis=-1))
+    # Nearly parallel pairs lose the closest points to rounding; for them the minimum is
+    # attained at an end point of one segment, so the end points settle it exactly.
+    near_parallel = a * e - b * b <= 1e-9 * a_s * e_s
+    if np.any(near_parallel):
+        k, j = np.nonzero(near_parallel)
+        ends = np.minimum.reduce([_point_segment(P[k, 0], q0[j], d2[j]),
+                                  _point_segment(P[k, 1], q0[j], d2[j]),
+                                  _point_segment(Q[j, 0], p0[k], d1[k]),
+                                  _point_segment(Q[j, 1], p0[k], d1[k])])
+        dist[k, j] = np.minimum(dist[k, j], ends)
+    return dist
+
+
+def _point_segment(x: NDArray[np.float64], o: NDArray[np.float64],
+                   d: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Distances from points x (N, 3) to segments o + [0, 1] d (N, 3), shape (N,)."""
+    u = np.clip(((x - o) * d).sum(axis=-1) / np.maximum((d * d).sum(axis=-1), _EPS), 0.0, 1.0)
+    r = x - o - u[:, None] * d
+    return np.sqrt((r * r).sum(axis=-1))
 
 
 def pair_distances(human_segments: ArrayLike, human_radii: ArrayLike,
