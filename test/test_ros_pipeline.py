@@ -6,7 +6,6 @@ servers would answer on ``/synthesize_motion``.
 
 from __future__ import annotations
 
-import textwrap
 from collections.abc import Iterator
 
 import pytest
@@ -15,6 +14,7 @@ from ltl_human_motion.srv import SynthesizeMotion
 from ltl_human_motion.ros.bringup import Bringup
 from ltl_human_motion.ros.bringup_config import load_bringup_config
 from ltl_human_motion.ros.client import ClientSession
+from ltl_human_motion.ros.testing import SYNTHESIS_ONLY_BRINGUP
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -25,16 +25,7 @@ BAD_SPEC = "grasp(O1) & (F assemble(R1)"       # unbalanced: error at line 1, co
 @pytest.fixture(scope="module")
 def real_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ClientSession]:
     path = tmp_path_factory.mktemp("config") / "synthesis_only.yaml"
-    path.write_text(textwrap.dedent("""\
-        bringup:
-          ros__parameters:
-            nodes: [synthesis_node]
-            humans: ["1"]
-        synthesis_node:
-          ros__parameters:
-            default_cell: paper_cell
-            max_concurrent: 4
-        """))
+    path.write_text(SYNTHESIS_ONLY_BRINGUP)
     bringup = Bringup(load_bringup_config(path), overrides={"store_dir": ""}).start()
     with ClientSession("test_pipeline_client") as session:
         yield session

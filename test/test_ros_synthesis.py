@@ -29,7 +29,10 @@ from ltl_human_motion.srv import SynthesizeMotion  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
 from ltl_human_motion.ros.common import LATCHED_QOS  # noqa: E402
-from ltl_human_motion.ros.testing import scripted_synthesize  # noqa: E402
+from ltl_human_motion.ros.testing import (  # noqa: E402
+    SYNTHESIS_ONLY_BRINGUP,
+    scripted_synthesize,
+)
 
 pytestmark = pytest.mark.ros
 
@@ -50,16 +53,7 @@ def slow_synthesize(spec: str, cell: object, **kwargs: object) -> list:
 @pytest.fixture(scope="module")
 def synthesis_only(tmp_path_factory: pytest.TempPathFactory) -> Path:
     path = tmp_path_factory.mktemp("config") / "synthesis_only.yaml"
-    path.write_text(textwrap.dedent("""\
-        bringup:
-          ros__parameters:
-            nodes: [synthesis_node]
-            humans: ["1"]
-        synthesis_node:
-          ros__parameters:
-            default_cell: paper_cell
-            max_concurrent: 4
-        """))
+    path.write_text(SYNTHESIS_ONLY_BRINGUP)
     return path
 
 

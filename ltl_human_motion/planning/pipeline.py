@@ -20,12 +20,12 @@ from typing import Any
 
 import numpy as np
 
-from ltl_human_motion.errors import CellError, PlanningError
+from ltl_human_motion.errors import CellError
 from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
 from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.blend import concatenate
-from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner
+from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner, task_kind
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, verify_motion
 
@@ -303,17 +303,8 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     t_start = time.perf_counter()
     steps = [(t.key, t.name, tuple(t.args)) for t in seq.tasks]
     planner = SequencePlanner(cell, library, rng, options.planner)
-    first_target = None
-    if steps:
-        from ltl_human_motion.planning.planner import task_kind
-        kind, args = task_kind(steps[0][1], steps[0][2], cell.shorthands)
-        try:
-            first_target = planner._target_of(kind, args)
-            if first_target is None and kind in ("walk", "carry"):
-                first_target = np.asarray(cell.region(args[-1]).center, dtype=float)
-        except (KeyError, ValueError):
-            first_target = None
-    start = _start_pose(cell, first_target, rng)
+    kind, args = task_kind(steps[0][1], steps[0][2], cell.shorthands)   # lassos are non-empty
+    start = _start_pose(cell, planner.target_of(kind, args), rng)
     t0 = time.perf_counter()
     plan = planner.plan(steps, start)
     t_planning = time.perf_counter() - t0
@@ -363,6 +354,4 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
         "start_pose": list(plan.start_pose),
         "segments": [[seg.name, int(a), int(b)] for seg, (a, b) in zip(plan.segments, spans)],
     }
-    if not steps:
-        raise PlanningError("the task sequence is empty", reason="empty")
     return synth

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -128,7 +127,6 @@ class StepPlan:
     contact_frame: int | None = None
     hand: str | None = None
     expanded: int = 0
-    search_seconds: float = 0.0
     primitive: str = ""
     objects_effect: dict = field(default_factory=dict)
 
@@ -141,7 +139,6 @@ class Plan:
     steps: list[StepPlan]
     start_pose: Pose
     expanded: int
-    search_seconds: float
 
 
 def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, tuple[str, ...]]:
@@ -195,11 +192,14 @@ class SequencePlanner:
         self._carry_stance = False
         self._back_limit = options.reach_tolerance
         self.expanded = 0
-        self.search_seconds = 0.0
 
     # ---------------------------------------------------------------- geometry
-    def _target_of(self, kind: str, args: tuple[str, ...]) -> np.ndarray | None:
+    def target_of(self, kind: str, args: tuple[str, ...]) -> np.ndarray | None:
+        """Where a step acts, shape (3,): grasp point, region or object centre, seat; the
+        region's centre for walk/carry; None for tasks in place (wait, bend, ...)."""
         cell = self.cell
+        if kind in ("walk", "carry"):
+            return np.asarray(cell.region(args[-1]).center, dtype=np.float64)
         if kind in ("grasp",):
             obj = cell.object(args[0])
             return np.asarray(obj.grasp_points_at(obj.position)[0], dtype=np.float64)
@@ -467,7 +467,6 @@ class SequencePlanner:
                     budget=self.options.budget, rng=self.rng,
                     cost_noise=self.options.cost_noise, body_clear=self._body_clear)
         self.expanded += res.expanded
-        self.search_seconds += res.seconds
         if isinstance(res, SearchFailure):
             if res.reason == "budget":
                 why = (f"the search budget ran out ({res.expanded} nodes; closest approach "
@@ -497,10 +496,9 @@ class SequencePlanner:
             step.last_segment = len(self.segments) - 1
             self.steps.append(step)
         self._stand_still(-1, 0.3)
-        return Plan(self.segments, self.steps, start, self.expanded, self.search_seconds)
+        return Plan(self.segments, self.steps, start, self.expanded)
 
     def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...]) -> StepPlan:
-        t0 = time.perf_counter()
         expanded0 = self.expanded
         if self.seated and kind not in ("standUp", "wait", "leftHand", "rightHand",
                                         "assemble", "sit"):
@@ -515,9 +513,8 @@ class SequencePlanner:
             self._stand_still(i, 0.25)
             return StepPlan(text, kind, np.asarray(region.center, dtype=float), walk_segments=n,
                             expanded=self.expanded - expanded0,
-                            search_seconds=time.perf_counter() - t0,
                             primitive=f"{n} gait primitives")
-        target = self._target_of(kind, args)
+        target = self.target_of(kind, args)
         if kind == "grasp" and args[0] in self.consumed:
             self.consumed.discard(args[0])           # a fresh part from the supply
         walked = 0
@@ -565,7 +562,7 @@ class SequencePlanner:
         return StepPlan(text, kind, target, walk_segments=walked, goal_segment=seg,
                         contact_frame=int(mp.meta.get("contact_frame", mp.n_frames - 1)),
                         hand=hand, expanded=self.expanded - expanded0,
-                        search_seconds=time.perf_counter() - t0, primitive=mp.name,
+                        primitive=mp.name,
                         objects_effect=effect)
 
     def _goal_segment(self, kind: str, target: np.ndarray | None, label: int,

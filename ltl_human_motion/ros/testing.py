@@ -64,3 +64,16 @@ def scripted_synthesize(spec: str, cell: Any, library: Any = None, variants: int
         time.sleep(delay)
     return [make_test_motion(duration=duration, stature=stature, name=f"variant_{v}")
             for v in range(max(int(variants), 1))]
+
+
+#: A bringup file that starts only the synthesis node (for service tests).
+SYNTHESIS_ONLY_BRINGUP = """\
+bringup:
+  ros__parameters:
+    nodes: [synthesis_node]
+    humans: ["1"]
+synthesis_node:
+  ros__parameters:
+    default_cell: paper_cell
+    max_concurrent: 4
+"""
