@@ -21,5 +21,10 @@ export PYTHONPATH="$_LHM_ROOT${PYTHONPATH:+:$PYTHONPATH}"
 # stack on another machine).
 export ROS_AUTOMATIC_DISCOVERY_RANGE="${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST}"
 export RMW_IMPLEMENTATION="${RMW_IMPLEMENTATION:-rmw_fastrtps_cpp}"
+# Service responses wait up to 5 s for discovery instead of 100 ms (see the file). A profile
+# file of the user's own is kept.
+if [ -z "${FASTDDS_DEFAULT_PROFILES_FILE:-}${FASTRTPS_DEFAULT_PROFILES_FILE:-}" ]; then
+  export FASTDDS_DEFAULT_PROFILES_FILE="$_LHM_ROOT/ltl_human_motion/ros/fastdds_profiles.xml"
+fi
 export MPLBACKEND="${MPLBACKEND:-Agg}"
 unset _LHM_ROOT

@@ -1,7 +1,7 @@
 """Shared pytest set-up: isolate DDS traffic of this test session; repeatable hypothesis.
 
 Every session gets its own ROS_DOMAIN_ID (random in 100..200, unless the caller set one)
-and keeps discovery on loopback, before any test initializes rclpy; subprocesses inherit
+keeps discovery on loopback and loads the package's Fast DDS profile, before any test initializes rclpy; subprocesses inherit
 both through ``os.environ``.
 
 Property-based tests draw the same examples on every run (profile ``deterministic``), so
@@ -16,12 +16,15 @@ import random
 import pytest
 from hypothesis import settings
 
+from ltl_human_motion.ros.middleware import apply_middleware_defaults
+
 settings.register_profile("deterministic", derandomize=True, database=None, deadline=None)
 settings.register_profile("explore", deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 os.environ.setdefault("ROS_DOMAIN_ID", str(random.SystemRandom().randint(100, 200)))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+apply_middleware_defaults()
 
 
 def pytest_configure(config: pytest.Config) -> None:

@@ -146,7 +146,8 @@ def _pipeline_available() -> bool:
 @pytest.mark.slow
 @pytest.mark.skipif(not _pipeline_available(), reason="planning.synthesize is not available yet")
 def test_ros_demo_loop_with_the_pipeline_s2(tmp_path: Path) -> None:
-    summary = run_ros_demo("S2", "paper_cell", tmp_path, playback_rate=10.0)
+    summary = run_ros_demo("S2", "paper_cell", tmp_path, playback_rate=10.0,
+                           synthesis_timeout=180.0)
     assert summary["success"], summary["error"]
     for task in ("grasp(O1)", "grasp(O2)", "assemble(R1)"):
         assert task in summary["task_sequence"]

@@ -23,6 +23,7 @@ from rclpy.parameter import Parameter
 
 from ltl_human_motion.ros.bringup_config import BringupConfig, NodeSpec, load_bringup_config
 from ltl_human_motion.ros.common import SpinThread
+from ltl_human_motion.ros.middleware import apply_middleware_defaults
 from ltl_human_motion.ros.motion_store import MotionStore
 from ltl_human_motion.ros.occupancy_node import OccupancyNode
 from ltl_human_motion.ros.playback import Playback
@@ -56,6 +57,7 @@ class Bringup:
             else load_bringup_config(config)
         self._owns_context = context is None
         if context is None:
+            apply_middleware_defaults()
             context = Context()
             rclpy.init(args=self.config.ros_args(), context=context)
         self.context = context

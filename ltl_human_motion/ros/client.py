@@ -21,11 +21,20 @@ from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message
 
 from ltl_human_motion.ros.common import STREAM_QOS, SpinThread
+from ltl_human_motion.ros.middleware import apply_middleware_defaults
 
 
 def call_service(client: Client, request: Any, timeout: float,
-                 wait_for_service: float = 10.0) -> Any:
+                 wait_for_service: float = 10.0, resend_after: float | None = None) -> Any:
     """Send ``request`` and return the response.
+
+    Parameters
+    ----------
+    resend_after : float, optional
+        For idempotent services: send the request again whenever no response has come for
+        this many seconds, and take the first response that arrives. A response lost by
+        the middleware (a server that had not yet discovered this client drops it) then
+        costs this long instead of the whole ``timeout``.
 
     Raises
     ------
@@ -37,12 +46,24 @@ def call_service(client: Client, request: Any, timeout: float,
         raise TimeoutError(f"service {client.service_name} not available after "
                            f"{wait_for_service:g} s")
     done = threading.Event()
-    future = client.call_async(request)
-    future.add_done_callback(lambda _f: done.set())
-    if not done.wait(timeout):
-        client.remove_pending_request(future)
-        raise TimeoutError(f"service {client.service_name} did not answer within {timeout:g} s")
-    return future.result()
+    futures = []
+    deadline = time.monotonic() + timeout
+    try:
+        while True:
+            future = client.call_async(request)
+            future.add_done_callback(lambda _f: done.set())
+            futures.append(future)
+            remaining = deadline - time.monotonic()
+            wait = remaining if resend_after is None else min(remaining, resend_after)
+            if done.wait(max(wait, 0.0)):
+                return next(f for f in futures if f.done()).result()
+            if time.monotonic() >= deadline:
+                raise TimeoutError(f"service {client.service_name} did not answer within "
+                                   f"{timeout:g} s ({len(futures)} request(s) sent)")
+    finally:
+        for f in futures:
+            if not f.done():
+                client.remove_pending_request(f)
 
 
 def wait_until(predicate: Callable[[], bool], timeout: float, what: str,
@@ -128,6 +149,7 @@ class ClientSession:
     """
 
     def __init__(self, name: str = "client") -> None:
+        apply_middleware_defaults()
         self.context = Context()
         rclpy.init(context=self.context)
         self.node = Node(name, context=self.context)
@@ -140,12 +162,14 @@ class ClientSession:
         """Log what ``topic`` delivers (see :class:`TopicWatcher`)."""
         return self.watcher.watch(msg_type, topic, keep, qos)
 
-    def call(self, srv_type: Any, name: str, request: Any, timeout: float = 10.0) -> Any:
-        """Call service ``name`` (the client is made once per name and type)."""
+    def call(self, srv_type: Any, name: str, request: Any, timeout: float = 10.0,
+             resend_after: float | None = None) -> Any:
+        """Call service ``name`` (the client is made once per name and type); see
+        :func:`call_service` for ``resend_after``."""
         key = (srv_type, name)
         if key not in self._clients:
             self._clients[key] = self.node.create_client(srv_type, name)
-        return call_service(self._clients[key], request, timeout)
+        return call_service(self._clients[key], request, timeout, resend_after=resend_after)
 
     def close(self) -> None:
         """Stop spinning, destroy the node, shut the context down."""

@@ -80,7 +80,8 @@ def run_ros_demo(spec: str, cell: str, out_dir: str | Path, duration: float | No
 
         started = time.monotonic()
         response = session.call(SynthesizeMotion, "/synthesize_motion", SynthesizeMotion.Request(
-            spec=spec, cell=cell, seed=seed), timeout=synthesis_timeout)
+            spec=spec, cell=cell, seed=seed), timeout=synthesis_timeout,
+            resend_after=min(30.0, synthesis_timeout))
         summary["synthesis_wall_time"] = round(time.monotonic() - started, 3)
         if not response.success:
             summary["error"] = response.error_message

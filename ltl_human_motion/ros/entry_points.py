@@ -16,9 +16,11 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 
 from ltl_human_motion.ros.common import spin_nodes
+from ltl_human_motion.ros.middleware import apply_middleware_defaults
 
 
 def _run_node(factory: Callable[[], Node], args: list[str] | None) -> int:
+    apply_middleware_defaults()
     rclpy.init(args=args)
     node: Node | None = None
     try:
