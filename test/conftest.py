@@ -1,8 +1,8 @@
 """Shared pytest set-up: isolate DDS traffic of this test session; repeatable hypothesis.
 
-Every session gets its own ROS_DOMAIN_ID (random in 100..200, unless the caller set one)
-keeps discovery on loopback and loads the package's Fast DDS profile, before any test initializes rclpy; subprocesses inherit
-both through ``os.environ``.
+Every session gets its own ROS_DOMAIN_ID (random in 100..200, unless the caller set one),
+keeps discovery on loopback and loads the package's Fast DDS profile, before any test
+initializes rclpy; subprocesses inherit all three through ``os.environ``.
 
 Property-based tests draw the same examples on every run (profile ``deterministic``), so
 CI is repeatable; ``HYPOTHESIS_PROFILE=explore`` draws new ones to hunt for bugs.

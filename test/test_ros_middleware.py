@@ -52,12 +52,12 @@ def _serving(name: str, service: str, callback: Callable[[Any, Any], Any]) -> It
     """A SynthesizeMotion server ``name`` on ``service`` in a context of its own, whose
     callbacks may run concurrently."""
     rclpy = pytest.importorskip("rclpy")
+    from ltl_human_motion.srv import SynthesizeMotion
     from rclpy.callback_groups import ReentrantCallbackGroup
     from rclpy.context import Context
     from rclpy.node import Node
 
     from ltl_human_motion.ros.common import SpinThread
-    from ltl_human_motion.srv import SynthesizeMotion
 
     context = Context()
     rclpy.init(context=context)
@@ -78,8 +78,9 @@ def test_a_resent_request_is_answered_when_the_first_answer_is_late() -> None:
     """The first request is held for 4 s; the client resends after 0.5 s and takes the
     answer to the second, well before the first comes back."""
     pytest.importorskip("rclpy")
-    from ltl_human_motion.ros.client import ClientSession
     from ltl_human_motion.srv import SynthesizeMotion
+
+    from ltl_human_motion.ros.client import ClientSession
 
     calls: list[float] = []
     lock = threading.Lock()
@@ -110,8 +111,9 @@ def test_a_resent_request_is_answered_when_the_first_answer_is_late() -> None:
 @pytest.mark.ros
 def test_without_resend_a_silent_service_times_out_naming_it() -> None:
     pytest.importorskip("rclpy")
-    from ltl_human_motion.ros.client import ClientSession
     from ltl_human_motion.srv import SynthesizeMotion
+
+    from ltl_human_motion.ros.client import ClientSession
 
     release = threading.Event()
 
