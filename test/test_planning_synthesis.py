@@ -221,3 +221,49 @@ def test_every_table_i_task_plans_and_verifies(spec: str, library) -> None:
     synth = synthesize(spec, TASK_CELL, library=library, seed=0)[0]
     assert synth.verification["passed"], synth.verification
     assert len(synth.timeline) == len(synth.sequence) >= 3
+
+
+@pytest.mark.parametrize("stature", [1.55, 1.95])
+def test_s1_verifies_for_the_smallest_and_the_tallest_worker(stature: float,
+                                                              paper_cell) -> None:
+    """The part carried by a 1.55 m worker hangs lower: the planner checks it against
+    the bench while stepping in, as verification does."""
+    synth = synthesize("S1", paper_cell, stature=stature, seed=0)[0]
+    assert synth.verification["passed"], synth.verification
+    head = synth.motion.positions[0, synth.motion.skeleton.index("head"), 2]
+    assert abs(head - 0.9 * stature) < 0.1 * stature
+
+
+@pytest.mark.parametrize("spec, last_primitive", [
+    ("F move(O1, R1)", "rightHand"),          # R1 (final region) is entered by a hand
+    ("F carry(O1, R1)", "move"),              # the part is put into R1
+    ("F (grasp(O1) & F (release(O1) & F grasp(O2)))", "rightHand"),
+])
+def test_a_region_above_the_bench_is_entered_with_the_hands(spec: str, last_primitive: str,
+                                                             paper_cell, library) -> None:
+    """Nobody can stand in R1 (a box above the bench), yet walk(R1) and carry(O, R1) need
+    enter(x, R1): the planner reaches into it, and verification agrees."""
+    synth = synthesize(spec, paper_cell, library=library, seed=0)[0]
+    assert synth.verification["passed"], synth.verification
+    assert synth.timeline[-1].primitive.startswith(last_primitive)
+    r1 = paper_cell.region("R1")
+    hands = synth.motion.positions[:, [synth.motion.skeleton.index(j)
+                                       for j in ("l_hand", "r_hand")]]
+    inside = np.all((hands >= r1.lo) & (hands <= r1.hi), axis=-1).any(axis=-1)
+    assert inside.any()
+
+
+def test_carry_and_move_fetch_the_part_first(library) -> None:
+    """carry(O1, R2) and move(O1, R1) without an earlier grasp: the part is grasped on
+    the way, and its track passes through the region during the task."""
+    for spec, region in (("carry(O1, R2)", "R2"), ("move(O1, R1)", "R1")):
+        synth = synthesize(spec, TASK_CELL, library=library, seed=0)[0]
+        assert synth.verification["passed"], (spec, synth.verification)
+        cell = resolve_cell(TASK_CELL)
+        start = np.asarray(cell.object("O1").position)
+        seg = synth.timeline[0]
+        track = synth.objects["O1"]
+        assert np.allclose(track[0], start)
+        reg = cell.region(region)
+        window = track[seg.start_frame:seg.end_frame]
+        assert np.all((window >= reg.lo) & (window <= reg.hi), axis=-1).any()

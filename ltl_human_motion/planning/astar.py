@@ -107,6 +107,17 @@ def _path_clearance(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: 
     return clearance(pts).reshape(p.shape[:2]).min(axis=1)
 
 
+def _body_at(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float
+             ) -> np.ndarray:
+    """Sampled body poses of primitives ``ids`` placed at (x, y, yaw), shape (M, B, J, 3)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    body = index.body[ids] @ rot.T
+    body[..., 0] += x
+    body[..., 1] += y
+    return body
+
+
 def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | None = None,
           clearance: Callable[[np.ndarray], np.ndarray], body_radius: float = 0.25,
           heuristic_speed: float = 0.7, turn_rate: float = 2.0, carry: bool = False,
@@ -205,13 +216,9 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         if body_clear is not None and index.body.size:
             exact = index.standing[succ] | (gap < near_radius)
             if exact.any():
-                c, s_ = np.cos(pyaw), np.sin(pyaw)
-                rot = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
-                sweep = index.body[succ[exact]] @ rot.T
-                sweep[..., 0] += px
-                sweep[..., 1] += py
                 ok = np.ones(len(succ), dtype=bool)
-                ok[exact] = body_clear(sweep, index.standing[succ[exact]])
+                ok[exact] = body_clear(_body_at(index, succ[exact], px, py, pyaw),
+                                       index.standing[succ[exact]])
                 if not ok.any():
                     continue
                 succ, ends = succ[ok], ends[ok]
@@ -230,6 +237,11 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
                 stop_ends = _place(index, stop_ids, mx, my, myaw)
                 stop_ok = goal.reached(stop_ends[:, 0], stop_ends[:, 1], stop_ends[:, 2])
                 stop_ok &= _path_clearance(index, stop_ids, mx, my, myaw, clearance) > body_radius
+                if stop_ok.any() and body_clear is not None and index.body.size:
+                    # The arms swing as the worker stops: check the whole body, as above.
+                    cand = stop_ids[stop_ok]
+                    stop_ok[stop_ok] = body_clear(_body_at(index, cand, mx, my, myaw),
+                                                  index.standing[cand])
                 if stop_ok.any():
                     k = int(np.flatnonzero(stop_ok)[0])
                     tail = [(int(stop_ids[k]), (mx, my, myaw))]

@@ -175,7 +175,8 @@ def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np
     held: dict[str, np.ndarray] = {}
     supply = {name: np.asarray(obj.position, dtype=float) for name, obj in cell.objects.items()}
     events: list[tuple[int, int, str, str, str | None]] = []
-    for order, step in enumerate(plan.steps):
+    flat = [sub for step in plan.steps for sub in (*step.sub_steps, step)]
+    for order, step in enumerate(flat):
         if step.goal_segment is None:
             continue
         start = spans[step.goal_segment][0]

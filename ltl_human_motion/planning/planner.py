@@ -115,6 +115,11 @@ class StepPlan:
         A* nodes expanded for this step.
     primitive : str
         Name of the goal primitive (or of the last gait primitive for walks).
+    objects_effect : dict
+        What the step does to the objects (``attach``, ``detach``, ...).
+    sub_steps : list of StepPlan
+        Steps the planner added before this one, e.g. the grasp of a part that
+        carry/move/insert needs in hand; their effects come first.
     """
 
     task: str
@@ -129,6 +134,7 @@ class StepPlan:
     expanded: int = 0
     primitive: str = ""
     objects_effect: dict = field(default_factory=dict)
+    sub_steps: list[StepPlan] = field(default_factory=list)
 
 
 @dataclass
@@ -439,15 +445,22 @@ class SequencePlanner:
         self._add(mp, self.pose, label, self.overlap)
 
     def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int = 16) -> bool:
-        """Whether ``mp`` placed at ``pose`` keeps clear of every obstacle, checked with
-        the exact capsule distances on ``samples`` frames (these checks are few)."""
-        from ltl_human_motion.scene.predicates import body_clearance
+        """Whether ``mp`` placed at ``pose`` keeps the body and the objects held (at their
+        hand offsets) clear of every obstacle, checked with the exact distances on
+        ``samples`` frames (these checks are few)."""
+        from ltl_human_motion.scene.predicates import body_clearance, object_clearance
         if not self.cell.obstacles:
             return True
         frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
-        world = world_positions(mp, *pose)[frames]
-        d = body_clearance(world, self.cell, stature=self.library.skeleton.stature)
-        return bool(np.min(d) > 0.003)
+        world = world_positions(mp, *pose)
+        d = body_clearance(world[frames], self.cell, stature=self.library.skeleton.stature)
+        if np.min(d) <= 0.003:
+            return False
+        for name, joint in self.held.items():
+            centre = world[::2, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
+            if np.any(object_clearance(self.cell, name, centre) <= 0.0):
+                return False
+        return True
 
     def _step_back(self, carrying: bool, label: int) -> None:
         """Step back from an obstacle in front (a step primitive of the gait index)."""
@@ -506,14 +519,28 @@ class SequencePlanner:
             self.seated = False
         if kind in ("walk", "carry"):
             region = self.cell.region(args[-1])
-            if kind == "carry" and args[0] not in self.held:
-                self._plan_step(i, f"grasp({args[0]})", "grasp", (args[0],))
-            n = self._walk(self._region_goal(region, f"walk into {region.name}", text), text,
-                           i, carry=bool(self.held))
+            subs = [self._fetch(i, args[0])] if kind == "carry" and args[0] not in self.held \
+                else []
+            try:
+                goal = self._region_goal(region, f"walk into {region.name}", text)
+            except PlanningError as exc:
+                if exc.reason != "unreachable":
+                    raise
+                # Nowhere to stand in the region (e.g. a box above a bench). Its entry,
+                # enter(x, R), holds once any body part is in it: reach in with a hand, or
+                # for carry(O, R) put the held part in it.
+                step = self._reach_into(i, text, kind, args, exc)
+                step.sub_steps[:0] = subs
+                return step
+            n = self._walk(goal, text, i, carry=bool(self.held))
             self._stand_still(i, 0.25)
             return StepPlan(text, kind, np.asarray(region.center, dtype=float), walk_segments=n,
                             expanded=self.expanded - expanded0,
-                            primitive=f"{n} gait primitives")
+                            primitive=f"{n} gait primitives", sub_steps=subs)
+        subs = []
+        if kind in ("move", "insert") and args[0] not in self.held:
+            # The part is fetched first, as for carry(O, R).
+            subs.append(self._fetch(i, args[0]))
         target = self.target_of(kind, args)
         if kind == "grasp" and args[0] in self.consumed:
             self.consumed.discard(args[0])           # a fresh part from the supply
@@ -556,6 +583,14 @@ class SequencePlanner:
         self._carry_stance = False
         hand = mp.meta.get("hand")
         effect = self._apply_effects(kind, args, hand)
+        contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
+        for name, joint in effect.get("attach", {}).items():
+            # As the object tracks are made: the part keeps its world offset from the hand.
+            hand_at_contact = self.segments[seg].positions[contact, JOINT_INDEX[joint]]
+            self.held_offsets[name] = np.asarray(self.cell.object(name).position,
+                                                 dtype=np.float64) - hand_at_contact
+        for name in (*effect.get("detach", ()), *effect.get("detach_after", ())):
+            self.held_offsets.pop(name, None)
         if bool(self.held) != carrying_before:
             self._arm_transition(carrying_before, i)
         self.seated = kind == "sit" or (self.seated and kind != "standUp")
@@ -563,7 +598,28 @@ class SequencePlanner:
                         contact_frame=int(mp.meta.get("contact_frame", mp.n_frames - 1)),
                         hand=hand, expanded=self.expanded - expanded0,
                         primitive=mp.name,
-                        objects_effect=effect)
+                        objects_effect=effect, sub_steps=subs)
+
+    def _fetch(self, i: int, obj: str) -> StepPlan:
+        """Grasp ``obj`` as part of step ``i`` (which needs it in hand)."""
+        first = len(self.segments)
+        step = self._plan_step(i, f"grasp({obj})", "grasp", (obj,))
+        step.first_segment, step.last_segment = first, len(self.segments) - 1
+        return step
+
+    def _reach_into(self, i: int, text: str, kind: str, args: tuple[str, ...],
+                    cause: PlanningError) -> StepPlan:
+        """walk(R) / carry(O, R) for a region nobody can stand in: a hand task into R
+        (rightHand(R), or move(O, R) with the held part). Raises ``cause`` if that fails too.
+        """
+        hand_kind, hand_args = ("move", (args[0], args[-1])) if kind == "carry" \
+            else ("rightHand", (args[-1],))
+        try:
+            step = self._plan_step(i, text, hand_kind, hand_args)
+        except PlanningError as exc:
+            raise PlanningError(f"{cause}; reaching into it instead failed too: {exc}",
+                                task=text, reason=cause.reason) from None
+        return replace(step, kind=f"{kind} (by {hand_kind})")
 
     def _goal_segment(self, kind: str, target: np.ndarray | None, label: int,
                       text: str) -> tuple[int, MotionPrimitive]:
