@@ -84,8 +84,16 @@ def seat_height_range(skeleton: Skeleton) -> tuple[float, float]:
     return 0.20 * skeleton.stature, 0.34 * skeleton.stature
 
 
-def _arm_length(skeleton: Skeleton) -> float:
+@lru_cache(maxsize=64)
+def _bones(skeleton: Skeleton) -> np.ndarray:
+    """``skeleton.bone_lengths()`` (J,), computed once per skeleton (read-only)."""
     b = skeleton.bone_lengths()
+    b.flags.writeable = False
+    return b
+
+
+def _arm_length(skeleton: Skeleton) -> float:
+    b = _bones(skeleton)
     return float(b[_J["l_elbow"]] + b[_J["l_wrist"]] + b[_J["l_hand"]])
 
 
@@ -119,10 +127,16 @@ def _check_task(task: str) -> None:
 
 # ------------------------------------------------------------------------ body model
 def _rot_y(angle: np.ndarray) -> np.ndarray:
+    """Rotations about +y, shape (..., 3, 3) for ``angle`` of shape (...)."""
+    angle = np.asarray(angle, dtype=np.float64)
     c, s = np.cos(angle), np.sin(angle)
-    z, o = np.zeros_like(angle), np.ones_like(angle)
-    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1),
-                     np.stack([-s, z, c], -1)], -2)
+    out = np.zeros((*angle.shape, 3, 3))
+    out[..., 0, 0] = c
+    out[..., 0, 2] = s
+    out[..., 1, 1] = 1.0
+    out[..., 2, 0] = -s
+    out[..., 2, 2] = c
+    return out
 
 
 _TRUNK = (("spine", "pelvis", 0.5), ("chest", "spine", 0.85), ("neck", "chest", 1.0),
@@ -136,9 +150,12 @@ def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray) -> np.ndar
     T = pelvis.shape[0]
     out = np.zeros((T, len(rest), 3))
     out[:, 0] = pelvis
+    rot: dict[float, np.ndarray] = {}          # one rotation per distinct flexion fraction
     for name, parent, frac in _TRUNK:
         j, p = _J[name], _J[parent]
-        out[:, j] = out[:, p] + _rot_y(frac * pitch) @ (rest[j] - rest[p])
+        if frac not in rot:
+            rot[frac] = _rot_y(frac * pitch)
+        out[:, j] = out[:, p] + rot[frac] @ (rest[j] - rest[p])
     for name in ("l_hip", "r_hip"):
         out[:, _J[name]] = pelvis + (rest[_J[name]] - rest[0])
     return out
@@ -146,20 +163,22 @@ def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray) -> np.ndar
 
 def _body(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, ankles: np.ndarray,
           toes: np.ndarray, knee_pole: np.ndarray, hands: np.ndarray, hand_dir: np.ndarray,
-          elbow_pole: np.ndarray) -> np.ndarray:
+          elbow_pole: np.ndarray, trunk: np.ndarray | None = None) -> np.ndarray:
     """Full pose of every frame.
 
     Parameters
     ----------
     pelvis : (T, 3); pitch : (T,); ankles, toes, knee_pole, hands, hand_dir, elbow_pole :
     (T, 2, 3) with index 0 = left, 1 = right.
+    trunk : (T, J, 3), optional
+        ``_trunk(skeleton, pelvis, pitch)`` if already computed (it is not modified).
 
     Returns
     -------
     ndarray, shape (T, J, 3)
     """
-    b = skeleton.bone_lengths()
-    out = _trunk(skeleton, pelvis, pitch)
+    b = _bones(skeleton)
+    out = _trunk(skeleton, pelvis, pitch) if trunk is None else trunk.copy()
     for k, s in enumerate(_SIDES):
         hip, knee, ank, toe = (_J[f"{s}_{n}"] for n in ("hip", "knee", "ankle", "toe"))
         kn, an = two_bone_ik(out[:, hip], ankles[:, k], b[knee], b[ank], knee_pole[:, k],
@@ -229,23 +248,38 @@ def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
                      np.broadcast_to(st.toes, (T, 2, 3)), np.broadcast_to(st.knee_pole,
                                                                           (T, 2, 3)),
                      hnd, np.broadcast_to(st.hand_dir, (T, 2, 3)),
-                     np.broadcast_to(st.elbow_pole, (T, 2, 3)))
+                     np.broadcast_to(st.elbow_pole, (T, 2, 3)), tr)
         cx = center_of_mass(pose)[:, 0]
         shift += (np.clip(cx, lo, hi) - cx) / 0.8
     return shift
 
 
 # ------------------------------------------------------------------- posture search
-def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...]
-          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Costs of trunk flexion / pelvis drop candidates for hand targets.
+#: Target-independent part of :func:`_grid` per (skeleton, start pose); see :func:`_grid_base`.
+_GRID_CACHE: dict[tuple, tuple[np.ndarray, ...]] = {}
 
-    Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
+
+def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
+    """The candidate postures of :func:`_grid`, which do not depend on the targets.
+
+    Balance shifts, trunk poses, the posture cost and the leg/head feasibility depend only
+    on the skeleton and the start pose, of which a worker has a few (walking and carrying
+    stance), so they are computed once per pair and kept (read-only arrays).
+
+    Returns
+    -------
+    P, D, shift, base_cost : ndarray, shape (C,)
+    shoulders : ndarray, shape (C, 2, 3)
+        Left and right shoulder of each candidate.
+    feasible : ndarray of bool, shape (C,)
     """
+    key = (skeleton, st.pose.tobytes())
+    hit = _GRID_CACHE.get(key)
+    if hit is not None:
+        return hit
     H = skeleton.stature
-    b = skeleton.bone_lengths()
+    b = _bones(skeleton)
     leg = b[_J["l_knee"]] + b[_J["l_ankle"]]
-    arm = _arm_length(skeleton)
     pitch_v = np.linspace(0.0, 1.45, 30)
     drop_v = np.linspace(0.0, 0.36 * H, 25)
     P, D = np.meshgrid(pitch_v, drop_v, indexing="ij")
@@ -257,17 +291,34 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     tr = _trunk(skeleton, pelvis, P)
     cost = P ** 2 + (D / (0.14 * H)) ** 2
     feasible = np.ones(P.size, bool)
-    for k in active:
-        sh = tr[:, _J[f"{_SIDES[k]}_shoulder"]]
-        d = np.linalg.norm(targets[k] - sh, axis=-1)
-        feasible &= d <= _REACH_FRACTION * arm
-        cost = cost + 0.5 * (d / arm - 0.8) ** 2
     for k, s in enumerate(_SIDES):
         hip = tr[:, _J[f"{s}_hip"]]
         d = np.linalg.norm(hip - st.ankles[k], axis=-1)
         feasible &= (d <= leg * 1.0000001) & (d >= 0.30 * leg)
     # the head must not go below the hands' height band (no diving into the floor)
     feasible &= tr[:, _J["head"], 2] > 0.12 * H
+    shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
+    out = (P, D, shift, cost, shoulders, feasible)
+    for arr in out:
+        arr.flags.writeable = False
+    if len(_GRID_CACHE) >= 32:
+        _GRID_CACHE.clear()
+    _GRID_CACHE[key] = out
+    return out
+
+
+def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...]
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Costs of trunk flexion / pelvis drop candidates for hand targets.
+
+    Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
+    """
+    arm = _arm_length(skeleton)
+    P, D, shift, cost, shoulders, feasible = _grid_base(skeleton, st)
+    for k in active:
+        d = np.linalg.norm(targets[k] - shoulders[:, k], axis=-1)
+        feasible = feasible & (d <= _REACH_FRACTION * arm)
+        cost = cost + 0.5 * (d / arm - 0.8) ** 2
     cost = np.where(feasible, cost, np.inf)
     return P, D, shift, cost
 
@@ -396,12 +447,14 @@ def _finish(name: str, task: str, world: np.ndarray, st: _Start, fps: float, sou
 def _frames(skeleton: Skeleton, st: _Start, t: np.ndarray, pelvis: np.ndarray,
             pitch: np.ndarray, hands: np.ndarray, hand_dir: np.ndarray,
             elbow_pole: np.ndarray, ankles: np.ndarray | None = None,
-            toes: np.ndarray | None = None, knee_pole: np.ndarray | None = None) -> np.ndarray:
+            toes: np.ndarray | None = None, knee_pole: np.ndarray | None = None,
+            trunk: np.ndarray | None = None) -> np.ndarray:
     T = t.size
     ankles = np.broadcast_to(st.ankles, (T, 2, 3)) if ankles is None else ankles
     toes = np.broadcast_to(st.toes, (T, 2, 3)) if toes is None else toes
     knee_pole = np.broadcast_to(st.knee_pole, (T, 2, 3)) if knee_pole is None else knee_pole
-    return _body(skeleton, pelvis, pitch, ankles, toes, knee_pole, hands, hand_dir, elbow_pole)
+    return _body(skeleton, pelvis, pitch, ankles, toes, knee_pole, hands, hand_dir, elbow_pole,
+                 trunk)
 
 
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
@@ -529,7 +582,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         side = 1.0 if k == 0 else -1.0
         goal_pole = np.array([-0.35, 1.0 * side, -0.45])
         elbow_pole[:, k] = (1 - s_hand)[:, None] * st.elbow_pole[k] + s_hand[:, None] * goal_pole
-    world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole)
+    world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
     contact = min(round(contact_t * fps), T - 1)
     meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
             "hold_frames": [f1, f2], "trunk_flexion": pitch1, "pelvis_drop": drop1,
@@ -560,7 +613,7 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
              hand: str) -> MotionPrimitive:
     """bend, stoop and kneel: go down, stay, come back up."""
     H = skeleton.stature
-    b = skeleton.bone_lengths()
+    b = _bones(skeleton)
     jitter = rng.uniform(0.9, 1.1)
     t_down = {"bend": 1.1, "stoop": 1.3, "kneel": 1.7}[task] * jitter
     t_up = t_down * rng.uniform(1.0, 1.15)
@@ -676,7 +729,7 @@ def _sit(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: flo
         raise ValueError(f"sit: seat height {target[2]:.3f} m is outside [{lo:.3f}, {hi:.3f}] m "
                          f"for a {H:.2f} m worker")
     rest = skeleton.rest_positions()
-    b = skeleton.bone_lengths()
+    b = _bones(skeleton)
     leg = b[_J["l_knee"]] + b[_J["l_ankle"]]
     hip_z = target[2] + 0.055 * H
     pel1 = np.array([target[0], target[1], hip_z + (rest[0, 2] - rest[_J["l_hip"], 2])])

@@ -48,9 +48,12 @@ def two_bone_ik(base: np.ndarray, target: np.ndarray, l1: float, l2: float,
     p = pole - np.sum(pole * u, axis=-1, keepdims=True) * u
     pn = np.linalg.norm(p, axis=-1, keepdims=True)
     # fall back to any perpendicular when the pole is parallel to the chain
-    alt = np.cross(u, np.array([0.0, 1.0, 0.0]))
-    p = np.where(pn > 1e-9, p / np.maximum(pn, 1e-12), alt / np.maximum(
-        np.linalg.norm(alt, axis=-1, keepdims=True), 1e-12))
+    if np.all(pn > 1e-9):
+        p = p / np.maximum(pn, 1e-12)
+    else:
+        alt = np.cross(u, np.array([0.0, 1.0, 0.0]))
+        p = np.where(pn > 1e-9, p / np.maximum(pn, 1e-12), alt / np.maximum(
+            np.linalg.norm(alt, axis=-1, keepdims=True), 1e-12))
     middle = base + u * a + p * h
     return middle, end
 

@@ -56,37 +56,64 @@ def frame_from_axes(lateral: np.ndarray, up: np.ndarray) -> np.ndarray:
     return np.stack([x, y, z], axis=-1)
 
 
+_RIGID = {JOINT_INDEX[n]: "pelvis" for n in _PELVIS_RIGID} | {
+    JOINT_INDEX[n]: "chest" for n in _CHEST_RIGID}
+#: Joints placed along their source bone, and their parents.
+_FREE_J = np.array([j for j in range(1, len(JOINT_NAMES)) if j not in _RIGID])
+_FREE_P = np.array([PARENTS[j] for j in _FREE_J])
+
+
 def _build(points: dict[str, np.ndarray], pelvis: np.ndarray, skeleton: Skeleton) -> np.ndarray:
     """Canonical positions (T, J, 3) from source points and a given pelvis path."""
-    rest = skeleton.rest_positions()
-    lengths = skeleton.bone_lengths()
-    T = pelvis.shape[0]
-    out = np.zeros((T, len(JOINT_NAMES), 3))
-    out[:, 0] = pelvis
-    src_pelvis = points["pelvis"]
-    src_chest = points["chest"]
     spine = points.get("spine")
     if spine is None:
-        spine = 0.5 * (src_pelvis + src_chest)
-    src = dict(points)
-    src["spine"] = spine
-    r_pelvis = frame_from_axes(points["l_hip"] - points["r_hip"], src_chest - src_pelvis)
-    r_chest = frame_from_axes(points["l_shoulder"] - points["r_shoulder"],
-                              points["neck"] - src_chest)
-    for j in range(1, len(JOINT_NAMES)):
-        name, p = JOINT_NAMES[j], PARENTS[j]
-        if name in _PELVIS_RIGID:
-            out[:, j] = out[:, p] + r_pelvis @ (rest[j] - rest[p])
-        elif name in _CHEST_RIGID:
-            out[:, j] = out[:, p] + r_chest @ (rest[j] - rest[p])
-        else:
-            vec = src[name] - src[JOINT_NAMES[p]]
-            norm = np.linalg.norm(vec, axis=-1, keepdims=True)
-            # a degenerate (zero-length) source bone keeps the canonical rest direction
-            rest_dir = (rest[j] - rest[p]) / max(float(np.linalg.norm(rest[j] - rest[p])), 1e-12)
-            direction = np.where(norm > 1e-9, vec / np.maximum(norm, 1e-12), rest_dir)
-            out[:, j] = out[:, p] + lengths[j] * direction
-    return out
+        spine = 0.5 * (points["pelvis"] + points["chest"])
+    src = np.zeros((pelvis.shape[0], len(JOINT_NAMES), 3))
+    for j, n in enumerate(JOINT_NAMES):
+        if n == "spine":
+            src[:, j] = spine
+        elif n in points:
+            src[:, j] = points[n]             # clavicles are placed rigidly, not from points
+    return _build_array(src, pelvis, skeleton)
+
+
+def _build_array(src: np.ndarray, pelvis: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+    """Canonical positions (T, J, 3) from source points ``src`` (T, J, 3) and a pelvis path.
+
+    Limb bones keep their source direction (a degenerate source bone the rest direction)
+    and get the canonical length; hips, clavicles and shoulders follow the frames of
+    the source pelvis and chest. Each joint is its parent plus its bone. The work is
+    done on a joint-, then coordinate-major copy (J, 3, T), so every step runs over
+    contiguous rows.
+    """
+    rest = skeleton.rest_positions()
+    lengths = skeleton.bone_lengths()
+    T, J = pelvis.shape[0], len(JOINT_NAMES)
+    s = np.ascontiguousarray(np.asarray(src, dtype=np.float64).transpose(1, 2, 0))  # (J,3,T)
+
+    def point(name: str) -> np.ndarray:                  # (T, 3) view
+        return s[JOINT_INDEX[name]].T
+
+    frames = {"pelvis": frame_from_axes(point("l_hip") - point("r_hip"),
+                                        point("chest") - point("pelvis")),
+              "chest": frame_from_axes(point("l_shoulder") - point("r_shoulder"),
+                                       point("neck") - point("chest"))}
+    bone = np.empty((J, 3, T))                          # each joint minus its parent
+    for j, which in _RIGID.items():
+        bone[j] = (frames[which] @ (rest[j] - rest[PARENTS[j]])).T
+    vec = s[_FREE_J] - s[_FREE_P]                                       # (n, 3, T)
+    norm = np.sqrt(vec[:, 0] * vec[:, 0] + vec[:, 1] * vec[:, 1]
+                   + vec[:, 2] * vec[:, 2])[:, None]                     # (n, 1, T)
+    # a degenerate (zero-length) source bone keeps the canonical rest direction
+    rest_vec = rest[_FREE_J] - rest[_FREE_P]
+    rest_dir = rest_vec / np.maximum(np.linalg.norm(rest_vec, axis=-1, keepdims=True), 1e-12)
+    direction = np.where(norm > 1e-9, vec / np.maximum(norm, 1e-12), rest_dir[:, :, None])
+    bone[_FREE_J] = lengths[_FREE_J][:, None, None] * direction
+    out = np.empty((J, 3, T))
+    out[0] = np.asarray(pelvis, dtype=np.float64).T
+    for j in range(1, J):                               # parents come before children
+        out[j] = out[PARENTS[j]] + bone[j]
+    return np.ascontiguousarray(out.transpose(2, 0, 1))
 
 
 def _check_points(points: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -227,8 +254,7 @@ def enforce_bone_lengths(positions: np.ndarray, skeleton: Skeleton) -> np.ndarra
         Same pelvis path; every bone has its canonical length.
     """
     pos = np.asarray(positions, dtype=np.float64)
-    pts = {n: pos[:, i] for i, n in enumerate(JOINT_NAMES)}
-    return _build(pts, pos[:, 0], skeleton)
+    return _build_array(pos, pos[:, 0], skeleton)
 
 
 def mirror_positions(positions: np.ndarray) -> np.ndarray:

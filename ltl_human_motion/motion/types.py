@@ -122,28 +122,68 @@ def yaw_matrix(yaw: np.ndarray | float) -> np.ndarray:
     """Rotation matrices about +z, shape (..., 3, 3) for ``yaw`` of shape (...)."""
     yaw = np.asarray(yaw, dtype=np.float64)
     c, s = np.cos(yaw), np.sin(yaw)
-    z, o = np.zeros_like(yaw), np.ones_like(yaw)
-    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1),
-                     np.stack([z, z, o], -1)], -2)
+    out = np.zeros((*yaw.shape, 3, 3))
+    out[..., 0, 0] = c
+    out[..., 0, 1] = -s
+    out[..., 1, 0] = s
+    out[..., 1, 1] = c
+    out[..., 2, 2] = 1.0
+    return out
 
 
 def world_positions(primitive: MotionPrimitive, x: float = 0.0, y: float = 0.0,
-                    yaw: float = 0.0) -> np.ndarray:
+                    yaw: float = 0.0, frames: np.ndarray | None = None) -> np.ndarray:
     """World joint positions of ``primitive`` started at floor pose (x, y, yaw).
+
+    Parameters
+    ----------
+    primitive : MotionPrimitive
+    x, y, yaw : float
+    frames : array-like of int, shape (F,), optional
+        Only these frames (the same values as the full result's rows).
+
+    Returns
+    -------
+    positions : ndarray, shape (T, J, 3) or (F, J, 3)
+    """
+    root, poses = primitive.root, primitive.poses
+    if frames is not None:
+        root, poses = root[frames], poses[frames]
+    return place_poses(root, poses, x, y, yaw)
+
+
+def place_poses(root: np.ndarray, poses: np.ndarray, x: float = 0.0, y: float = 0.0,
+                yaw: float = 0.0) -> np.ndarray:
+    """World joint positions of frames given by their root and root-relative pose.
+
+    Row by row what :func:`world_positions` computes, for rows gathered from any
+    primitives (all placed at the same floor pose).
+
+    Parameters
+    ----------
+    root : ndarray, shape (T, 4)
+        x, y, z, yaw of the root in the start frame.
+    poses : ndarray, shape (T, J, 3)
+        Root-relative poses in the heading frame.
+    x, y, yaw : float
 
     Returns
     -------
     positions : ndarray, shape (T, J, 3)
     """
-    root = primitive.root
     heading = yaw + root[:, 3]
-    rot = yaw_matrix(heading)                                       # (T, 3, 3)
-    body = np.einsum("tij,tkj->tki", rot, primitive.poses)          # (T, J, 3)
+    # The poses turned about z by the heading (yaw_matrix(heading) @ pose, written out),
+    # plus the root's floor position turned by ``yaw`` and its height.
+    ch, sh = np.cos(heading)[:, None], np.sin(heading)[:, None]     # (T, 1)
+    px, py = poses[..., 0], poses[..., 1]                           # (T, J)
     c, s = np.cos(yaw), np.sin(yaw)
     rx = x + c * root[:, 0] - s * root[:, 1]
     ry = y + s * root[:, 0] + c * root[:, 1]
-    origin = np.stack([rx, ry, root[:, 2]], axis=-1)                # (T, 3)
-    return body + origin[:, None, :]
+    out = np.empty(poses.shape)
+    out[..., 0] = (ch * px - sh * py) + rx[:, None]
+    out[..., 1] = (sh * px + ch * py) + ry[:, None]
+    out[..., 2] = poses[..., 2] + root[:, 2][:, None]
+    return out
 
 
 def end_pose(primitive: MotionPrimitive, x: float = 0.0, y: float = 0.0,

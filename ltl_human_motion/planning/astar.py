@@ -271,10 +271,11 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         closest = min(closest, float(goal.distance(ends[keep, 0], ends[keep, 1]).min()))
         succ, ends, g_new = succ[keep], ends[keep], g_new[keep]
         f_new = g_new + h_new[keep]
-        for m in range(len(succ)):
+        for prim, end, g, f in zip(succ.tolist(), ends.tolist(), g_new.tolist(),
+                                   f_new.tolist()):
             parents.append(node)
-            prims.append(int(succ[m]))
-            poses.append((float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2])))
-            g_cost.append(float(g_new[m]))
-            heapq.heappush(open_heap, (float(f_new[m]), len(prims) - 1))
+            prims.append(prim)
+            poses.append((end[0], end[1], end[2]))
+            g_cost.append(g)
+            heapq.heappush(open_heap, (f, len(prims) - 1))
     return SearchFailure("blocked", expanded, time.perf_counter() - t0, closest)

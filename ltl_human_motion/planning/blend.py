@@ -72,34 +72,41 @@ def concatenate(segments: list[PlacedSegment]) -> tuple[np.ndarray, np.ndarray, 
     """
     if not segments:
         raise ValueError("no segments to concatenate")
-    pos_parts: list[np.ndarray] = [segments[0].positions]
-    yaw_parts: list[np.ndarray] = [np.unwrap(segments[0].root_yaw)]
-    lab_parts: list[np.ndarray] = [np.full(len(segments[0].root_yaw), segments[0].label)]
-    spans = [(0, len(segments[0].root_yaw))]
-    length = spans[0][1]
+    # Every segment after the first starts ``nf`` frames before the end of the result so
+    # far (nf: its blend, at most the length of either side); write into one buffer.
+    nfs, length = [], len(segments[0].root_yaw)
+    part = length
     for seg in segments[1:]:
-        nf = int(seg.blend_in)
-        prev_pos, prev_yaw, prev_lab = pos_parts[-1], yaw_parts[-1], lab_parts[-1]
-        nf = min(nf, len(prev_yaw), len(seg.root_yaw))
+        nf = min(int(seg.blend_in), part, len(seg.root_yaw))
+        nfs.append(nf)
+        part = len(seg.root_yaw) - nf
+        length += part
+    first = segments[0]
+    positions = np.empty((length, *first.positions.shape[1:]))
+    yaw = np.empty(length)
+    labels = np.empty(length, dtype=np.int64)
+    end = len(first.root_yaw)
+    positions[:end] = first.positions
+    yaw[:end] = np.unwrap(first.root_yaw)
+    labels[:end] = first.label
+    spans = [(0, end)]
+    for seg, nf in zip(segments[1:], nfs):
         yaw_in = np.unwrap(seg.root_yaw)
         # Continue the heading without a 2*pi jump.
-        ref = prev_yaw[-nf] if nf else prev_yaw[-1]
+        ref = yaw[end - nf] if nf else yaw[end - 1]
         yaw_in = yaw_in + 2.0 * np.pi * np.round((ref - yaw_in[0]) / (2.0 * np.pi))
+        start = end - nf
         if nf:
             w = blend_weights(nf)
-            a_pos, b_pos = prev_pos[-nf:], seg.positions[:nf]
-            mixed = w[:, None, None] * a_pos + (1.0 - w[:, None, None]) * b_pos
-            a_yaw, b_yaw = prev_yaw[-nf:], yaw_in[:nf]
-            mixed_yaw = a_yaw + (1.0 - w) * wrap_angle(b_yaw - a_yaw)
-            mixed_lab = np.where(w >= 0.5, prev_lab[-nf:], seg.label)
-            pos_parts[-1] = np.concatenate([prev_pos[:-nf], mixed])
-            yaw_parts[-1] = np.concatenate([prev_yaw[:-nf], mixed_yaw])
-            lab_parts[-1] = np.concatenate([prev_lab[:-nf], mixed_lab])
-        pos_parts.append(seg.positions[nf:])
-        yaw_parts.append(yaw_in[nf:])
-        lab_parts.append(np.full(len(yaw_in) - nf, seg.label))
-        start = length - nf
-        length = start + len(seg.root_yaw)
-        spans.append((start, length))
-    return (np.concatenate(pos_parts), np.concatenate(yaw_parts),
-            np.concatenate(lab_parts).astype(np.int64), spans)
+            a_pos, b_pos = positions[start:end], seg.positions[:nf]
+            positions[start:end] = w[:, None, None] * a_pos + (1.0 - w[:, None, None]) * b_pos
+            a_yaw, b_yaw = yaw[start:end], yaw_in[:nf]
+            yaw[start:end] = a_yaw + (1.0 - w) * wrap_angle(b_yaw - a_yaw)
+            labels[start:end] = np.where(w >= 0.5, labels[start:end], seg.label)
+        n = len(seg.root_yaw)
+        positions[end:start + n] = seg.positions[nf:]
+        yaw[end:start + n] = yaw_in[nf:]
+        labels[end:start + n] = seg.label
+        end = start + n
+        spans.append((start, end))
+    return positions, yaw, labels, spans

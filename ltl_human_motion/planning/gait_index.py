@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ltl_human_motion.motion.types import MotionPrimitive, world_positions
+from ltl_human_motion.motion.types import MotionPrimitive, place_poses, world_positions
 from ltl_human_motion.planning.turns import turn_primitives
 
 BODY_SAMPLES = 5
@@ -16,7 +16,25 @@ BODY_SAMPLES = 5
 def sample_body(mp: MotionPrimitive, samples: int = BODY_SAMPLES) -> np.ndarray:
     """Poses of ``mp`` placed at the origin at evenly spaced frames, shape (S, J, 3)."""
     frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
-    return world_positions(mp)[frames]
+    return world_positions(mp, frames=frames)
+
+
+def sample_bodies(primitives: Sequence[MotionPrimitive], samples: int = BODY_SAMPLES
+                  ) -> np.ndarray:
+    """:func:`sample_body` of every primitive, shape (N, S, J, 3), in one vectorized pass."""
+    if not primitives:
+        return np.zeros((0, samples, 0, 3))
+    picks: dict[int, np.ndarray] = {}
+    roots, poses = [], []
+    for mp in primitives:
+        frames = picks.get(mp.n_frames)
+        if frames is None:
+            frames = picks[mp.n_frames] = np.linspace(0, mp.n_frames - 1,
+                                                      samples).round().astype(int)
+        roots.append(mp.root[frames])
+        poses.append(mp.poses[frames])
+    body = place_poses(np.concatenate(roots), np.concatenate(poses))
+    return body.reshape(len(primitives), samples, *body.shape[1:])
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,7 +92,7 @@ class GaitIndex:
         n = library.n_primitives
         stops = np.zeros(n, dtype=bool)
         stops[np.asarray(library.stops, dtype=np.int64)] = True
-        body = np.stack([sample_body(mp) for mp in library.primitives])
+        body = sample_bodies(library.primitives)
         return cls(list(library.primitives), np.asarray(library.displacement),
                    np.asarray(library.durations), np.asarray(library.root_paths),
                    np.asarray(library.indptr, dtype=np.int64),
@@ -110,7 +128,7 @@ class GaitIndex:
         indices = (np.concatenate([np.asarray(s, dtype=np.int64) for s in successors])
                    if lengths.sum() else np.zeros(0, dtype=np.int64))
         start_ids = np.arange(n) if starts is None else np.asarray(starts, dtype=np.int64)
-        body = np.stack([sample_body(mp) for mp in primitives])
+        body = sample_bodies(primitives)
         stop_mask = np.ones(n, dtype=bool)
         if stops is not None:
             stop_mask[:] = False

@@ -18,8 +18,11 @@ from scipy.sparse.csgraph import dijkstra
 _NEIGHBOURS = ((1, 0), (0, 1), (1, 1), (1, -1))
 
 
-class NavigationField:
-    """Geodesic distance to a goal set over the free floor.
+class FloorGrid:
+    """A floor grid: cell centres, the free cells and the graph joining free neighbours.
+
+    The part of a :class:`NavigationField` that does not depend on the goal; fields for
+    different goals on the same floor share one grid (:func:`floor_grid`).
 
     Parameters
     ----------
@@ -27,15 +30,22 @@ class NavigationField:
         Floor area covered, metres.
     free : callable
         ``free(xy (N, 2)) -> bool (N,)``: where the walking root may be.
-    goal : callable
-        ``goal(xy (N, 2)) -> bool (N,)``: goal cells.
     resolution : float
         Cell size in metres.
+
+    Attributes
+    ----------
+    lo : ndarray, shape (2,)
+    res : float
+    shape : (int, int)
+    centres : ndarray, shape (nx * ny, 2)
+    free : ndarray of bool, shape (nx, ny)
+    graph : scipy.sparse.csr_matrix, shape (nx * ny, nx * ny)
+        8-connected free neighbours, both directions, weighted by the step length.
     """
 
     def __init__(self, lo: np.ndarray, hi: np.ndarray,
-                 free: Callable[[np.ndarray], np.ndarray],
-                 goal: Callable[[np.ndarray], np.ndarray], resolution: float = 0.1) -> None:
+                 free: Callable[[np.ndarray], np.ndarray], resolution: float = 0.1) -> None:
         lo = np.asarray(lo, dtype=np.float64)
         hi = np.asarray(hi, dtype=np.float64)
         if lo.shape != (2,) or hi.shape != (2,) or np.any(hi <= lo):
@@ -45,10 +55,9 @@ class NavigationField:
         nx, ny = self.shape
         gx, gy = np.meshgrid(lo[0] + np.arange(nx) * self.res, lo[1] + np.arange(ny) * self.res,
                              indexing="ij")
-        centres = np.stack([gx.ravel(), gy.ravel()], axis=-1)
-        self.free = np.asarray(free(centres), dtype=bool).reshape(self.shape)
-        goal_cells = np.asarray(goal(centres), dtype=bool).reshape(self.shape) & self.free
-        self.has_goal = bool(goal_cells.any())
+        self.centres = np.stack([gx.ravel(), gy.ravel()], axis=-1)
+        self.free = np.asarray(free(self.centres), dtype=bool).reshape(self.shape)
+        self.free.flags.writeable = False              # grids are shared (floor_grid)
         ids = np.arange(nx * ny).reshape(self.shape)
         rows, cols, weights = [], [], []
         for dx, dy in _NEIGHBOURS:
@@ -59,9 +68,44 @@ class NavigationField:
             cols.append(b.ravel()[ok])
             weights.append(np.full(int(ok.sum()), self.res * np.hypot(dx, dy)))
         r, c, w = np.concatenate(rows), np.concatenate(cols), np.concatenate(weights)
-        graph = coo_matrix((w, (r, c)), shape=(nx * ny, nx * ny)).tocsr()
+        # Both directions stored, so the search needs no symmetrized copy per goal.
+        self.graph = coo_matrix((np.concatenate([w, w]), (np.concatenate([r, c]),
+                                                          np.concatenate([c, r]))),
+                                shape=(nx * ny, nx * ny)).tocsr()
+
+
+class NavigationField:
+    """Geodesic distance to a goal set over the free floor.
+
+    Parameters
+    ----------
+    lo, hi, free, resolution
+        The floor grid, as for :class:`FloorGrid` (``free(xy (N, 2)) -> bool (N,)``).
+    goal : callable
+        ``goal(xy (N, 2)) -> bool (N,)``: goal cells.
+    """
+
+    def __init__(self, lo: np.ndarray, hi: np.ndarray,
+                 free: Callable[[np.ndarray], np.ndarray],
+                 goal: Callable[[np.ndarray], np.ndarray], resolution: float = 0.1) -> None:
+        self._solve(FloorGrid(lo, hi, free, resolution), goal)
+
+    @classmethod
+    def on_grid(cls, grid: FloorGrid, goal: Callable[[np.ndarray], np.ndarray]
+                ) -> NavigationField:
+        """The field of ``goal`` on a grid already made (see :func:`floor_grid`)."""
+        field = cls.__new__(cls)
+        field._solve(grid, goal)
+        return field
+
+    def _solve(self, grid: FloorGrid, goal: Callable[[np.ndarray], np.ndarray]) -> None:
+        self.grid = grid
+        self.lo, self.res, self.shape, self.free = grid.lo, grid.res, grid.shape, grid.free
+        nx, ny = self.shape
+        goal_cells = np.asarray(goal(grid.centres), dtype=bool).reshape(self.shape) & self.free
+        self.has_goal = bool(goal_cells.any())
         if self.has_goal:
-            dist = dijkstra(graph, directed=False, indices=np.flatnonzero(goal_cells),
+            dist = dijkstra(grid.graph, directed=True, indices=np.flatnonzero(goal_cells),
                             min_only=True)
         else:
             dist = np.full(nx * ny, np.inf)
@@ -71,6 +115,8 @@ class NavigationField:
         filled = np.where(np.isfinite(self.dist), self.dist, big)
         gxd, gyd = np.gradient(filled, self.res)
         self.descent = np.arctan2(-gyd, -gxd)
+        for arr in (self.dist, self.descent):
+            arr.flags.writeable = False                # fields may be shared (cached)
 
     def _cells(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         i = np.clip(np.rint((np.asarray(x) - self.lo[0]) / self.res).astype(int), 0,
@@ -101,7 +147,8 @@ class ClearanceMap:
     ``tall_extra`` closer, because the swinging arms pass them at shoulder width; low
     parts (bench and table tops at hip height) do not, so a worker can step up to a
     bench. Points outside the workspace get -1 (not walkable). Values are interpolated
-    bilinearly (error below the grid step).
+    bilinearly (error below the grid step), with the arithmetic of SciPy's
+    ``RegularGridInterpolator`` (same values, without importing ``scipy.interpolate``).
 
     Parameters
     ----------
@@ -114,7 +161,6 @@ class ClearanceMap:
 
     def __init__(self, cell, resolution: float = 0.04, tall_extra: float = 0.25,
                  tall_height: float = 1.2) -> None:
-        from scipy.interpolate import RegularGridInterpolator
         lo = np.asarray(cell.workspace_lo[:2], dtype=np.float64)
         hi = np.asarray(cell.workspace_hi[:2], dtype=np.float64)
         xs = np.arange(lo[0], hi[0] + resolution, resolution)
@@ -127,14 +173,70 @@ class ClearanceMap:
                 extra = tall_extra if part.aabb()[1][2] > tall_height else 0.0
                 values = np.minimum(values, part.footprint().signed_distance(pts) - extra)
         self.lo, self.hi = lo, hi
-        self._interp = RegularGridInterpolator((xs, ys), values.reshape(gx.shape),
-                                               bounds_error=False, fill_value=-1.0)
+        self._xs, self._ys = xs, ys
+        self._values = np.ascontiguousarray(values.reshape(gx.shape))
+        # Interpolated inside both the workspace and the grid; -1 elsewhere.
+        self._in_lo = np.maximum(lo, [xs[0], ys[0]])
+        self._in_hi = np.minimum(hi, [xs[-1], ys[-1]])
 
     def __call__(self, xy: np.ndarray) -> np.ndarray:
         """Clearance of floor points, shape (N,) for ``xy`` of shape (N, 2)."""
         xy = np.asarray(xy, dtype=np.float64)
-        inside = np.all((xy >= self.lo) & (xy <= self.hi), axis=-1)
-        return np.where(inside, self._interp(xy), -1.0)
+        x, y = xy[..., 0], xy[..., 1]
+        xs, ys = self._xs, self._ys
+        flat, ny = self._values.ravel(), self._values.shape[1]
+        # The grid cell of each point (the last one for points on the far edge) and the
+        # point's place in it, then the bilinear sum in SciPy's order.
+        i = np.searchsorted(xs, x, side="right") - 1
+        np.minimum(np.maximum(i, 0, out=i), len(xs) - 2, out=i)
+        j = np.searchsorted(ys, y, side="right") - 1
+        np.minimum(np.maximum(j, 0, out=j), len(ys) - 2, out=j)
+        with np.errstate(invalid="ignore"):          # non-finite points end up at -1
+            x0, y0 = xs[i], ys[j]
+            tx = (x - x0) / (xs[i + 1] - x0)
+            ty = (y - y0) / (ys[j + 1] - y0)
+            sx, sy = 1 - tx, 1 - ty
+            k = i * ny + j                           # flat index of corner (i, j)
+            out = 0.0 + flat[k] * sx * sy
+            out = out + flat[k + 1] * sx * ty
+            k += ny
+            out = out + flat[k] * tx * sy
+            out = out + flat[k + 1] * tx * ty
+        inside = ((x >= self._in_lo[0]) & (x <= self._in_hi[0])
+                  & (y >= self._in_lo[1]) & (y <= self._in_hi[1]))
+        return np.where(inside, out, -1.0)
+
+
+def _trilinear(grid: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Trilinear interpolation of ``grid`` (nx, ny, nz) at index coordinates ``u`` (N, 3).
+
+    The arithmetic of ``scipy.ndimage.map_coordinates(grid, u.T, order=1,
+    mode="nearest")``, value for value (per axis the weights ``1 - f`` and
+    ``1 - (1 - f)`` of the fractional part ``f``, corners outside the grid clamped to
+    its edge, the eight corners summed in C order), without importing ``scipy.ndimage``.
+
+    Returns
+    -------
+    values : ndarray, shape (N,)
+    """
+    flat = np.ascontiguousarray(grid, dtype=np.float64).ravel()
+    step = (grid.shape[1] * grid.shape[2], grid.shape[2], 1)       # elements per axis step
+    offsets, weights = [], []
+    for d in range(3):
+        n = grid.shape[d]
+        base = np.floor(u[:, d])
+        w0 = 1.0 - (u[:, d] - base)
+        weights.append((w0, 1.0 - w0))
+        offsets.append((np.clip(base, 0, n - 1).astype(np.intp) * step[d],
+                        np.clip(base + 1, 0, n - 1).astype(np.intp) * step[d]))
+    out = np.zeros(len(u))
+    for f0 in (0, 1):
+        for f1 in (0, 1):
+            at = offsets[0][f0] + offsets[1][f1]
+            for f2 in (0, 1):
+                out = out + flat[at + offsets[2][f2]] * weights[0][f0] * weights[1][f1] \
+                    * weights[2][f2]
+    return out
 
 
 class ObstacleField:
@@ -172,16 +274,18 @@ class ObstacleField:
         self.shape = np.array(gx.shape)
         self.dist = dist.reshape(gx.shape)
         self.far = pad
+        parts = [part.aabb() for ob in cell.obstacles for part in ob.parts]
+        self.part_lo = np.array([b[0] for b in parts])          # (P, 3)
+        self.part_hi = np.array([b[1] for b in parts])
 
     def distance(self, points: np.ndarray) -> np.ndarray:
         """Interpolated obstacle distance of points (..., 3), shape (...)."""
         pts = np.asarray(points, dtype=np.float64)
         if self.empty:
             return np.full(pts.shape[:-1], np.inf)
-        from scipy.ndimage import map_coordinates
         u = (pts.reshape(-1, 3) - self.lo) / self.res
         outside = np.any((u < 0) | (u > self.shape - 1), axis=-1)
-        out = map_coordinates(self.dist, u.T, order=1, mode="nearest")
+        out = _trilinear(self.dist, u)
         out = np.where(outside, np.maximum(out, self.far), out)
         return out.reshape(pts.shape[:-1])
 
@@ -203,21 +307,72 @@ class ObstacleField:
         -------
         ok : ndarray of bool, shape (M,)
         """
-        from ltl_human_motion.scene.occupancy import capsules_from_positions
+        from ltl_human_motion.scene.geometry import box_gap, point_bounds
+        from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
         if self.empty:
             return np.ones(poses.shape[0], dtype=bool)
-        seg, rad = capsules_from_positions(poses, stature)              # (M, S, K, 2, 3)
-        pts = np.concatenate([seg, seg.mean(axis=-2, keepdims=True)], axis=-2)
-        gap = self.distance(pts) - (rad[:, None] + margin + self.res * 0.4)   # (M, S, K, 3)
-        gap = gap.min(axis=-1)                                              # (M, S, K)
+        # Each capsule is sampled at its end points (joints) and its middle; the joints
+        # are shared by capsules, so the field is read once per joint.
+        ia, ib = capsule_ends()
+        long = ia != ib                                  # spheres: the middle is the joint
+        pos = np.asarray(poses, dtype=np.float64)
+        radii = capsule_radii(stature)
+        ok = np.ones(pos.shape[0], dtype=bool)
+        # A candidate whose joints (and so its sample points) all keep more than the
+        # largest radius, the margins and the largest interpolation error (sqrt(3) res)
+        # from every part's bounding box passes whatever the grid says (points off the
+        # grid read at least ``far``): read the grid only for the others.
+        limit = radii.max() + margin + self.res * (0.4 + np.sqrt(3.0))
+        if limit <= self.far:
+            lo, hi = point_bounds(pos.reshape(pos.shape[0], -1, 3))
+            box = box_gap(lo[:, None], hi[:, None], self.part_lo, self.part_hi).min(axis=1)
+            check = box < limit
+        else:
+            check = np.ones(pos.shape[0], dtype=bool)
+        if not check.any():
+            return ok
+        pos = pos[check]
+        d_joint = self.distance(pos)                                        # (m, S, J)
+        d_mid = self.distance((pos[..., ia[long], :] + pos[..., ib[long], :]) / 2.0)
+        closest = np.minimum(d_joint[..., ia], d_joint[..., ib])            # (m, S, K)
+        closest[..., long] = np.minimum(closest[..., long], d_mid)
+        gap = closest - (radii + margin + self.res * 0.4)                   # (m, S, K)
         # With ``relative``, a body part that starts closer than the margin (a worker
         # standing at a bench) may stay there; it must not get closer.
         allowed = np.minimum(gap[:, :1], 0.0) - 0.005 if relative else 0.0
-        return np.all(gap >= allowed, axis=(1, 2))
+        ok[check] = np.all(gap >= allowed, axis=(1, 2))
+        return ok
 
 
 _CLEARANCE_CACHE: dict[str, tuple[ClearanceMap, ObstacleField]] = {}
-_FIELDS_FORMAT = 1
+_FIELDS_FORMAT = 3
+_GRID_CACHE: dict[tuple, tuple[ClearanceMap, FloorGrid]] = {}
+
+
+def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: float,
+               resolution: float) -> FloorGrid:
+    """The :class:`FloorGrid` whose free cells keep ``radius`` of floor clearance.
+
+    Built once per clearance map (one per obstacle layout, :func:`clearance_maps`),
+    area, radius and resolution, and shared by every navigation field on that floor.
+
+    Parameters
+    ----------
+    clearance : ClearanceMap
+    lo, hi : array-like, shape (2,)
+    radius, resolution : float
+        Metres.
+    """
+    key = (id(clearance), np.asarray(lo, dtype=np.float64).tobytes(),
+           np.asarray(hi, dtype=np.float64).tobytes(), float(radius), float(resolution))
+    hit = _GRID_CACHE.get(key)
+    if hit is not None and hit[0] is clearance:     # the map is held, so its id is unique
+        return hit[1]
+    grid = FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution)
+    if len(_GRID_CACHE) >= 16:
+        _GRID_CACHE.clear()
+    _GRID_CACHE[key] = (clearance, grid)
+    return grid
 
 
 def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
@@ -241,7 +396,10 @@ def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
     try:
         with open(path, "rb") as fh:
             maps = pickle.load(fh)
-        if not (isinstance(maps, tuple) and isinstance(maps[0], ClearanceMap)):
+        if not (isinstance(maps, tuple) and len(maps) == 2
+                and isinstance(maps[0], ClearanceMap) and isinstance(maps[1], ObstacleField)
+                and hasattr(maps[0], "_values")
+                and (maps[1].empty or hasattr(maps[1], "part_lo"))):
             maps = None
     except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ValueError,
             zipfile.BadZipFile):

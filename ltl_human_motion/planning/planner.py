@@ -31,9 +31,12 @@ from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import Goal, SearchBudget, SearchFailure, astar
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.gait_index import gait_index
-from ltl_human_motion.planning.navigation import NavigationField, clearance_maps
+from ltl_human_motion.planning.navigation import NavigationField, clearance_maps, floor_grid
 
 Pose = tuple[float, float, float]
+
+#: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
+_FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
 
 #: Tasks done with the hands: the arms are raised to the carry stance before them.
 HAND_TASKS = {"grasp", "release", "move", "insert", "extract", "leftHand", "rightHand",
@@ -197,6 +200,7 @@ class SequencePlanner:
         self.held_offsets: dict[str, np.ndarray] = {}
         self._carry_stance = False
         self._back_limit = options.reach_tolerance
+        self._backs: dict[float, np.ndarray] = {}     # step-back distances per limit
         self.expanded = 0
 
     # ---------------------------------------------------------------- geometry
@@ -233,11 +237,24 @@ class SequencePlanner:
     def _clearance(self, xy: np.ndarray) -> np.ndarray:
         return self.clearance(xy)
 
-    def _field(self, goal_cells) -> NavigationField:
-        lo, hi = self.cell.workspace_lo[:2], self.cell.workspace_hi[:2]
-        radius = self.options.body_radius
-        return NavigationField(lo, hi, lambda xy: self._clearance(xy) > radius, goal_cells,
-                               self.options.grid_resolution)
+    def _field(self, goal_cells, key: tuple | None = None) -> NavigationField:
+        """The navigation field of ``goal_cells`` on the floor grid. ``key``: numbers that
+        determine the goal cells on this floor; fields with a key are kept (a target that
+        does not move between items, e.g. an assembly region, reuses its field)."""
+        grid = floor_grid(self.clearance, self.cell.workspace_lo[:2],
+                          self.cell.workspace_hi[:2], self.options.body_radius,
+                          self.options.grid_resolution)
+        if key is None:
+            return NavigationField.on_grid(grid, goal_cells)
+        full = (id(grid), *key)
+        hit = _FIELD_CACHE.get(full)
+        if hit is not None and hit[0] is grid:         # the grid is held, its id unique
+            return hit[1]
+        field = NavigationField.on_grid(grid, goal_cells)
+        if len(_FIELD_CACHE) >= 16:
+            _FIELD_CACHE.pop(next(iter(_FIELD_CACHE)))
+        _FIELD_CACHE[full] = (grid, field)
+        return field
 
     def _goal_from_field(self, field: NavigationField, reached, desc: str,
                          task: str) -> Goal:
@@ -257,26 +274,33 @@ class SequencePlanner:
         return Goal(reached, distance, field.heading, desc)
 
     def _ideal_placement(self, target: np.ndarray, placement: tuple[float, float],
-                         x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray,
-                                                                np.ndarray, np.ndarray]:
+                         x: np.ndarray, y: np.ndarray, room: bool = False
+                         ) -> tuple[np.ndarray, ...]:
         """Root pose (x*, y*, yaw*) from which the goal primitive reaches ``target``,
         facing it from the side of (x, y), and whether that spot is free.
 
         Where the ideal spot is too close to an obstacle (a bench in front), the worker
-        stands up to ``max_step_back`` further back. Arrays shaped like ``x``.
+        stands up to ``max_step_back`` further back. Arrays shaped like ``x``. With
+        ``room``, also the floor clearance at (x, y) itself (from the same map lookup).
         """
         d, lat = placement
         yaw = np.arctan2(target[1] - y, target[0] - x) - np.arctan2(lat, d)
         c, s = np.cos(yaw), np.sin(yaw)
-        back = np.linspace(0.0, self._back_limit, 8)
+        back = self._backs.get(self._back_limit)
+        if back is None:
+            back = self._backs[self._back_limit] = np.linspace(0.0, self._back_limit, 8)
         px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)
         py = target[1] - (s[..., None] * (d + back) + c[..., None] * lat)
-        free = self._clearance(np.stack([px, py], axis=-1).reshape(-1, 2)).reshape(px.shape)
-        free = free > self.options.stand_clearance
+        pts = np.stack([px, py], axis=-1).reshape(-1, 2)
+        if room:
+            pts = np.concatenate([pts, np.stack([x, y], axis=-1).reshape(-1, 2)])
+        clear = self._clearance(pts)
+        free = clear[:px.size].reshape(px.shape) > self.options.stand_clearance
         k = np.argmax(free, axis=-1)
         pick = np.take_along_axis
-        return (pick(px, k[..., None], -1)[..., 0], pick(py, k[..., None], -1)[..., 0], yaw,
-                free.any(axis=-1))
+        out = (pick(px, k[..., None], -1)[..., 0], pick(py, k[..., None], -1)[..., 0], yaw,
+               free.any(axis=-1))
+        return (*out, clear[px.size:].reshape(np.shape(x))) if room else out
 
     def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
                     task: str) -> Goal:
@@ -290,23 +314,30 @@ class SequencePlanner:
 
         def ring(xy: np.ndarray) -> np.ndarray:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
-            return ((r >= dist - tol) & (r <= dist + self._back_limit)
-                    & (self._clearance(xy) > self.options.stand_clearance))
+            out = (r >= dist - tol) & (r <= dist + self._back_limit)
+            # The floor clearance only where the distance fits (few of the cells).
+            out[out] = self._clearance(xy[out]) > self.options.stand_clearance
+            return out
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-            px, py, pyaw, free = self._ideal_placement(target, placement, x, y)
+            px, py, pyaw, free, here = self._ideal_placement(target, placement, x, y,
+                                                             room=True)
             # Turning on the spot needs room for the hips; facing nearly right needs none.
-            room = self._clearance(np.stack([x, y], axis=-1)) > self.options.turn_clearance
+            room = here > self.options.turn_clearance
             facing = np.abs(wrap_angle(pyaw - yaw)) <= self.options.heading_tolerance
             return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing)
 
         # Stand within the reach tolerance where possible; only where an obstacle leaves
         # no such place (a tall worker at a bench) stand up to max_step_back further.
+        def ring_key() -> tuple:
+            return ("ring", tx, ty, dist, tol, float(self._back_limit),
+                    float(self.options.stand_clearance))
+
         self._back_limit = tol
-        field = self._field(ring)
+        field = self._field(ring, ring_key())
         if not field.has_goal:
             self._back_limit = self.options.max_step_back
-            field = self._field(ring)
+            field = self._field(ring, ring_key())
         goal = self._goal_from_field(field, reached, desc, task)
         base_heading = field.heading
 
@@ -344,19 +375,21 @@ class SequencePlanner:
             dyaw = float(wrap_angle(pyaw - yaw))
             if math.hypot(dx, dy) < 0.02 and abs(dyaw) < 0.05:
                 return True
-            # Step and turn at once; or turn where the walk ended, then step in.
+            # Step and turn at once; or turn where the walk ended, then step in. The
+            # primitives are made when tried (the first plan is usually clear).
             cp, sp = math.cos(dyaw), math.sin(dyaw)
-            plans = [[step(dx, dy, dyaw)],
-                     [step(0.0, 0.0, dyaw), step(cp * dx + sp * dy, -sp * dx + cp * dy, 0.0)]]
-            for plan in plans:
+            plans = [((dx, dy, dyaw),),
+                     ((0.0, 0.0, dyaw), (cp * dx + sp * dy, -sp * dx + cp * dy, 0.0))]
+            for moves in plans:
                 pose = self.pose
-                ok = True
-                for mp in plan:
+                plan = []
+                for move in moves:
+                    mp = step(*move)
                     if not self._placed_clear(mp, pose):
-                        ok = False
                         break
+                    plan.append(mp)
                     pose = self._hand_over_pose(mp, pose)
-                if ok:
+                if len(plan) == len(moves):
                     for mp in plan:
                         self._add(mp, self.pose, -1, self.overlap)
                         self.pose = self._hand_over_pose(mp, self.pose)
@@ -375,7 +408,8 @@ class SequencePlanner:
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             return gap(x, y) <= margin
 
-        field = self._field(lambda xy: gap(xy[:, 0], xy[:, 1]) <= margin)
+        field = self._field(lambda xy: gap(xy[:, 0], xy[:, 1]) <= margin,
+                            ("region", *lo[:2].tolist(), *hi[:2].tolist(), margin))
         return self._goal_from_field(field, reached, desc, task)
 
     # ---------------------------------------------------------------- segments
@@ -444,16 +478,22 @@ class SequencePlanner:
             self._step_back(carrying_before, label)
         self._add(mp, self.pose, label, self.overlap)
 
-    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int = 16) -> bool:
+    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int = 16,
+                      world: np.ndarray | None = None) -> bool:
         """Whether ``mp`` placed at ``pose`` keeps the body and the objects held (at their
         hand offsets) clear of every obstacle, checked with the exact distances on
-        ``samples`` frames (these checks are few)."""
+        ``samples`` frames (these checks are few). ``world``: ``world_positions(mp,
+        *pose)`` if already made."""
         from ltl_human_motion.scene.predicates import body_clearance, object_clearance
         if not self.cell.obstacles:
             return True
         frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
-        world = world_positions(mp, *pose)
-        d = body_clearance(world[frames], self.cell, stature=self.library.skeleton.stature)
+        if world is None and self.held:
+            world = world_positions(mp, *pose)
+        body = world_positions(mp, *pose, frames=frames) if world is None else world[frames]
+        # Only clearances up to the 3 mm limit matter: those are exact.
+        d = body_clearance(body, self.cell, stature=self.library.skeleton.stature,
+                           exact_below=0.01)
         if np.min(d) <= 0.003:
             return False
         for name, joint in self.held.items():
@@ -664,7 +704,7 @@ class SequencePlanner:
     def _goal_clear(self, mp: MotionPrimitive, kind: str) -> bool:
         """Whether the body, and any object in the hands, keep clear of obstacles."""
         world = world_positions(mp, *self.pose)
-        if not self._placed_clear(mp, self.pose, samples=24):
+        if not self._placed_clear(mp, self.pose, samples=24, world=world):
             return False
         contact = int(mp.meta.get("contact_frame", 0))
         carried = dict(self.held)

@@ -12,7 +12,7 @@ import numpy as np
 
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
-from ltl_human_motion.motion.types import MotionPrimitive, yaw_matrix
+from ltl_human_motion.motion.types import MotionPrimitive
 
 TURN_ANGLES_DEG = (-180.0, -135.0, -90.0, -45.0, -20.0, 20.0, 45.0, 90.0, 135.0)
 #: Steps on the spot: (forward, left, turn in degrees). The short ones let a walk end
@@ -21,6 +21,31 @@ STEPS = ((-0.3, 0.0, 0.0), (-0.3, 0.0, 90.0), (-0.3, 0.0, -90.0), (0.0, 0.25, 0.
          (0.0, -0.25, 0.0), (0.15, 0.0, 0.0), (-0.15, 0.0, 0.0), (0.0, 0.12, 0.0),
          (0.0, -0.12, 0.0))
 _FOOT = {"l": ("l_ankle", "l_toe"), "r": ("r_ankle", "r_toe")}
+
+
+def _turned(yaw: np.ndarray, points: np.ndarray, inverse: bool = False) -> np.ndarray:
+    """Points turned about +z per frame: ``yaw_matrix(yaw) @ p`` (``inverse``: its
+    transpose), written out instead of a matrix product.
+
+    Parameters
+    ----------
+    yaw : ndarray, shape (T,)
+    points : ndarray, shape (T, J, 3) or (1, J, 3)
+    inverse : bool
+
+    Returns
+    -------
+    ndarray, shape (T, J, 3)
+    """
+    c, s = np.cos(yaw)[:, None], np.sin(yaw)[:, None]                   # (T, 1)
+    if inverse:
+        s = -s
+    x, y = points[..., 0], points[..., 1]
+    out = np.empty((len(yaw), points.shape[1], 3))
+    out[..., 0] = c * x - s * y
+    out[..., 1] = s * x + c * y
+    out[..., 2] = points[..., 2]
+    return out
 
 
 def _progress(t: np.ndarray, a: float, b: float) -> np.ndarray:
@@ -66,7 +91,7 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
     root_xy = np.stack([dx * s_root, dy * s_root], axis=-1)
     # The pelvis dips a little mid-step so the straight standing legs can reach.
     dip = (0.02 + 0.08 * np.hypot(dx, dy)) * np.sin(np.pi * s_root)
-    body = np.einsum("tij,kj->tki", yaw_matrix(heading), stand)        # (T, J, 3)
+    body = _turned(heading, stand[None])                                 # (T, J, 3)
     body[:, :, :2] += root_xy[:, None, :]
     body[:, :, 2] -= dip[:, None]
     lead = "l" if (angle > 0 or (angle == 0 and dy > 0)) else "r"
@@ -77,7 +102,7 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
         foot_yaw = angle * s
         for name in _FOOT[side]:
             j = JOINT_INDEX[name]
-            body[:, j] = np.einsum("tij,j->ti", yaw_matrix(foot_yaw), stand[j])
+            body[:, j] = _turned(foot_yaw, stand[None, None, j])[:, 0]
             body[:, j, 0] += dx * s
             body[:, j, 1] += dy * s
             body[:, j, 2] += lift * np.sin(np.pi * s)
@@ -89,7 +114,7 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
                                                      pole, max_stretch=1.0)
     body[:, :, :2] -= root_xy[:, None, :]
     body[:, :, 2] += dip[:, None]
-    poses = np.einsum("tji,tkj->tki", yaw_matrix(heading), body)     # back to heading frame
+    poses = _turned(heading, body, inverse=True)                       # back to heading frame
     root = np.zeros((n, 4))
     root[:, :2] = root_xy
     root[:, 2] = height - dip

@@ -19,7 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ltl_human_motion.errors import VerificationError
-from ltl_human_motion.motion.skeleton import JOINT_INDEX
+from ltl_human_motion.motion.skeleton import JOINT_INDEX, MAX_STATURE
+from ltl_human_motion.scene.geometry import point_bounds
+from ltl_human_motion.scene.occupancy import capsule_radii
 
 FOOT_JOINTS = ("l_ankle", "l_toe", "r_ankle", "r_toe")
 
@@ -49,11 +51,13 @@ class VerificationOptions:
     flight_height: float = 0.12
 
 
-_MAX_RADIUS = 0.16   # largest body capsule radius (m) at the tallest stature
+#: Largest body capsule radius (m) at the tallest stature (0.162 m).
+_MAX_RADIUS = float(capsule_radii(MAX_STATURE).max())
 
 
 def near_frames(positions: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                margin: float = 0.0) -> np.ndarray:
+                margin: float = 0.0, boxes: tuple[np.ndarray, np.ndarray] | None = None
+                ) -> np.ndarray:
     """Frames whose body bounding box comes within ``margin`` of the box [lo, hi].
 
     A cheap broad phase: frames not returned cannot enter, touch or collide with
@@ -64,51 +68,17 @@ def near_frames(positions: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     positions : ndarray, shape (T, J, 3)
     lo, hi : array-like, shape (3,)
     margin : float
+    boxes : (ndarray (T, 3), ndarray (T, 3)), optional
+        :func:`~ltl_human_motion.scene.geometry.point_bounds` of ``positions`` if known.
 
     Returns
     -------
     frames : ndarray of int
     """
-    body_lo = positions.min(axis=1) - _MAX_RADIUS - margin
-    body_hi = positions.max(axis=1) + _MAX_RADIUS + margin
-    hit = np.all((body_lo <= np.asarray(hi)) & (body_hi >= np.asarray(lo)), axis=1)
+    body_lo, body_hi = point_bounds(positions) if boxes is None else boxes
+    hit = np.all((body_lo - _MAX_RADIUS - margin <= np.asarray(hi))
+                 & (body_hi + _MAX_RADIUS + margin >= np.asarray(lo)), axis=1)
     return np.flatnonzero(hit)
-
-
-def _collision_candidates(pos: np.ndarray, cell, carried: dict[str, np.ndarray],
-                          stature: float, slack: float = 0.06) -> np.ndarray:
-    """Frames that may collide: a broad phase on the cached 3D obstacle distance grid.
-
-    Frames whose every capsule (and carried part) keeps ``slack`` more than the grid's
-    interpolation error from the obstacles are clear; the rest go to the exact test.
-
-    Returns
-    -------
-    frames : ndarray of int
-    """
-    from ltl_human_motion.planning.navigation import clearance_maps
-    from ltl_human_motion.scene.occupancy import capsules_from_positions
-    field = clearance_maps(cell)[1]
-    near = np.zeros(len(pos), dtype=bool)
-    if field.empty:
-        return np.flatnonzero(near)
-    # Only frames whose body box meets the grid can come near an obstacle (the grid
-    # covers the obstacles grown by more than the slack).
-    grid_hi = field.lo + (field.shape - 1) * field.res
-    frames = near_frames(pos, field.lo, grid_hi)
-    if frames.size:
-        seg, rad = capsules_from_positions(pos[frames], stature)        # (F, K, 2, 3)
-        pts = np.concatenate([seg, seg.mean(axis=-2, keepdims=True)], axis=-2)
-        gap = (field.distance(pts) - rad[:, None]).min(axis=(1, 2))     # (F,)
-        near[frames] = gap < slack + field.res
-    for name, traj in carried.items():
-        lo, hi = cell.object(name).occupancy.aabb()
-        reach = 0.5 * float(np.linalg.norm(hi - lo))
-        ok = np.isfinite(traj).all(axis=1)
-        d = np.full(len(traj), np.inf)
-        d[ok] = field.distance(traj[ok]) - reach
-        near |= d < slack + field.res
-    return np.flatnonzero(near)
 
 
 def _check(passed: bool, detail: str, **values: object) -> dict:
@@ -138,6 +108,7 @@ def observed_letters(synth, cell, spec, steps: list[tuple[str, tuple[str, ...]]]
     pos = synth.motion.positions
     windows = step_windows(synth, len(steps))
     regions = list(cell.regions.values())
+    body_lo, body_hi = point_bounds(pos)
     letters = []
     for (name, args), ok, (a, b) in zip(steps, termination, windows):
         letter: set[str] = set()
@@ -147,7 +118,8 @@ def observed_letters(synth, cell, spec, steps: list[tuple[str, tuple[str, ...]]]
                        if not key.startswith("enter(")}
         window = pos[a:b]
         for region in regions:
-            cand = near_frames(window, region.lo, region.hi)
+            cand = near_frames(window, region.lo, region.hi,
+                               boxes=(body_lo[a:b], body_hi[a:b]))
             # Most entered regions are entered for many frames: try every 8th first.
             if cand.size and (np.any(enter(window[cand[::8]], region, stature=stature))
                               or np.any(enter(window[cand], region, stature=stature))):
@@ -206,10 +178,9 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
                for name, mask in (held or {}).items() if np.any(mask)}
     hits = np.zeros(len(pos), dtype=bool)
     if cell.obstacles:
-        cand = _collision_candidates(pos, cell, carried, stature)
-        if cand.size:
-            hits[cand] = collision(pos[cand], cell, stature=stature,
-                                   carried={k: v[cand] for k, v in carried.items()})
+        # Exact on every frame: the capsule test itself skips (frame, part) pairs whose
+        # bounding boxes are apart.
+        hits = collision(pos, cell, stature=stature, carried=carried)
     n_hit = int(np.sum(hits))
     report["collision"] = _check(n_hit == 0, "no frame collides" if n_hit == 0 else
                                  f"{n_hit} frames collide, first at t = "
@@ -240,7 +211,9 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
                            else "the observed trace violates the specification",
                            trace=[sorted(x) for x in letters])
 
-    speed = np.linalg.norm(np.diff(pos, axis=0), axis=-1) * fps       # (T-1, J)
+    step = np.diff(pos, axis=0)                                         # (T-1, J, 3)
+    speed = np.sqrt(step[..., 0] * step[..., 0] + step[..., 1] * step[..., 1]
+                    + step[..., 2] * step[..., 2]) * fps                  # (T-1, J)
     vmax = float(speed.max()) if speed.size else 0.0
     worst = synth.motion.skeleton.names[int(np.argmax(speed.max(axis=0)))] if speed.size else ""
     report["smoothness"] = _check(vmax <= options.max_joint_speed,
@@ -250,11 +223,9 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
     feet = pos[:, [JOINT_INDEX[j] for j in FOOT_JOINTS], 2] - cell.floor_z
     lowest = float(feet.min())
     flying = feet.min(axis=1) > options.flight_height
-    longest = 0
-    run = 0
-    for f in flying:
-        run = run + 1 if f else 0
-        longest = max(longest, run)
+    # Longest run of flying frames: the gaps between the edges of the runs.
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], flying.astype(np.int8), [0]])))
+    longest = int(np.max(edges[1::2] - edges[::2])) if edges.size else 0
     feet_ok = lowest >= -options.floor_tolerance and longest / fps <= options.max_flight
     report["feet"] = _check(feet_ok, f"lowest foot joint {lowest:+.3f} m, longest flight "
                             f"{longest / fps:.2f} s", lowest=lowest, flight=longest / fps)

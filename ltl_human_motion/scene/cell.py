@@ -54,6 +54,7 @@ from typing import Any
 import numpy as np
 
 from ltl_human_motion.errors import CellError
+from ltl_human_motion.scene.clearance import EXACT_BELOW, PartSet, part_set
 from ltl_human_motion.scene.frames import ZUP_FROM_YUP, extents_zup_from_yup, zup_from_yup
 from ltl_human_motion.scene.geometry import min_along_segment
 from ltl_human_motion.scene.shapes import Box, Cylinder, Footprint, MeshShape, Shape, Sphere
@@ -357,13 +358,23 @@ class Cell:
             blocked |= ~(self.in_workspace(a, radius) & self.in_workspace(b, radius))
         return bool(blocked) if blocked.ndim == 0 else blocked
 
-    def obstacle_clearance(self, segments: np.ndarray, radii: np.ndarray) -> np.ndarray:
-        """Smallest clearance of capsules (..., 2, 3) to any obstacle, shape (...)."""
+    def obstacle_clearance(self, segments: np.ndarray, radii: np.ndarray,
+                           exact_below: float = EXACT_BELOW) -> np.ndarray:
+        """Smallest clearance of capsules (..., 2, 3) to any obstacle, shape (...).
+
+        Exact below ``exact_below`` (see :meth:`Shape.capsule_clearance`), a lower bound
+        at or above it; ``inf`` without obstacles. All parts are checked in one
+        vectorized pass (:class:`~ltl_human_motion.scene.clearance.PartSet`).
+        """
         seg = np.asarray(segments, dtype=np.float64)
         if not self.obstacles:
             return np.full(seg.shape[:-2], np.inf)
-        return np.min(np.stack([ob.capsule_clearance(seg, radii) for ob in self.obstacles]),
-                      axis=0)
+        return self.part_set.capsule_clearance(seg, radii, exact_below)
+
+    @property
+    def part_set(self) -> PartSet:
+        """The obstacles' parts as arrays for vectorized checks (built once per layout)."""
+        return part_set(self.obstacles)
 
     def lookup(self, name: str) -> Region | SceneObject:
         """A region or an object by name (regions first)."""

@@ -14,9 +14,11 @@ from collections.abc import Callable
 import numpy as np
 
 __all__ = [
+    "box_gap",
     "capsule_box_distance",
     "capsule_capsule_distance",
     "min_along_segment",
+    "point_bounds",
     "point_box_distance",
     "point_box_signed_distance",
     "point_circle_signed_distance",
@@ -97,6 +99,40 @@ def segment_segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray,
     cp = p0 + s[..., None] * d1
     cq = q0 + t[..., None] * d2
     return np.linalg.norm(cp - cq, axis=-1)
+
+
+def box_gap(lo_a: np.ndarray, hi_a: np.ndarray, lo_b: np.ndarray,
+            hi_b: np.ndarray) -> np.ndarray:
+    """Euclidean gap between axis-aligned boxes (0 when they overlap).
+
+    Parameters
+    ----------
+    lo_a, hi_a, lo_b, hi_b : array-like, shape (..., 3), broadcast together
+
+    Returns
+    -------
+    gap : ndarray, shape (...)
+    """
+    g = np.maximum(np.maximum(lo_b - hi_a, lo_a - hi_b), 0.0)
+    return np.sqrt(g[..., 0] * g[..., 0] + g[..., 1] * g[..., 1] + g[..., 2] * g[..., 2])
+
+
+def point_bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Bounding box of each set of points.
+
+    Parameters
+    ----------
+    points : array-like, shape (..., N, 3)
+
+    Returns
+    -------
+    lo, hi : ndarray, shape (..., 3)
+    """
+    p = np.asarray(points, dtype=np.float64)
+    # Reduced over the leading axis of a point-major copy: elementwise over contiguous
+    # rows, much faster than a reduction over the middle axis.
+    rows = np.ascontiguousarray(np.moveaxis(p, -2, 0))                    # (N, ..., 3)
+    return rows.min(axis=0), rows.max(axis=0)
 
 
 def point_box_distance(p: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -213,7 +249,8 @@ def segment_aabb_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,
     Parameters
     ----------
     a, b : array-like, shape (..., 3)
-    lo, hi : array-like, shape (3,)
+    lo, hi : array-like, shape (3,) or (..., 3)
+        One box for all segments, or one box per segment (broadcast against ``a``).
 
     Returns
     -------
@@ -224,6 +261,7 @@ def segment_aabb_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,
     a, b = np.broadcast_arrays(a, b)
     lo = np.asarray(lo, dtype=np.float64)
     hi = np.asarray(hi, dtype=np.float64)
+    lo_k, hi_k = lo[..., None, :], hi[..., None, :]             # against (..., k, 3)
     d = b - a
     with np.errstate(divide="ignore", invalid="ignore"):
         cross = np.concatenate([(lo - a) / d, (hi - a) / d], axis=-1)      # (..., 6)
@@ -233,8 +271,9 @@ def segment_aabb_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,
     knots = np.sort(np.concatenate([ends, cross], axis=-1), axis=-1)          # (..., 8)
     t0, t1 = knots[..., :-1], knots[..., 1:]                                  # (..., 7)
     mid = a[..., None, :] + 0.5 * (t0 + t1)[..., None] * d[..., None, :]      # (..., 7, 3)
-    below, above = mid < lo, mid > hi
-    offset = np.where(below, a[..., None, :] - lo, np.where(above, a[..., None, :] - hi, 0.0))
+    below, above = mid < lo_k, mid > hi_k
+    offset = np.where(below, a[..., None, :] - lo_k,
+                      np.where(above, a[..., None, :] - hi_k, 0.0))
     slope = np.where(below | above, d[..., None, :], 0.0)
     num = -np.sum(offset * slope, axis=-1)
     den = np.sum(slope * slope, axis=-1)
@@ -243,7 +282,7 @@ def segment_aabb_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,
     stat = np.clip(stat, t0, t1)
     ts = np.concatenate([knots, stat], axis=-1)                               # (..., 15)
     pts = a[..., None, :] + ts[..., None] * d[..., None, :]
-    return point_box_distance(pts, lo, hi).min(axis=-1)
+    return point_box_distance(pts, lo_k, hi_k).min(axis=-1)
 
 
 def segment_box_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,

@@ -23,6 +23,7 @@ __all__ = [
     "BODY_PARTS",
     "PART_ALIASES",
     "body_radius_xy",
+    "capsule_ends",
     "capsule_radii",
     "capsules_from_positions",
     "occ",
@@ -73,6 +74,12 @@ PART_ALIASES: dict[str, tuple[str, ...]] = {
 _IA = np.array([JOINT_INDEX[c[1]] for c in BODY_CAPSULES])
 _IB = np.array([JOINT_INDEX[c[2]] for c in BODY_CAPSULES])
 _R = np.array([c[3] for c in BODY_CAPSULES])
+_IAB = np.stack([_IA, _IB], axis=-1).ravel()       # end points a0, b0, a1, b1, ...
+
+
+def capsule_ends() -> tuple[np.ndarray, np.ndarray]:
+    """Joint indices of the two ends of every capsule, ``(a (K,), b (K,))`` (a copy)."""
+    return _IA.copy(), _IB.copy()
 
 
 def capsule_radii(stature: float = DEFAULT_STATURE) -> np.ndarray:
@@ -124,9 +131,14 @@ def capsules_from_positions(positions: np.ndarray, stature: float = DEFAULT_STAT
     pos = np.asarray(positions, dtype=np.float64)
     if pos.ndim < 2 or pos.shape[-2:] != (N_JOINTS, 3):
         raise ValueError(f"positions must have shape (..., {N_JOINTS}, 3), got {pos.shape}")
-    idx = part_indices(parts)
-    segments = np.stack([pos[..., _IA[idx], :], pos[..., _IB[idx], :]], axis=-2)
-    return segments, capsule_radii(stature)[idx]
+    if parts is None:
+        ends, radii = _IAB, capsule_radii(stature)
+    else:
+        idx = part_indices(parts)
+        ends, radii = np.stack([_IA[idx], _IB[idx]], axis=-1).ravel(), capsule_radii(stature)[idx]
+    # One gather of both end points of every capsule: (..., 2K, 3) -> (..., K, 2, 3).
+    segments = np.take(pos, ends, axis=-2).reshape(*pos.shape[:-2], -1, 2, 3)
+    return segments, radii
 
 
 def occ(positions: np.ndarray, parts: str | Iterable[str] | None = None,

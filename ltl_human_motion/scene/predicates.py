@@ -23,8 +23,15 @@ import numpy as np
 
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE
 from ltl_human_motion.scene.cell import Cell, Region, SceneObject
+from ltl_human_motion.scene.geometry import box_gap, point_bounds
 from ltl_human_motion.scene.occupancy import capsules_from_positions
-from ltl_human_motion.scene.shapes import Box, Shape, shape_distance, shape_enclosed_in
+from ltl_human_motion.scene.shapes import (
+    EXACT_BELOW,
+    Box,
+    Shape,
+    shape_distance,
+    shape_enclosed_in,
+)
 
 __all__ = [
     "as_shape",
@@ -74,7 +81,10 @@ def enter(positions: np.ndarray, region: Target, parts: str | Iterable[str] | No
     if margin < 0:
         raise ValueError(f"margin must be non-negative, got {margin!r}")
     seg, rad = capsules_from_positions(positions, stature, parts)
-    return np.any(as_shape(region).capsule_clearance(seg, rad) <= margin, axis=-1)
+    # Clearances up to the margin are exact; capsules bounded beyond it cannot enter.
+    clearance = as_shape(region).capsule_clearance(
+        seg, rad, exact_below=float(np.nextafter(margin, np.inf)))
+    return np.any(clearance <= margin, axis=-1)
 
 
 def distance_to(positions: np.ndarray, target: Target,
@@ -146,12 +156,18 @@ def ground_enter(positions: np.ndarray, parts: str | Iterable[str] | None, heigh
 
 
 def body_clearance(positions: np.ndarray, cell: Cell, *,
-                   stature: float = DEFAULT_STATURE) -> np.ndarray:
+                   stature: float = DEFAULT_STATURE,
+                   exact_below: float = EXACT_BELOW) -> np.ndarray:
     """Smallest distance between the body and any obstacle per frame.
 
     Parameters
     ----------
     positions : array-like, shape (..., J, 3)
+    stature : float
+    exact_below : float
+        Clearances below this are exact; frames farther from every obstacle get a lower
+        bound that is at least ``exact_below`` (a test ``clearance <= m`` with
+        ``m < exact_below`` is exact).
 
     Returns
     -------
@@ -159,7 +175,11 @@ def body_clearance(positions: np.ndarray, cell: Cell, *,
         Negative (or 0) when the body touches an obstacle; ``inf`` without obstacles.
     """
     seg, rad = capsules_from_positions(positions, stature)
-    return np.min(cell.obstacle_clearance(seg, rad), axis=-1)
+    if not cell.obstacles:
+        return np.full(seg.shape[:-3], np.inf)
+    # Every capsule ends at joints: the joints' box holds the capsules' end points.
+    return cell.part_set.body_clearance(seg, rad, exact_below,
+                                        bounds=point_bounds(np.asarray(positions)))
 
 
 def object_clearance(cell: Cell, name: str, trajectory: np.ndarray) -> np.ndarray:
@@ -187,24 +207,21 @@ def object_clearance(cell: Cell, name: str, trajectory: np.ndarray) -> np.ndarra
     out = np.full(len(traj), np.inf)
     valid = np.all(np.isfinite(traj), axis=-1)
     if valid.any() and cell.obstacles:
+        ps = cell.part_set
         lo0, hi0 = obj.shape.aabb()
         rel_lo, rel_hi = lo0 - obj.position, hi0 - obj.position
-        parts = [p for ob in cell.obstacles for p in ob.parts]
-        for part in parts:
-            plo, phi = part.aabb()
-            # Cheap bound: the gap between bounding boxes; exact distance only when close.
-            gap = np.maximum(np.maximum(plo - (traj + rel_hi), (traj + rel_lo) - phi), 0.0)
-            bound = np.linalg.norm(gap, axis=-1)
-            exact_needed = valid & (bound < out)
-            axis_box = isinstance(part, Box) and part.axis_aligned and \
-                isinstance(obj.shape, Box) and obj.shape.axis_aligned
-            if axis_box:
-                out = np.where(valid, np.minimum(out, bound), out)
-                continue
-            for t in np.flatnonzero(exact_needed & (bound <= 0.5)):
-                out[t] = min(out[t], shape_distance(obj.occupancy_at(traj[t]), part))
-            far = exact_needed & (bound > 0.5)
-            out = np.where(far, np.minimum(out, bound), out)
+        tv = traj[valid]
+        # Cheap bound for every (frame, part): the gap between the bounding boxes, which is
+        # the distance itself for two axis-aligned boxes.
+        bound = box_gap((tv + rel_lo)[:, None], (tv + rel_hi)[:, None], ps.lo, ps.hi)
+        obj_box = isinstance(obj.shape, Box) and obj.shape.axis_aligned
+        need = (bound <= 0.5) & ~(ps.is_box & obj_box)            # exact distance wanted
+        best = np.where(need, np.inf, bound).min(axis=1)
+        for k in np.flatnonzero(need.any(axis=0)):
+            # Exact only where it could be the smallest (it is at least the bound).
+            for t in np.flatnonzero(need[:, k] & (bound[:, k] < best)):
+                best[t] = min(best[t], shape_distance(obj.occupancy_at(tv[t]), ps.parts[k]))
+        out[valid] = best
     return out[0] if single else out
 
 
@@ -230,7 +247,10 @@ def collision(positions: np.ndarray, cell: Cell, *, stature: float = DEFAULT_STA
     pos = np.asarray(positions, dtype=np.float64)
     if margin < 0:
         raise ValueError(f"margin must be non-negative, got {margin!r}")
-    hit = body_clearance(pos, cell, stature=stature) <= margin
+    # Every capsule-part pair whose bound is at most the margin is computed exactly, so
+    # the test is exact; pairs bounded beyond the margin cannot collide.
+    exact_below = float(np.nextafter(margin, np.inf))
+    hit = body_clearance(pos, cell, stature=stature, exact_below=exact_below) <= margin
     for name, traj in (carried or {}).items():
         traj = np.asarray(traj, dtype=np.float64)
         if traj.shape != (*pos.shape[:-2], 3):

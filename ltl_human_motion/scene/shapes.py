@@ -21,6 +21,7 @@ import numpy as np
 
 from ltl_human_motion.errors import MissingDependencyError
 from ltl_human_motion.scene.geometry import (
+    box_gap,
     min_along_segment,
     point_box_signed_distance,
     point_circle_signed_distance,
@@ -203,9 +204,8 @@ class Shape(ABC):
             raise ValueError(f"segments must have shape (..., 2, 3), got {seg.shape}")
         radii = np.broadcast_to(np.asarray(radii, dtype=np.float64), seg.shape[:-2])
         lo, hi = self.aabb()
-        seg_lo, seg_hi = seg.min(axis=-2), seg.max(axis=-2)
-        gap = np.maximum(np.maximum(lo - seg_hi, seg_lo - hi), 0.0)
-        bound = np.linalg.norm(gap, axis=-1) - radii
+        a, b = seg[..., 0, :], seg[..., 1, :]
+        bound = box_gap(np.minimum(a, b), np.maximum(a, b), lo, hi) - radii
         near = bound < exact_below
         if not np.any(near):
             return bound
@@ -303,6 +303,9 @@ class Box(Shape):
         return segment_aabb_distance(self.to_local(a), self.to_local(b), -self.half, self.half)
 
     def aabb(self) -> tuple[np.ndarray, np.ndarray]:
+        if self.axis_aligned:
+            # The corners centre +- half, as min/max of the vertices give them.
+            return self.center_ - self.half, self.center_ + self.half
         v = self.vertices()
         return v.min(axis=0), v.max(axis=0)
 
