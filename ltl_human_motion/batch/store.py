@@ -107,6 +107,9 @@ class DatasetStore:
                              f"{self.shard_size}")
         self.staging = self.root / "staging"
         self.shards = self.root / "shards"
+        # Items staged by this process, kept until their shard is packed, so packing
+        # does not read back what was just written (the files stay for crash recovery).
+        self._staged_here: dict[int, tuple[dict, dict, dict[str, np.ndarray] | None]] = {}
         self._open()
 
     # ------------------------------------------------------------------ set-up
@@ -213,14 +216,19 @@ class DatasetStore:
     # ------------------------------------------------------------------ writing
     def stage(self, result: ItemResult) -> None:
         """Write one finished item atomically."""
-        meta = {"record": result.record, "timing": result.timing}
-        entries: list[tuple[str, np.ndarray]] = [
-            ("meta", np.array(json.dumps(meta, sort_keys=True, allow_nan=False)))]
+        text = json.dumps({"record": result.record, "timing": result.timing}, sort_keys=True,
+                          allow_nan=False)
+        entries: list[tuple[str, np.ndarray]] = [("meta", np.array(text))]
         if result.arrays is not None:
             entries += [(name, result.arrays[name]) for name in ARRAY_NAMES]
         atomic_write_bytes(self._item_path(result.index), npz_bytes_of(entries))
+        meta = json.loads(text)                 # as a read-back would give it
+        self._staged_here[result.index] = (meta["record"], meta["timing"], result.arrays)
 
     def _read_staged(self, index: int) -> tuple[dict, dict, dict[str, np.ndarray] | None]:
+        kept = self._staged_here.pop(index, None)
+        if kept is not None:
+            return kept
         path = self._item_path(index)
         with np.load(path, allow_pickle=False) as z:
             meta = json.loads(str(z["meta"].reshape(-1)[0]))
