@@ -17,6 +17,7 @@ from ltl_human_motion.robot import (
     predictive_separation,
     segment_distances,
     separation,
+    signed_distances,
     slider_from_separation,
 )
 
@@ -170,3 +171,23 @@ def test_nearly_parallel_segments_sharing_an_end_point_touch() -> None:
     P = np.array([[[0.0, e, e], [e, 7.86905002e-01, e]]])
     Q = np.array([[[0.0, 0.0, e], [e, 7.86905002e-01, e]]])
     assert segment_distances(P, Q)[0, 0] == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_signed_distances_are_exact_at_the_minimum_overall_and_per_group(seed: int) -> None:
+    """The control loop's fast path: never below the exact values, and equal to them at
+    the minimum (overall and per group of rows), nearly parallel pairs included."""
+    rng = np.random.default_rng(seed)
+    P, Q = random_segments(rng)
+    e = 6.10351562e-05                      # the nearly parallel pair hypothesis found
+    P = np.concatenate([P, [[[0.0, e, e], [e, 7.86905002e-01, e]]]])
+    Q = np.concatenate([Q, [[[0.0, 0.0, e], [e, 7.86905002e-01, e]]]])
+    pr, qr = rng.uniform(0.0, 0.1, len(P)), rng.uniform(0.0, 0.1, len(Q))
+    exact = segment_distances(P, Q) - pr[:, None] - qr[None, :]
+    fast = signed_distances(P, pr, Q, qr)
+    assert np.all(fast >= exact - 1e-12)
+    assert fast.min() == pytest.approx(exact.min(), abs=1e-12)
+    groups = np.array([0, 3, 7])
+    grouped = signed_distances(P, pr, Q, qr, row_groups=groups)
+    assert np.allclose(np.minimum.reduceat(grouped.min(axis=1), groups),
+                       np.minimum.reduceat(exact.min(axis=1), groups), atol=1e-12)

@@ -39,6 +39,7 @@ from ltl_human_motion.robot.separation import (
     pair_distances,
     segment_distances,
     separation,
+    signed_distances,
 )
 from ltl_human_motion.robot.sim_state import SimulatedUR
 from ltl_human_motion.robot.ssm import (
@@ -96,6 +97,7 @@ __all__ = [
     "run_ur_sim",
     "segment_distances",
     "separation",
+    "signed_distances",
     "slider_from_separation",
     "start_ur_sim_process",
     "tcp_pose",

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ltl_human_motion.robot.kinematics import URModel, robot_capsules, ur_model
-from ltl_human_motion.robot.separation import check_capsules, segment_distances
+from ltl_human_motion.robot.separation import check_capsules, signed_distances
 from ltl_human_motion.robot.ssm import (
     SSMParameters,
     predictive_separation,
@@ -465,12 +465,11 @@ class CoexistenceController:
         if occ is None:
             return math.nan, math.nan
         rseg, rrad = self.robot_capsules(q)
-        d = segment_distances(occ.segments, rseg) - occ.radii[:, None] - rrad[None, :]
-        current = float(d.min())
+        current = float(signed_distances(occ.segments, occ.radii, rseg, rrad).min())
         if occ.pred_segments is None or not self.config.use_prediction:
             return current, current
-        dp = segment_distances(occ.pred_segments, rseg) - occ.pred_radii[:, None] \
-            - rrad[None, :]
+        dp = signed_distances(occ.pred_segments, occ.pred_radii, rseg, rrad,
+                              row_groups=occ.pred_offsets)
         per_horizon = np.minimum.reduceat(dp.min(axis=1), occ.pred_offsets)
         return current, predictive_separation(current, per_horizon, occ.horizons, self.params)
 
