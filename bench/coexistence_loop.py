@@ -111,15 +111,17 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=10.0, help="seconds per mode")
     parser.add_argument("--rate", type=float, default=125.0, help="target loop rate (Hz)")
-    parser.add_argument("--switch-interval", type=float, default=0.001, metavar="S",
-                        help="sys.setswitchinterval for the process (default 0.001 as set "
-                             "by the node's entry point and `coexist`; Python's is 0.005)")
+    parser.add_argument("--switch-interval", type=float, default=None, metavar="S",
+                        help="sys.setswitchinterval for the process (default: the node's "
+                             "CONTROL_SWITCH_INTERVAL, as its entry point and `coexist` "
+                             "set it; Python's is 0.005)")
     parser.add_argument("--out", type=Path, default=ROOT / "bench" / "results"
                         / "coexistence_loop.json")
     args = parser.parse_args(argv)
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-    if args.switch_interval is not None:
-        sys.setswitchinterval(args.switch_interval)
+    from ltl_human_motion.ros.coexistence_node import CONTROL_SWITCH_INTERVAL
+    sys.setswitchinterval(args.switch_interval if args.switch_interval is not None
+                          else CONTROL_SWITCH_INTERVAL)
 
     import rtde_receive
     from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
