@@ -702,28 +702,20 @@ class SequencePlanner:
         return seg, mp
 
     def _goal_clear(self, mp: MotionPrimitive, kind: str) -> bool:
-        """Whether the body, and any object in the hands, keep clear of obstacles."""
+        """Whether the body, the objects already in the hands and, for a grasp, the part
+        from its contact frame on keep clear of obstacles."""
         world = world_positions(mp, *self.pose)
         if not self._placed_clear(mp, self.pose, samples=24, world=world):
             return False
-        contact = int(mp.meta.get("contact_frame", 0))
-        carried = dict(self.held)
-        if kind == "grasp" and self.grasp_object is not None:
-            carried[self.grasp_object] = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(
-                mp.meta.get("hand"), "r_hand")
+        if kind != "grasp" or self.grasp_object is None:
+            return True
         from ltl_human_motion.scene.predicates import object_clearance
-        for name, joint in carried.items():
-            j = JOINT_INDEX[joint]
-            start = contact if name == self.grasp_object else 0
-            hand = world[start:, j]
-            if name == self.grasp_object:
-                offset = self.cell.object(name).position - hand[0]
-            else:
-                offset = self.held_offsets.get(name, np.zeros(3))
-            centre = hand[::4] + offset
-            if centre.size and np.any(object_clearance(self.cell, name, centre) <= 0.0):
-                return False
-        return True
+        joint = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(mp.meta.get("hand"), "r_hand")
+        hand = world[int(mp.meta.get("contact_frame", 0)):, JOINT_INDEX[joint]]
+        if not hand.size:
+            return True
+        centre = hand[::4] + (self.cell.object(self.grasp_object).position - hand[0])
+        return not np.any(object_clearance(self.cell, self.grasp_object, centre) <= 0.0)
 
     def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None) -> dict:
         """Update which objects are held; return the effect for the object tracks."""

@@ -211,13 +211,12 @@ def signed_distances(P: NDArray[np.float64], p_radii: NDArray[np.float64],
     dist, parallel = _closest_points_pass(P, Q)
     signed = dist - p_radii[:, None] - q_radii[None, :]
     if parallel.any():
-        rows = signed.min(axis=1)
         if row_groups is None:
-            floor = np.full(len(rows), rows.min())
+            floor = signed.min()
         else:
-            floor = np.repeat(np.minimum.reduceat(rows, row_groups),
-                              np.diff(np.append(row_groups, len(rows))))
-        near = parallel & (signed <= floor[:, None] + _PARALLEL_SLACK)
+            floor = np.repeat(np.minimum.reduceat(signed.min(axis=1), row_groups),
+                              np.diff(np.append(row_groups, len(signed))))[:, None]
+        near = parallel & (signed <= floor + _PARALLEL_SLACK)
         if near.any():
             _refine_parallel(dist, P, Q, near)
             signed = dist - p_radii[:, None] - q_radii[None, :]
