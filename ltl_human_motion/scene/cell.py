@@ -143,6 +143,10 @@ class SceneObject:
     sitting_offsets : ndarray, shape (2, 3) or None
         ``lo``/``hi`` of the sitting surface relative to ``position``.
     color : str or None
+    mass : float
+        Mass in kg (default 1 kg): the load of ergonomic scores and lifting equations.
+    two_handed : bool
+        True when the part takes both hands to hold (task planning counts both as busy).
     """
 
     name: str
@@ -152,6 +156,8 @@ class SceneObject:
     movable: bool = True
     sitting_offsets: np.ndarray | None = None
     color: str | None = None
+    mass: float = 1.0
+    two_handed: bool = False
 
     @property
     def occupancy(self) -> Shape:
@@ -541,7 +547,8 @@ class _Parser:
     def obj(self, name: str, spec: Any) -> SceneObject:
         key = f"objects.{name}"
         spec = self.mapping(spec, key, self._SHAPE_KEYS | {"grasp_points", "movable",
-                                                          "sitting_surface", "color"},
+                                                          "sitting_surface", "color",
+                                                          "mass", "two_handed"},
                             required=("position",))
         shape = self.shape(spec, key)
         position = self.point(spec["position"], f"{key}.position")
@@ -558,8 +565,14 @@ class _Parser:
             skey = f"{key}.sitting_surface"
             s = self.mapping(spec["sitting_surface"], skey, {"lo", "hi"}, ("lo", "hi"))
             sitting = np.stack(self.bounds(s["lo"], s["hi"], skey))
+        mass = self.number(spec.get("mass", 1.0), f"{key}.mass")
+        if mass <= 0.0:
+            raise self.error(f"{key}.mass", f"expected a positive mass in kg, got {mass!r}")
+        two_handed = spec.get("two_handed", False)
+        if not isinstance(two_handed, bool):
+            raise self.error(f"{key}.two_handed", f"expected true or false, got {two_handed!r}")
         return SceneObject(name, position, shape, offsets, movable, sitting,
-                           self.color(spec, key))
+                           self.color(spec, key), mass, two_handed)
 
     def region(self, name: str, spec: Any) -> Region:
         key = f"regions.{name}"
