@@ -24,6 +24,7 @@ setup(
     install_requires=["numpy>=1.24", "scipy>=1.10", "PyYAML>=6", "trimesh>=4"],
     extras_require={
         "collision": ["python-fcl>=0.7"],
+        "fast": ["numba>=0.60"],
         "viz": ["matplotlib>=3.7", "imageio>=2.30", "pillow>=10"],
         "data": ["pybullet>=3.2"],
         "robot": ["ur-rtde>=1.5"],

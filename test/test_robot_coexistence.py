@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from robot_sim import start_sim
 
+from ltl_human_motion.kernel.segments import compiled
 from ltl_human_motion.robot import (
     CoexistenceConfig,
     CoexistenceController,
@@ -58,6 +59,7 @@ def human_at(x: float, y: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
 
 @pytest.fixture(scope="module")
 def sim() -> Iterator[URSimHandle]:
+    compiled()   # load the distance kernel (as a node does at start-up) before the arm moves
     handle = start_sim()
     yield handle
     handle.stop()

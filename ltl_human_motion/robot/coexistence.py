@@ -45,8 +45,13 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ltl_human_motion.kernel.segments import (
+    check_capsules,
+    compiled,
+    group_min_signed_distances,
+    min_signed_distance,
+)
 from ltl_human_motion.robot.kinematics import URModel, robot_capsules, ur_model
-from ltl_human_motion.robot.separation import check_capsules, signed_distances
 from ltl_human_motion.robot.ssm import (
     SSMParameters,
     predictive_separation,
@@ -262,6 +267,7 @@ class CoexistenceController:
         self._robot_stamp: float | None = None
         self._robot_stamp_changed = -math.inf
         self._lock = threading.Lock()
+        compiled()   # load the distance kernel now, not in the first control cycle
         self.rejections = 0
         self.reconnects = 0
         self.last_rejection: str | None = None
@@ -465,12 +471,11 @@ class CoexistenceController:
         if occ is None:
             return math.nan, math.nan
         rseg, rrad = self.robot_capsules(q)
-        current = float(signed_distances(occ.segments, occ.radii, rseg, rrad).min())
+        current = min_signed_distance(occ.segments, occ.radii, rseg, rrad)
         if occ.pred_segments is None or not self.config.use_prediction:
             return current, current
-        dp = signed_distances(occ.pred_segments, occ.pred_radii, rseg, rrad,
-                              row_groups=occ.pred_offsets)
-        per_horizon = np.minimum.reduceat(dp.min(axis=1), occ.pred_offsets)
+        per_horizon = group_min_signed_distances(occ.pred_segments, occ.pred_radii, rseg, rrad,
+                                                 occ.pred_offsets)
         return current, predictive_separation(current, per_horizon, occ.horizons, self.params)
 
     def step(self) -> ControlDecision:

@@ -4,7 +4,8 @@ All functions broadcast over leading dimensions. Distances between a segment and
 convex set are computed by minimising the (convex) point-to-set distance along the
 segment with a golden-section search (:func:`min_along_segment`); 40 iterations shrink
 the bracket to ``5e-9`` of the segment length, so the result is exact to well below a
-micrometre for cell-sized segments.
+micrometre for cell-sized segments. Segment-segment distances come from the shared
+kernel (:mod:`ltl_human_motion.kernel.segments`), exact also for parallel segments.
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+
+from ltl_human_motion.kernel.segments import segment_segment_distance
 
 __all__ = [
     "box_gap",
@@ -55,50 +58,6 @@ def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.nd
     t = np.clip(t, 0.0, 1.0)
     closest = a + t[..., None] * ab
     return np.linalg.norm(p - closest, axis=-1)
-
-
-def segment_segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray,
-                             q1: np.ndarray) -> np.ndarray:
-    """Minimum distance between segments ``[p0, p1]`` and ``[q0, q1]``.
-
-    Closed form (Ericson, *Real-Time Collision Detection*, Sec. 5.1.9), robust for
-    degenerate (point) segments and parallel segments.
-
-    Parameters
-    ----------
-    p0, p1, q0, q1 : array-like, shape (..., 3)
-
-    Returns
-    -------
-    d : ndarray, shape (...)
-    """
-    p0 = np.asarray(p0, dtype=np.float64)
-    p1 = np.asarray(p1, dtype=np.float64)
-    q0 = np.asarray(q0, dtype=np.float64)
-    q1 = np.asarray(q1, dtype=np.float64)
-    d1 = p1 - p0
-    d2 = q1 - q0
-    r = p0 - q0
-    a = np.sum(d1 * d1, axis=-1)
-    e = np.sum(d2 * d2, axis=-1)
-    f = np.sum(d2 * r, axis=-1)
-    c = np.sum(d1 * r, axis=-1)
-    b = np.sum(d1 * d2, axis=-1)
-    a, e, f, c, b = np.broadcast_arrays(a, e, f, c, b)
-    denom = a * e - b * b
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.where(denom > _EPS * np.maximum(a * e, _EPS),
-                     np.clip((b * f - c * e) / denom, 0.0, 1.0), 0.0)
-        s = np.where(a > _EPS, s, 0.0)
-        t = np.where(e > _EPS, (b * s + f) / e, 0.0)
-        # Clamp t and recompute s where t left [0, 1].
-        s_lo = np.where(a > _EPS, np.clip(-c / a, 0.0, 1.0), 0.0)
-        s_hi = np.where(a > _EPS, np.clip((b - c) / a, 0.0, 1.0), 0.0)
-    s = np.where(t < 0.0, s_lo, np.where(t > 1.0, s_hi, s))
-    t = np.clip(t, 0.0, 1.0)
-    cp = p0 + s[..., None] * d1
-    cq = q0 + t[..., None] * d2
-    return np.linalg.norm(cp - cq, axis=-1)
 
 
 def box_gap(lo_a: np.ndarray, hi_a: np.ndarray, lo_b: np.ndarray,
