@@ -17,7 +17,7 @@ from ltl_human_motion.robot import (
     default_pick_and_place,
     forward_kinematics,
     load_robot_config,
-    matrix_from_axis_angle,
+    matrix_from_compact_axis_angle,
     pose_from_xyz_rpy,
     robot_capsules,
     tcp_pose,
@@ -41,7 +41,7 @@ def test_ur5e_zero_configuration_matches_dh_closed_form() -> None:
     # At q = 0: x = a2 + a3, y = -(d4 + d6), z = d1 - d5.
     assert pose[:3] == pytest.approx([-0.425 - 0.3922, -(0.1333 + 0.0996), 0.1625 - 0.0997])
     # Flange orientation: rotation of pi/2 about x (from the DH twists).
-    R = matrix_from_axis_angle(pose[3:])
+    R = matrix_from_compact_axis_angle(pose[3:])
     assert R @ np.array([0, 0, 1.0]) == pytest.approx([0, -1.0, 0], abs=1e-12)
 
 
@@ -67,9 +67,9 @@ def test_axis_angle_round_trip_including_near_pi() -> None:
     axes /= np.linalg.norm(axes, axis=1, keepdims=True)
     angles = np.concatenate([rng.uniform(0, np.pi, 190), np.full(5, np.pi), np.full(5, 1e-9)])
     v = axes * angles[:, None]
-    R = matrix_from_axis_angle(v)
+    R = matrix_from_compact_axis_angle(v)
     back = axis_angle_from_matrix(R)
-    assert np.allclose(matrix_from_axis_angle(back), R, atol=1e-9)
+    assert np.allclose(matrix_from_compact_axis_angle(back), R, atol=1e-9)
     regular = angles < np.pi - 1e-6
     assert np.allclose(back[regular], v[regular], atol=1e-7)
 

@@ -242,6 +242,11 @@ def _numpy_elementwise(p0: NDArray[np.float64], d1: NDArray[np.float64],
 
 
 # ---------------------------------------------------------------------------- public API
+def _contiguous(*arrays: ArrayLike) -> list[NDArray[np.float64]]:
+    """The arrays as C-contiguous float64 (no copy when they already are)."""
+    return [np.ascontiguousarray(a, dtype=np.float64) for a in arrays]
+
+
 def segment_segment_distance(p0: ArrayLike, p1: ArrayLike, q0: ArrayLike,
                              q1: ArrayLike) -> NDArray[np.float64]:
     """Exact minimum distance between segments ``[p0, p1]`` and ``[q0, q1]``, elementwise.
@@ -285,8 +290,7 @@ def segment_distances(P: ArrayLike, Q: ArrayLike) -> NDArray[np.float64]:
     distances : ndarray, shape (K, L)
         Distance between the closest points (clamped to both segments).
     """
-    P = np.ascontiguousarray(P, dtype=np.float64)
-    Q = np.ascontiguousarray(Q, dtype=np.float64)
+    P, Q = _contiguous(P, Q)
     nb = _compiled()
     if nb is None:
         return _numpy_segment_distances(P, Q)
@@ -318,9 +322,7 @@ def signed_distances(P: ArrayLike, p_radii: ArrayLike, Q: ArrayLike, q_radii: Ar
     -------
     distances : ndarray, shape (K, L)
     """
-    P, Q = np.ascontiguousarray(P, dtype=np.float64), np.ascontiguousarray(Q, dtype=np.float64)
-    pr = np.ascontiguousarray(p_radii, dtype=np.float64)
-    qr = np.ascontiguousarray(q_radii, dtype=np.float64)
+    P, pr, Q, qr = _contiguous(P, p_radii, Q, q_radii)
     nb = _compiled()
     if nb is None:
         groups = None if row_groups is None else np.asarray(row_groups, dtype=np.intp)
@@ -361,9 +363,7 @@ def group_min_signed_distances(P: ArrayLike, p_radii: ArrayLike, Q: ArrayLike,
     -------
     minima : ndarray, shape (G,)
     """
-    P, Q = np.ascontiguousarray(P, dtype=np.float64), np.ascontiguousarray(Q, dtype=np.float64)
-    pr = np.ascontiguousarray(p_radii, dtype=np.float64)
-    qr = np.ascontiguousarray(q_radii, dtype=np.float64)
+    P, pr, Q, qr = _contiguous(P, p_radii, Q, q_radii)
     starts = np.ascontiguousarray(row_groups, dtype=np.intp)
     nb = _compiled()
     if nb is None:

@@ -27,8 +27,12 @@ from pathlib import Path
 import numpy as np
 
 from ltl_human_motion.errors import MissingDependencyError, MotionFormatError
+from ltl_human_motion.kernel.rotations import (
+    ZUP_FROM_YUP,
+    matrix_from_axis_angle,
+    matrix_from_quaternion,
+)
 from ltl_human_motion.motion.retarget import retarget_points
-from ltl_human_motion.motion.rotations import matrix_from_axis_angle, matrix_from_quaternion
 from ltl_human_motion.motion.skeleton import Skeleton
 from ltl_human_motion.motion.types import Motion
 
@@ -75,8 +79,6 @@ DEFAULT_GAIT_CLIPS: tuple[str, ...] = (
     "walker/0walk_forward.txt", "walker/turn_left0.txt", "walker/turn_left1.txt",
     "walker/turn_right0.txt", "walker/turn_right1.txt", "humanoid3d_walk.txt",
 )
-# y up (x forward, z right) -> z up (x forward, y left)
-_ZUP_FROM_YUP = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
 
 
 def _data_path() -> Path:
@@ -187,7 +189,7 @@ def load_raw(path: str | os.PathLike[str]) -> tuple[dict[str, np.ndarray], float
         rot[name] = rot[parent] @ local
     for name, (link, local_xyz) in _EXTRA.items():
         pos[name] = pos[link] + rot[link] @ (np.asarray(local_xyz) * URDF_SCALE)
-    points = {k: v @ _ZUP_FROM_YUP.T for k, v in pos.items()}
+    points = {k: v @ ZUP_FROM_YUP.T for k, v in pos.items()}
     fps = 1.0 / float(arr[0, 0])
     return points, fps, loop
 

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.ops import (
     compose,
@@ -34,7 +35,7 @@ from ltl_human_motion.motion.ops import (
 )
 from ltl_human_motion.motion.retarget import enforce_bone_lengths, fix_feet, mirror_positions
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
-from ltl_human_motion.motion.types import Motion, MotionPrimitive, yaw_matrix
+from ltl_human_motion.motion.types import Motion, MotionPrimitive
 
 __all__ = [
     "CARRY_HAND_OFFSET",
@@ -140,7 +141,7 @@ def prepare_loop(motion: Motion, name: str, source: str, mirror: bool = False,
     from scipy.ndimage import uniform_filter1d
 
     smooth = uniform_filter1d(root3[:, 3], size=n - 1, mode="nearest")
-    twist = yaw_matrix(root3[:, 3] - smooth)
+    twist = matrix_from_yaw(root3[:, 3] - smooth)
     poses3 = np.einsum("tij,tkj->tki", twist, poses3)
     root3[:, 3] = smooth
     root_r = resample_positions(root3, motion.fps, fps)

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.motion.rotations import unwrap_angles, yaw_from_positions
-from ltl_human_motion.motion.types import MotionPrimitive, yaw_matrix
+from ltl_human_motion.motion.types import MotionPrimitive
 
 __all__ = [
     "compose",
@@ -36,7 +37,7 @@ def decompose(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"positions must have shape (T, J, 3), got {p.shape}")
     yaw = unwrap_angles(yaw_from_positions(p))
     rel = p - p[:, :1, :]
-    poses = np.einsum("tji,tkj->tki", yaw_matrix(yaw), rel)  # R^T @ rel
+    poses = np.einsum("tji,tkj->tki", matrix_from_yaw(yaw), rel)  # R^T @ rel
     root = np.concatenate([p[:, 0, :], yaw[:, None]], axis=1)
     return root, poses
 
@@ -44,14 +45,14 @@ def decompose(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def compose(root: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """Inverse of :func:`decompose`: world positions (T, J, 3) from root (T, 4) and poses."""
     root = np.asarray(root, dtype=np.float64)
-    rot = yaw_matrix(root[:, 3])
+    rot = matrix_from_yaw(root[:, 3])
     return np.einsum("tij,tkj->tki", rot, poses) + root[:, None, :3]
 
 
 def poses_from_world(positions: np.ndarray, yaw: np.ndarray) -> np.ndarray:
     """Root-relative poses (T, J, 3) of world positions for a given heading track (T,)."""
     p = np.asarray(positions, dtype=np.float64)
-    return np.einsum("tji,tkj->tki", yaw_matrix(np.asarray(yaw, dtype=np.float64)),
+    return np.einsum("tji,tkj->tki", matrix_from_yaw(np.asarray(yaw, dtype=np.float64)),
                      p - p[:, :1, :])
 
 

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.motion.skeleton import Skeleton
 
 
@@ -118,17 +119,8 @@ class MotionPrimitive:
         return self.task in ("walk", "carry")
 
 
-def yaw_matrix(yaw: np.ndarray | float) -> np.ndarray:
-    """Rotation matrices about +z, shape (..., 3, 3) for ``yaw`` of shape (...)."""
-    yaw = np.asarray(yaw, dtype=np.float64)
-    c, s = np.cos(yaw), np.sin(yaw)
-    out = np.zeros((*yaw.shape, 3, 3))
-    out[..., 0, 0] = c
-    out[..., 0, 1] = -s
-    out[..., 1, 0] = s
-    out[..., 1, 1] = c
-    out[..., 2, 2] = 1.0
-    return out
+yaw_matrix = matrix_from_yaw
+"""Old name of :func:`ltl_human_motion.kernel.rotations.matrix_from_yaw`."""
 
 
 def world_positions(primitive: MotionPrimitive, x: float = 0.0, y: float = 0.0,

@@ -46,6 +46,7 @@ import numpy as np
 
 from ltl_human_motion.atomic import atomic_write_bytes, atomic_write_text
 from ltl_human_motion.errors import MotionFormatError
+from ltl_human_motion.kernel.rotations import MOCAP_FROM_ZUP
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, Skeleton
 from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
@@ -275,7 +276,7 @@ _TWIST_REF: dict[str, tuple[str, str]] = {
     "spine": ("r_clavicle", "l_clavicle"),
 }
 # File axes from ours: bvh = C @ ours.
-_UP_FROM_Z = {"z": np.eye(3), "y": np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])}
+_UP_FROM_Z = {"z": np.eye(3), "y": MOCAP_FROM_ZUP}
 
 
 def _normalize(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

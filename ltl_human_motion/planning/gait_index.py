@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion.types import MotionPrimitive, place_poses, world_positions
 from ltl_human_motion.planning.turns import turn_primitives
 
@@ -175,16 +176,11 @@ class GaitIndex:
         return self.indices[self.indptr[j]:self.indptr[j + 1]]
 
 
-_INDEX_CACHE: dict[int, tuple[object, GaitIndex]] = {}
+_INDEX_CACHE: BoundedCache[GaitIndex] = BoundedCache(8)
 
 
 def gait_index(library) -> GaitIndex:
     """The library's gait index extended with turns on the spot, built once per library."""
-    hit = _INDEX_CACHE.get(id(library))
-    if hit is not None and hit[0] is library:
-        return hit[1]
-    index = GaitIndex.from_library(library).with_standing_primitives(turn_primitives(library))
-    if len(_INDEX_CACHE) > 8:
-        _INDEX_CACHE.clear()
-    _INDEX_CACHE[id(library)] = (library, index)
-    return index
+    return _INDEX_CACHE.get_or_build(
+        "gait", lambda: GaitIndex.from_library(library).with_standing_primitives(
+            turn_primitives(library)), owner=library)

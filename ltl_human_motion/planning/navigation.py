@@ -15,6 +15,8 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from ltl_human_motion.kernel.cache import BoundedCache
+
 _NEIGHBOURS = ((1, 0), (0, 1), (1, 1), (1, -1))
 
 
@@ -344,9 +346,9 @@ class ObstacleField:
         return ok
 
 
-_CLEARANCE_CACHE: dict[str, tuple[ClearanceMap, ObstacleField]] = {}
+_CLEARANCE_CACHE: BoundedCache[tuple[ClearanceMap, ObstacleField]] = BoundedCache(64)
 _FIELDS_FORMAT = 3
-_GRID_CACHE: dict[tuple, tuple[ClearanceMap, FloorGrid]] = {}
+_GRID_CACHE: BoundedCache[FloorGrid] = BoundedCache(16)
 
 
 def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: float,
@@ -363,16 +365,11 @@ def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: 
     radius, resolution : float
         Metres.
     """
-    key = (id(clearance), np.asarray(lo, dtype=np.float64).tobytes(),
+    key = (np.asarray(lo, dtype=np.float64).tobytes(),
            np.asarray(hi, dtype=np.float64).tobytes(), float(radius), float(resolution))
-    hit = _GRID_CACHE.get(key)
-    if hit is not None and hit[0] is clearance:     # the map is held, so its id is unique
-        return hit[1]
-    grid = FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution)
-    if len(_GRID_CACHE) >= 16:
-        _GRID_CACHE.clear()
-    _GRID_CACHE[key] = (clearance, grid)
-    return grid
+    return _GRID_CACHE.get_or_build(
+        key, lambda: FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution),
+        owner=clearance)
 
 
 def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
@@ -410,7 +407,4 @@ def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
             atomic_write_with(path, lambda fh: pickle.dump(maps, fh, protocol=5))
         except OSError:
             pass            # a read-only cache folder must not stop synthesis
-    if len(_CLEARANCE_CACHE) > 64:
-        _CLEARANCE_CACHE.clear()
-    _CLEARANCE_CACHE[key] = maps
-    return maps
+    return _CLEARANCE_CACHE.put(key, maps)

@@ -6,6 +6,7 @@ Core package: no ROS imports. The simulated controller runs in its own process
 connects.
 """
 
+from ltl_human_motion.kernel.rotations import matrix_from_compact_axis_angle
 from ltl_human_motion.robot.coexistence import (
     CoexistenceConfig,
     CoexistenceController,
@@ -19,7 +20,6 @@ from ltl_human_motion.robot.kinematics import (
     URModel,
     axis_angle_from_matrix,
     forward_kinematics,
-    matrix_from_axis_angle,
     pose_from_xyz_rpy,
     robot_capsules,
     tcp_pose,
@@ -87,7 +87,7 @@ __all__ = [
     "default_pick_and_place",
     "forward_kinematics",
     "load_robot_config",
-    "matrix_from_axis_angle",
+    "matrix_from_compact_axis_angle",
     "min_distance",
     "pair_distances",
     "plot_commissioning",

@@ -18,7 +18,6 @@ __all__ = [
     "URModel",
     "axis_angle_from_matrix",
     "forward_kinematics",
-    "matrix_from_axis_angle",
     "pose_from_xyz_rpy",
     "robot_capsules",
     "tcp_pose",
@@ -176,31 +175,6 @@ def axis_angle_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
         axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
         out[near_pi] = axis * angle[near_pi][..., None]
     return out
-
-
-def matrix_from_axis_angle(rotvec: ArrayLike) -> NDArray[np.float64]:
-    """Rotation matrices of rotation vectors.
-
-    Parameters
-    ----------
-    rotvec : array-like, shape (..., 3)
-
-    Returns
-    -------
-    R : ndarray, shape (..., 3, 3)
-    """
-    v = np.asarray(rotvec, dtype=np.float64)
-    if v.shape[-1:] != (3,):
-        raise ValueError(f"rotation vectors: expected shape (..., 3), got {v.shape}")
-    angle = np.linalg.norm(v, axis=-1)
-    safe = np.where(angle > 1e-12, angle, 1.0)
-    k = v / safe[..., None]
-    K = np.zeros((*v.shape[:-1], 3, 3))
-    K[..., 0, 1], K[..., 0, 2] = -k[..., 2], k[..., 1]
-    K[..., 1, 0], K[..., 1, 2] = k[..., 2], -k[..., 0]
-    K[..., 2, 0], K[..., 2, 1] = -k[..., 1], k[..., 0]
-    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
 def tcp_pose(q: ArrayLike, model: str | URModel = "ur5e") -> NDArray[np.float64]:

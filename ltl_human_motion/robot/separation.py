@@ -96,13 +96,7 @@ def min_distance(human_segments: ArrayLike, human_radii: ArrayLike,
                  validate: bool = True) -> float:
     """Minimum signed human-robot capsule separation (m).
 
-    Parameters
-    ----------
-    human_segments : array-like, shape (K, 2, 3)
-    human_radii : array-like, shape (K,)
-    robot_segments : array-like, shape (L, 2, 3)
-    robot_radii : array-like, shape (L,)
-    validate : bool
+    Parameters are those of :func:`pair_distances`.
 
     Returns
     -------
@@ -119,13 +113,7 @@ def separation(human_segments: ArrayLike, human_radii: ArrayLike,
                validate: bool = True) -> Separation:
     """Minimum separation with the closest pair and all pair distances.
 
-    Parameters
-    ----------
-    human_segments : array-like, shape (K, 2, 3)
-    human_radii : array-like, shape (K,)
-    robot_segments : array-like, shape (L, 2, 3)
-    robot_radii : array-like, shape (L,)
-    validate : bool
+    Parameters are those of :func:`pair_distances`.
 
     Returns
     -------

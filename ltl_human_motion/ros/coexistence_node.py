@@ -52,6 +52,7 @@ from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
+from ltl_human_motion.kernel.rotations import quaternion_from_matrix
 from ltl_human_motion.msg import HumanOccupancy, SafetyStatus
 from ltl_human_motion.robot.coexistence import (
     CoexistenceConfig,
@@ -315,29 +316,6 @@ def occupancy_from_message(msg: Any) -> OccupancySample:
 
 
 # ---------------------------------------------------------------------- small helpers
-def _quaternion_from_matrix(R: np.ndarray) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of a rotation matrix (3, 3)."""
-    m = R
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    if trace > 0:
-        s = 2.0 * math.sqrt(trace + 1.0)
-        w, x = 0.25 * s, (m[2, 1] - m[1, 2]) / s
-        y, z = (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
-        w, x = (m[2, 1] - m[1, 2]) / s, 0.25 * s
-        y, z = (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
-    elif m[1, 1] > m[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
-        w, x = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s
-        y, z = 0.25 * s, (m[1, 2] + m[2, 1]) / s
-    else:
-        s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
-        w, x = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s
-        y, z = (m[1, 2] + m[2, 1]) / s, 0.25 * s
-    return float(x), float(y), float(z), float(w)
-
-
 def _transform(parent: str, child: str, T: np.ndarray, stamp: Any) -> TransformStamped:
     tf = TransformStamped()
     tf.header.stamp = stamp
@@ -346,7 +324,7 @@ def _transform(parent: str, child: str, T: np.ndarray, stamp: Any) -> TransformS
     t = tf.transform.translation
     t.x, t.y, t.z = (float(v) for v in T[:3, 3])
     q = tf.transform.rotation
-    q.x, q.y, q.z, q.w = _quaternion_from_matrix(T[:3, :3])
+    q.w, q.x, q.y, q.z = (float(v) for v in quaternion_from_matrix(T[:3, :3]))
     return tf
 
 

@@ -20,6 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.scene.geometry import box_gap, point_bounds, segment_aabb_distance
 from ltl_human_motion.scene.shapes import EXACT_BELOW, Box, Shape
 
@@ -176,7 +177,7 @@ class PartSet:
         return out.reshape(lead)
 
 
-_PART_SETS: dict[int, tuple[tuple, PartSet]] = {}
+_PART_SETS: BoundedCache[PartSet] = BoundedCache(64)
 
 
 def part_set(obstacles: tuple) -> PartSet:
@@ -185,11 +186,5 @@ def part_set(obstacles: tuple) -> PartSet:
     Cells made from one another (jittered objects or regions) share the obstacle tuple
     and so the part set. The cache keeps the tuple alive, so its id stays unique.
     """
-    hit = _PART_SETS.get(id(obstacles))
-    if hit is not None and hit[0] is obstacles:
-        return hit[1]
-    ps = PartSet([p for ob in obstacles for p in ob.parts])
-    if len(_PART_SETS) >= 64:
-        _PART_SETS.clear()
-    _PART_SETS[id(obstacles)] = (obstacles, ps)
-    return ps
+    return _PART_SETS.get_or_build(
+        "parts", lambda: PartSet([p for ob in obstacles for p in ob.parts]), owner=obstacles)

@@ -13,13 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ltl_human_motion.kernel.rotations import ZUP_FROM_YUP
+
 __all__ = ["ZUP_FROM_YUP", "extents_zup_from_yup", "yup_from_zup", "zup_from_yup"]
-
-#: Rotation matrix taking y-up vectors to z-up vectors, shape (3, 3).
-ZUP_FROM_YUP = np.array([[1.0, 0.0, 0.0],
-                         [0.0, 0.0, -1.0],
-                         [0.0, 1.0, 0.0]])
-
 
 def _as_vectors(points: np.ndarray, name: str) -> np.ndarray:
     arr = np.asarray(points, dtype=np.float64)

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ltl_human_motion.errors import MissingDependencyError
+from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.scene.geometry import (
     box_gap,
     min_along_segment,
@@ -61,11 +62,6 @@ def _points(points: np.ndarray) -> np.ndarray:
     if p.ndim == 0 or p.shape[-1] != 3:
         raise ValueError(f"points must have shape (..., 3), got {p.shape}")
     return p
-
-
-def _yaw_rotation(yaw: float) -> np.ndarray:
-    c, s = np.cos(yaw), np.sin(yaw)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def _fcl():
@@ -235,7 +231,7 @@ class Shape(ABC):
         -------
         lo, hi : ndarray, shape (3,)
         """
-        local = (self.vertices() - origin) @ _yaw_rotation(yaw)
+        local = (self.vertices() - origin) @ matrix_from_yaw(yaw)
         return local.min(axis=0), local.max(axis=0)
 
 
@@ -290,7 +286,7 @@ class Box(Shape):
     @property
     def rotation(self) -> np.ndarray:
         """Box-to-world rotation, shape (3, 3)."""
-        return _yaw_rotation(self.yaw)
+        return matrix_from_yaw(self.yaw)
 
     def to_local(self, points: np.ndarray) -> np.ndarray:
         """World points (..., 3) expressed in the box frame (origin at the centre)."""
@@ -385,7 +381,7 @@ class Cylinder(Shape):
         return self.center_ + np.vstack([bottom, top])
 
     def extent_in_frame(self, yaw: float, origin: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        c = (self.center_ - origin) @ _yaw_rotation(yaw)
+        c = (self.center_ - origin) @ matrix_from_yaw(yaw)
         h = np.array([self.radius, self.radius, self.height / 2.0])
         return c - h, c + h
 
@@ -446,7 +442,7 @@ class Sphere(Shape):
         return self.to_trimesh().vertices * 1.0
 
     def extent_in_frame(self, yaw: float, origin: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        c = (self.center_ - origin) @ _yaw_rotation(yaw)
+        c = (self.center_ - origin) @ matrix_from_yaw(yaw)
         return c - self.radius, c + self.radius
 
     def to_trimesh(self):
