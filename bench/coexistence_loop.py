@@ -4,7 +4,7 @@ The node runs inside a one-process bringup, as in ``ltl-human-motion coexist``: 
 skeleton publisher (TF and markers at 30 Hz) and occupancy node (100 Hz, 1 s prediction =
 11 samples of 23 capsules) share the process with the coexistence node (target 125 Hz),
 which talks to the simulated UR (own process, 127.0.0.1:30004) through the REAL ur_rtde
-client. The worker loops a test motion (:func:`ltl_human_motion.ros.testing.make_test_motion`)
+client. The worker loops a test motion (``make_test_motion`` of test/ros_fakes.py)
 so the occupancy stream never pauses. For the reactive and the predictive mode the
 benchmark records every control step for ``--duration`` seconds and reports the achieved
 rate, the step period (median, p99, max) and the share of late steps (period > 1.5 x
@@ -129,7 +129,8 @@ def main(argv: list[str] | None = None) -> int:
     from ltl_human_motion.ros.bringup import Bringup
     from ltl_human_motion.ros.client import ClientSession
     from ltl_human_motion.ros.coexistence_demo import rtde_port_lock, start_sim_when_free
-    from ltl_human_motion.ros.testing import scripted_synthesize
+    sys.path.insert(0, str(ROOT / "test"))   # the scripted synthesizer (test/ros_fakes.py)
+    from ros_fakes import scripted_synthesize
 
     results: dict[str, Any] = {
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),

@@ -39,7 +39,8 @@ def run_publisher(args: argparse.Namespace) -> int:
     from ltl_human_motion.ros.common import now_seconds, spin_nodes
     from ltl_human_motion.ros.occupancy_node import OccupancyNode
     from ltl_human_motion.ros.playback import Playback
-    from ltl_human_motion.ros.testing import make_test_motion
+    sys.path.insert(0, str(ROOT / "test"))   # the hand-made test motion (test/ros_fakes.py)
+    from ros_fakes import make_test_motion
 
     rclpy.init(args=["--ros-args", "-r", "__ns:=/bench_human", "-p", f"rate:={args.rate}",
                      "-p", f"prediction_horizon:={args.horizon}", "-p", "marker_rate:=0.0"])

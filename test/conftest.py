@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import random
+from collections.abc import Iterator
 
 import pytest
 from hypothesis import settings
@@ -30,3 +31,30 @@ apply_middleware_defaults()
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", "pipeline: needs the full synthesis pipeline (planning.synthesize)")
+
+
+# ---------------------------------------------------------------------- robot fixtures
+@pytest.fixture(scope="module")
+def sim() -> Iterator[object]:
+    """The simulated UR controller on 127.0.0.1 for one test module (test/robot_sim.py);
+    the distance kernel is loaded first, as a node does at start-up, so the arm's
+    trajectory starts when the test does."""
+    from robot_sim import start_sim
+
+    from ltl_human_motion.kernel.segments import compiled
+
+    compiled()
+    handle = start_sim()
+    yield handle
+    handle.stop()
+
+
+@pytest.fixture(scope="module")
+def receive(sim: object) -> Iterator[object]:
+    """A real ur_rtde receive interface on the module's simulator."""
+    rtde_receive = pytest.importorskip("rtde_receive")
+    from robot_sim import HOST
+
+    r = rtde_receive.RTDEReceiveInterface(HOST)
+    yield r
+    r.disconnect()

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from demo_motion import demo_synthesized_motion
 
 from ltl_human_motion.errors import MotionFormatError
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, Skeleton
@@ -26,7 +27,6 @@ from ltl_human_motion.planning.exports import (
 )
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.scene import cell_by_name
-from ltl_human_motion.viz.demo import demo_synthesized_motion
 
 
 @pytest.fixture(scope="module")

@@ -15,9 +15,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from robot_sim import start_sim
+from robot_sim import feed_and_step, human_at
 
-from ltl_human_motion.kernel.segments import compiled
 from ltl_human_motion.robot import (
     CoexistenceConfig,
     CoexistenceController,
@@ -46,25 +45,6 @@ class FakeClock:
         return self.t
 
 
-def human_at(x: float, y: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """A standing worker (legs, torso, head, one arm reaching towards -x) at (x, y)."""
-    segments = np.array([
-        [[x, y, 0.1], [x, y, 0.9]],
-        [[x, y, 0.9], [x, y, 1.5]],
-        [[x, y, 1.6], [x, y, 1.75]],
-        [[x, y, 1.4], [x - 0.5, y, 1.2]],
-    ])
-    return segments, np.array([0.15, 0.2, 0.12, 0.06])
-
-
-@pytest.fixture(scope="module")
-def sim() -> Iterator[URSimHandle]:
-    compiled()   # load the distance kernel (as a node does at start-up) before the arm moves
-    handle = start_sim()
-    yield handle
-    handle.stop()
-
-
 @pytest.fixture
 def controller(sim: URSimHandle) -> Iterator[CoexistenceController]:
     receive_factory, io_factory = ur_rtde_factories(HOST)
@@ -75,52 +55,35 @@ def controller(sim: URSimHandle) -> Iterator[CoexistenceController]:
     ctl.close()
 
 
-@pytest.fixture(scope="module")
-def readback(sim: URSimHandle) -> Iterator[object]:
-    r = rtde_receive.RTDEReceiveInterface(HOST)
-    yield r
-    r.disconnect()
-
-
-def feed_and_step(ctl: CoexistenceController, occupancy: tuple[np.ndarray, np.ndarray],
-                  steps: int = 5, period: float = 0.008) -> list:
-    decisions = []
-    for _ in range(steps):
-        ctl.update_occupancy(*occupancy, stamp=time.monotonic())
-        decisions.append(ctl.step())
-        time.sleep(period)
-    return decisions
-
-
-def settle(readback: object, value: float, timeout: float = 2.0) -> bool:
+def settle(receive: object, value: float, timeout: float = 2.0) -> bool:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        if abs(readback.getTargetSpeedFraction() - value) < 1e-9:
+        if abs(receive.getTargetSpeedFraction() - value) < 1e-9:
             return True
         time.sleep(0.005)
     return False
 
 
-def test_speed_follows_separation(controller: CoexistenceController, readback: object) -> None:
+def test_speed_follows_separation(controller: CoexistenceController, receive: object) -> None:
     far = feed_and_step(controller, human_at(4.0))
     assert far[-1].mode == "full" and far[-1].slider == 1.0 and far[-1].connected
-    assert settle(readback, 1.0)
-    assert readback.getSpeedScaling() == pytest.approx(1.0)
+    assert settle(receive, 1.0)
+    assert receive.getSpeedScaling() == pytest.approx(1.0)
     near = feed_and_step(controller, human_at(0.6))
     assert near[-1].mode == "stop" and near[-1].slider == MIN
     assert near[-1].separation <= PARAMS.protective_distance
-    assert settle(readback, MIN)
-    assert readback.getSpeedScaling() == pytest.approx(MIN)
+    assert settle(receive, MIN)
+    assert receive.getSpeedScaling() == pytest.approx(MIN)
     # Inside the band the command is the linear map of the separation.
     band = feed_and_step(controller, human_at(1.9), steps=10)
     reduced = [d for d in band if d.mode == "reduced"]
     assert reduced, [d.separation for d in band]
     for d in reduced:
         assert d.slider == pytest.approx(slider_from_separation(d.separation, PARAMS))
-    assert settle(readback, band[-1].slider)
+    assert settle(receive, band[-1].slider)
 
 
-def test_stale_occupancy_commands_the_minimum(sim: URSimHandle, readback: object) -> None:
+def test_stale_occupancy_commands_the_minimum(sim: URSimHandle, receive: object) -> None:
     clock = FakeClock()                               # injected: staleness is deterministic
     receive_factory, io_factory = ur_rtde_factories(HOST)
     ctl = CoexistenceController(receive_factory, io_factory, "ur5e", params=PARAMS,
@@ -129,24 +92,24 @@ def test_stale_occupancy_commands_the_minimum(sim: URSimHandle, readback: object
         assert ctl.step().mode == "stale"             # nothing received yet
         ctl.update_occupancy(*human_at(4.0), stamp=clock())
         assert ctl.step().mode == "full"
-        assert settle(readback, 1.0)
+        assert settle(receive, 1.0)
         clock.t += 0.1
         assert ctl.step().mode == "full"              # 0.1 s old: still fresh
         clock.t += 0.1
         d = ctl.step()                                # 0.2 s old: stale
         assert d.mode == "stale" and d.slider == MIN and d.sent
-        assert settle(readback, MIN)
+        assert settle(receive, MIN)
         ctl.update_occupancy(*human_at(4.0))          # data returns (stamped on receipt)
         assert ctl.step().mode == "full"              # and it recovers by itself
-        assert settle(readback, 1.0)
+        assert settle(receive, 1.0)
     finally:
         ctl.close()
 
 
 def test_rejected_occupancy_never_raises_speed(controller: CoexistenceController,
-                                               readback: object) -> None:
+                                               receive: object) -> None:
     feed_and_step(controller, human_at(0.6))
-    assert settle(readback, MIN)
+    assert settle(receive, MIN)
     segs, radii = human_at(4.0)
     bad_inputs = [
         (np.where(np.arange(12).reshape(4, 1, 3) == 5, np.nan, segs), radii),
@@ -176,7 +139,7 @@ def test_rejected_occupancy_never_raises_speed(controller: CoexistenceController
         d = controller.step()
         assert d.slider <= ceiling + 1e-12
         time.sleep(0.008)
-    assert readback.getTargetSpeedFraction() <= ceiling + 1e-12
+    assert receive.getTargetSpeedFraction() <= ceiling + 1e-12
     assert feed_and_step(controller, human_at(4.0))[-1].slider == 1.0
 
 

@@ -13,7 +13,7 @@ from ltl_human_motion.robot import (
     commissioning_metrics,
     write_commissioning_report,
 )
-from ltl_human_motion.robot import rtde_protocol as rp
+from ltl_human_motion.robot.sim import rtde_protocol as rp
 
 
 def decisions() -> list[ControlDecision]:

@@ -6,9 +6,8 @@ from __future__ import annotations
 import time
 from collections.abc import Iterator
 
-import numpy as np
 import pytest
-from robot_sim import start_sim
+from robot_sim import feed_and_step, human_at, start_sim
 
 from ltl_human_motion.robot import (
     CoexistenceConfig,
@@ -24,27 +23,6 @@ pytest.importorskip("rtde_io")
 HOST = "127.0.0.1"
 PARAMS = SSMParameters()
 MIN = PARAMS.min_slider
-
-
-def human_at(x: float, y: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """A standing worker (legs, torso, head, one arm reaching towards -x) at (x, y)."""
-    segments = np.array([
-        [[x, y, 0.1], [x, y, 0.9]],
-        [[x, y, 0.9], [x, y, 1.5]],
-        [[x, y, 1.6], [x, y, 1.75]],
-        [[x, y, 1.4], [x - 0.5, y, 1.2]],
-    ])
-    return segments, np.array([0.15, 0.2, 0.12, 0.06])
-
-
-def feed_and_step(ctl: CoexistenceController, occupancy: tuple[np.ndarray, np.ndarray],
-                  steps: int = 5, period: float = 0.008) -> list:
-    decisions = []
-    for _ in range(steps):
-        ctl.update_occupancy(*occupancy, stamp=time.monotonic())
-        decisions.append(ctl.step())
-        time.sleep(period)
-    return decisions
 
 
 @pytest.fixture

@@ -20,10 +20,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from robot_sim import start_sim
 
 from ltl_human_motion.robot import URSimHandle, start_ur_sim_process, tcp_pose
-from ltl_human_motion.robot import rtde_protocol as rp
+from ltl_human_motion.robot.sim import rtde_protocol as rp
 
 rtde_receive = pytest.importorskip("rtde_receive")
 rtde_io = pytest.importorskip("rtde_io")
@@ -40,20 +39,6 @@ def wait_for(predicate, timeout: float = 3.0, period: float = 0.01) -> bool:
             return True
         time.sleep(period)
     return bool(predicate())
-
-
-@pytest.fixture(scope="module")
-def sim() -> Iterator[URSimHandle]:
-    handle = start_sim()
-    yield handle
-    handle.stop()
-
-
-@pytest.fixture(scope="module")
-def receive(sim: URSimHandle) -> Iterator[object]:
-    r = rtde_receive.RTDEReceiveInterface(HOST)
-    yield r
-    r.disconnect()
 
 
 @pytest.fixture

@@ -36,7 +36,7 @@ from sensor_msgs.msg import JointState  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 from visualization_msgs.msg import MarkerArray  # noqa: E402
 
-from ltl_human_motion.robot.ur_sim import URSimHandle  # noqa: E402
+from ltl_human_motion.robot.sim.process import URSimHandle  # noqa: E402
 from ltl_human_motion.ros import conversions as cv  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.bringup_config import load_bringup_config  # noqa: E402

@@ -16,6 +16,7 @@ rclpy = pytest.importorskip("rclpy")
 from launch_stand_ins import launch_description, launched_nodes  # noqa: E402
 from ltl_human_motion.msg import HumanOccupancy, PredictedOccupancy  # noqa: E402
 from rclpy.serialization import deserialize_message  # noqa: E402
+from ros_fakes import make_test_motion  # noqa: E402
 
 from ltl_human_motion.ros import conversions as cv  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
@@ -23,7 +24,6 @@ from ltl_human_motion.ros.bringup_config import load_bringup_config  # noqa: E40
 from ltl_human_motion.ros.motion_store import MotionStore, check_motion_id  # noqa: E402
 from ltl_human_motion.ros.occupancy_cdr import encode_human_occupancy  # noqa: E402
 from ltl_human_motion.ros.playback import Playback  # noqa: E402
-from ltl_human_motion.ros.testing import make_test_motion  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

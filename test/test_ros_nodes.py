@@ -24,6 +24,7 @@ rclpy = pytest.importorskip("rclpy")
 from ltl_human_motion.msg import HumanOccupancy, TaskState  # noqa: E402
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
+from ros_fakes import scripted_synthesize  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray  # noqa: E402
 
@@ -32,7 +33,6 @@ from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
 from ltl_human_motion.ros.common import TF_STATIC_QOS  # noqa: E402
 from ltl_human_motion.ros.occupancy_node import OccupancyNode  # noqa: E402
-from ltl_human_motion.ros.testing import scripted_synthesize  # noqa: E402
 from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_radii  # noqa: E402
 
 pytestmark = pytest.mark.ros

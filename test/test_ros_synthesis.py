@@ -25,14 +25,14 @@ rclpy = pytest.importorskip("rclpy")
 
 from ltl_human_motion.msg import MotionCatalog  # noqa: E402
 from ltl_human_motion.srv import SynthesizeMotion  # noqa: E402
+from ros_fakes import (  # noqa: E402
+    SYNTHESIS_ONLY_BRINGUP,
+    scripted_synthesize,
+)
 
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
 from ltl_human_motion.ros.common import LATCHED_QOS  # noqa: E402
-from ltl_human_motion.ros.testing import (  # noqa: E402
-    SYNTHESIS_ONLY_BRINGUP,
-    scripted_synthesize,
-)
 
 pytestmark = pytest.mark.ros
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from demo_motion import demo_synthesized_motion, reach_pose
 
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.scene import (
@@ -17,7 +18,6 @@ from ltl_human_motion.scene import (
     termination_holds,
     termination_series,
 )
-from ltl_human_motion.viz.demo import demo_synthesized_motion, reach_pose
 
 REST = Skeleton().rest_positions()
 J = JOINT_INDEX

@@ -7,11 +7,12 @@ import time
 
 import numpy as np
 import pytest
+from demo_motion import demo_synthesized_motion
 from PIL import Image
 
 from ltl_human_motion.errors import MissingDependencyError
 from ltl_human_motion.scene import cell_by_name
-from ltl_human_motion.viz import demo_synthesized_motion, render_animation
+from ltl_human_motion.viz import render_animation
 
 
 @pytest.fixture(scope="module")

@@ -6,12 +6,12 @@ import sys
 
 import numpy as np
 import pytest
+from demo_motion import demo_synthesized_motion
 from PIL import Image
 
 from ltl_human_motion.errors import MissingDependencyError
 from ltl_human_motion.scene import cell_by_name
 from ltl_human_motion.viz import (
-    demo_synthesized_motion,
     plot_cell,
     plot_hand_trajectory,
     render_snapshots,

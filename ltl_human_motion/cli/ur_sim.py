@@ -32,8 +32,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Serve until Ctrl-C; returns the exit code."""
-    from ltl_human_motion.robot.rtde_server import ControllerServer
-    from ltl_human_motion.robot.ur_sim import URSimConfig, run_ur_sim
+    from ltl_human_motion.robot.sim.process import URSimConfig, run_ur_sim
+    from ltl_human_motion.robot.sim.server import ControllerServer
 
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(asctime)s %(name)s: %(message)s")

@@ -1,7 +1,8 @@
 """Robot coexistence: UR kinematics, a simulated UR controller speaking RTDE, human-robot
 separation, ISO/TS 15066 speed and separation monitoring, and commissioning metrics.
 
-Core package: no ROS imports. The simulated controller runs in its own process
+Core package: no ROS imports. The simulated controller is the sub-package
+:mod:`ltl_human_motion.robot.sim` (``ltl-human-motion ur-sim``); it runs in its own process
 (:func:`start_ur_sim_process`) because the ``ur_rtde`` client holds the GIL while it
 connects.
 """
@@ -31,7 +32,6 @@ from ltl_human_motion.robot.metrics import (
     plot_commissioning,
     write_commissioning_report,
 )
-from ltl_human_motion.robot.rtde_server import ControllerServer
 from ltl_human_motion.robot.separation import (
     Separation,
     check_capsules,
@@ -41,25 +41,26 @@ from ltl_human_motion.robot.separation import (
     separation,
     signed_distances,
 )
-from ltl_human_motion.robot.sim_state import SimulatedUR
-from ltl_human_motion.robot.ssm import (
-    SLIDER_MIN,
-    SSMParameters,
-    predictive_separation,
-    slider_from_separation,
-)
-from ltl_human_motion.robot.trajectory import (
-    JointTrajectory,
-    Waypoint,
-    default_pick_and_place,
-    load_robot_config,
-)
-from ltl_human_motion.robot.ur_sim import (
+from ltl_human_motion.robot.sim.process import (
     URSimConfig,
     URSimHandle,
     build_controller,
     run_ur_sim,
     start_ur_sim_process,
+)
+from ltl_human_motion.robot.sim.server import ControllerServer
+from ltl_human_motion.robot.sim.state import SimulatedUR
+from ltl_human_motion.robot.sim.trajectory import (
+    JointTrajectory,
+    Waypoint,
+    default_pick_and_place,
+    load_robot_config,
+)
+from ltl_human_motion.robot.ssm import (
+    SLIDER_MIN,
+    SSMParameters,
+    predictive_separation,
+    slider_from_separation,
 )
 
 __all__ = [

@@ -9,8 +9,8 @@ This package is the only place in ``ltl_human_motion`` that imports ``rclpy``. M
   (:mod:`~ltl_human_motion.ros.recorder`, MCAP in rosbag2's layout).
 * :mod:`~ltl_human_motion.ros.demo_loop` -- ``run_ros_demo``: bring-up, service call,
   playback and recording in one call; :mod:`~ltl_human_motion.ros.client` -- service calls
-  with bounded waits and topic watchers; :mod:`~ltl_human_motion.ros.testing` -- hand-made
-  motions and a scripted synthesizer for tests and benchmarks.
+  with bounded waits and topic watchers (the hand-made test motions and the scripted
+  synthesizer live in ``test/ros_fakes.py``, outside the package).
 * :mod:`~ltl_human_motion.ros.playback`, :mod:`~ltl_human_motion.ros.motion_store` and
   :mod:`~ltl_human_motion.ros.bringup_config` are plain Python (no rclpy import), so
   launch files and tools can use them without a ROS context.

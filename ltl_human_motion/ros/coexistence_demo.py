@@ -40,9 +40,9 @@ from ltl_human_motion.atomic import atomic_write_text
 from ltl_human_motion.msg import SafetyStatus
 from ltl_human_motion.robot.coexistence import ControlDecision
 from ltl_human_motion.robot.metrics import write_commissioning_report
-from ltl_human_motion.robot.port_lock import RTDE_PORT, rtde_port_lock, wait_port_free
-from ltl_human_motion.robot.trajectory import load_robot_config
-from ltl_human_motion.robot.ur_sim import URSimHandle, start_ur_sim_process
+from ltl_human_motion.robot.sim.port_lock import RTDE_PORT, rtde_port_lock, wait_port_free
+from ltl_human_motion.robot.sim.process import URSimHandle, start_ur_sim_process
+from ltl_human_motion.robot.sim.trajectory import load_robot_config
 from ltl_human_motion.ros.bringup import Bringup
 from ltl_human_motion.ros.client import ClientSession, wait_until
 from ltl_human_motion.ros.coexistence_node import CONTROL_SWITCH_INTERVAL, CoexistenceNode

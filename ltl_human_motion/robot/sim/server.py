@@ -1,7 +1,7 @@
 """RTDE (TCP 30004) and dashboard (TCP 29999) servers of the simulated UR controller.
 
 One thread, one ``selectors`` loop: it accepts clients, parses their packets, ticks the
-:class:`~ltl_human_motion.robot.sim_state.SimulatedUR` at the controller rate and streams
+:class:`~ltl_human_motion.robot.sim.state.SimulatedUR` at the controller rate and streams
 data packages at each output recipe's frequency. Sockets are non-blocking; a client that
 stops reading loses data packages (never blocks the loop). A client sending garbage is
 answered with an RTDE text message, or disconnected when its stream cannot be resynchronised;
@@ -25,8 +25,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from ltl_human_motion.robot import rtde_protocol as rp
-from ltl_human_motion.robot.sim_state import (
+from ltl_human_motion.robot.sim import rtde_protocol as rp
+from ltl_human_motion.robot.sim.state import (
     RUNTIME_PLAYING,
     SAFETY_NORMAL,
     SAFETY_PROTECTIVE_STOP,

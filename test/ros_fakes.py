@@ -17,8 +17,9 @@ from typing import Any
 
 import numpy as np
 
+from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
-from ltl_human_motion.motion.types import Motion, yaw_matrix
+from ltl_human_motion.motion.types import Motion
 
 
 def make_test_motion(duration: float = 2.0, fps: float = 60.0, stature: float = 1.75,
@@ -35,7 +36,7 @@ def make_test_motion(duration: float = 2.0, fps: float = 60.0, stature: float = 
     yaw = -np.pi / 2 * np.minimum(s * 2, 1.0)                         # turn towards -y
     root = np.stack([-0.6 * np.minimum(s * 2, 1.0), -0.6 * np.minimum(s * 2, 1.0),
                      np.zeros(n)], axis=-1)
-    body = np.einsum("tij,kj->tki", yaw_matrix(yaw), rest)            # (T, J, 3)
+    body = np.einsum("tij,kj->tki", matrix_from_yaw(yaw), rest)            # (T, J, 3)
     positions = body + root[:, None, :]
     half = n // 2
     task_index = np.full(n, -1, dtype=np.int64)

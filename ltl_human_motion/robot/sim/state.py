@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ltl_human_motion.robot.kinematics import URModel, tcp_pose, ur_model
-from ltl_human_motion.robot.trajectory import JointTrajectory, default_pick_and_place
+from ltl_human_motion.robot.sim.trajectory import JointTrajectory, default_pick_and_place
 
 __all__ = [
     "ROBOT_MODE_RUNNING",
@@ -51,7 +51,7 @@ class SimulatedUR:
     ----------
     model : str or URModel
     trajectory : JointTrajectory, optional
-        Default :func:`~ltl_human_motion.robot.trajectory.default_pick_and_place`.
+        Default :func:`~ltl_human_motion.robot.sim.trajectory.default_pick_and_place`.
     clock : callable
         Monotonic seconds.
     zero_slider_protective_stop : bool

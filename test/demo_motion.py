@@ -13,8 +13,9 @@ import itertools
 
 import numpy as np
 
+from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
-from ltl_human_motion.motion.types import Motion, yaw_matrix
+from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.scene.cell import Cell
 
@@ -162,10 +163,10 @@ def demo_synthesized_motion(cell: Cell | None = None, region: str | None = None,
                 sh = rest[JOINT_INDEX[f"{side}_shoulder"]]
                 arm = [JOINT_INDEX[f"{side}_{n}"] for n in ("elbow", "wrist", "hand")]
                 pose[arm] = (rest[arm] - sh) @ _rot_y(sign * 0.4 * swing).T + sh
-        frames[t] = pose @ yaw_matrix(yaw[t]).T + np.array([xy[t, 0], xy[t, 1], 0.0])
+        frames[t] = pose @ matrix_from_yaw(yaw[t]).T + np.array([xy[t, 0], xy[t, 1], 0.0])
     # Reaching: world-frame IK towards target points inside the region.
     sides = {"both": ("l", "r"), "right": ("r",), "left": ("l",)}[hands]
-    lateral = yaw_matrix(yaw1) @ np.array([0.0, 1.0, 0.0])
+    lateral = matrix_from_yaw(yaw1) @ np.array([0.0, 1.0, 0.0])
     for t in range(n_walk, T):
         u = min((t - n_walk) / (n_reach - 1), 1.0)
         for side in sides:

@@ -18,9 +18,9 @@ from pathlib import Path
 from typing import Any
 
 from ltl_human_motion.robot.kinematics import pose_from_xyz_rpy, ur_model
-from ltl_human_motion.robot.rtde_server import ControllerServer
-from ltl_human_motion.robot.sim_state import SimulatedUR
-from ltl_human_motion.robot.trajectory import load_robot_config
+from ltl_human_motion.robot.sim.server import ControllerServer
+from ltl_human_motion.robot.sim.state import SimulatedUR
+from ltl_human_motion.robot.sim.trajectory import load_robot_config
 
 __all__ = ["URSimConfig", "URSimHandle", "build_controller", "run_ur_sim",
            "start_ur_sim_process"]
