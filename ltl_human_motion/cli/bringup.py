@@ -61,3 +61,15 @@ def run(args: argparse.Namespace) -> int:
         summary = {"mcap": str(path), "topics": node_set.recorder.summary()}
         print(json.dumps(summary, indent=2))
     return 0
+
+
+def ros_entry_point(args: list[str] | None = None) -> int:
+    """``ltl-human-motion bringup`` under another name (``ros2 run ltl_human_motion
+    bringup``): the ROS arguments are dropped, the rest parsed as by the CLI. It lives in
+    the CLI layer so that the ROS layer never imports the CLI."""
+    import rclpy.utilities
+
+    from ltl_human_motion.cli import main
+
+    argv = sys.argv[1:] if args is None else list(args)
+    return main([NAME, *rclpy.utilities.remove_ros_args(argv)])

@@ -36,10 +36,8 @@ commissioning report (``coexistence.json`` and ``coexistence.png``) there when d
 from __future__ import annotations
 
 import math
-import struct
 import threading
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -47,7 +45,6 @@ import numpy as np
 from geometry_msgs.msg import TransformStamped
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.node import Node
-from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
@@ -62,6 +59,7 @@ from ltl_human_motion.robot.coexistence import (
     ReceiveLike,
     ur_rtde_factories,
 )
+from ltl_human_motion.robot.fusion import OccupancySample, fuse_occupancies
 from ltl_human_motion.robot.kinematics import (
     UR_MODELS,
     forward_kinematics,
@@ -72,7 +70,8 @@ from ltl_human_motion.robot.kinematics import (
 from ltl_human_motion.robot.metrics import DecisionRecorder, write_commissioning_report
 from ltl_human_motion.robot.ssm import SLIDER_MIN, SSMParameters
 from ltl_human_motion.ros import conversions as cv
-from ltl_human_motion.ros.common import STREAM_QOS, TF_QOS, TF_STATIC_QOS, stamp_seconds
+from ltl_human_motion.ros.common import STREAM_QOS, TF_QOS, TF_STATIC_QOS
+from ltl_human_motion.ros.occupancy_decode import decode_human_occupancy, occupancy_from_message
 from ltl_human_motion.ros.params import (
     ParamSpec,
     declare_parameters,
@@ -202,117 +201,6 @@ def coexistence_parameters() -> list[ParamSpec]:
         spec("markers_topic", "/robot_markers", "MarkerArray topic", topic_name,
              read_only=True),
     ]
-
-
-# ---------------------------------------------------------------------- occupancy decoding
-@dataclass
-class OccupancySample:
-    """One decoded HumanOccupancy: stamp (s, ROS time), capsules and predictions."""
-
-    human_id: str
-    stamp: float
-    segments: np.ndarray                                  # (K, 2, 3)
-    radii: np.ndarray                                     # (K,)
-    predicted: list[tuple[float, np.ndarray, np.ndarray]]
-
-
-class _Reader:
-    """Reads plain little-endian CDR, aligning relative to the payload start."""
-
-    def __init__(self, data: bytes) -> None:
-        self.data = data
-        self.pos = 4                                      # after the encapsulation header
-
-    def _align(self, n: int) -> None:
-        self.pos += (-(self.pos - 4)) % n
-
-    def uint32(self) -> int:
-        self._align(4)
-        (value,) = struct.unpack_from("<I", self.data, self.pos)
-        self.pos += 4
-        return value
-
-    def int32(self) -> int:
-        self._align(4)
-        (value,) = struct.unpack_from("<i", self.data, self.pos)
-        self.pos += 4
-        return value
-
-    def float64(self) -> float:
-        self._align(8)
-        (value,) = struct.unpack_from("<d", self.data, self.pos)
-        self.pos += 8
-        return value
-
-    def string(self) -> str:
-        n = self.uint32()
-        if n == 0 or self.pos + n > len(self.data):
-            raise ValueError("bad string length")
-        text = self.data[self.pos:self.pos + n - 1].decode("utf-8")
-        self.pos += n
-        return text
-
-    def capsules(self) -> np.ndarray:
-        k = self.uint32()
-        if k == 0:
-            return np.zeros((0, 7))
-        self._align(8)
-        end = self.pos + 56 * k
-        if end > len(self.data):
-            raise ValueError("capsule sequence runs past the message")
-        rows = np.frombuffer(self.data, dtype="<f8", count=7 * k, offset=self.pos)
-        self.pos = end
-        return rows.reshape(k, 7).astype(np.float64)
-
-
-def _split(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    return rows[:, :6].reshape(-1, 2, 3), rows[:, 6].copy()
-
-
-def decode_human_occupancy(data: bytes) -> OccupancySample:
-    """Decode serialized ``HumanOccupancy`` bytes straight into numpy arrays.
-
-    Plain little-endian CDR (what rclpy and Fast DDS send) is read with numpy, a few
-    microseconds for a message of 250 capsules; anything else goes through rclpy's
-    deserializer. Raises ValueError on malformed data.
-    """
-    data = bytes(data)
-    if data[:2] == b"\x00\x01":
-        try:
-            r = _Reader(data)
-            sec, nanosec = r.int32(), r.uint32()
-            r.string()                                    # frame_id
-            human_id = r.string()
-            for _ in range(r.uint32()):
-                r.string()                                # part names
-            segments, radii = _split(r.capsules())
-            r.float64()                                   # prediction_horizon
-            predicted = []
-            for _ in range(r.uint32()):
-                horizon = r.float64()
-                predicted.append((horizon, *_split(r.capsules())))
-            return OccupancySample(human_id, sec + nanosec * 1e-9, segments, radii, predicted)
-        except (struct.error, ValueError, UnicodeDecodeError):
-            pass                                          # let rclpy decide below
-    try:
-        msg = deserialize_message(data, HumanOccupancy)
-    except Exception as exc:  # rclpy raises several types for garbage
-        raise ValueError(f"cannot deserialize HumanOccupancy: {exc}") from None
-    return occupancy_from_message(msg)
-
-
-def _capsule_rows(capsules: Any) -> np.ndarray:
-    return np.array([[c.a.x, c.a.y, c.a.z, c.b.x, c.b.y, c.b.z, c.radius] for c in capsules],
-                    dtype=np.float64).reshape(-1, 7)
-
-
-def occupancy_from_message(msg: Any) -> OccupancySample:
-    """An :class:`OccupancySample` from a ``HumanOccupancy`` message object."""
-    segments, radii = _split(_capsule_rows(msg.capsules))
-    predicted = [(float(p.time_from_now), *_split(_capsule_rows(p.capsules)))
-                 for p in msg.predicted]
-    return OccupancySample(msg.human_id, stamp_seconds(msg.header.stamp), segments, radii,
-                           predicted)
 
 
 # ---------------------------------------------------------------------- small helpers
@@ -461,17 +349,9 @@ class CoexistenceNode(Node):
                     self.get_logger().warning(f"human {k!r} silent for over "
                                               f"{self.forget_after:g} s: forgotten")
             entries = list(self._humans.values())
-        stamp = min(s for s, _ in entries)
-        if len(entries) == 1:
-            segments, radii = sample.segments, sample.radii
-        else:
-            segments = np.concatenate([e.segments for _, e in entries])
-            radii = np.concatenate([e.radii for _, e in entries])
-        predicted = None
-        if self.use_prediction:
-            predicted = [(h + (s - stamp), ps, pr) for s, e in entries
-                         for h, ps, pr in e.predicted] or None
-        if not self.controller.update_occupancy(segments, radii, stamp, predicted):
+        fused = fuse_occupancies(entries, self.use_prediction)
+        if not self.controller.update_occupancy(fused.segments, fused.radii, fused.stamp,
+                                                fused.predicted):
             self.messages_rejected += 1
 
     # ------------------------------------------------------------------ control

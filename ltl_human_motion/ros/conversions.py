@@ -27,6 +27,8 @@ from visualization_msgs.msg import Marker
 
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS
 from ltl_human_motion.msg import Capsule
+from ltl_human_motion.scene.cell import Cell, Obstacle
+from ltl_human_motion.scene.shapes import Shape
 
 _Z = np.array([0.0, 0.0, 1.0])
 
@@ -227,42 +229,36 @@ def delete_markers(keys: Sequence[tuple[str, int]], frame_id: str, stamp: Time) 
     return out
 
 
-def object_size(cell: Any, name: str, default: float = 0.08) -> np.ndarray:
+def object_size(cell: Cell | None, name: str, default: float = 0.08) -> np.ndarray:
     """Bounding-box size (3,) of a cell object for its marker (a small cube if unknown)."""
-    obj = (getattr(cell, "objects", None) or {}).get(name) if cell is not None else None
-    shape = getattr(obj, "shape", None)
-    try:
-        lo, hi = shape.aabb()
-        size = np.asarray(hi, dtype=np.float64) - np.asarray(lo, dtype=np.float64)
-    except (AttributeError, TypeError, ValueError):
+    obj = cell.objects.get(name) if cell is not None else None
+    if obj is None:
         return np.full(3, default)
+    lo, hi = obj.shape.aabb()
+    size = np.asarray(hi, dtype=np.float64) - np.asarray(lo, dtype=np.float64)
     if size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
         return np.full(3, default)
     return size
 
 
-def _mesh_of(thing: Any) -> Any:
-    """A trimesh of a region shape or obstacle, or None."""
-    for candidate in (thing, getattr(thing, "shape", None)):
-        to_trimesh = getattr(candidate, "to_trimesh", None)
-        if callable(to_trimesh):
-            try:
-                return to_trimesh()
-            except (ImportError, NotImplementedError, ValueError):
-                return None
-    return getattr(thing, "mesh", None)
+def _mesh_of(thing: Shape | Obstacle) -> Any:
+    """A trimesh of a region's shape or of an obstacle, or None when none can be made."""
+    try:
+        return thing.to_trimesh()
+    except (ImportError, NotImplementedError, ValueError):
+        return None
 
 
-def cell_markers(cell: Any, factory: MarkerFactory) -> list[Marker]:
+def cell_markers(cell: Cell, factory: MarkerFactory) -> list[Marker]:
     """Markers of a cell: regions as translucent CUBEs (meshes for non-box regions) with
     a label, obstacles as TRIANGLE_LISTs of their trimesh meshes (their bounding CUBE
     when no mesh can be made)."""
     out: list[Marker] = []
     region_rgba, label_rgba = color(0.1, 0.8, 0.2, 0.25), color(1.0, 1.0, 1.0, 0.9)
-    for k, (name, region) in enumerate(sorted((getattr(cell, "regions", None) or {}).items())):
+    for k, (name, region) in enumerate(sorted(cell.regions.items())):
         lo = np.asarray(region.lo, dtype=np.float64)
         hi = np.asarray(region.hi, dtype=np.float64)
-        mesh = None if getattr(region, "is_box", True) else _mesh_of(region)
+        mesh = None if region.is_box else _mesh_of(region.shape)
         if mesh is not None:
             out.append(factory.triangles("cell/regions", k, mesh.vertices, mesh.faces,
                                          region_rgba))
@@ -271,12 +267,12 @@ def cell_markers(cell: Any, factory: MarkerFactory) -> list[Marker]:
         top = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.1])
         out.append(factory.text("cell/region_labels", k, top, str(name), 0.12, label_rgba))
     obstacle_rgba = color(0.55, 0.45, 0.35, 0.9)
-    for k, obstacle in enumerate(getattr(cell, "obstacles", None) or []):
+    for k, obstacle in enumerate(cell.obstacles):
         mesh = _mesh_of(obstacle)
-        if mesh is not None and len(getattr(mesh, "faces", ())) > 0:
+        if mesh is not None and len(mesh.faces) > 0:
             out.append(factory.triangles("cell/obstacles", k, mesh.vertices, mesh.faces,
                                          obstacle_rgba))
-        elif callable(getattr(obstacle, "aabb", None)):
+        else:
             lo, hi = (np.asarray(v, dtype=np.float64) for v in obstacle.aabb())
             out.append(factory.cube("cell/obstacles", k, (lo + hi) / 2, hi - lo, obstacle_rgba))
     return out

@@ -1,4 +1,5 @@
-"""``ros2 run`` / console-script entry points: one function per node, plus ``bringup``.
+"""``ros2 run`` / console-script entry points: one function per node (``bringup`` is the
+CLI's, :func:`ltl_human_motion.cli.bringup.ros_entry_point`: the ROS layer imports no CLI).
 
 Each node entry point follows ros2/examples: ``rclpy.init(args=args)`` (so ``--ros-args
 -p name:=value --params-file f.yaml -r __ns:=/human_2`` work), spin in a
@@ -66,11 +67,3 @@ def coexistence_node(args: list[str] | None = None) -> int:
 
     sys.setswitchinterval(CONTROL_SWITCH_INTERVAL)   # the 125 Hz loop waits less for the GIL
     return _run_node(CoexistenceNode, args)
-
-
-def bringup(args: list[str] | None = None) -> int:
-    """``ltl-human-motion bringup`` under another name (``ros2 run ... bringup``)."""
-    from ltl_human_motion.cli import main
-
-    argv = sys.argv[1:] if args is None else list(args)
-    return main(["bringup", *rclpy.utilities.remove_ros_args(argv)])

@@ -15,9 +15,12 @@ from __future__ import annotations
 
 import threading
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ltl_human_motion.planning.result import SynthesizedMotion
 
 STOPPED = "stopped"
 PLAYING = "playing"
@@ -68,20 +71,18 @@ class Frame:
     state: str = PLAYING
 
 
-def task_sequence_text(motion: Any) -> str:
-    """The tasks of a synthesized motion, separated by ``" ; "`` (from its timeline)."""
-    timeline = getattr(motion, "timeline", None) or []
-    if timeline:
-        return " ; ".join(str(seg.task) for seg in timeline)
-    sequence = getattr(motion, "sequence", None)
-    tasks = getattr(sequence, "tasks", None) or []
-    return " ; ".join(str(t) for t in tasks)
+def task_sequence_text(motion: SynthesizedMotion) -> str:
+    """The tasks of a synthesized motion, separated by ``" ; "`` (from its timeline, else
+    from its task sequence)."""
+    if motion.timeline:
+        return " ; ".join(str(seg.task) for seg in motion.timeline)
+    return " ; ".join(str(t) for t in motion.sequence)
 
 
 class _MotionArrays:
     """The arrays of a SynthesizedMotion that playback needs, checked once."""
 
-    def __init__(self, motion: Any) -> None:
+    def __init__(self, motion: SynthesizedMotion) -> None:
         body = motion.motion
         self.positions = np.asarray(body.positions, dtype=np.float64)
         if self.positions.ndim != 3 or self.positions.shape[2] != 3 or len(self.positions) < 1:
@@ -91,17 +92,15 @@ class _MotionArrays:
         self.fps = float(body.fps)
         self.n_frames = int(self.positions.shape[0])
         self.duration = (self.n_frames - 1) / self.fps
-        self.stature = float(getattr(getattr(body, "skeleton", None), "stature", 1.75))
-        yaw = getattr(motion, "root_yaw", None)
-        self.yaw = (np.unwrap(np.asarray(yaw, dtype=np.float64)) if yaw is not None
-                    and len(yaw) == self.n_frames else np.zeros(self.n_frames))
-        index = getattr(motion, "task_index", None)
-        self.task_index = (np.asarray(index, dtype=np.int64) if index is not None
-                           and len(index) == self.n_frames
+        self.stature = float(body.skeleton.stature)
+        yaw = np.asarray(motion.root_yaw, dtype=np.float64)
+        self.yaw = np.unwrap(yaw) if yaw.shape == (self.n_frames,) else np.zeros(self.n_frames)
+        index = np.asarray(motion.task_index, dtype=np.int64)
+        self.task_index = (index if index.shape == (self.n_frames,)
                            else np.full(self.n_frames, -1, dtype=np.int64))
         self.objects = {str(k): np.asarray(v, dtype=np.float64)
-                        for k, v in (getattr(motion, "objects", None) or {}).items()}
-        timeline = getattr(motion, "timeline", None) or []
+                        for k, v in motion.objects.items()}
+        timeline = motion.timeline
         self.task_names = [str(seg.task) for seg in timeline]
         self.starts = np.array([int(seg.start_frame) for seg in timeline], dtype=np.int64)
         self.ends = np.array([int(seg.end_frame) for seg in timeline], dtype=np.int64)
