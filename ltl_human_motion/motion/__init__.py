@@ -42,7 +42,7 @@ from ltl_human_motion.motion.library import (
     load_library,
     load_motion,
 )
-from ltl_human_motion.motion.ops import compose, decompose, primitive_from_positions
+from ltl_human_motion.motion.ops import compose, decompose
 from ltl_human_motion.motion.quality import QualityThresholds, check_primitives, primitive_metrics
 from ltl_human_motion.motion.retarget import (
     enforce_bone_lengths,
@@ -72,7 +72,7 @@ __all__ = [
     "cache_dir", "carry_poses", "center_of_mass", "check_primitives", "chest_height",
     "compose", "decompose", "end_pose", "enforce_bone_lengths", "knee_height",
     "load_library", "load_motion", "make_goal_primitive", "max_reach", "min_jerk",
-    "min_reach_height", "mirror_positions", "pair_distance", "primitive_from_positions",
+    "min_reach_height", "mirror_positions", "pair_distance",
     "primitive_metrics", "reach_placement", "retarget_points", "seat_height_range",
     "standing_pose", "transition_distances", "two_bone_ik", "window_positions",
     "world_positions", "yaw_matrix",

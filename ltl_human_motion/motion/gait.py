@@ -44,7 +44,6 @@ __all__ = [
     "PRIMITIVE_FRAMES",
     "GaitClip",
     "carry_poses",
-    "clip_motion",
     "gait_primitives",
     "prepare_clip",
     "prepare_loop",
@@ -350,6 +349,3 @@ def start_stop_primitives(clip: GaitClip, skeleton: Skeleton, n_phases: int = 4,
     return out
 
 
-def clip_motion(clip: GaitClip, skeleton: Skeleton, fps: float = LIBRARY_FPS) -> Motion:
-    """World motion of the three tiled cycles of ``clip`` (for inspection and plots)."""
-    return Motion(compose(clip.root, clip.poses), fps, skeleton, clip.name)

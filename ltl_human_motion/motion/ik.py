@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
+from ltl_human_motion.motion.skeleton import JOINT_INDEX
 
 __all__ = ["SEGMENT_MASS", "center_of_mass", "min_jerk", "two_bone_ik"]
 
@@ -103,14 +103,5 @@ def center_of_mass(positions: np.ndarray) -> np.ndarray:
     return np.einsum("k,...kd->...d", _MASS, seg) / _MASS.sum()
 
 
-def arm_lengths(skeleton: Skeleton, side: str) -> tuple[float, float, float]:
-    """Upper arm, forearm and wrist-to-palm lengths of one side (``"l"`` or ``"r"``)."""
-    b = skeleton.bone_lengths()
-    return (float(b[JOINT_INDEX[f"{side}_elbow"]]), float(b[JOINT_INDEX[f"{side}_wrist"]]),
-            float(b[JOINT_INDEX[f"{side}_hand"]]))
 
 
-def leg_lengths(skeleton: Skeleton, side: str) -> tuple[float, float]:
-    """Thigh and shank lengths of one side."""
-    b = skeleton.bone_lengths()
-    return float(b[JOINT_INDEX[f"{side}_knee"]]), float(b[JOINT_INDEX[f"{side}_ankle"]])

@@ -222,17 +222,11 @@ class MotionLibrary:
     def primitive(self, i: int) -> MotionPrimitive:
         return self.automaton.primitives[i]
 
-    def walk_mask(self, carry: bool) -> np.ndarray:
-        """Boolean mask of the carry (``carry=True``) or walk primitives."""
-        return self.is_carry == bool(carry)
 
     def start_indices(self, carry: bool = False) -> np.ndarray:
         """Start primitives (from standing) of walk or carry."""
         return self.starts[self.is_carry[self.starts] == bool(carry)]
 
-    def stop_indices(self, carry: bool = False) -> np.ndarray:
-        """Stop primitives (ending standing) of walk or carry."""
-        return self.stops[self.is_carry[self.stops] == bool(carry)]
 
     def goal(self, task: str, target: np.ndarray | None, **kwargs) -> MotionPrimitive:
         """A goal primitive for ``task`` at ``target`` (start frame) on this body.

@@ -6,13 +6,11 @@ import numpy as np
 
 from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.motion.rotations import unwrap_angles, yaw_from_positions
-from ltl_human_motion.motion.types import MotionPrimitive
 
 __all__ = [
     "compose",
     "decompose",
     "poses_from_world",
-    "primitive_from_positions",
     "relative_root",
     "resample_positions",
 ]
@@ -69,12 +67,6 @@ def relative_root(root: np.ndarray) -> np.ndarray:
     return out
 
 
-def primitive_from_positions(positions: np.ndarray, fps: float, name: str, task: str,
-                             source: str = "", meta: dict | None = None) -> MotionPrimitive:
-    """A motion primitive from world positions (T, J, 3), rooted at its first frame."""
-    root, poses = decompose(positions)
-    return MotionPrimitive(name=name, task=task, poses=poses, root=relative_root(root),
-                           fps=fps, source=source, meta=dict(meta or {}))
 
 
 def resample_positions(values: np.ndarray, fps_in: float, fps_out: float,

@@ -114,10 +114,6 @@ class MotionPrimitive:
     def duration(self) -> float:
         return (self.n_frames - 1) / self.fps
 
-    @property
-    def is_gait(self) -> bool:
-        return self.task in ("walk", "carry")
-
 
 yaw_matrix = matrix_from_yaw
 """Old name of :func:`ltl_human_motion.kernel.rotations.matrix_from_yaw`."""

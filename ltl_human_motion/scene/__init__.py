@@ -21,7 +21,6 @@ from ltl_human_motion.scene.frames import (
     zup_from_yup,
 )
 from ltl_human_motion.scene.geometry import (
-    capsule_box_distance,
     capsule_capsule_distance,
     point_box_distance,
     point_segment_distance,
@@ -93,7 +92,6 @@ __all__ = [
     "Sphere",
     "body_clearance",
     "body_radius_xy",
-    "capsule_box_distance",
     "capsule_capsule_distance",
     "capsule_radii",
     "capsules_from_positions",

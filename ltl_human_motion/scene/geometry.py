@@ -18,14 +18,12 @@ from ltl_human_motion.kernel.segments import segment_segment_distance
 
 __all__ = [
     "box_gap",
-    "capsule_box_distance",
     "capsule_capsule_distance",
     "min_along_segment",
     "point_bounds",
     "point_box_distance",
     "point_box_signed_distance",
     "point_circle_signed_distance",
-    "point_cylinder_distance",
     "point_cylinder_signed_distance",
     "point_polygon_signed_distance",
     "point_segment_distance",
@@ -153,10 +151,6 @@ def point_cylinder_signed_distance(p: np.ndarray, center: np.ndarray, radius: fl
     return outside + inside
 
 
-def point_cylinder_distance(p: np.ndarray, center: np.ndarray, radius: float,
-                            half_height: float) -> np.ndarray:
-    """Distance from points to a solid vertical cylinder (0 inside), shape (...)."""
-    return np.maximum(point_cylinder_signed_distance(p, center, radius, half_height), 0.0)
 
 
 def min_along_segment(f: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.ndarray,
@@ -264,27 +258,6 @@ def segment_box_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray,
     return min_along_segment(lambda p: point_box_distance(p, lo, hi), a, b)
 
 
-def capsule_box_distance(segments: np.ndarray, radii: np.ndarray, lo: np.ndarray,
-                         hi: np.ndarray) -> np.ndarray:
-    """Clearance between capsules and an axis-aligned box (negative: they overlap).
-
-    Parameters
-    ----------
-    segments : array-like, shape (..., 2, 3)
-        Capsule axis end points.
-    radii : array-like, shape (...) (broadcast)
-    lo, hi : array-like, shape (3,)
-
-    Returns
-    -------
-    d : ndarray, shape (...)
-        Segment-box distance minus the radius; ``d <= 0`` iff capsule and box intersect
-        (for overlaps the magnitude is a lower bound of the penetration depth).
-    """
-    seg = np.asarray(segments, dtype=np.float64)
-    if seg.ndim < 2 or seg.shape[-2:] != (2, 3):
-        raise ValueError(f"segments must have shape (..., 2, 3), got {seg.shape}")
-    return segment_box_distance(seg[..., 0, :], seg[..., 1, :], lo, hi) - np.asarray(radii)
 
 
 def capsule_capsule_distance(seg_a: np.ndarray, radii_a: np.ndarray, seg_b: np.ndarray,
