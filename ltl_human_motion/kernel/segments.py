@@ -352,10 +352,8 @@ def group_min_signed_distances(P: ArrayLike, p_radii: ArrayLike, Q: ArrayLike,
 
     Parameters
     ----------
-    P : array-like, shape (K, 2, 3)
-    p_radii : array-like, shape (K,)
-    Q : array-like, shape (L, 2, 3)
-    q_radii : array-like, shape (L,)
+    P, p_radii, Q, q_radii
+        Capsules (K, 2, 3), (K,) and (L, 2, 3), (L,), as for :func:`signed_distances`.
     row_groups : array-like of int, shape (G,)
         Increasing start rows of the groups, the first 0 (as for ``np.minimum.reduceat``).
 
