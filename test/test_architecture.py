@@ -69,3 +69,15 @@ def test_fusion_stacks_humans_and_retimes_predictions_from_the_oldest_stamp() ->
     assert fuse_occupancies([(3.0, _sample("c", 0.0, []))]).predicted is None
     with pytest.raises(ValueError, match="no human"):
         fuse_occupancies([])
+
+
+def test_ros2_run_bringup_is_the_cli_with_ros_arguments_dropped() -> None:
+    pytest.importorskip("rclpy")
+    import subprocess
+    import sys
+
+    script = PACKAGE.parent / "nodes" / "bringup"
+    proc = subprocess.run([sys.executable, str(script), "--help", "--ros-args", "-r",
+                           "__ns:=/probe"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "usage: ltl-human-motion bringup" in proc.stdout
