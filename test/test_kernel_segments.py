@@ -145,3 +145,17 @@ def test_core_imports_without_numba_and_the_switch_turns_it_off() -> None:
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert float(proc.stdout) == pytest.approx(0.7)
+
+
+def test_read_only_inputs_use_the_compiled_signature() -> None:
+    seg = np.broadcast_to(np.array([[0.0, 0, 0], [1, 0, 0]]), (3, 2, 2, 3))[0]
+    rad = np.broadcast_to(np.array([0.1]), (2,))
+    assert not seg.flags.writeable and not rad.flags.writeable
+    checked, radii = check_capsules(seg, rad)
+    assert checked.flags.writeable and radii.flags.writeable
+    before = {name: len(getattr(segments._compiled(), name).signatures)
+              for name in ("group_min_signed", "bounded")}
+    assert min_signed_distance(seg, rad, seg + np.array([0, 1.0, 0]), rad) == \
+        pytest.approx(0.8)
+    after = {name: len(getattr(segments._compiled(), name).signatures) for name in before}
+    assert after == before, "a read-only input compiled a new specialization"

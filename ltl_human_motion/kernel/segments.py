@@ -102,8 +102,8 @@ def check_capsules(segments: ArrayLike, radii: ArrayLike, what: str = "capsules"
         Wrong shapes, no capsule, NaN/inf, negative or absurd radii, absurd coordinates.
     """
     try:
-        seg = np.ascontiguousarray(segments, dtype=np.float64)
-        rad = np.ascontiguousarray(radii, dtype=np.float64)
+        seg = _as_kernel_array(segments)
+        rad = _as_kernel_array(radii)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{what}: expected numeric arrays ({exc})") from exc
     if seg.ndim != 3 or seg.shape[1:] != (2, 3) or seg.shape[0] == 0:
@@ -242,9 +242,18 @@ def _numpy_elementwise(p0: NDArray[np.float64], d1: NDArray[np.float64],
 
 
 # ---------------------------------------------------------------------------- public API
+def _as_kernel_array(a: ArrayLike) -> NDArray[np.float64]:
+    """``a`` as a writeable C-contiguous float64 array, the one array type the compiled
+    kernels are built for (no copy when it already is one; a read-only view, e.g. from
+    ``np.broadcast_to`` or ``np.frombuffer``, is copied, so that it does not trigger a
+    second compilation in the middle of a control loop)."""
+    arr = np.ascontiguousarray(a, dtype=np.float64)
+    return arr if arr.flags.writeable else arr.copy()
+
+
 def _contiguous(*arrays: ArrayLike) -> list[NDArray[np.float64]]:
-    """The arrays as C-contiguous float64 (no copy when they already are)."""
-    return [np.ascontiguousarray(a, dtype=np.float64) for a in arrays]
+    """The arrays as :func:`_as_kernel_array` gives them."""
+    return [_as_kernel_array(a) for a in arrays]
 
 
 def segment_segment_distance(p0: ArrayLike, p1: ArrayLike, q0: ArrayLike,
