@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import statistics
 import sys
@@ -40,6 +41,7 @@ from ltl_human_motion.robot import (  # noqa: E402
     CoexistenceController,
     DecisionRecorder,
     SSMParameters,
+    URSimHandle,
     commissioning_metrics,
     min_distance,
     robot_capsules,
@@ -226,11 +228,25 @@ def walking_worker(ctl: CoexistenceController, predictive: bool):
     return feed, (4.0 - 0.9) / 1.2 * 2 + 1.0
 
 
+def start_sim_when_free(attempts: int = 10) -> URSimHandle:
+    """A simulated controller on 127.0.0.1, once no other one (another developer's test
+    or demo) holds ports 30004 and 29999; they can take the port between the wait and the
+    start, so a refused start is retried."""
+    for attempt in range(attempts):
+        wait_port_free(HOST, 30004, timeout=120.0)
+        wait_port_free(HOST, 29999, timeout=120.0)
+        try:
+            return start_ur_sim_process(host=HOST)
+        except OSError:
+            if attempt == attempts - 1:
+                raise
+            time.sleep(1.0)
+    raise AssertionError("unreachable")
+
+
 def closed_loop(duration: float, rate: float | None, predictive: bool | None,
                 params: SSMParameters) -> dict[str, object]:
-    wait_port_free(HOST, 30004, timeout=120.0)   # another simulator (a test) may hold it
-    wait_port_free(HOST, 29999, timeout=120.0)
-    sim = start_ur_sim_process(host=HOST)
+    sim = start_sim_when_free()
     receive_factory, io_factory = ur_rtde_factories(HOST)
     recorder = DecisionRecorder()
     ctl = CoexistenceController(receive_factory, io_factory, "ur5e", params=params,
@@ -311,7 +327,8 @@ def main() -> int:
     params = SSMParameters()
     results: dict[str, object] = {
         "python": platform.python_version(), "numpy": np.__version__,
-        "machine": platform.machine(), "ssm": params.terms(),
+        "machine": platform.machine(), "cpus": os.cpu_count(), "ssm": params.terms(),
+        "load_average_1min_at_start": os.getloadavg()[0],
     }
     segments.compiled()   # load the kernel before timing
     vs = results["vs_fcl"] = bench_vs_fcl(args.repeat)
