@@ -25,6 +25,8 @@ from geometry_msgs.msg import Point, Quaternion, TransformStamped
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker
 
+from ltl_human_motion.kernel import rotations
+from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS
 from ltl_human_motion.msg import Capsule
 from ltl_human_motion.scene.cell import Cell, Obstacle
@@ -45,7 +47,8 @@ def joint_frame(human_id: str, joint: str) -> str:
 
 def quaternion_from_yaw(yaw: float) -> Quaternion:
     """Rotation about +z as a Quaternion message."""
-    return Quaternion(x=0.0, y=0.0, z=float(np.sin(yaw / 2)), w=float(np.cos(yaw / 2)))
+    w, x, y, z = (float(v) for v in rotations.quaternion_from_yaw(yaw))
+    return Quaternion(x=x, y=y, z=z, w=w)
 
 
 def quaternion_z_to(vector: np.ndarray) -> Quaternion:
@@ -90,11 +93,9 @@ def skeleton_transforms(positions: np.ndarray, yaw: float, human_id: str, world_
     if positions.shape != (len(JOINT_NAMES), 3):
         raise ValueError(f"positions must have shape ({len(JOINT_NAMES)}, 3), got "
                          f"{positions.shape}")
-    c, s = np.cos(yaw), np.sin(yaw)
     parents = np.array(PARENTS)
     bones = positions[1:] - positions[parents[1:]]                    # world axes
-    local = np.stack([c * bones[:, 0] + s * bones[:, 1],
-                      -s * bones[:, 0] + c * bones[:, 1], bones[:, 2]], axis=-1)
+    local = bones @ matrix_from_yaw(yaw)                              # R(yaw)^T @ bone
     out = []
     root = TransformStamped()
     root.header.stamp = stamp
