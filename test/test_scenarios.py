@@ -166,7 +166,69 @@ def test_refusal_messages_name_target_numbers_and_limit() -> None:
 # ----------------------------------------------------------------------- fast subset
 #: One pair per family; value: None (verifies today) or the failure family seen on
 #: the corpus branch (planner bugs for the planner developer, not corpus labels).
-SUBSET: dict[str, str | None] = {}
+SUBSET: dict[str, str | None] = {
+    # every Table I task alone
+    "paper_cell/single/grasp(O1)": None,
+    "paper_cell/single/release(O1)": "planning:release:precondition (release of a part "
+                                     "not in hand does not grasp it first)",
+    "floor_parts/single/carry(O3, R1)": None,
+    "paper_cell/single/move(O2, R1)": None,
+    "bins/single/insert(O2, bin_a)": None,
+    "bins/single/extract(O2, bin_b)": None,
+    "obstacle_cell/single/leftHand(R1)": None,
+    "demo_cell/single/rightHand(R1)": None,
+    "paper_cell/single/assemble(R1)": None,
+    "floor_parts/single/walk(R2)": None,
+    "demo_cell/single/enter(R1)": None,
+    "floor_parts/single/wait(2.0)": None,
+    "seats/single/sit(chair)": None,
+    "floor_parts/single/standUp": "verification:smoothness (standUp when standing: a knee "
+                                  "at 14 m/s)",
+    "paper_cell/single/bend": None,
+    "floor_parts/single/stoop": None,
+    "floor_parts/single/kneel": None,
+    # the Dwyer patterns, each scope
+    "paper_cell/dwyer/absence_global/0": None,
+    "floor_parts/dwyer/absence_before/0": None,
+    "paper_cell/dwyer/absence_after/0": None,
+    "floor_parts/dwyer/absence_between/0": None,
+    "demo_cell/dwyer/existence_global/0": None,
+    "bins/dwyer/existence_before/0": None,
+    "floor_parts/dwyer/existence_after/0": None,
+    "paper_cell/dwyer/existence_between/0": None,
+    "demo_cell/dwyer/universality_global/0": None,
+    "bins/dwyer/universality_before/0": None,
+    "floor_parts/dwyer/universality_after/0": None,
+    "paper_cell/dwyer/universality_between/0": None,
+    "seats/dwyer/precedence_global/0": None,
+    "floor_parts/dwyer/precedence_before/0": None,
+    "bins/dwyer/precedence_after/0": None,
+    "demo_cell/dwyer/precedence_between/0": None,
+    "paper_cell/dwyer/response_global/0": None,
+    "bins/dwyer/response_before/0": None,
+    "floor_parts/dwyer/response_after/0": None,
+    "demo_cell/dwyer/response_between/0": None,
+    # jobs
+    "paper_cell/job/S2": None,
+    "demo_cell/job/pick_sit_assemble": None,
+    "floor_parts/job/stoop_pick": None,
+    "stations/job/big_box": None,
+    "paper_cell/job/stand_up": "verification:smoothness (body transition: a knee above "
+                               "10 m/s)",
+    "kitting/job/kit_three": "planning:grasp:blocked (parts on shelf boards)",
+    "under_shelf/job/low_shelf_assemble": "planning:grasp:blocked (part under a low board)",
+    "bins/job/bin_to_bin": "verification:termination (insert after extract)",
+    "aisle/single/walk(R2)": "planning:walk:unreachable (an aisle 0.8 m wide)",
+    "shelf_heights/single/grasp(O_shoulder)": "planning:grasp:blocked (shoulder-high shelf)",
+    # refused before any search, one per reason
+    "shelf_heights/infeasible/F grasp(O_top)": None,
+    "seats/infeasible/F sit(locker)": None,
+    "wall_gap/infeasible/F grasp(O_pen)": None,
+    "big_table/infeasible/F grasp(O_mid)": None,
+    "cluttered/infeasible/F walk(R_in)": None,
+    "bins/infeasible/F insert(O1, tray)": None,
+    "demo_cell/infeasible/G grasp(O1)": None,
+}
 
 
 def _subset_params():
