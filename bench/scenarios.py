@@ -67,8 +67,9 @@ def _spread(pairs: list, limit: int) -> list:
     for p in pairs:
         by_family[p.family][p.cell].append(p)
     queues = []
-    for per_cell in by_family.values():               # interleave the cells of a family
-        lists = list(per_cell.values())
+    for k, per_cell in enumerate(by_family.values()):  # interleave the cells of a family,
+        lists = list(per_cell.values())                # each family from another cell on
+        lists = lists[k % len(lists):] + lists[:k % len(lists)]
         queues.append([q[i] for i in range(max(map(len, lists))) for q in lists if i < len(q)])
     chosen: list = []
     while len(chosen) < limit:
@@ -98,6 +99,16 @@ def _items(args) -> list[dict]:
                               "family_label": gp.family, "stature": scen.stature,
                               "seed": 0, "timeout": args.timeout})
     return items
+
+
+def _commit() -> str | None:
+    """The source tree's git commit, if it is a git checkout."""
+    import subprocess
+    try:
+        return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+                              capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
 
 
 def _rate(num: int, den: int) -> float | None:
@@ -231,7 +242,7 @@ def main(argv: list[str] | None = None) -> int:
     wall = time.perf_counter() - t0
     results.sort(key=lambda r: (r["source"], r["id"], r["stature"], r["seed"]))
     summary = summarize(results)
-    report = {"benchmark": "scenarios", "machine": machine(),
+    report = {"benchmark": "scenarios", "machine": machine(), "commit": _commit(),
               "load_average": list(os.getloadavg()), "statures": args.statures,
               "seeds": args.seeds, "timeout_s": args.timeout, "workers": workers,
               "wall_time_s": wall, "specs": str(args.specs.relative_to(ROOT))
