@@ -143,12 +143,15 @@ class FloorMap:
         Free cells reachable on the floor from the start region.
     start_found : bool
         Whether the start region has free floor at all.
+    tree : scipy.spatial.cKDTree or None
+        Of ``free_xy``, for the cells near a target.
     """
 
     grid: FloorGrid
     free_xy: np.ndarray
     connected: np.ndarray
     start_found: bool
+    tree: object = None
 
 
 _FLOOR_CACHE: dict[tuple, FloorMap] = {}
@@ -174,10 +177,18 @@ def _layout_key(cell, stature: float) -> tuple:
     return _digest(cell), round(float(stature), 4)
 
 
-def floor_map(cell, stature: float) -> FloorMap:
-    """The :class:`FloorMap` of ``cell`` for a worker of ``stature`` (cached per layout)."""
-    key = _layout_key(cell, stature)
-    hit = _FLOOR_CACHE.get(key)
+#: Free floor and its components per obstacle layout and stature (objects, regions and
+#: the start region may change from call to call, e.g. in batches, without a rebuild).
+_GRID_CACHE: dict[tuple, tuple] = {}
+
+
+def _floor_grid(cell, stature: float) -> tuple:
+    """``(grid, free_xy (F, 2), free_labels (F,), tree)`` for the cell's obstacle layout."""
+    from scipy.spatial import cKDTree
+    key = (hashlib.sha1(pickle.dumps((cell.floor_z, np.asarray(cell.workspace_lo),
+                                      np.asarray(cell.workspace_hi), cell.obstacles))
+                        ).hexdigest(), round(float(stature), 4))
+    hit = _GRID_CACHE.get(key)
     if hit is not None:
         return hit
     H = float(stature)
@@ -197,17 +208,29 @@ def floor_map(cell, stature: float) -> FloorMap:
     grid = FloorGrid(lo, hi, free, FLOOR_RESOLUTION)
     flat_free = grid.free.ravel()
     _, labels = connected_components(grid.graph, directed=False)
+    free_xy = grid.centres[flat_free]
+    out = (grid, free_xy, labels[flat_free], cKDTree(free_xy) if len(free_xy) else None)
+    if len(_GRID_CACHE) >= 32:
+        _GRID_CACHE.pop(next(iter(_GRID_CACHE)))
+    _GRID_CACHE[key] = out
+    return out
+
+
+def floor_map(cell, stature: float) -> FloorMap:
+    """The :class:`FloorMap` of ``cell`` for a worker of ``stature`` (cached per layout)."""
+    key = _layout_key(cell, stature)
+    hit = _FLOOR_CACHE.get(key)
+    if hit is not None:
+        return hit
+    grid, free_xy, free_labels, tree = _floor_grid(cell, stature)
     r0 = cell.start_region
-    in_start = (flat_free & np.all(grid.centres >= np.asarray(r0.lo[:2]) - 1e-9, axis=-1)
-                & np.all(grid.centres <= np.asarray(r0.hi[:2]) + 1e-9, axis=-1))
-    if not in_start.any():                 # a start patch smaller than a cell
-        centre = np.asarray(r0.center[:2])
-        d = np.where(flat_free, np.hypot(*(grid.centres - centre).T), np.inf)
-        in_start = d <= max(FLOOR_RESOLUTION, float(d.min()) if np.isfinite(d.min()) else 0)
-        in_start &= np.isfinite(d)
-    start_labels = np.unique(labels[in_start])
-    connected = np.isin(labels, start_labels) & flat_free
-    fmap = FloorMap(grid, grid.centres[flat_free], connected[flat_free], bool(in_start.any()))
+    in_start = (np.all(free_xy >= np.asarray(r0.lo[:2]) - 1e-9, axis=-1)
+                & np.all(free_xy <= np.asarray(r0.hi[:2]) + 1e-9, axis=-1))
+    if not in_start.any() and len(free_xy):      # a start patch smaller than a cell
+        d = np.hypot(*(free_xy - np.asarray(r0.center[:2])).T)
+        in_start = d <= max(FLOOR_RESOLUTION, float(d.min()))
+    connected = np.isin(free_labels, np.unique(free_labels[in_start]))
+    fmap = FloorMap(grid, free_xy, connected, bool(in_start.any()), tree)
     if len(_FLOOR_CACHE) >= 32:
         _FLOOR_CACHE.pop(next(iter(_FLOOR_CACHE)))
     _FLOOR_CACHE[key] = fmap
@@ -292,9 +315,17 @@ class _Checker:
                 f"task {task}: {what} at {shown}{where} is above the reach of a {H:.2f} m "
                 f"worker ({env.vertical:.2f} m)", task=task, reason="reach")
         radius = env.horizontal(zlo, zhi) + FLOOR_RESOLUTION * math.sqrt(0.5)
-        d = _box_xy_distance(self.floor.free_xy, np.asarray(lo[:2]), np.asarray(hi[:2]))
-        near = d <= radius
-        if np.any(near & self.floor.connected):
+        fl = self.floor
+        if fl.tree is None:
+            idx = np.zeros(0, dtype=np.intp)
+        else:                                   # cells near the box, then the exact test
+            half = float(np.hypot(*(np.asarray(hi[:2]) - np.asarray(lo[:2])))) / 2
+            idx = np.asarray(fl.tree.query_ball_point((np.asarray(lo[:2]) + hi[:2]) / 2,
+                                                      radius + half), dtype=np.intp)
+        d = _box_xy_distance(fl.free_xy[idx], np.asarray(lo[:2]), np.asarray(hi[:2]))
+        near = np.zeros(len(fl.free_xy), dtype=bool)
+        near[idx[d <= radius]] = True
+        if np.any(near & fl.connected):
             return None
         if np.any(near):
             return PlanningError(
