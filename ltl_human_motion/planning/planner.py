@@ -28,12 +28,55 @@ import numpy as np
 from ltl_human_motion.errors import PlanningError
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
-from ltl_human_motion.planning.astar import Goal, SearchBudget, SearchFailure, astar
+from ltl_human_motion.planning.astar import (
+    Goal,
+    SearchBudget,
+    SearchFailure,
+    astar,
+    placement_key,
+)
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.gait_index import gait_index
 from ltl_human_motion.planning.navigation import NavigationField, clearance_maps, floor_grid
+from ltl_human_motion.planning.placement import RegionEntry
 
 Pose = tuple[float, float, float]
+
+#: How long ``standUp`` by a worker already standing stands still, seconds (a short,
+#: visible pause; the blends at both ends take 2 x overlap frames of it).
+STAND_UP_IN_PLACE_SECONDS = 0.4
+
+#: Height of the hand where a held part is let go, as a fraction of the stature (waist
+#: height: 0.75 m for a 1.75 m worker, the planner's value since the first release).
+RELEASE_HEIGHT = 0.75 / 1.75
+
+#: Places a part is let go at, (metres ahead of the root, turn from the heading in
+#: radians), tried in order: straight ahead at a forearm's length, then to either side
+#: and nearer the body when furniture stands in front.
+RELEASE_PLACES: tuple[tuple[float, float], ...] = (
+    (0.45, 0.0), (0.45, math.pi / 4), (0.45, -math.pi / 4), (0.4, math.pi / 2),
+    (0.4, -math.pi / 2), (0.3, 0.0))
+
+#: Seeded primitives tried at each release place after the first (the first gets
+#: ``PlannerOptions.goal_attempts``).
+RELEASE_ATTEMPTS_ELSEWHERE = 2
+
+#: Step left to the standing adjustment when the first one from where a walk ended was
+#: not clear: the walk goes on to a spot that needs almost none, metres.
+FINAL_ADJUST_RADIUS = 0.05
+
+#: Searches run again after the path found collided on a frame the search did not
+#: sample (each forbids the colliding primitive at its pose).
+WALK_REPAIRS = 4
+
+#: Tops of furniture a released part is set down on: up to this fraction of the stature
+#: (1.2 m at 1.75 m, about chest height: higher tops are shelves out of a natural
+#: put-down).
+RELEASE_SURFACE_MAX = 1.2 / 1.75
+
+#: Gap between a part set down and the surface under it when it is let go, metres (the
+#: cells' parts rest 1 cm above their tables).
+RELEASE_GAP = 0.01
 
 #: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
@@ -195,10 +238,7 @@ class SequencePlanner:
         self.seated = False
         self.held: dict[str, str] = {}               # object -> hand joint
         self.consumed: set[str] = set()
-        self._wait_seconds: float | None = None
-        self.grasp_object: str | None = None
         self.held_offsets: dict[str, np.ndarray] = {}
-        self._carry_stance = False
         self._back_limit = options.reach_tolerance
         self._backs: dict[float, np.ndarray] = {}     # step-back distances per limit
         self.expanded = 0
@@ -303,14 +343,15 @@ class SequencePlanner:
         return (*out, clear[px.size:].reshape(np.shape(x))) if room else out
 
     def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
-                    task: str) -> Goal:
-        """Walk until a standing adjustment (a step of at most ``adjust_radius`` and a
-        turn) puts the worker where the goal primitive reaches the target."""
+                    task: str, adjust: float | None = None) -> Goal:
+        """Walk until a standing adjustment (a step of at most ``adjust``, default
+        ``options.adjust_radius``, and a turn) puts the worker where the goal primitive
+        reaches the target."""
         tx, ty = float(target[0]), float(target[1])
         tol = self.options.reach_tolerance
         dist = float(np.hypot(*placement))
         offset = float(np.arctan2(placement[1], placement[0]))
-        adjust = self.options.adjust_radius
+        adjust = self.options.adjust_radius if adjust is None else float(adjust)
 
         def ring(xy: np.ndarray) -> np.ndarray:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
@@ -358,7 +399,7 @@ class SequencePlanner:
         x, y, yaw = self.pose
         px, py, pyaw, _ = (float(v[0]) for v in self._ideal_placement(
             target, placement, np.array([x]), np.array([y])))
-        carrying = bool(self.held) or self._carry_stance
+        carrying = bool(self.held)
         back_dir = np.array([math.cos(pyaw), math.sin(pyaw)])
         c, s = math.cos(yaw), math.sin(yaw)
         stance = self._stance(carrying)
@@ -397,20 +438,28 @@ class SequencePlanner:
         return False
 
     def _region_goal(self, region, desc: str, task: str) -> Goal:
-        lo, hi = np.asarray(region.lo, dtype=float), np.asarray(region.hi, dtype=float)
-        margin = 0.15
+        """Walk until the standing body enters ``region`` (the verifier's predicate).
 
-        def gap(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-            gx = np.maximum(np.maximum(lo[0] - x, x - hi[0]), 0.0)
-            gy = np.maximum(np.maximum(lo[1] - y, y - hi[1]), 0.0)
-            return np.hypot(gx, gy)
+        The goal cells of the heuristic are the spots with room to turn
+        (``turn_clearance``) from which the standing body enters the region facing some
+        heading; none (a region above a bench, beside a wall) makes the region
+        unreachable on foot (the caller reaches into it by hand).
+        """
+        from ltl_human_motion.scene.occupancy import capsule_radii
+        stature = self.library.skeleton.stature
+        carrying = bool(self.held)
+        entry = RegionEntry(region, self._stance(carrying), self.library.standing_height,
+                            stature, float(capsule_radii(stature).max()))
+        room = self.options.turn_clearance
 
-        def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-            return gap(x, y) <= margin
+        def cells(xy: np.ndarray) -> np.ndarray:
+            out = entry.cells(xy)
+            out[out] = self._clearance(xy[out]) > room
+            return out
 
-        field = self._field(lambda xy: gap(xy[:, 0], xy[:, 1]) <= margin,
-                            ("region", *lo[:2].tolist(), *hi[:2].tolist(), margin))
-        return self._goal_from_field(field, reached, desc, task)
+        field = self._field(cells, ("region", *entry.lo.tolist(), *entry.hi.tolist(),
+                                    stature, carrying, room))
+        return self._goal_from_field(field, entry.enters, desc, task)
 
     # ---------------------------------------------------------------- segments
     def _add(self, mp: MotionPrimitive, pose: Pose, label: int, blend: int) -> int:
@@ -478,16 +527,17 @@ class SequencePlanner:
             self._step_back(carrying_before, label)
         self._add(mp, self.pose, label, self.overlap)
 
-    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int = 16,
+    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = 16,
                       world: np.ndarray | None = None) -> bool:
         """Whether ``mp`` placed at ``pose`` keeps the body and the objects held (at their
         hand offsets) clear of every obstacle, checked with the exact distances on
-        ``samples`` frames (these checks are few). ``world``: ``world_positions(mp,
-        *pose)`` if already made."""
+        ``samples`` frames (None: every frame, as the verifier checks). ``world``:
+        ``world_positions(mp, *pose)`` if already made."""
         from ltl_human_motion.scene.predicates import body_clearance, object_clearance
         if not self.cell.obstacles:
             return True
-        frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
+        frames = np.arange(mp.n_frames) if samples is None else \
+            np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
         if world is None and self.held:
             world = world_positions(mp, *pose)
         body = world_positions(mp, *pose, frames=frames) if world is None else world[frames]
@@ -497,10 +547,19 @@ class SequencePlanner:
         if np.min(d) <= 0.003:
             return False
         for name, joint in self.held.items():
-            centre = world[::2, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
+            step = 1 if samples is None else 2
+            centre = world[::step, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
             if np.any(object_clearance(self.cell, name, centre) <= 0.0):
                 return False
         return True
+
+    def _first_collision(self, primitives: list[int], poses: list[Pose]) -> int | None:
+        """Index of the first gait primitive of a path that comes within the planner's
+        margin of an obstacle on any frame (body or held parts), or None."""
+        for k, (prim_id, pose) in enumerate(zip(primitives, poses)):
+            if not self._placed_clear(self.index.primitives[prim_id], pose, samples=None):
+                return k
+        return None
 
     def _step_back(self, carrying: bool, label: int) -> None:
         """Step back from an obstacle in front (a step primitive of the gait index)."""
@@ -512,14 +571,34 @@ class SequencePlanner:
                 return
 
     def _walk(self, goal: Goal, task: str, label: int, carry: bool) -> int:
-        """A* from the current pose; appends the gait segments; returns their count."""
-        res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
-                    clearance=self._clearance, body_radius=self.options.body_radius,
-                    heuristic_speed=self.options.heuristic_speed,
-                    turn_rate=self.options.turn_rate, carry=carry,
-                    budget=self.options.budget, rng=self.rng,
-                    cost_noise=self.options.cost_noise, body_clear=self._body_clear)
-        self.expanded += res.expanded
+        """A* from the current pose; appends the gait segments; returns their count.
+
+        The search checks the body on sampled frames of a distance grid; every frame of
+        the path it returns is then checked as the verifier does (exact capsules, held
+        parts). A primitive that collides is forbidden from its pose and the search runs
+        again (at most ``WALK_REPAIRS`` times)."""
+        forbidden: set[tuple[int, int, int, int]] = set()
+        noise_state = self.rng.bit_generator.state
+        for _repair in range(WALK_REPAIRS + 1):
+            self.rng.bit_generator.state = noise_state      # the same costs every time
+            res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
+                        clearance=self._clearance, body_radius=self.options.body_radius,
+                        heuristic_speed=self.options.heuristic_speed,
+                        turn_rate=self.options.turn_rate, carry=carry,
+                        budget=self.options.budget, rng=self.rng,
+                        cost_noise=self.options.cost_noise, body_clear=self._body_clear,
+                        forbidden=frozenset(forbidden))
+            self.expanded += res.expanded
+            if isinstance(res, SearchFailure):
+                break
+            bad = self._first_collision(res.primitives, res.poses)
+            if bad is None:
+                break
+            forbidden.add((res.primitives[bad], *placement_key(*res.poses[bad])))
+        else:
+            raise PlanningError(f"task {task}: {goal.description}: every path found "
+                                f"({WALK_REPAIRS + 1}) collides on a frame the search did "
+                                "not sample", task=task, reason="blocked")
         if isinstance(res, SearchFailure):
             if res.reason == "budget":
                 why = (f"the search budget ran out ({res.expanded} nodes; closest approach "
@@ -551,37 +630,49 @@ class SequencePlanner:
         self._stand_still(-1, 0.3)
         return Plan(self.segments, self.steps, start, self.expanded)
 
-    def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...]) -> StepPlan:
+    def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
+                   keep_hold: bool = False) -> StepPlan:
+        """Plan step ``i`` (``text``) as the goal task ``kind``; ``keep_hold``: a part a
+        move puts into its region stays in hand (carry)."""
         expanded0 = self.expanded
         if self.seated and kind not in ("standUp", "wait", "leftHand", "rightHand",
                                         "assemble", "sit"):
             self._goal_segment("standUp", None, -1, text)
             self.seated = False
-        if kind in ("walk", "carry"):
+        if kind == "carry":
+            # carry(O, R) holds when the body enters R with O inside it: the held part is
+            # put into R by hand (so the palm enters R too), and it stays in hand.
+            step = self._plan_step(i, text, "move", args, keep_hold=True)
+            return replace(step, kind="carry (by move)")
+        if kind == "walk":
             region = self.cell.region(args[-1])
-            subs = [self._fetch(i, args[0])] if kind == "carry" and args[0] not in self.held \
-                else []
+            subs: list[StepPlan] = []
             try:
                 goal = self._region_goal(region, f"walk into {region.name}", text)
             except PlanningError as exc:
                 if exc.reason != "unreachable":
                     raise
                 # Nowhere to stand in the region (e.g. a box above a bench). Its entry,
-                # enter(x, R), holds once any body part is in it: reach in with a hand, or
-                # for carry(O, R) put the held part in it.
-                step = self._reach_into(i, text, kind, args, exc)
-                step.sub_steps[:0] = subs
-                return step
+                # enter(x, R), holds once any body part is in it: reach in with a hand.
+                return self._reach_into(i, text, args, exc)
             n = self._walk(goal, text, i, carry=bool(self.held))
             self._stand_still(i, 0.25)
             return StepPlan(text, kind, np.asarray(region.center, dtype=float), walk_segments=n,
                             expanded=self.expanded - expanded0,
                             primitive=f"{n} gait primitives", sub_steps=subs)
+        if kind == "standUp" and not self.seated:
+            # Already standing (every bend, stoop and kneel ends upright): standUp holds
+            # once the worker stands still for a moment.
+            self._stand_still(i, STAND_UP_IN_PLACE_SECONDS)
+            return StepPlan(text, "standUp (standing)", None, expanded=0, primitive="stand")
         subs = []
-        if kind in ("move", "insert") and args[0] not in self.held:
+        if kind in ("move", "insert", "release") and args[0] not in self.held:
             # The part is fetched first, as for carry(O, R).
             subs.append(self._fetch(i, args[0]))
         target = self.target_of(kind, args)
+        if kind in ("move", "insert") and args[0] in self.held_offsets:
+            # The hand puts the part's centre (held at its offset) on the target.
+            target = target - self.held_offsets[args[0]]
         if kind == "grasp" and args[0] in self.consumed:
             self.consumed.discard(args[0])           # a fresh part from the supply
         walked = 0
@@ -593,22 +684,13 @@ class SequencePlanner:
             if not self._adjust_to(target, placement, text):
                 # No clear step from where the walk ended: walk on to a spot that needs
                 # (almost) none.
-                adjust = self.options.adjust_radius
-                self.options = replace(self.options, adjust_radius=0.05)
-                try:
-                    goal = self._reach_goal(target, placement, goal.description, text)
-                    walked += self._walk(goal, text, -1, carry=bool(self.held))
-                finally:
-                    self.options = replace(self.options, adjust_radius=adjust)
+                goal = self._reach_goal(target, placement, goal.description, text,
+                                        adjust=FINAL_ADJUST_RADIUS)
+                walked += self._walk(goal, text, -1, carry=bool(self.held))
                 self._adjust_to(target, placement, text)
+        targets = [target]
         if kind == "release":
-            obj = args[0]
-            c, s = math.cos(self.pose[2]), math.sin(self.pose[2])
-            height = 0.75 * self.library.skeleton.stature / 1.75
-            target = np.array([self.pose[0] + 0.45 * c, self.pose[1] + 0.45 * s, height])
-            if obj not in self.held:
-                raise PlanningError(f"task {text}: {obj} is not held, so it cannot be "
-                                    "released", task=text, reason="precondition")
+            targets = self._release_targets(args[0])
         carrying_before = bool(self.held)
         if kind in HAND_TASKS and not carrying_before:
             # Raise the arms to the carry stance first: hands then reach from the chest
@@ -616,13 +698,19 @@ class SequencePlanner:
             # past the edge of the surface in front.
             self._arm_transition(False, -1)
             carrying_before = True
-            self._carry_stance = True
-        self._wait_seconds = float(args[0]) if kind == "wait" and args else None
-        self.grasp_object = args[0] if kind == "grasp" else None
-        seg, mp = self._goal_segment(kind, target, i, text)
-        self._carry_stance = False
+        for k, target in enumerate(targets):
+            try:
+                seg, mp = self._goal_segment(
+                    kind, target, i, text, carry_stance=carrying_before,
+                    seconds=float(args[0]) if kind == "wait" and args else None,
+                    grasped=args[0] if kind == "grasp" else None,
+                    attempts=None if k == 0 else RELEASE_ATTEMPTS_ELSEWHERE)
+                break
+            except PlanningError as exc:
+                if exc.reason != "blocked" or k == len(targets) - 1:
+                    raise
         hand = mp.meta.get("hand")
-        effect = self._apply_effects(kind, args, hand)
+        effect = self._apply_effects(kind, args, hand, keep_hold)
         contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
         for name, joint in effect.get("attach", {}).items():
             # As the object tracks are made: the part keeps its world offset from the hand.
@@ -647,22 +735,55 @@ class SequencePlanner:
         step.first_segment, step.last_segment = first, len(self.segments) - 1
         return step
 
-    def _reach_into(self, i: int, text: str, kind: str, args: tuple[str, ...],
+    def _reach_into(self, i: int, text: str, args: tuple[str, ...],
                     cause: PlanningError) -> StepPlan:
-        """walk(R) / carry(O, R) for a region nobody can stand in: a hand task into R
-        (rightHand(R), or move(O, R) with the held part). Raises ``cause`` if that fails too.
-        """
-        hand_kind, hand_args = ("move", (args[0], args[-1])) if kind == "carry" \
-            else ("rightHand", (args[-1],))
+        """walk(R) for a region nobody can stand in: rightHand(R) (the palm in R makes
+        enter(x, R) hold). Raises ``cause`` if that fails too."""
         try:
-            step = self._plan_step(i, text, hand_kind, hand_args)
+            step = self._plan_step(i, text, "rightHand", (args[-1],))
         except PlanningError as exc:
             raise PlanningError(f"{cause}; reaching into it instead failed too: {exc}",
                                 task=text, reason=cause.reason) from None
-        return replace(step, kind=f"{kind} (by {hand_kind})")
+        return replace(step, kind="walk (by rightHand)")
+
+    def _release_targets(self, obj: str) -> list[np.ndarray]:
+        """Where the hand holding ``obj`` may let it go, palm positions (3,), in order:
+        ahead of the worker, then turned to either side, then nearer
+        (``RELEASE_PLACES``). Over a table or bench the part is set down on its top;
+        elsewhere it is let go at ``RELEASE_HEIGHT`` of the stature."""
+        x, y, yaw = self.pose
+        stature = self.library.skeleton.stature
+        offset = self.held_offsets.get(obj, np.zeros(3))
+        half = 0.5 * float(np.ptp(self.cell.object(obj).occupancy.aabb(), axis=0)[2])
+        out = []
+        for dist, turn in RELEASE_PLACES:
+            c, s = math.cos(yaw + turn), math.sin(yaw + turn)
+            palm = np.array([x + dist * c, y + dist * s, RELEASE_HEIGHT * stature])
+            top = self._surface_below(palm[:2], RELEASE_SURFACE_MAX * stature)
+            if top is not None:
+                # The part (held at ``offset`` from the palm) comes to rest on the top.
+                palm[2] = max(palm[2], top + half + RELEASE_GAP - float(offset[2]))
+            out.append(palm)
+        return out
+
+    def _surface_below(self, xy: np.ndarray, highest: float) -> float | None:
+        """Height of the highest obstacle top under the floor point ``xy`` (2,) that is
+        no higher than ``highest``, metres; None if none."""
+        tops = [float(part.aabb()[1][2]) for ob in self.cell.obstacles for part in ob.parts
+                if float(part.aabb()[1][2]) <= highest
+                and float(part.footprint().signed_distance(xy[None])[0]) <= 0.0]
+        return max(tops) if tops else None
 
     def _goal_segment(self, kind: str, target: np.ndarray | None, label: int,
-                      text: str) -> tuple[int, MotionPrimitive]:
+                      text: str, *, carry_stance: bool = False, seconds: float | None = None,
+                      grasped: str | None = None, attempts: int | None = None
+                      ) -> tuple[int, MotionPrimitive]:
+        """Make, check and place the goal primitive of ``kind`` for ``target``.
+
+        ``carry_stance``: the arms are already in the carry stance; ``seconds``: how long
+        a wait lasts; ``grasped``: the part a grasp picks up (checked from contact on);
+        ``attempts``: seeded primitives tried (default ``options.goal_attempts``).
+        """
         x, y, yaw = self.pose
         local = None
         if target is not None:
@@ -671,20 +792,21 @@ class SequencePlanner:
             local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
         hold_hand = next(iter(self.held.values()), None)
         kwargs = {"rng": self.rng,
-                  "start_pose": self._stance(bool(self.held) or self._carry_stance)}
+                  "start_pose": self._stance(bool(self.held) or carry_stance)}
         if kind in ("move", "insert", "extract", "release") and hold_hand:
             kwargs["hand"] = hold_hand
-        if kind == "wait" and target is None and self._wait_seconds is not None:
+        if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
-            kwargs["duration"] = self._wait_seconds + (2 * self.overlap + 6) / self.library.fps
+            kwargs["duration"] = seconds + (2 * self.overlap + 6) / self.library.fps
         mp = None
-        for attempt in range(self.options.goal_attempts):
+        attempts = self.options.goal_attempts if attempts is None else attempts
+        for attempt in range(attempts):
             try:
                 candidate = self.library.goal(kind, local, **kwargs)
             except ValueError as exc:
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
-            if self._goal_clear(candidate, kind):
+            if self._goal_clear(candidate, grasped):
                 mp = candidate
                 break
             if attempt == 1 and kind in ("grasp", "leftHand", "rightHand", "release"):
@@ -694,31 +816,33 @@ class SequencePlanner:
                     kwargs["hand"] = other
         if mp is None:
             raise PlanningError(f"task {text}: every {kind} motion tried "
-                                f"({self.options.goal_attempts}) runs into an obstacle; "
+                                f"({attempts}) runs into an obstacle; "
                                 "an obstacle blocks the reach", task=text, reason="blocked")
         seg = self._add(mp, self.pose, label, self.overlap)
         self.pose = self._hand_over_pose(mp, self.pose)
         self.gait_state = None
         return seg, mp
 
-    def _goal_clear(self, mp: MotionPrimitive, kind: str) -> bool:
-        """Whether the body, the objects already in the hands and, for a grasp, the part
-        from its contact frame on keep clear of obstacles."""
+    def _goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
+        """Whether the body, the objects already in the hands and the part being grasped
+        (``grasped``, from its contact frame on) keep clear of obstacles."""
         world = world_positions(mp, *self.pose)
         if not self._placed_clear(mp, self.pose, samples=24, world=world):
             return False
-        if kind != "grasp" or self.grasp_object is None:
+        if grasped is None:
             return True
         from ltl_human_motion.scene.predicates import object_clearance
         joint = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(mp.meta.get("hand"), "r_hand")
         hand = world[int(mp.meta.get("contact_frame", 0)):, JOINT_INDEX[joint]]
         if not hand.size:
             return True
-        centre = hand[::4] + (self.cell.object(self.grasp_object).position - hand[0])
-        return not np.any(object_clearance(self.cell, self.grasp_object, centre) <= 0.0)
+        centre = hand[::4] + (self.cell.object(grasped).position - hand[0])
+        return not np.any(object_clearance(self.cell, grasped, centre) <= 0.0)
 
-    def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None) -> dict:
-        """Update which objects are held; return the effect for the object tracks."""
+    def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None,
+                       keep_hold: bool = False) -> dict:
+        """Update which objects are held; return the effect for the object tracks
+        (``keep_hold``: a held part that a move puts into its region stays in hand)."""
         hand_joint = {"l_hand": "l_hand", "r_hand": "r_hand", "both": "r_hand",
                       None: "r_hand"}.get(hand, "r_hand")
         if kind == "grasp":
@@ -732,7 +856,11 @@ class SequencePlanner:
             if args[0] not in self.held:
                 self.held[args[0]] = hand_joint
                 return {"attach": {args[0]: hand_joint}, "detach_after": [args[0]]}
-            return {}
+            if kind == "extract" or keep_hold:
+                return {}
+            # move / insert of a held part: it stays where the hand put it.
+            self.held.pop(args[0], None)
+            return {"detach": [args[0]]}
         if kind == "assemble":
             parts = list(self.held)
             self.consumed.update(parts)

@@ -1,0 +1,98 @@
+"""Synthesis in the shipped cells for the failure families of issue 11.
+
+Each test synthesizes with verification on (a failing check raises), so a pass means the
+motion passed every check of ``planning/verify.py`` unchanged.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.planning.pipeline import get_library, resolve_cell, synthesize
+from ltl_human_motion.planning.placement import RegionEntry
+from ltl_human_motion.scene.occupancy import capsule_radii
+from ltl_human_motion.scene.predicates import collision
+
+
+def _verified(spec: str, cell: str, seed: int = 0):
+    motion = synthesize(spec, cell, seed=seed)[0]
+    assert motion.verification["passed"], motion.verification
+    return motion
+
+
+@pytest.mark.parametrize("spec", ["F(walk(R1))", "F(wait(2.0))", "F(stoop)",
+                                  "F(sit(stool) & X standUp)"])
+def test_final_region_over_the_bench_is_entered(spec):
+    """demo_cell's R1 sits above a bench: the always-on F enter(R1) used to exhaust the
+    search; now the hand reaches in (or the body, where it fits)."""
+    motion = _verified(spec, "demo_cell")
+    assert motion.sequence[-1] == "walk(R1)"
+    assert motion.stats["nodes_expanded"] < 8000
+
+
+def test_region_entry_is_the_exact_predicate():
+    lib = get_library(1.75)
+    cell = resolve_cell("demo_cell")
+    radius = float(capsule_radii(1.75).max())
+    floor = RegionEntry(cell.region("R0"), lib.standing_pose, lib.standing_height, 1.75, radius)
+    assert floor.enters(np.array([0.0]), np.array([0.0]), np.array([0.0]))[0]
+    assert not floor.enters(np.array([1.5]), np.array([0.0]), np.array([0.0]))[0]
+    above = RegionEntry(cell.region("R1"), lib.standing_pose, lib.standing_height, 1.75, radius)
+    # 0.5 m in front of R1's edge the standing body does not reach it, whatever the heading.
+    assert not above.cells(np.array([[0.6, -1.0]]))[0]
+
+
+@pytest.mark.parametrize("spec", ["F(standUp)", "F(kneel & X(standUp & X wait(3.0)))"])
+def test_stand_up_when_standing_is_a_standing_pause(spec):
+    motion = _verified(spec, "paper_cell")
+    step = motion.sequence.index("standUp")
+    seg = motion.timeline[step]
+    assert seg.primitive == "stand"
+    assert (seg.end_frame - seg.start_frame) / motion.motion.fps < 1.0
+
+
+def test_release_of_a_part_not_in_hand_grasps_it_first():
+    motion = _verified("F(release(O1))", "demo_cell")
+    steps = motion.stats["goal_primitives"]
+    assert steps[0]["task"] == "release(O1)"
+    # The grasp is planned inside the release step: a grasp primitive precedes it.
+    names = [s[0] for s in motion.stats["segments"]]
+    assert names.index(next(n for n in names if n.startswith("grasp_"))) < \
+        names.index(next(n for n in names if n.startswith("release_")))
+
+
+def test_release_next_to_a_table_sets_the_part_down_on_it():
+    motion = _verified("F(grasp(O1) & X release(O1))", "demo_cell")
+    end = motion.objects["O1"][-1]
+    # Let go over the table top (0.75 m): the part rests on it, not inside it.
+    assert end[2] > 0.75
+
+
+def test_carry_into_a_region_above_a_bench():
+    motion = _verified("F(carry(O1, R1))", "demo_cell")
+    r1 = resolve_cell("demo_cell").region("R1")
+    inside = np.all((motion.objects["O1"] >= r1.lo) & (motion.objects["O1"] <= r1.hi), axis=1)
+    assert inside.any()
+
+
+def test_move_places_the_part_and_frees_the_hand():
+    motion = _verified("F(move(O1, R0))", "demo_cell")
+    r0 = resolve_cell("demo_cell").region("R0")
+    end = motion.objects["O1"][-1]
+    assert np.all(end >= r0.lo) and np.all(end <= r0.hi)
+
+
+def test_walk_paths_are_checked_on_every_frame():
+    """The search samples frames; the planner checks every frame of the path it takes,
+    as the verifier does (this spec's final walk used to clip the bench on 4 frames)."""
+    motion = _verified("F(move(O1, R0))", "demo_cell")
+    cell = resolve_cell("demo_cell")
+    assert not collision(motion.motion.positions, cell, stature=1.75).any()
+
+
+def test_unplannable_shorthand_still_says_why():
+    with pytest.raises(PlanningError, match="no motion of its own"):
+        from ltl_human_motion.planning.planner import task_kind
+        task_kind("odd", ("R1",), {"odd": (("R",), "walk(R) & grasp(O1)")})
