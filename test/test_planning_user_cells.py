@@ -96,3 +96,10 @@ def test_unplannable_shorthand_still_says_why():
     with pytest.raises(PlanningError, match="no motion of its own"):
         from ltl_human_motion.planning.planner import task_kind
         task_kind("odd", ("R1",), {"odd": (("R",), "walk(R) & grasp(O1)")})
+
+
+def test_kneel_next_to_the_table_steps_to_a_roomier_spot():
+    """After grasping at the table, kneeling where the worker stands hits the table:
+    the planner walks to a spot with room first."""
+    motion = _verified("F(grasp(O1) & X kneel)", "demo_cell")
+    assert motion.sequence[:2] == ["grasp(O1)", "kneel"]

@@ -69,6 +69,14 @@ FINAL_ADJUST_RADIUS = 0.05
 #: sample (each forbids the colliding primitive at its pose).
 WALK_REPAIRS = 4
 
+#: Tasks done where the worker stands (no target); when furniture there blocks them,
+#: the worker first walks to a spot with ``IN_PLACE_ROOM`` of floor clearance.
+IN_PLACE_TASKS = ("bend", "stoop", "kneel", "wait")
+
+#: Floor clearance around the root a kneel or stoop needs, metres (the knee goes about
+#: 0.5 m ahead of the root and the head as far when stooping, plus a hand's width).
+IN_PLACE_ROOM = 0.6
+
 #: Tops of furniture a released part is set down on: up to this fraction of the stature
 #: (1.2 m at 1.75 m, about chest height: higher tops are shelves out of a natural
 #: put-down).
@@ -698,13 +706,18 @@ class SequencePlanner:
             # past the edge of the surface in front.
             self._arm_transition(False, -1)
             carrying_before = True
+        in_place = target is None and kind in IN_PLACE_TASKS
+        if in_place:
+            targets = [None, None]            # the second time from a roomier spot
         for k, target in enumerate(targets):
+            if in_place and k:
+                walked += self._walk_to_room(text)
             try:
                 seg, mp = self._goal_segment(
                     kind, target, i, text, carry_stance=carrying_before,
                     seconds=float(args[0]) if kind == "wait" and args else None,
                     grasped=args[0] if kind == "grasp" else None,
-                    attempts=None if k == 0 else RELEASE_ATTEMPTS_ELSEWHERE)
+                    attempts=None if k == 0 or in_place else RELEASE_ATTEMPTS_ELSEWHERE)
                 break
             except PlanningError as exc:
                 if exc.reason != "blocked" or k == len(targets) - 1:
@@ -745,6 +758,18 @@ class SequencePlanner:
             raise PlanningError(f"{cause}; reaching into it instead failed too: {exc}",
                                 task=text, reason=cause.reason) from None
         return replace(step, kind="walk (by rightHand)")
+
+    def _walk_to_room(self, text: str) -> int:
+        """Walk to the nearest spot with ``IN_PLACE_ROOM`` of floor clearance (a task done
+        where the worker stands hit the furniture there); returns the primitives walked."""
+        room = IN_PLACE_ROOM
+
+        def roomy(x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None = None) -> np.ndarray:
+            return self._clearance(np.stack([x, y], axis=-1)) > room
+
+        field = self._field(lambda xy: roomy(xy[:, 0], xy[:, 1]), ("room", room))
+        goal = self._goal_from_field(field, roomy, f"find room for {text}", text)
+        return self._walk(goal, text, -1, carry=bool(self.held))
 
     def _release_targets(self, obj: str) -> list[np.ndarray]:
         """Where the hand holding ``obj`` may let it go, palm positions (3,), in order:
