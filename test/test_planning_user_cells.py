@@ -103,3 +103,16 @@ def test_kneel_next_to_the_table_steps_to_a_roomier_spot():
     the planner walks to a spot with room first."""
     motion = _verified("F(grasp(O1) & X kneel)", "demo_cell")
     assert motion.sequence[:2] == ["grasp(O1)", "kneel"]
+
+
+@pytest.mark.parametrize("spec", ["F(sit(stool) & X wait(2.0))", "F(sit(stool) & X standUp)"])
+def test_seated_tasks_stay_on_the_seat(spec):
+    """A wait after sit holds the seated pose (it used to stand up in one blend: a knee
+    at 14 m/s); standUp rises from the seat that was sat on."""
+    motion = _verified(spec, "demo_cell")
+    step = motion.timeline[1]
+    pelvis = motion.motion.positions[step.start_frame:step.end_frame, 0, 2]
+    if spec.endswith("wait(2.0))"):
+        assert pelvis.max() < 0.8            # seated: the pelvis stays near seat height
+    else:
+        assert pelvis[-1] > pelvis[0] + 0.2  # rose from the seat

@@ -19,8 +19,10 @@ where every grasp picks a new part from the floor.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -57,9 +59,23 @@ RELEASE_PLACES: tuple[tuple[float, float], ...] = (
     (0.45, 0.0), (0.45, math.pi / 4), (0.45, -math.pi / 4), (0.4, math.pi / 2),
     (0.4, -math.pi / 2), (0.3, 0.0))
 
-#: Seeded primitives tried at each release place after the first (the first gets
-#: ``PlannerOptions.goal_attempts``).
-RELEASE_ATTEMPTS_ELSEWHERE = 2
+#: Seeded primitives tried at each alternative (release place, approach) after the first
+#: (the first gets ``PlannerOptions.goal_attempts``).
+ALTERNATIVE_ATTEMPTS = 2
+
+#: Other ways to stand for a reach whose motions all hit an obstacle, in order: (turn of
+#: the approach direction about the target, rad; extra distance from the target, m).
+#: First a step further back (a knee or thigh at a desk or low shelf front), then the
+#: target's other sides (an arm hitting a crate beside it).
+ALTERNATE_APPROACHES: tuple[tuple[float, float], ...] = (
+    (0.0, 0.08), (math.pi / 3, 0.0), (-math.pi / 3, 0.0))
+
+#: Node budget of the walk to an alternative approach (most are a few steps round the
+#: target; a side that needs a long way round is not worth the search).
+ALTERNATIVE_NODES = 500
+
+#: Half width of the side of the target an alternative approach walks to, rad.
+APPROACH_HALF_WIDTH = math.pi / 6
 
 #: Step left to the standing adjustment when the first one from where a walk ended was
 #: not clear: the walk goes on to a spot that needs almost none, metres.
@@ -243,7 +259,7 @@ class SequencePlanner:
         self.steps: list[StepPlan] = []
         self.pose: Pose = (0.0, 0.0, 0.0)
         self.gait_state: int | None = None          # None = standing
-        self.seated = False
+        self.seat: np.ndarray | None = None          # the seat sat on (3,); None: standing
         self.held: dict[str, str] = {}               # object -> hand joint
         self.consumed: set[str] = set()
         self.held_offsets: dict[str, np.ndarray] = {}
@@ -351,11 +367,19 @@ class SequencePlanner:
         return (*out, clear[px.size:].reshape(np.shape(x))) if room else out
 
     def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
-                    task: str, adjust: float | None = None) -> Goal:
+                    task: str, adjust: float | None = None,
+                    sector: tuple[float, float] | None = None) -> Goal:
         """Walk until a standing adjustment (a step of at most ``adjust``, default
         ``options.adjust_radius``, and a turn) puts the worker where the goal primitive
-        reaches the target."""
+        reaches the target; with ``sector`` (direction from the target, half width, rad)
+        only from that side."""
         tx, ty = float(target[0]), float(target[1])
+
+        def side(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+            if sector is None:
+                return np.ones(np.shape(x), dtype=bool)
+            return np.abs(wrap_angle(np.arctan2(y - ty, x - tx) - sector[0])) <= sector[1]
+
         tol = self.options.reach_tolerance
         dist = float(np.hypot(*placement))
         offset = float(np.arctan2(placement[1], placement[0]))
@@ -363,7 +387,7 @@ class SequencePlanner:
 
         def ring(xy: np.ndarray) -> np.ndarray:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
-            out = (r >= dist - tol) & (r <= dist + self._back_limit)
+            out = (r >= dist - tol) & (r <= dist + self._back_limit) & side(xy[:, 0], xy[:, 1])
             # The floor clearance only where the distance fits (few of the cells).
             out[out] = self._clearance(xy[out]) > self.options.stand_clearance
             return out
@@ -374,13 +398,13 @@ class SequencePlanner:
             # Turning on the spot needs room for the hips; facing nearly right needs none.
             room = here > self.options.turn_clearance
             facing = np.abs(wrap_angle(pyaw - yaw)) <= self.options.heading_tolerance
-            return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing)
+            return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing) & side(x, y)
 
         # Stand within the reach tolerance where possible; only where an obstacle leaves
         # no such place (a tall worker at a bench) stand up to max_step_back further.
         def ring_key() -> tuple:
             return ("ring", tx, ty, dist, tol, float(self._back_limit),
-                    float(self.options.stand_clearance))
+                    float(self.options.stand_clearance), sector)
 
         self._back_limit = tol
         field = self._field(ring, ring_key())
@@ -503,6 +527,27 @@ class SequencePlanner:
                 out[sel] = self.obstacle_field.clear(poses[sel], stature, relative=rel)
         return out
 
+    def _sit_still(self, seconds: float) -> MotionPrimitive:
+        """A wait on the seat: the seated pose held (the standing wait model would rebuild
+        the legs for standing)."""
+        pose = self._seated_pose()
+        n = max(round(seconds * self.library.fps), self.overlap + 2)
+        root = np.zeros((n, 4))
+        root[:, :3] = pose[0]
+        rel = np.repeat((pose - pose[0])[None], n, axis=0)
+        return MotionPrimitive(f"sit_still_{seconds:.2f}s", "wait", rel, root,
+                               self.library.fps, "planner: seated wait",
+                               meta={"contact_frame": n - 1, "hand": "none"})
+
+    def _seated_pose(self) -> np.ndarray:
+        """The last frame placed (the worker seated), in the start frame of the current
+        pose (root floor point at the origin, facing +x; heights above the floor), (J, 3)."""
+        x, y, yaw = self.pose
+        last = self.segments[-1].positions[-1]
+        c, s = math.cos(-yaw), math.sin(-yaw)
+        dx, dy = last[:, 0] - x, last[:, 1] - y
+        return np.stack([c * dx - s * dy, s * dx + c * dy, last[:, 2]], axis=-1)
+
     def _stance(self, carrying: bool) -> np.ndarray:
         lib = self.library
         return np.asarray(lib.carry_standing_pose if carrying else lib.standing_pose)
@@ -578,7 +623,8 @@ class SequencePlanner:
                 self.pose = self._hand_over_pose(mp, self.pose)
                 return
 
-    def _walk(self, goal: Goal, task: str, label: int, carry: bool) -> int:
+    def _walk(self, goal: Goal, task: str, label: int, carry: bool,
+              budget: SearchBudget | None = None) -> int:
         """A* from the current pose; appends the gait segments; returns their count.
 
         The search checks the body on sampled frames of a distance grid; every frame of
@@ -593,7 +639,7 @@ class SequencePlanner:
                         clearance=self._clearance, body_radius=self.options.body_radius,
                         heuristic_speed=self.options.heuristic_speed,
                         turn_rate=self.options.turn_rate, carry=carry,
-                        budget=self.options.budget, rng=self.rng,
+                        budget=budget or self.options.budget, rng=self.rng,
                         cost_noise=self.options.cost_noise, body_clear=self._body_clear,
                         forbidden=frozenset(forbidden))
             self.expanded += res.expanded
@@ -643,10 +689,10 @@ class SequencePlanner:
         """Plan step ``i`` (``text``) as the goal task ``kind``; ``keep_hold``: a part a
         move puts into its region stays in hand (carry)."""
         expanded0 = self.expanded
-        if self.seated and kind not in ("standUp", "wait", "leftHand", "rightHand",
-                                        "assemble", "sit"):
-            self._goal_segment("standUp", None, -1, text)
-            self.seated = False
+        if self.seat is not None and kind not in ("standUp", "wait", "leftHand", "rightHand",
+                                                  "assemble", "sit"):
+            self._goal_segment("standUp", self.seat, -1, text)
+            self.seat = None
         if kind == "carry":
             # carry(O, R) holds when the body enters R with O inside it: the held part is
             # put into R by hand (so the palm enters R too), and it stays in hand.
@@ -668,7 +714,7 @@ class SequencePlanner:
             return StepPlan(text, kind, np.asarray(region.center, dtype=float), walk_segments=n,
                             expanded=self.expanded - expanded0,
                             primitive=f"{n} gait primitives", sub_steps=subs)
-        if kind == "standUp" and not self.seated:
+        if kind == "standUp" and self.seat is None:
             # Already standing (every bend, stoop and kneel ends upright): standUp holds
             # once the worker stands still for a moment.
             self._stand_still(i, STAND_UP_IN_PLACE_SECONDS)
@@ -677,51 +723,47 @@ class SequencePlanner:
         if kind in ("move", "insert", "release") and args[0] not in self.held:
             # The part is fetched first, as for carry(O, R).
             subs.append(self._fetch(i, args[0]))
-        target = self.target_of(kind, args)
+        target = self.seat if kind == "standUp" else self.target_of(kind, args)
         if kind in ("move", "insert") and args[0] in self.held_offsets:
             # The hand puts the part's centre (held at its offset) on the target.
             target = target - self.held_offsets[args[0]]
         if kind == "grasp" and args[0] in self.consumed:
             self.consumed.discard(args[0])           # a fresh part from the supply
         walked = 0
-        if target is not None and kind != "release":
+        placement = None
+        if target is not None and kind not in ("release", "standUp") and self.seat is None:
+            # (Seated, the hands work from the seat.)
             placement = self._placement(kind, target, text)
-            goal = self._reach_goal(target, placement, f"reach {text} at "
-                                    f"({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})", text)
-            walked = self._walk(goal, text, -1, carry=bool(self.held))
-            if not self._adjust_to(target, placement, text):
-                # No clear step from where the walk ended: walk on to a spot that needs
-                # (almost) none.
-                goal = self._reach_goal(target, placement, goal.description, text,
-                                        adjust=FINAL_ADJUST_RADIUS)
-                walked += self._walk(goal, text, -1, carry=bool(self.held))
-                self._adjust_to(target, placement, text)
-        targets = [target]
-        if kind == "release":
-            targets = self._release_targets(args[0])
+            walked = self._approach(target, placement, text)
         carrying_before = bool(self.held)
-        if kind in HAND_TASKS and not carrying_before:
+        raised = kind in HAND_TASKS and not carrying_before and self.seat is None
+        if raised:
             # Raise the arms to the carry stance first: hands then reach from the chest
             # (and a grasped part comes up to it) instead of swinging up from the thighs
             # past the edge of the surface in front.
             self._arm_transition(False, -1)
             carrying_before = True
-        in_place = target is None and kind in IN_PLACE_TASKS
-        if in_place:
-            targets = [None, None]            # the second time from a roomier spot
-        for k, target in enumerate(targets):
-            if in_place and k:
-                walked += self._walk_to_room(text)
+        tries = self._alternatives(kind, args, target, placement, text, raised)
+        failure = None
+        for k, (target, prepare) in enumerate(tries):
             try:
+                if prepare is not None:
+                    walked += prepare()
                 seg, mp = self._goal_segment(
                     kind, target, i, text, carry_stance=carrying_before,
                     seconds=float(args[0]) if kind == "wait" and args else None,
                     grasped=args[0] if kind == "grasp" else None,
-                    attempts=None if k == 0 or in_place else RELEASE_ATTEMPTS_ELSEWHERE)
+                    attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
                 break
             except PlanningError as exc:
-                if exc.reason != "blocked" or k == len(targets) - 1:
+                if k == 0 and exc.reason != "blocked":
                     raise
+                failure = failure or exc       # an alternative may fail in any way
+        else:
+            if len(tries) == 1:
+                raise failure
+            raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements "
+                                "tried", task=text, reason="blocked")
         hand = mp.meta.get("hand")
         effect = self._apply_effects(kind, args, hand, keep_hold)
         contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
@@ -732,9 +774,10 @@ class SequencePlanner:
                                                  dtype=np.float64) - hand_at_contact
         for name in (*effect.get("detach", ()), *effect.get("detach_after", ())):
             self.held_offsets.pop(name, None)
-        if bool(self.held) != carrying_before:
+        if bool(self.held) != carrying_before and self.seat is None:
             self._arm_transition(carrying_before, i)
-        self.seated = kind == "sit" or (self.seated and kind != "standUp")
+        if kind in ("sit", "standUp"):
+            self.seat = target if kind == "sit" else None
         return StepPlan(text, kind, target, walk_segments=walked, goal_segment=seg,
                         contact_frame=int(mp.meta.get("contact_frame", mp.n_frames - 1)),
                         hand=hand, expanded=self.expanded - expanded0,
@@ -758,6 +801,57 @@ class SequencePlanner:
             raise PlanningError(f"{cause}; reaching into it instead failed too: {exc}",
                                 task=text, reason=cause.reason) from None
         return replace(step, kind="walk (by rightHand)")
+
+    def _approach(self, target: np.ndarray, placement: tuple[float, float], text: str,
+                  sector: tuple[float, float] | None = None,
+                  budget: SearchBudget | None = None) -> int:
+        """Walk to where the goal primitive reaches ``target`` (from ``sector``, see
+        :meth:`_reach_goal`; within ``budget``) and take the standing step there; returns
+        the gait primitives walked."""
+        desc = f"reach {text} at ({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})"
+        goal = self._reach_goal(target, placement, desc, text, sector=sector)
+        walked = self._walk(goal, text, -1, carry=bool(self.held), budget=budget)
+        if not self._adjust_to(target, placement, text):
+            # No clear step from where the walk ended: walk on to a spot that needs
+            # (almost) none.
+            goal = self._reach_goal(target, placement, desc, text, adjust=FINAL_ADJUST_RADIUS,
+                                    sector=sector)
+            walked += self._walk(goal, text, -1, carry=bool(self.held), budget=budget)
+            self._adjust_to(target, placement, text)
+        return walked
+
+    def _alternatives(self, kind: str, args: tuple[str, ...], target: np.ndarray | None,
+                      placement: tuple[float, float] | None, text: str, raised: bool
+                      ) -> list[tuple[np.ndarray | None, Callable[[], int] | None]]:
+        """What to try when the goal primitive is blocked, in order: (target, prepare),
+        where ``prepare()`` moves the worker first and returns the primitives walked.
+
+        release: other places to let go; bend/stoop/kneel/wait: a roomier spot; tasks
+        with a target: the other ``ALTERNATE_APPROACHES`` (further back, other sides).
+        """
+        if kind == "release":
+            return [(t, None) for t in self._release_targets(args[0])]
+        if target is None:
+            return [(None, None)] + ([(None, lambda: self._walk_to_room(text))]
+                                     if kind in IN_PLACE_TASKS else [])
+        if placement is None:
+            return [(target, None)]
+        first = math.atan2(self.pose[1] - target[1], self.pose[0] - target[0])
+
+        def approach(turn: float, back: float) -> int:
+            lowered = raised and not self.held
+            if lowered:
+                self._arm_transition(True, -1)
+            walked = self._approach(target, (placement[0] + back, placement[1]), text,
+                                    sector=(first + turn, APPROACH_HALF_WIDTH),
+                                    budget=SearchBudget(ALTERNATIVE_NODES))
+            if lowered:
+                self._arm_transition(False, -1)
+            return walked
+
+        return [(target, None)] + [
+            (target, functools.partial(approach, turn, back))
+            for turn, back in ALTERNATE_APPROACHES]
 
     def _walk_to_room(self, text: str) -> int:
         """Walk to the nearest spot with ``IN_PLACE_ROOM`` of floor clearance (a task done
@@ -816,8 +910,10 @@ class SequencePlanner:
             dx, dy = target[0] - x, target[1] - y
             local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
         hold_hand = next(iter(self.held.values()), None)
+        seated = self.seat is not None and kind != "standUp"
         kwargs = {"rng": self.rng,
-                  "start_pose": self._stance(bool(self.held) or carry_stance)}
+                  "start_pose": self._seated_pose() if seated
+                  else self._stance(bool(self.held) or carry_stance)}
         if kind in ("move", "insert", "extract", "release") and hold_hand:
             kwargs["hand"] = hold_hand
         if kind == "wait" and target is None and seconds is not None:
@@ -827,7 +923,8 @@ class SequencePlanner:
         attempts = self.options.goal_attempts if attempts is None else attempts
         for attempt in range(attempts):
             try:
-                candidate = self.library.goal(kind, local, **kwargs)
+                candidate = self._sit_still(kwargs.get("duration", 2.0)) \
+                    if seated and kind == "wait" else self.library.goal(kind, local, **kwargs)
             except ValueError as exc:
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
