@@ -116,3 +116,18 @@ def test_seated_tasks_stay_on_the_seat(spec):
         assert pelvis.max() < 0.8            # seated: the pelvis stays near seat height
     else:
         assert pelvis[-1] > pelvis[0] + 0.2  # rose from the seat
+
+
+def test_parts_are_grasped_where_they_were_put_down():
+    """extract keeps the part in hand, and a later insert takes it from there; a part
+    moved to R0 is grasped again at R0, not at its supply position."""
+    motion = _verified("F(extract(O2, bin_b) & F insert(O2, bin_a))", "scenarios/cells/bins.yaml")
+    cell = resolve_cell("scenarios/cells/bins.yaml")
+    lo, hi = cell.object("bin_a").occupancy.aabb()
+    end = motion.objects["O2"][-1]
+    assert np.all(end > lo) and np.all(end < hi)
+    moved = _verified("F(move(O1, R0) & F grasp(O1))", "demo_cell")
+    k = moved.sequence.index("grasp(O1)")
+    r0 = resolve_cell("demo_cell").region("R0")
+    at_grasp = moved.objects["O1"][moved.timeline[k].start_frame]
+    assert np.all(at_grasp >= r0.lo) and np.all(at_grasp <= r0.hi)

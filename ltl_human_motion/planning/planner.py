@@ -262,6 +262,7 @@ class SequencePlanner:
         self.seat: np.ndarray | None = None          # the seat sat on (3,); None: standing
         self.held: dict[str, str] = {}               # object -> hand joint
         self.consumed: set[str] = set()
+        self.object_at: dict[str, np.ndarray] = {}   # where parts were put down (3,)
         self.held_offsets: dict[str, np.ndarray] = {}
         self._back_limit = options.reach_tolerance
         self._backs: dict[float, np.ndarray] = {}     # step-back distances per limit
@@ -276,17 +277,25 @@ class SequencePlanner:
             return np.asarray(cell.region(args[-1]).center, dtype=np.float64)
         if kind in ("grasp",):
             obj = cell.object(args[0])
-            return np.asarray(obj.grasp_points_at(obj.position)[0], dtype=np.float64)
+            return np.asarray(obj.grasp_points_at(self.object_position(args[0]))[0],
+                              dtype=np.float64)
         if kind in ("move",):
             return np.asarray(cell.region(args[1]).center, dtype=np.float64)
         if kind in ("insert", "extract"):
-            return np.asarray(cell.object(args[1]).position, dtype=np.float64)
+            return self.object_position(args[1])
         if kind in ("leftHand", "rightHand", "assemble"):
             return np.asarray(cell.region(args[0]).center, dtype=np.float64)
         if kind == "sit":
             obj = cell.object(args[0])
             return np.asarray(obj.sitting_surface_at(obj.position).center, dtype=np.float64)
         return None
+
+    def object_position(self, name: str) -> np.ndarray:
+        """Where object ``name`` rests now (3,): where the last step put it down, else its
+        supply position in the cell."""
+        at = self.object_at.get(name)
+        return np.asarray(self.cell.object(name).position if at is None else at,
+                          dtype=np.float64)
 
     def _placement(self, kind: str, target: np.ndarray, task: str) -> tuple[float, float]:
         """Where the target should be in the standing root's frame: (ahead, left), metres."""
@@ -723,12 +732,14 @@ class SequencePlanner:
         if kind in ("move", "insert", "release") and args[0] not in self.held:
             # The part is fetched first, as for carry(O, R).
             subs.append(self._fetch(i, args[0]))
+        respawn = kind == "grasp" and args[0] in self.consumed
+        if respawn:
+            self.consumed.discard(args[0])           # a fresh part from the supply
+            self.object_at.pop(args[0], None)
         target = self.seat if kind == "standUp" else self.target_of(kind, args)
         if kind in ("move", "insert") and args[0] in self.held_offsets:
             # The hand puts the part's centre (held at its offset) on the target.
             target = target - self.held_offsets[args[0]]
-        if kind == "grasp" and args[0] in self.consumed:
-            self.consumed.discard(args[0])           # a fresh part from the supply
         walked = 0
         placement = None
         if target is not None and kind not in ("release", "standUp") and self.seat is None:
@@ -765,15 +776,11 @@ class SequencePlanner:
             raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements "
                                 "tried", task=text, reason="blocked")
         hand = mp.meta.get("hand")
+        joints = dict(self.held)
         effect = self._apply_effects(kind, args, hand, keep_hold)
-        contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
-        for name, joint in effect.get("attach", {}).items():
-            # As the object tracks are made: the part keeps its world offset from the hand.
-            hand_at_contact = self.segments[seg].positions[contact, JOINT_INDEX[joint]]
-            self.held_offsets[name] = np.asarray(self.cell.object(name).position,
-                                                 dtype=np.float64) - hand_at_contact
-        for name in (*effect.get("detach", ()), *effect.get("detach_after", ())):
-            self.held_offsets.pop(name, None)
+        if respawn:
+            effect["respawn"] = [args[0]]
+        self._track_objects(effect, joints, seg, mp)
         if bool(self.held) != carrying_before and self.seat is None:
             self._arm_transition(carrying_before, i)
         if kind in ("sit", "standUp"):
@@ -783,6 +790,27 @@ class SequencePlanner:
                         hand=hand, expanded=self.expanded - expanded0,
                         primitive=mp.name,
                         objects_effect=effect, sub_steps=subs)
+
+    def _track_objects(self, effect: dict, joints: dict[str, str], seg: int,
+                       mp: MotionPrimitive) -> None:
+        """Follow a step's effect on the parts as the object tracks will: a part keeps
+        its world offset from the hand from the contact frame on, and rests where the
+        hand let it go (``joints``: the hands holding parts before the step)."""
+        contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
+        positions = self.segments[seg].positions
+        for name, joint in effect.get("attach", {}).items():
+            joints[name] = joint
+            self.held_offsets[name] = (self.object_position(name)
+                                       - positions[contact, JOINT_INDEX[joint]])
+        for names, frame in ((effect.get("detach", ()), contact),
+                             (effect.get("detach_after", ()),
+                              min(max(mp.n_frames - self.overlap, 0), mp.n_frames - 1))):
+            for name in names:
+                offset = self.held_offsets.pop(name, np.zeros(3))
+                if name in joints:
+                    self.object_at[name] = positions[frame, JOINT_INDEX[joints[name]]] + offset
+        for name in effect.get("consume", ()):
+            self.object_at.pop(name, None)
 
     def _fetch(self, i: int, obj: str) -> StepPlan:
         """Grasp ``obj`` as part of step ``i`` (which needs it in hand)."""
@@ -958,7 +986,7 @@ class SequencePlanner:
         hand = world[int(mp.meta.get("contact_frame", 0)):, JOINT_INDEX[joint]]
         if not hand.size:
             return True
-        centre = hand[::4] + (self.cell.object(grasped).position - hand[0])
+        centre = hand[::4] + (self.object_position(grasped) - hand[0])
         return not np.any(object_clearance(self.cell, grasped, centre) <= 0.0)
 
     def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None,
@@ -974,10 +1002,11 @@ class SequencePlanner:
             self.held.pop(args[0], None)
             return {"detach": [args[0]]}
         if kind in ("move", "insert", "extract"):
-            # The part is placed where the hand put it.
             if args[0] not in self.held:
+                # extract takes the part out of its container and keeps it in hand (move
+                # and insert fetch the part first).
                 self.held[args[0]] = hand_joint
-                return {"attach": {args[0]: hand_joint}, "detach_after": [args[0]]}
+                return {"attach": {args[0]: hand_joint}}
             if kind == "extract" or keep_hold:
                 return {}
             # move / insert of a held part: it stays where the hand put it.
