@@ -267,12 +267,24 @@ class ObstacleField:
         lo = np.min([b[0] for b in boxes], axis=0) - pad
         hi = np.max([b[1] for b in boxes], axis=0) + pad
         axes = [np.arange(lo[i], hi[i] + self.res, self.res) for i in range(3)]
-        gx, gy, gz = np.meshgrid(*axes, indexing="ij")
-        pts = np.stack([gx, gy, gz], axis=-1).reshape(-1, 3)
-        dist = np.min(np.stack([ob.distance(pts) for ob in cell.obstacles]), axis=0)
+        # Each part's distance is computed only within ``pad`` of its bounding box; beyond,
+        # the field holds ``pad`` (min(distance, pad) is 1-Lipschitz too, and every test
+        # of :meth:`clear` passes well below ``pad``). A large cell's grid has millions of
+        # points, most of them far from any one part.
+        dist = np.full([len(a) for a in axes], float(pad))
+        for ob in cell.obstacles:
+            for part in ob.parts:
+                plo, phi = part.aabb()
+                sl = tuple(slice(int(np.searchsorted(a, plo[i] - pad, side="left")),
+                                 int(np.searchsorted(a, phi[i] + pad, side="right")))
+                           for i, a in enumerate(axes))
+                sub = np.meshgrid(*(a[k] for a, k in zip(axes, sl)), indexing="ij")
+                pts = np.stack(sub, axis=-1).reshape(-1, 3)
+                if pts.size:
+                    dist[sl] = np.minimum(dist[sl], part.distance(pts).reshape(sub[0].shape))
         self.lo = lo
-        self.shape = np.array(gx.shape)
-        self.dist = dist.reshape(gx.shape)
+        self.shape = np.array(dist.shape)
+        self.dist = dist
         self.far = pad
         parts = [part.aabb() for ob in cell.obstacles for part in ob.parts]
         self.part_lo = np.array([b[0] for b in parts])          # (P, 3)
