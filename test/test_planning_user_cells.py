@@ -131,3 +131,10 @@ def test_parts_are_grasped_where_they_were_put_down():
     r0 = resolve_cell("demo_cell").region("R0")
     at_grasp = moved.objects["O1"][moved.timeline[k].start_frame]
     assert np.all(at_grasp >= r0.lo) and np.all(at_grasp <= r0.hi)
+
+
+def test_part_on_a_rack_shelf_at_waist_height():
+    """The rack's tall side panels keep walks further off than a worker standing at the
+    shelf needs: the worker steps in to reach, and steps out again before walking on."""
+    motion = _verified("F grasp(O_waist)", "scenarios/cells/shelf_heights.yaml")
+    assert motion.sequence[0] == "grasp(O_waist)"

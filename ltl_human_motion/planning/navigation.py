@@ -387,20 +387,48 @@ def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: 
     return grid
 
 
+_STAND_CACHE: dict[str, ClearanceMap] = {}
+
+
+def _layout_key(cell) -> str:
+    """A hash of the cell's workspace and obstacles (what the maps depend on)."""
+    import hashlib
+    import pickle
+    return hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, np.asarray(cell.workspace_lo),
+                                      np.asarray(cell.workspace_hi), cell.obstacles))
+                        ).hexdigest()
+
+
+def stand_clearance_map(cell) -> ClearanceMap:
+    """Floor clearance from every obstacle footprint with no allowance for tall parts.
+
+    Where a worker *stands* to reach (a goal primitive that is then checked exactly),
+    a tall rack or wall is as close as its footprint: the arms do not swing there. The
+    walking map (:func:`clearance_maps`) counts tall parts ``tall_extra`` closer. Kept in
+    memory per cell (cheap to build).
+    """
+    key = _layout_key(cell)
+    stand = _STAND_CACHE.get(key)
+    if stand is None:
+        stand = ClearanceMap(cell, tall_extra=0.0)
+        if len(_STAND_CACHE) >= 16:
+            _STAND_CACHE.pop(next(iter(_STAND_CACHE)))
+        _STAND_CACHE[key] = stand
+    return stand
+
+
 def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
     """The floor clearance map and 3D obstacle field of ``cell``, once per obstacle layout.
 
     Cached in memory and on disk (next to the motion library cache), keyed by a hash of
     the workspace and the obstacles; an unreadable cache file is rebuilt.
     """
-    import hashlib
     import pickle
     import zipfile
 
     from ltl_human_motion.atomic import atomic_write_with
     from ltl_human_motion.motion.library import cache_dir
-    key = hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, np.asarray(cell.workspace_lo),
-                                     np.asarray(cell.workspace_hi), cell.obstacles))).hexdigest()
+    key = _layout_key(cell)
     maps = _CLEARANCE_CACHE.get(key)
     if maps is not None:
         return maps

@@ -39,7 +39,12 @@ from ltl_human_motion.planning.astar import (
 )
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.gait_index import gait_index
-from ltl_human_motion.planning.navigation import NavigationField, clearance_maps, floor_grid
+from ltl_human_motion.planning.navigation import (
+    NavigationField,
+    clearance_maps,
+    floor_grid,
+    stand_clearance_map,
+)
 from ltl_human_motion.planning.placement import RegionEntry
 
 Pose = tuple[float, float, float]
@@ -81,9 +86,19 @@ APPROACH_HALF_WIDTH = math.pi / 6
 #: not clear: the walk goes on to a spot that needs almost none, metres.
 FINAL_ADJUST_RADIUS = 0.05
 
+#: Clearance (m) the planner keeps between the body and obstacles on the frames it
+#: checks exactly: the verifier allows none below 0; blends between segments move
+#: joints by a few millimetres.
+PLACED_MARGIN = 0.003
+
 #: Searches run again after the path found collided on a frame the search did not
 #: sample (each forbids the colliding primitive at its pose).
 WALK_REPAIRS = 4
+
+#: Backward steps tried (m) to leave a spot closer to an obstacle than walking allows,
+#: and the clearance beyond ``PlannerOptions.body_radius`` the step must reach (m).
+STEP_OUT_DISTANCES: tuple[float, ...] = (0.1, 0.2, 0.3)
+STEP_OUT_MARGIN = 0.02
 
 #: Tasks done where the worker stands (no target); when furniture there blocks them,
 #: the worker first walks to a spot with ``IN_PLACE_ROOM`` of floor clearance.
@@ -254,6 +269,7 @@ class SequencePlanner:
         self.rng = rng
         self.options = options
         self.clearance, self.obstacle_field = clearance_maps(cell)
+        self.stand_map = stand_clearance_map(cell)
         self.overlap = int(library.overlap)
         self.segments: list[PlacedSegment] = []
         self.steps: list[StepPlan] = []
@@ -365,15 +381,15 @@ class SequencePlanner:
         px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)
         py = target[1] - (s[..., None] * (d + back) + c[..., None] * lat)
         pts = np.stack([px, py], axis=-1).reshape(-1, 2)
-        if room:
-            pts = np.concatenate([pts, np.stack([x, y], axis=-1).reshape(-1, 2)])
-        clear = self._clearance(pts)
-        free = clear[:px.size].reshape(px.shape) > self.options.stand_clearance
+        free = self.stand_map(pts).reshape(px.shape) > self.options.stand_clearance
         k = np.argmax(free, axis=-1)
         pick = np.take_along_axis
         out = (pick(px, k[..., None], -1)[..., 0], pick(py, k[..., None], -1)[..., 0], yaw,
                free.any(axis=-1))
-        return (*out, clear[px.size:].reshape(np.shape(x))) if room else out
+        if not room:
+            return out
+        return (*out, self._clearance(np.stack([x, y], axis=-1).reshape(-1, 2)
+                                      ).reshape(np.shape(x)))
 
     def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
                     task: str, adjust: float | None = None,
@@ -398,8 +414,15 @@ class SequencePlanner:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
             out = (r >= dist - tol) & (r <= dist + self._back_limit) & side(xy[:, 0], xy[:, 1])
             # The floor clearance only where the distance fits (few of the cells).
-            out[out] = self._clearance(xy[out]) > self.options.stand_clearance
+            out[out] = self.stand_map(xy[out]) > self.options.stand_clearance
             return out
+
+        def near_ring(xy: np.ndarray) -> np.ndarray:
+            # Where a walk may end to step in (a rack: the walking map keeps tall
+            # parts further off than a worker standing at them needs).
+            r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
+            return ((r >= dist - tol) & (r <= dist + self._back_limit + adjust)
+                    & side(xy[:, 0], xy[:, 1]))
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             px, py, pyaw, free, here = self._ideal_placement(target, placement, x, y,
@@ -420,6 +443,8 @@ class SequencePlanner:
         if not field.has_goal:
             self._back_limit = self.options.max_step_back
             field = self._field(ring, ring_key())
+        if not field.has_goal:
+            field = self._field(near_ring, ("near", *ring_key(), adjust))
         goal = self._goal_from_field(field, reached, desc, task)
         base_heading = field.heading
 
@@ -603,10 +628,10 @@ class SequencePlanner:
         if world is None and self.held:
             world = world_positions(mp, *pose)
         body = world_positions(mp, *pose, frames=frames) if world is None else world[frames]
-        # Only clearances up to the 3 mm limit matter: those are exact.
+        # Only clearances up to the PLACED_MARGIN limit matter: those are exact.
         d = body_clearance(body, self.cell, stature=self.library.skeleton.stature,
                            exact_below=0.01)
-        if np.min(d) <= 0.003:
+        if np.min(d) <= PLACED_MARGIN:
             return False
         for name, joint in self.held.items():
             step = 1 if samples is None else 2
@@ -615,13 +640,48 @@ class SequencePlanner:
                 return False
         return True
 
+    def _step_out(self) -> None:
+        """Step back onto walkable floor if the worker stands closer to an obstacle than a
+        walk may start (at a rack, where reaching allowed it): the search could not
+        leave the spot otherwise."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        x, y, yaw = self.pose
+        need = self.options.body_radius + STEP_OUT_MARGIN
+        if float(self._clearance(np.array([[x, y]]))[0]) > need:
+            return
+        carrying = bool(self.held)
+        lib = self.library
+        c, s = math.cos(yaw), math.sin(yaw)
+        for back in STEP_OUT_DISTANCES:
+            if float(self._clearance(np.array([[x - back * c, y - back * s]]))[0]) <= need:
+                continue
+            mp = make_step_primitive(self._stance(carrying), lib.standing_height, -back, 0.0,
+                                     0.0, lib.skeleton, lib.fps,
+                                     "carry" if carrying else "walk")
+            if self._placed_clear(mp, self.pose, samples=None):
+                self._add(mp, self.pose, -1, self.overlap)
+                self.pose = self._hand_over_pose(mp, self.pose)
+                return
+
     def _first_collision(self, primitives: list[int], poses: list[Pose]) -> int | None:
         """Index of the first gait primitive of a path that comes within the planner's
-        margin of an obstacle on any frame (body or held parts), or None."""
-        for k, (prim_id, pose) in enumerate(zip(primitives, poses)):
-            if not self._placed_clear(self.index.primitives[prim_id], pose, samples=None):
-                return k
-        return None
+        margin of an obstacle on any frame (body or held parts), or None; what
+        :meth:`_placed_clear` checks on every frame, in one pass over the whole path."""
+        from ltl_human_motion.scene.predicates import body_clearance, object_clearance
+        if not self.cell.obstacles or not primitives:
+            return None
+        worlds = [world_positions(self.index.primitives[p], *pose)
+                  for p, pose in zip(primitives, poses)]
+        ends = np.cumsum([len(w) for w in worlds])
+        world = np.concatenate(worlds)
+        bad = body_clearance(world, self.cell, stature=self.library.skeleton.stature,
+                             exact_below=0.01) <= PLACED_MARGIN
+        for name, joint in self.held.items():
+            centre = world[:, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
+            bad |= object_clearance(self.cell, name, centre) <= 0.0
+        if not bad.any():
+            return None
+        return int(np.searchsorted(ends, int(np.argmax(bad)), side="right"))
 
     def _step_back(self, carrying: bool, label: int) -> None:
         """Step back from an obstacle in front (a step primitive of the gait index)."""
@@ -698,6 +758,8 @@ class SequencePlanner:
         """Plan step ``i`` (``text``) as the goal task ``kind``; ``keep_hold``: a part a
         move puts into its region stays in hand (carry)."""
         expanded0 = self.expanded
+        if self.seat is None:
+            self._step_out()
         if self.seat is not None and kind not in ("standUp", "wait", "leftHand", "rightHand",
                                                   "assemble", "sit"):
             self._goal_segment("standUp", self.seat, -1, text)
