@@ -138,3 +138,11 @@ def test_part_on_a_rack_shelf_at_waist_height():
     shelf needs: the worker steps in to reach, and steps out again before walking on."""
     motion = _verified("F grasp(O_waist)", "scenarios/cells/shelf_heights.yaml")
     assert motion.sequence[0] == "grasp(O_waist)"
+
+
+def test_motion_ending_seated_stays_seated():
+    """A sequence whose last task is sit ends on the seat (it used to stand up in one
+    blend at the very end)."""
+    motion = _verified("F(grasp(O1) & F sit(stool)) & G(sit(stool) -> X sit(stool))",
+                       "demo_cell")
+    assert motion.motion.positions[-1, 0, 2] < 0.8

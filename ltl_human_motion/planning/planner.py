@@ -79,6 +79,10 @@ ALTERNATE_APPROACHES: tuple[tuple[float, float], ...] = (
 #: target; a side that needs a long way round is not worth the search).
 ALTERNATIVE_NODES = 500
 
+#: Node budget of the walk to the side of a seat that faces the seated work (without
+#: it the worker sits facing whichever way the walk arrives).
+FACING_NODES = 600
+
 #: Half width of the side of the target an alternative approach walks to, rad.
 APPROACH_HALF_WIDTH = math.pi / 6
 
@@ -99,6 +103,9 @@ WALK_REPAIRS = 4
 #: and the clearance beyond ``PlannerOptions.body_radius`` the step must reach (m).
 STEP_OUT_DISTANCES: tuple[float, ...] = (0.1, 0.2, 0.3)
 STEP_OUT_MARGIN = 0.02
+
+#: Hand tasks a seated worker does from the seat (others make the worker stand up).
+SEATED_HAND_TASKS = ("leftHand", "rightHand", "assemble")
 
 #: Tasks done where the worker stands (no target); when furniture there blocks them,
 #: the worker first walks to a spot with ``IN_PLACE_ROOM`` of floor clearance.
@@ -614,7 +621,7 @@ class SequencePlanner:
             self._step_back(carrying_before, label)
         self._add(mp, self.pose, label, self.overlap)
 
-    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = 16,
+    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = None,
                       world: np.ndarray | None = None) -> bool:
         """Whether ``mp`` placed at ``pose`` keeps the body and the objects held (at their
         hand offsets) clear of every obstacle, checked with the exact distances on
@@ -746,22 +753,37 @@ class SequencePlanner:
         for i, (text, name, args) in enumerate(tasks):
             kind, args = task_kind(name, args, self.cell.shorthands)
             first = len(self.segments)
-            step = self._plan_step(i, text, kind, args)
+            facing = self._seated_work(tasks[i + 1:]) if kind == "sit" else None
+            step = self._plan_step(i, text, kind, args, facing=facing)
             step.first_segment = first
             step.last_segment = len(self.segments) - 1
             self.steps.append(step)
-        self._stand_still(-1, 0.3)
+        if self.seat is None:
+            self._stand_still(-1, 0.3)
+        else:                                # the motion ends seated: stay on the seat
+            self._add(self._sit_still(0.3), self.pose, -1, self.overlap)
         return Plan(self.segments, self.steps, start, self.expanded)
 
+    def _seated_work(self, rest: list[tuple[str, str, tuple[str, ...]]]) -> np.ndarray | None:
+        """Target (3,) of the first hand task done seated after a sit (the tasks in
+        ``rest``, up to the first that needs standing), or None."""
+        for _text, name, args in rest:
+            kind, args = task_kind(name, args, self.cell.shorthands)
+            if kind in SEATED_HAND_TASKS:
+                return self.target_of(kind, args)
+            if kind != "wait":
+                return None
+        return None
+
     def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
-                   keep_hold: bool = False) -> StepPlan:
+                   keep_hold: bool = False, facing: np.ndarray | None = None) -> StepPlan:
         """Plan step ``i`` (``text``) as the goal task ``kind``; ``keep_hold``: a part a
-        move puts into its region stays in hand (carry)."""
+        move puts into its region stays in hand (carry); ``facing``: for sit, where the
+        seated worker will work (sit facing it)."""
         expanded0 = self.expanded
         if self.seat is None:
             self._step_out()
-        if self.seat is not None and kind not in ("standUp", "wait", "leftHand", "rightHand",
-                                                  "assemble", "sit"):
+        if self.seat is not None and kind not in ("standUp", "wait", "sit", *SEATED_HAND_TASKS):
             self._goal_segment("standUp", self.seat, -1, text)
             self.seat = None
         if kind == "carry":
@@ -807,7 +829,7 @@ class SequencePlanner:
         if target is not None and kind not in ("release", "standUp") and self.seat is None:
             # (Seated, the hands work from the seat.)
             placement = self._placement(kind, target, text)
-            walked = self._approach(target, placement, text)
+            walked = self._approach_facing(target, placement, text, facing)
         carrying_before = bool(self.held)
         raised = kind in HAND_TASKS and not carrying_before and self.seat is None
         if raised:
@@ -909,6 +931,23 @@ class SequencePlanner:
             walked += self._walk(goal, text, -1, carry=bool(self.held), budget=budget)
             self._adjust_to(target, placement, text)
         return walked
+
+    def _approach_facing(self, target: np.ndarray, placement: tuple[float, float],
+                         text: str, facing: np.ndarray | None) -> int:
+        """:meth:`_approach`; with ``facing`` (3,), from the side of the target that makes
+        the worker face it (a seat: sit facing the desk), else from any side."""
+        if facing is not None:
+            ahead = math.atan2(facing[1] - target[1], facing[0] - target[0])
+            # The worker stands ``placement`` from the target: with the target behind
+            # (a seat), the standing spot lies towards what the worker will face.
+            side = ahead if placement[0] < 0 else ahead + math.pi
+            try:
+                return self._approach(target, placement, text,
+                                      sector=(side, APPROACH_HALF_WIDTH),
+                                      budget=SearchBudget(FACING_NODES))
+            except PlanningError:
+                pass
+        return self._approach(target, placement, text)
 
     def _alternatives(self, kind: str, args: tuple[str, ...], target: np.ndarray | None,
                       placement: tuple[float, float] | None, text: str, raised: bool
@@ -1039,7 +1078,7 @@ class SequencePlanner:
         """Whether the body, the objects already in the hands and the part being grasped
         (``grasped``, from its contact frame on) keep clear of obstacles."""
         world = world_positions(mp, *self.pose)
-        if not self._placed_clear(mp, self.pose, samples=24, world=world):
+        if not self._placed_clear(mp, self.pose, samples=None, world=world):
             return False
         if grasped is None:
             return True
