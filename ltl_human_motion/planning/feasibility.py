@@ -226,7 +226,7 @@ def _support(cell, lo: np.ndarray, hi: np.ndarray) -> str:
     for ob in cell.obstacles:
         for part in ob.parts:
             plo, phi = part.aabb()
-            if (0.0 <= lo[2] - phi[2] <= 0.06 and np.all(plo[:2] <= hi[:2])
+            if (-1e-6 <= lo[2] - phi[2] <= 0.06 and np.all(plo[:2] <= hi[:2])
                     and np.all(phi[:2] >= lo[:2])):
                 return f" on top of the {ob.name}"
     return ""
@@ -277,17 +277,20 @@ class _Checker:
         self.floor = floor_map(cell, self.H)
         self.start = cell.start_region.name
 
-    def reach(self, task: str, what: str, lo: np.ndarray, hi: np.ndarray
-              ) -> PlanningError | None:
-        """Can a palm get into the box [lo, hi] (3,) from floor connected to the start?"""
+    def reach(self, task: str, what: str, lo: np.ndarray, hi: np.ndarray,
+              margin: float = 0.0) -> PlanningError | None:
+        """Can a palm get within ``margin`` of the box [lo, hi] (3,) from floor connected
+        to the start?"""
         env, H = self.env, self.H
         floor_z = float(self.cell.floor_z)
+        where = _support(self.cell, lo, hi)
+        shown = f"{float(lo[2]) - floor_z:.2f}-{float(hi[2]) - floor_z:.2f} m"
+        lo, hi = lo - margin, hi + margin
         zlo, zhi = float(lo[2]) - floor_z, float(hi[2]) - floor_z
         if zlo > env.vertical:
             return PlanningError(
-                f"task {task}: {what} at {zlo:.2f}-{zhi:.2f} m{_support(self.cell, lo, hi)} "
-                f"is above the reach of a {H:.2f} m worker ({env.vertical:.2f} m)",
-                task=task, reason="reach")
+                f"task {task}: {what} at {shown}{where} is above the reach of a {H:.2f} m "
+                f"worker ({env.vertical:.2f} m)", task=task, reason="reach")
         radius = env.horizontal(zlo, zhi) + FLOOR_RESOLUTION * math.sqrt(0.5)
         d = _box_xy_distance(self.floor.free_xy, np.asarray(lo[:2]), np.asarray(hi[:2]))
         near = d <= radius
@@ -299,9 +302,9 @@ class _Checker:
                 f"{radius:.2f} m of it is connected to {self.start}", task=task,
                 reason="enclosed")
         return PlanningError(
-            f"task {task}: no floor to stand on within {radius:.2f} m of {what} (the "
-            f"reach of a {H:.2f} m worker at {max(zlo, 0):.2f} m): obstacles cover it",
-            task=task, reason="no_floor")
+            f"task {task}: no floor to stand on within {radius:.2f} m of {what}"
+            f"{where} (a {H:.2f} m worker's reach at that height): "
+            "obstacles cover it", task=task, reason="no_floor")
 
     def region(self, task: str, name: str) -> PlanningError | None:
         reg = self.cell.region(name)
@@ -314,7 +317,7 @@ class _Checker:
 
     def part(self, task: str, name: str) -> PlanningError | None:
         lo, hi = self.cell.object(name).shape.aabb()
-        return self.reach(task, name, lo - GRASP_EPS, hi + GRASP_EPS)
+        return self.reach(task, name, lo, hi, margin=GRASP_EPS)
 
     def fits(self, task: str, part: str, container: str, is_region: bool
              ) -> PlanningError | None:
@@ -405,7 +408,9 @@ def _problems(cell, steps: Sequence[tuple[str, Sequence[str]]], stature: float
                 found.append(check.region(text, a[0]))
             elif task == "sit":
                 found.append(check.seat(text, a[0]))
-            out.extend(p for p in found if p is not None)
+            for p in found:
+                if p is not None and all(str(p) != str(q) for q in out):
+                    out.append(p)
     return out
 
 

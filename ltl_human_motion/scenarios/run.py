@@ -19,11 +19,16 @@ from ltl_human_motion.errors import (
     VerificationError,
 )
 
-__all__ = ["Outcome", "judge", "run_pair"]
+__all__ = ["Outcome", "judge", "prepare_cell", "run_pair"]
 
 
 class _PairTimeoutError(Exception):
-    """Raised by the alarm when a pair runs past its time limit."""
+    """Raised by the alarm when a pair runs past its time limit; ``task`` is the task
+    step the planner was working on (None if it was elsewhere)."""
+
+    def __init__(self, task: str | None = None) -> None:
+        super().__init__(task)
+        self.task = task
 
 
 @dataclass
@@ -54,7 +59,13 @@ class Outcome:
 
 
 def _on_alarm(signum, frame) -> None:
-    raise _PairTimeoutError()
+    task = None
+    while frame is not None:                 # the innermost task step being planned
+        if frame.f_code.co_name == "_plan_step" and "text" in frame.f_locals:
+            task = str(frame.f_locals["text"])
+            break
+        frame = frame.f_back
+    raise _PairTimeoutError(task)
 
 
 def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None = None
@@ -83,8 +94,10 @@ def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None =
         passed = bool(motions[0].verification.get("passed", False))
         out = Outcome("verified" if passed else "verification", 0.0,
                       None if passed else "unknown")
-    except _PairTimeoutError:
-        out = Outcome("timeout", 0.0, message=f"no answer within {timeout} s")
+    except _PairTimeoutError as exc:
+        where = f" (planning {exc.task})" if exc.task else ""
+        out = Outcome("timeout", 0.0, None, exc.task,
+                      f"no answer within {timeout} s{where}")
     except PlanningError as exc:
         out = Outcome("planning", 0.0, exc.reason, exc.task, str(exc))
     except VerificationError as exc:
@@ -106,6 +119,19 @@ def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None =
     return out
 
 
+def prepare_cell(cell) -> float:
+    """Build (or load) the planner's floor and obstacle fields of ``cell``; seconds taken.
+
+    The first synthesis in a new obstacle layout pays this once (the fields are then
+    cached on disk); the benchmark measures it apart from the time per pair.
+    """
+    from ltl_human_motion.planning.navigation import clearance_maps
+    from ltl_human_motion.planning.pipeline import resolve_cell
+    t0 = time.perf_counter()
+    clearance_maps(resolve_cell(cell))
+    return time.perf_counter() - t0
+
+
 def _task_kind(task: str | None) -> str:
     if not task:
         return "?"
@@ -123,13 +149,16 @@ def judge(expect: str, expected_reason: str | None, outcome: Outcome) -> tuple[b
     ok : bool
     family : str
         ``"ok"``, or e.g. ``"planning:grasp:blocked"``, ``"verification:collision"``,
-        ``"timeout"``, ``"false_verified"``, ``"wrong_reason:reach<-planning:blocked"``.
+        ``"timeout:grasp"`` (the task being planned when time ran out), ``"timeout"``,
+        ``"false_verified"``, ``"wrong_reason:reach<-planning:blocked"``.
     """
     o = outcome
     if o.status == "planning":
         got = f"planning:{_task_kind(o.task)}:{o.reason}"
     elif o.status in ("verification", "spec", "cell", "crash"):
         got = f"{o.status}:{o.reason}"
+    elif o.status == "timeout" and o.task:
+        got = f"timeout:{_task_kind(o.task)}"
     else:
         got = o.status
     if expect == "feasible":
