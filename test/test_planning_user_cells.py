@@ -146,3 +146,15 @@ def test_motion_ending_seated_stays_seated():
     motion = _verified("F(grasp(O1) & F sit(stool)) & G(sit(stool) -> X sit(stool))",
                        "demo_cell")
     assert motion.motion.positions[-1, 0, 2] < 0.8
+
+
+def test_arm_transitions_are_checked_as_played():
+    """The planner's arm transition is made with the bone lengths the pipeline restores,
+    so the collision check sees the hands where they will be."""
+    from ltl_human_motion.motion.retarget import enforce_bone_lengths
+    from ltl_human_motion.planning.planner import SequencePlanner
+    lib = get_library(1.75)
+    planner = SequencePlanner(resolve_cell("demo_cell"), lib, np.random.default_rng(0))
+    planner._arm_transition(False, -1)
+    seg = planner.segments[-1].positions
+    assert np.allclose(enforce_bone_lengths(seg, lib.skeleton), seg, atol=1e-9)

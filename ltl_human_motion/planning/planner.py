@@ -612,13 +612,19 @@ class SequencePlanner:
             n = max(round(0.3 * self.library.fps), self.overlap + 2)
             s = min_jerk(np.linspace(0.0, 1.0, n))[:, None, None]
             legs.append(p[None] + s * (q - p)[None])
-        rel = np.concatenate([legs[0], legs[1][1:]])
+        # Straight joint paths shorten the arm bones; the pipeline restores their lengths
+        # (moving the hands out), so the transition is checked as it will be played.
+        from ltl_human_motion.motion.retarget import enforce_bone_lengths
+        rel = enforce_bone_lengths(np.concatenate([legs[0], legs[1][1:]]), self.library.skeleton)
         root = np.zeros((len(rel), 4))
         root[:, 2] = self.library.standing_height
         mp = MotionPrimitive("arms_to_carry" if not carrying_before else "arms_to_walk", "wait",
                              rel, root, self.library.fps, "planner: arm transition")
-        if not self._placed_clear(mp, self.pose):
-            self._step_back(carrying_before, label)
+        if not self._placed_clear(mp, self.pose) and not self._step_back(carrying_before,
+                                                                           label, mp):
+            raise PlanningError(f"bringing the arms {'down' if carrying_before else 'up'} at "
+                                f"({self.pose[0]:.2f}, {self.pose[1]:.2f}) hits an obstacle, "
+                                "also after a step back", reason="blocked")
         self._add(mp, self.pose, label, self.overlap)
 
     def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = None,
@@ -690,14 +696,26 @@ class SequencePlanner:
             return None
         return int(np.searchsorted(ends, int(np.argmax(bad)), side="right"))
 
-    def _step_back(self, carrying: bool, label: int) -> None:
-        """Step back from an obstacle in front (a step primitive of the gait index)."""
+    def _step_back(self, carrying: bool, label: int, then: MotionPrimitive) -> bool:
+        """Step back from an obstacle in front so that ``then`` is clear afterwards: the
+        gait index's 0.3 m step back, else a model-made step of ``STEP_OUT_DISTANCES``.
+        Returns False (nothing added) when no step and ``then`` are both clear."""
+        from ltl_human_motion.planning.turns import make_step_primitive
         task = "carry" if carrying else "walk"
-        for _j, mp in enumerate(self.index.primitives):
-            if mp.task == task and mp.meta.get("step") == [-0.3, 0.0] and not mp.meta.get("turn"):
+        steps = [mp for mp in self.index.primitives
+                 if mp.task == task and mp.meta.get("step") == [-0.3, 0.0]
+                 and not mp.meta.get("turn")][:1]
+        lib = self.library
+        steps += [make_step_primitive(self._stance(carrying), lib.standing_height, -back, 0.0,
+                                      0.0, lib.skeleton, lib.fps, task)
+                  for back in STEP_OUT_DISTANCES]
+        for mp in steps:
+            pose = self._hand_over_pose(mp, self.pose)
+            if self._placed_clear(mp, self.pose) and self._placed_clear(then, pose):
                 self._add(mp, self.pose, label, self.overlap)
-                self.pose = self._hand_over_pose(mp, self.pose)
-                return
+                self.pose = pose
+                return True
+        return False
 
     def _walk(self, goal: Goal, task: str, label: int, carry: bool,
               budget: SearchBudget | None = None) -> int:
