@@ -158,3 +158,15 @@ def test_arm_transitions_are_checked_as_played():
     planner._arm_transition(False, -1)
     seg = planner.segments[-1].positions
     assert np.allclose(enforce_bone_lengths(seg, lib.skeleton), seg, atol=1e-9)
+
+
+def test_part_resting_on_a_table_is_carried_once_lifted():
+    """stations' O1 rests on table_a (touching it): it counts as carried, and must keep
+    clear of the table, only once the hand lifts it off."""
+    cell = resolve_cell("scenarios/cells/stations.yaml")
+    from ltl_human_motion.scene.predicates import object_clearance
+    assert float(object_clearance(cell, "O1", cell.object("O1").position)) <= 0.0
+    motion = _verified("F(carry(O1, R1))", "scenarios/cells/stations.yaml")
+    r1 = cell.region("R1")
+    end = motion.objects["O1"][motion.timeline[0].end_frame - 1]
+    assert np.all(end >= r1.lo) and np.all(end <= r1.hi)

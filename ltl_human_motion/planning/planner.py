@@ -107,6 +107,10 @@ STEP_OUT_MARGIN = 0.02
 #: Hand tasks a seated worker does from the seat (others make the worker stand up).
 SEATED_HAND_TASKS = ("leftHand", "rightHand", "assemble")
 
+#: How far the gripping hand rises before a grasped part counts as lifted off its
+#: support (a part resting on a table touches it until then), metres.
+LIFT_RISE = 0.001
+
 #: Tasks done where the worker stands (no target); when furniture there blocks them,
 #: the worker first walks to a spot with ``IN_PLACE_ROOM`` of floor clearance.
 IN_PLACE_TASKS = ("bend", "stoop", "kneel", "wait")
@@ -202,6 +206,9 @@ class StepPlan:
         Index of the goal segment in the segment list.
     contact_frame : int or None
         Frame of the goal primitive where the task condition first holds.
+    lift_frame : int or None
+        For a grasp: the frame of the goal primitive from which the part is carried (it
+        rests on its support until the hand lifts it, :func:`lift_frame`).
     hand : str or None
     expanded : int
         A* nodes expanded for this step.
@@ -222,6 +229,7 @@ class StepPlan:
     first_segment: int = 0
     last_segment: int = 0
     contact_frame: int | None = None
+    lift_frame: int | None = None
     hand: str | None = None
     expanded: int = 0
     primitive: str = ""
@@ -237,6 +245,26 @@ class Plan:
     steps: list[StepPlan]
     start_pose: Pose
     expanded: int
+
+
+def lift_frame(mp: MotionPrimitive, hand: np.ndarray) -> int:
+    """The frame of a grasp primitive from which the part is carried: the first frame
+    after the hold where the hand has risen ``LIFT_RISE`` above its contact height (the
+    part rests on its support until then). The contact frame if the hand never rises.
+
+    Parameters
+    ----------
+    mp : MotionPrimitive
+        With ``meta["contact_frame"]`` and ``meta["hold_frames"]``.
+    hand : ndarray, shape (T, 3)
+        The gripping hand joint over the primitive's frames.
+    """
+    contact = int(mp.meta.get("contact_frame", 0))
+    if contact >= len(hand):
+        return contact
+    hold_end = max(int(mp.meta.get("hold_frames", [contact, contact])[1]), contact)
+    rose = np.flatnonzero(hand[hold_end:, 2] >= hand[contact, 2] + LIFT_RISE)
+    return hold_end + int(rose[0]) if rose.size else contact
 
 
 def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, tuple[str, ...]]:
@@ -887,9 +915,13 @@ class SequencePlanner:
             self._arm_transition(carrying_before, i)
         if kind in ("sit", "standUp"):
             self.seat = target if kind == "sit" else None
+        lift = None
+        if kind == "grasp" and effect.get("attach"):
+            joint = next(iter(effect["attach"].values()))
+            lift = lift_frame(mp, self.segments[seg].positions[:, JOINT_INDEX[joint]])
         return StepPlan(text, kind, target, walk_segments=walked, goal_segment=seg,
                         contact_frame=int(mp.meta.get("contact_frame", mp.n_frames - 1)),
-                        hand=hand, expanded=self.expanded - expanded0,
+                        lift_frame=lift, hand=hand, expanded=self.expanded - expanded0,
                         primitive=mp.name,
                         objects_effect=effect, sub_steps=subs)
 
@@ -1094,7 +1126,8 @@ class SequencePlanner:
 
     def _goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
         """Whether the body, the objects already in the hands and the part being grasped
-        (``grasped``, from its contact frame on) keep clear of obstacles."""
+        (``grasped``, from the frame the hand lifts it, :func:`lift_frame`) keep clear of
+        obstacles."""
         world = world_positions(mp, *self.pose)
         if not self._placed_clear(mp, self.pose, samples=None, world=world):
             return False
@@ -1102,10 +1135,13 @@ class SequencePlanner:
             return True
         from ltl_human_motion.scene.predicates import object_clearance
         joint = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(mp.meta.get("hand"), "r_hand")
-        hand = world[int(mp.meta.get("contact_frame", 0)):, JOINT_INDEX[joint]]
-        if not hand.size:
+        hand = world[:, JOINT_INDEX[joint]]
+        contact = int(mp.meta.get("contact_frame", 0))
+        lift = lift_frame(mp, hand)
+        if lift >= len(hand):
             return True
-        centre = hand[::4] + (self.object_position(grasped) - hand[0])
+        # The part rests on its support until the hand lifts it; carried from then on.
+        centre = hand[lift:] + (self.object_position(grasped) - hand[contact])
         return not np.any(object_clearance(self.cell, grasped, centre) <= 0.0)
 
     def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None,
