@@ -11,6 +11,8 @@ Labels come from the construction, checked with a deliberately comfortable worke
 0.5 m wide walking body, a standing reach of 0.55 m beyond the edge of a part, grasp
 points at most 1.7 m up): a target counts as feasible only if such a worker can get
 to it from the start; loose obstacles that would cut it off are drawn again. Some
+cells stand on a floor at another height than 0 or are written in the paper's y-up
+frame (the same layout, so the same labels). Some
 cells also hold what no worker can do, by construction: a part on top of a 2.6 m
 cabinet (``reach``), a part in a closed 1.6 m pen wider than any reach
 (``enclosed``), a tray smaller than a part (``size``).
@@ -32,6 +34,8 @@ __all__ = ["GeneratedPair", "Scenario", "generate_scenario", "generate_scenarios
 
 #: Half-width of the comfortable walking body used to label targets feasible, metres.
 COMFORT_RADIUS = 0.25
+#: Cell size of the floor grid of that check, metres (coarse: the radius is generous).
+COMFORT_RESOLUTION = 0.1
 #: A comfortable standing reach beyond the near edge of a target, metres.
 COMFORT_REACH = 0.55
 #: Highest grasp point of a part labelled feasible (the 1.55 m worker's overhead reach
@@ -39,6 +43,10 @@ COMFORT_REACH = 0.55
 MAX_FEASIBLE_HEIGHT = 1.70
 #: Statures the generated cells are drawn for.
 STATURES = (1.55, 1.75, 1.95)
+#: How often a generated cell stands on a floor at a height other than 0 (a platform
+#: or a pit), and how often it is written in the paper's y-up frame.
+FLOOR_SHIFT_PROBABILITY = 0.15
+PAPER_FRAME_PROBABILITY = 0.15
 #: Single-task pairs drawn per cell (of all the cell's feasible tasks).
 MAX_SINGLES = 8
 #: Tasks without a target, done where the worker stands.
@@ -384,6 +392,58 @@ class _Builder:
                 "shorthands": {"assemble(R)": "leftHand(R) & rightHand(R)"}}
 
 
+def _shift_z(d: dict, dz: float) -> dict:
+    """The cell dict with everything raised by ``dz`` (a floor at ``floor_z = dz``)."""
+    def up(p):
+        return [p[0], p[1], _r(p[2] + dz)]
+    d = {**d, "floor_z": _r(dz)}
+    d["workspace"] = {"lo": up(d["workspace"]["lo"]), "hi": up(d["workspace"]["hi"])}
+    d["objects"] = {k: {**v, "position": up(v["position"])} for k, v in d["objects"].items()}
+    d["regions"] = {k: {"lo": up(v["lo"]), "hi": up(v["hi"])} for k, v in d["regions"].items()}
+
+    def shape(s):
+        return {**s, "position": up(s["position"])}
+    d["obstacles"] = {k: ({**v, "parts": [shape(s) for s in v["parts"]]} if "parts" in v
+                          else shape(v)) for k, v in d["obstacles"].items()}
+    return d
+
+
+def _to_paper_yup(d: dict) -> dict:
+    """The cell dict written in the paper's y-up frame, ``(x, y, z) -> (x, z, -y)``: the
+    inverse of the conversion the cell loader applies (``frame: paper_yup``)."""
+    def pt(p):
+        return [p[0], p[2], _r(-p[1])]
+
+    def bounds(lo, hi):
+        a, b = np.array(pt(lo)), np.array(pt(hi))
+        return [_r(v) for v in np.minimum(a, b)], [_r(v) for v in np.maximum(a, b)]
+
+    def shape(s):
+        out = {**s, "position": pt(s["position"])}
+        if s["shape"] == "box":
+            sx, sy, sz = s["size"]
+            out["size"] = [sx, sz, sy]
+        return out
+    d = {**d, "frame": "paper_yup"}
+    lo, hi = bounds(d["workspace"]["lo"], d["workspace"]["hi"])
+    d["workspace"] = {"lo": lo, "hi": hi}
+    objects = {}
+    for k, v in d["objects"].items():
+        o = shape(v)
+        if "grasp_points" in v:
+            o["grasp_points"] = [pt(g) for g in v["grasp_points"]]
+        if "sitting_surface" in v:
+            slo, shi = bounds(v["sitting_surface"]["lo"], v["sitting_surface"]["hi"])
+            o["sitting_surface"] = {"lo": slo, "hi": shi}
+        objects[k] = o
+    d["objects"] = objects
+    d["regions"] = {k: dict(zip(("lo", "hi"), bounds(v["lo"], v["hi"])))
+                    for k, v in d["regions"].items()}
+    d["obstacles"] = {k: ({**v, "parts": [shape(s) for s in v["parts"]]} if "parts" in v
+                          else shape(v)) for k, v in d["obstacles"].items()}
+    return d
+
+
 def _accessible(cell_yaml: str, targets) -> bool:
     """Whether every target box has comfortable floor near it, connected to R0."""
     from scipy.sparse.csgraph import connected_components
@@ -400,7 +460,7 @@ def _accessible(cell_yaml: str, targets) -> bool:
             ok &= fp.signed_distance(xy) > COMFORT_RADIUS
         return ok
 
-    grid = FloorGrid(lo, hi, free, 0.05)
+    grid = FloorGrid(lo, hi, free, COMFORT_RESOLUTION)
     flat = grid.free.ravel()
     _, labels = connected_components(grid.graph, directed=False)
     start = flat & (np.abs(grid.centres) <= 0.3).all(axis=-1)
@@ -498,7 +558,17 @@ def generate_scenario(seed: int, index: int = 0) -> Scenario:
             if not _accessible(text, b.targets):
                 continue
         stature = float(rng.choice(STATURES))
-        return Scenario(name, text, stature, _specs(b, rng), int(seed))
+        pairs = _specs(b, rng)
+        # The same cell raised onto a platform, or written in the paper's frame: the
+        # labels do not change (the layout is the same).
+        if rng.random() < FLOOR_SHIFT_PROBABILITY or rng.random() < PAPER_FRAME_PROBABILITY:
+            data = yaml.safe_load(text)
+            if rng.random() < 0.5:
+                data = _shift_z(data, float(rng.choice([-0.4, 0.5, 1.2])))
+            else:
+                data = _to_paper_yup(data)
+            text = yaml.safe_dump(data, sort_keys=False)
+        return Scenario(name, text, stature, pairs, int(seed))
     raise RuntimeError(f"generator: no usable cell for seed {seed}, index {index}")
 
 
