@@ -858,6 +858,14 @@ class SequencePlanner:
             # once the worker stands still for a moment.
             self._stand_still(i, STAND_UP_IN_PLACE_SECONDS)
             return StepPlan(text, "standUp (standing)", None, expanded=0, primitive="stand")
+        return self._goal_step(i, text, kind, args, keep_hold, facing, expanded0)
+
+    def _goal_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
+                   keep_hold: bool, facing: np.ndarray | None, expanded0: int) -> StepPlan:
+        """A step done with a goal primitive (hand tasks, postures, sit): fetch the part
+        if needed, walk to the placement, make the primitive (trying the alternatives
+        when it is blocked) and follow its effect on the parts (see :meth:`_plan_step`;
+        ``expanded0``: nodes expanded before the step)."""
         subs = []
         if kind in ("move", "insert", "release") and args[0] not in self.held:
             # The part is fetched first, as for carry(O, R).
