@@ -95,6 +95,11 @@ FINAL_ADJUST_RADIUS = 0.05
 #: joints by a few millimetres.
 PLACED_MARGIN = 0.003
 
+#: Stride of the measured frames of an every-frame check, and the clearance below which
+#: those measurements are exact, metres (:func:`body_clear_every_frame`).
+CLEAR_STRIDE = 4
+CLEAR_EXACT = 0.1
+
 #: Searches run again after the path found collided on a frame the search did not
 #: sample (each forbids the colliding primitive at its pose).
 WALK_REPAIRS = 4
@@ -130,6 +135,10 @@ RELEASE_GAP = 0.01
 
 #: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
+
+#: Arm transitions by (stances, stature, rate, blend, carrying before) (see
+#: :meth:`SequencePlanner._arm_poses`).
+_ARM_POSES: dict[tuple, np.ndarray] = {}
 
 #: Tasks done with the hands: the arms are raised to the carry stance before them.
 HAND_TASKS = {"grasp", "release", "move", "insert", "extract", "leftHand", "rightHand",
@@ -245,6 +254,30 @@ class Plan:
     steps: list[StepPlan]
     start_pose: Pose
     expanded: int
+
+
+def body_clear_every_frame(world: np.ndarray, cell, stature: float) -> bool:
+    """Whether every frame of ``world`` (T, J, 3) keeps ``PLACED_MARGIN`` from the
+    obstacles, with exact capsule distances: every ``CLEAR_STRIDE``-th frame is measured
+    (exact up to ``CLEAR_EXACT``); the frames between two measured ones are measured too
+    unless the joints' travel between them proves them clear (a capsule's distance to an
+    obstacle changes by at most the largest joint displacement)."""
+    from ltl_human_motion.scene.predicates import body_clearance
+    T = len(world)
+    idx = np.unique(np.r_[np.arange(0, T, CLEAR_STRIDE), T - 1])
+    d = body_clearance(world[idx], cell, stature=stature, exact_below=CLEAR_EXACT)
+    if np.min(d) <= PLACED_MARGIN:
+        return False
+    step = np.sqrt(np.max(np.sum(np.diff(world, axis=0) ** 2, axis=-1), axis=-1))   # (T-1,)
+    travel = np.add.reduceat(step, idx[:-1]) if len(idx) > 1 else np.zeros(0)
+    # Within a gap, every frame is within the gap's travel of both ends.
+    safe = 0.5 * (d[:-1] + d[1:] - travel) > PLACED_MARGIN
+    todo = [np.arange(idx[k] + 1, idx[k + 1]) for k in np.flatnonzero(~safe)]
+    todo = np.concatenate(todo) if todo else np.zeros(0, dtype=int)
+    if not todo.size:
+        return True
+    return bool(np.min(body_clearance(world[todo], cell, stature=stature,
+                                      exact_below=0.01)) > PLACED_MARGIN)
 
 
 def lift_frame(mp: MotionPrimitive, hand: np.ndarray) -> int:
@@ -627,7 +660,29 @@ class SequencePlanner:
         The hands first come in to the body, then go to the other stance (two min-jerk
         legs), so they never sweep through a bench in front of the worker.
         """
+        rel = self._arm_poses(carrying_before)
+        root = np.zeros((len(rel), 4))
+        root[:, 2] = self.library.standing_height
+        mp = MotionPrimitive("arms_to_carry" if not carrying_before else "arms_to_walk", "wait",
+                             rel, root, self.library.fps, "planner: arm transition")
+        if not self._placed_clear(mp, self.pose) and not self._step_back(carrying_before,
+                                                                           label, mp):
+            raise PlanningError(f"bringing the arms {'down' if carrying_before else 'up'} at "
+                                f"({self.pose[0]:.2f}, {self.pose[1]:.2f}) hits an obstacle, "
+                                "also after a step back", reason="blocked")
+        self._add(mp, self.pose, label, self.overlap)
+
+    def _arm_poses(self, carrying_before: bool) -> np.ndarray:
+        """Root-relative poses (T, J, 3) of the arm transition (made once per library and
+        direction: it depends on nothing else)."""
         from ltl_human_motion.motion.ik import min_jerk
+        from ltl_human_motion.motion.retarget import enforce_bone_lengths
+        key = (self._stance(False).tobytes(), self._stance(True).tobytes(),
+               self.library.skeleton.stature, self.library.fps, self.overlap,
+               bool(carrying_before))
+        hit = _ARM_POSES.get(key)
+        if hit is not None:
+            return hit
         a, b = self._stance(carrying_before), self._stance(not carrying_before)
         carry, free = (a, b) if carrying_before else (b, a)
         tucked = carry.copy()
@@ -642,18 +697,12 @@ class SequencePlanner:
             legs.append(p[None] + s * (q - p)[None])
         # Straight joint paths shorten the arm bones; the pipeline restores their lengths
         # (moving the hands out), so the transition is checked as it will be played.
-        from ltl_human_motion.motion.retarget import enforce_bone_lengths
         rel = enforce_bone_lengths(np.concatenate([legs[0], legs[1][1:]]), self.library.skeleton)
-        root = np.zeros((len(rel), 4))
-        root[:, 2] = self.library.standing_height
-        mp = MotionPrimitive("arms_to_carry" if not carrying_before else "arms_to_walk", "wait",
-                             rel, root, self.library.fps, "planner: arm transition")
-        if not self._placed_clear(mp, self.pose) and not self._step_back(carrying_before,
-                                                                           label, mp):
-            raise PlanningError(f"bringing the arms {'down' if carrying_before else 'up'} at "
-                                f"({self.pose[0]:.2f}, {self.pose[1]:.2f}) hits an obstacle, "
-                                "also after a step back", reason="blocked")
-        self._add(mp, self.pose, label, self.overlap)
+        rel.flags.writeable = False
+        if len(_ARM_POSES) >= 32:
+            _ARM_POSES.clear()
+        _ARM_POSES[key] = rel
+        return rel
 
     def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = None,
                       world: np.ndarray | None = None) -> bool:
@@ -664,16 +713,20 @@ class SequencePlanner:
         from ltl_human_motion.scene.predicates import body_clearance, object_clearance
         if not self.cell.obstacles:
             return True
-        frames = np.arange(mp.n_frames) if samples is None else \
-            np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
-        if world is None and self.held:
-            world = world_positions(mp, *pose)
-        body = world_positions(mp, *pose, frames=frames) if world is None else world[frames]
-        # Only clearances up to the PLACED_MARGIN limit matter: those are exact.
-        d = body_clearance(body, self.cell, stature=self.library.skeleton.stature,
-                           exact_below=0.01)
-        if np.min(d) <= PLACED_MARGIN:
-            return False
+        stature = self.library.skeleton.stature
+        if samples is None:
+            world = world_positions(mp, *pose) if world is None else world
+            if not body_clear_every_frame(world, self.cell, stature):
+                return False
+        else:
+            frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
+            if world is None and self.held:
+                world = world_positions(mp, *pose)
+            body = world_positions(mp, *pose, frames=frames) if world is None else world[frames]
+            # Only clearances up to the PLACED_MARGIN limit matter: those are exact.
+            d = body_clearance(body, self.cell, stature=stature, exact_below=0.01)
+            if np.min(d) <= PLACED_MARGIN:
+                return False
         for name, joint in self.held.items():
             step = 1 if samples is None else 2
             centre = world[::step, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
