@@ -269,12 +269,24 @@ class ObstacleField:
         lo = np.min([b[0] for b in boxes], axis=0) - pad
         hi = np.max([b[1] for b in boxes], axis=0) + pad
         axes = [np.arange(lo[i], hi[i] + self.res, self.res) for i in range(3)]
-        gx, gy, gz = np.meshgrid(*axes, indexing="ij")
-        pts = np.stack([gx, gy, gz], axis=-1).reshape(-1, 3)
-        dist = np.min(np.stack([ob.distance(pts) for ob in cell.obstacles]), axis=0)
+        # Each part's distance is computed only within ``pad`` of its bounding box; beyond,
+        # the field holds ``pad`` (min(distance, pad) is 1-Lipschitz too, and every test
+        # of :meth:`clear` passes well below ``pad``). A large cell's grid has millions of
+        # points, most of them far from any one part.
+        dist = np.full([len(a) for a in axes], float(pad))
+        for ob in cell.obstacles:
+            for part in ob.parts:
+                plo, phi = part.aabb()
+                sl = tuple(slice(int(np.searchsorted(a, plo[i] - pad, side="left")),
+                                 int(np.searchsorted(a, phi[i] + pad, side="right")))
+                           for i, a in enumerate(axes))
+                sub = np.meshgrid(*(a[k] for a, k in zip(axes, sl)), indexing="ij")
+                pts = np.stack(sub, axis=-1).reshape(-1, 3)
+                if pts.size:
+                    dist[sl] = np.minimum(dist[sl], part.distance(pts).reshape(sub[0].shape))
         self.lo = lo
-        self.shape = np.array(gx.shape)
-        self.dist = dist.reshape(gx.shape)
+        self.shape = np.array(dist.shape)
+        self.dist = dist
         self.far = pad
         parts = [part.aabb() for ob in cell.obstacles for part in ob.parts]
         self.part_lo = np.array([b[0] for b in parts])          # (P, 3)
@@ -372,20 +384,48 @@ def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: 
         owner=clearance)
 
 
+_STAND_CACHE: dict[str, ClearanceMap] = {}
+
+
+def _layout_key(cell) -> str:
+    """A hash of the cell's workspace and obstacles (what the maps depend on)."""
+    import hashlib
+    import pickle
+    return hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, np.asarray(cell.workspace_lo),
+                                      np.asarray(cell.workspace_hi), cell.obstacles))
+                        ).hexdigest()
+
+
+def stand_clearance_map(cell) -> ClearanceMap:
+    """Floor clearance from every obstacle footprint with no allowance for tall parts.
+
+    Where a worker *stands* to reach (a goal primitive that is then checked exactly),
+    a tall rack or wall is as close as its footprint: the arms do not swing there. The
+    walking map (:func:`clearance_maps`) counts tall parts ``tall_extra`` closer. Kept in
+    memory per cell (cheap to build).
+    """
+    key = _layout_key(cell)
+    stand = _STAND_CACHE.get(key)
+    if stand is None:
+        stand = ClearanceMap(cell, tall_extra=0.0)
+        if len(_STAND_CACHE) >= 16:
+            _STAND_CACHE.pop(next(iter(_STAND_CACHE)))
+        _STAND_CACHE[key] = stand
+    return stand
+
+
 def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
     """The floor clearance map and 3D obstacle field of ``cell``, once per obstacle layout.
 
     Cached in memory and on disk (next to the motion library cache), keyed by a hash of
     the workspace and the obstacles; an unreadable cache file is rebuilt.
     """
-    import hashlib
     import pickle
     import zipfile
 
     from ltl_human_motion.atomic import atomic_write_with
     from ltl_human_motion.motion.library import cache_dir
-    key = hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, np.asarray(cell.workspace_lo),
-                                     np.asarray(cell.workspace_hi), cell.obstacles))).hexdigest()
+    key = _layout_key(cell)
     maps = _CLEARANCE_CACHE.get(key)
     if maps is not None:
         return maps

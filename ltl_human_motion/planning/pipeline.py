@@ -184,9 +184,13 @@ def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np
         contact = min(start + int(step.contact_frame or 0), T - 1)
         eff = step.objects_effect
         for name, joint in eff.get("attach", {}).items():
-            begin = spans[step.first_segment][0]
-            events.append((begin, order, "respawn", name, None))
-            events.append((contact, order, "attach", name, joint))
+            if name in eff.get("respawn", ()):      # a fresh part after one was assembled
+                events.append((spans[step.first_segment][0], order, "respawn", name, None))
+            events.append((contact, order, "grip", name, joint))
+            # The part rests on its support until the hand lifts it (a grasp's lift frame).
+            lift = contact if step.lift_frame is None else \
+                min(start + int(step.lift_frame), T - 1)
+            events.append((lift, order, "attach", name, joint))
         for name in eff.get("detach", []):
             events.append((contact, order, "detach", name, None))
         for name in eff.get("detach_after", []):
@@ -197,7 +201,7 @@ def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np
         mask = np.zeros(T, dtype=bool)
         current = supply[name].copy()
         joint: str | None = None
-        offset = np.zeros(3)
+        offset = grip = np.zeros(3)
         last = 0
         for frame, _, kind, obj, j in events:
             if obj != name:
@@ -209,10 +213,13 @@ def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np
                 mask[last:frame] = True
             if kind == "respawn" and joint is None:
                 current = supply[name].copy()
+            elif kind == "grip":
+                current = pos[frame - 1] if frame > 0 and joint is not None else current
+                grip = current - positions[frame, JOINT_INDEX[j]]
             elif kind == "attach":
                 current = pos[frame - 1] if frame > 0 and joint is not None else current
                 joint = j
-                offset = current - positions[frame, JOINT_INDEX[j]]
+                offset = grip
             elif kind == "detach" and joint is not None:
                 current = positions[frame, JOINT_INDEX[joint]] + offset
                 joint = None

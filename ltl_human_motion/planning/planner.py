@@ -19,8 +19,10 @@ where every grasp picks a new part from the floor.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -28,15 +30,115 @@ import numpy as np
 from ltl_human_motion.errors import PlanningError
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
-from ltl_human_motion.planning.astar import Goal, SearchBudget, SearchFailure, astar
+from ltl_human_motion.planning.astar import (
+    Goal,
+    SearchBudget,
+    SearchFailure,
+    astar,
+    placement_key,
+)
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.gait_index import gait_index
-from ltl_human_motion.planning.navigation import NavigationField, clearance_maps, floor_grid
+from ltl_human_motion.planning.navigation import (
+    NavigationField,
+    clearance_maps,
+    floor_grid,
+    stand_clearance_map,
+)
+from ltl_human_motion.planning.placement import RegionEntry
 
 Pose = tuple[float, float, float]
 
+#: How long ``standUp`` by a worker already standing stands still, seconds (a short,
+#: visible pause; the blends at both ends take 2 x overlap frames of it).
+STAND_UP_IN_PLACE_SECONDS = 0.4
+
+#: Height of the hand where a held part is let go, as a fraction of the stature (waist
+#: height: 0.75 m for a 1.75 m worker, the planner's value since the first release).
+RELEASE_HEIGHT = 0.75 / 1.75
+
+#: Places a part is let go at, (metres ahead of the root, turn from the heading in
+#: radians), tried in order: straight ahead at a forearm's length, then to either side
+#: and nearer the body when furniture stands in front.
+RELEASE_PLACES: tuple[tuple[float, float], ...] = (
+    (0.45, 0.0), (0.45, math.pi / 4), (0.45, -math.pi / 4), (0.4, math.pi / 2),
+    (0.4, -math.pi / 2), (0.3, 0.0))
+
+#: Seeded primitives tried at each alternative (release place, approach) after the first
+#: (the first gets ``PlannerOptions.goal_attempts``).
+ALTERNATIVE_ATTEMPTS = 2
+
+#: Other ways to stand for a reach whose motions all hit an obstacle, in order: (turn of
+#: the approach direction about the target, rad; extra distance from the target, m).
+#: First a step further back (a knee or thigh at a desk or low shelf front), then the
+#: target's other sides (an arm hitting a crate beside it).
+ALTERNATE_APPROACHES: tuple[tuple[float, float], ...] = (
+    (0.0, 0.08), (math.pi / 3, 0.0), (-math.pi / 3, 0.0))
+
+#: Node budget of the walk to an alternative approach (most are a few steps round the
+#: target; a side that needs a long way round is not worth the search).
+ALTERNATIVE_NODES = 500
+
+#: Node budget of the walk to the side of a seat that faces the seated work (without
+#: it the worker sits facing whichever way the walk arrives).
+FACING_NODES = 600
+
+#: Half width of the side of the target an alternative approach walks to, rad.
+APPROACH_HALF_WIDTH = math.pi / 6
+
+#: Step left to the standing adjustment when the first one from where a walk ended was
+#: not clear: the walk goes on to a spot that needs almost none, metres.
+FINAL_ADJUST_RADIUS = 0.05
+
+#: Clearance (m) the planner keeps between the body and obstacles on the frames it
+#: checks exactly: the verifier allows none below 0; blends between segments move
+#: joints by a few millimetres.
+PLACED_MARGIN = 0.003
+
+#: Stride of the measured frames of an every-frame check, and the clearance below which
+#: those measurements are exact, metres (:func:`body_clear_every_frame`).
+CLEAR_STRIDE = 4
+CLEAR_EXACT = 0.1
+
+#: Searches run again after the path found collided on a frame the search did not
+#: sample (each forbids the colliding primitive at its pose).
+WALK_REPAIRS = 4
+
+#: Backward steps tried (m) to leave a spot closer to an obstacle than walking allows,
+#: and the clearance beyond ``PlannerOptions.body_radius`` the step must reach (m).
+STEP_OUT_DISTANCES: tuple[float, ...] = (0.1, 0.2, 0.3)
+STEP_OUT_MARGIN = 0.02
+
+#: Hand tasks a seated worker does from the seat (others make the worker stand up).
+SEATED_HAND_TASKS = ("leftHand", "rightHand", "assemble")
+
+#: How far the gripping hand rises before a grasped part counts as lifted off its
+#: support (a part resting on a table touches it until then), metres.
+LIFT_RISE = 0.001
+
+#: Tasks done where the worker stands (no target); when furniture there blocks them,
+#: the worker first walks to a spot with ``IN_PLACE_ROOM`` of floor clearance.
+IN_PLACE_TASKS = ("bend", "stoop", "kneel", "wait")
+
+#: Floor clearance around the root a kneel or stoop needs, metres (the knee goes about
+#: 0.5 m ahead of the root and the head as far when stooping, plus a hand's width).
+IN_PLACE_ROOM = 0.6
+
+#: Tops of furniture a released part is set down on: up to this fraction of the stature
+#: (1.2 m at 1.75 m, about chest height: higher tops are shelves out of a natural
+#: put-down).
+RELEASE_SURFACE_MAX = 1.2 / 1.75
+
+#: Gap between a part set down and the surface under it when it is let go, metres (the
+#: cells' parts rest 1 cm above their tables).
+RELEASE_GAP = 0.01
+
 #: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
+
+#: Arm transitions by (stances, stature, rate, blend, carrying before) (see
+#: :meth:`SequencePlanner._arm_poses`).
+_ARM_POSES: dict[tuple, np.ndarray] = {}
 
 #: Tasks done with the hands: the arms are raised to the carry stance before them.
 HAND_TASKS = {"grasp", "release", "move", "insert", "extract", "leftHand", "rightHand",
@@ -113,6 +215,9 @@ class StepPlan:
         Index of the goal segment in the segment list.
     contact_frame : int or None
         Frame of the goal primitive where the task condition first holds.
+    lift_frame : int or None
+        For a grasp: the frame of the goal primitive from which the part is carried (it
+        rests on its support until the hand lifts it, :func:`lift_frame`).
     hand : str or None
     expanded : int
         A* nodes expanded for this step.
@@ -133,6 +238,7 @@ class StepPlan:
     first_segment: int = 0
     last_segment: int = 0
     contact_frame: int | None = None
+    lift_frame: int | None = None
     hand: str | None = None
     expanded: int = 0
     primitive: str = ""
@@ -148,6 +254,50 @@ class Plan:
     steps: list[StepPlan]
     start_pose: Pose
     expanded: int
+
+
+def body_clear_every_frame(world: np.ndarray, cell, stature: float) -> bool:
+    """Whether every frame of ``world`` (T, J, 3) keeps ``PLACED_MARGIN`` from the
+    obstacles, with exact capsule distances: every ``CLEAR_STRIDE``-th frame is measured
+    (exact up to ``CLEAR_EXACT``); the frames between two measured ones are measured too
+    unless the joints' travel between them proves them clear (a capsule's distance to an
+    obstacle changes by at most the largest joint displacement)."""
+    from ltl_human_motion.scene.predicates import body_clearance
+    T = len(world)
+    idx = np.unique(np.r_[np.arange(0, T, CLEAR_STRIDE), T - 1])
+    d = body_clearance(world[idx], cell, stature=stature, exact_below=CLEAR_EXACT)
+    if np.min(d) <= PLACED_MARGIN:
+        return False
+    step = np.sqrt(np.max(np.sum(np.diff(world, axis=0) ** 2, axis=-1), axis=-1))   # (T-1,)
+    travel = np.add.reduceat(step, idx[:-1]) if len(idx) > 1 else np.zeros(0)
+    # Within a gap, every frame is within the gap's travel of both ends.
+    safe = 0.5 * (d[:-1] + d[1:] - travel) > PLACED_MARGIN
+    todo = [np.arange(idx[k] + 1, idx[k + 1]) for k in np.flatnonzero(~safe)]
+    todo = np.concatenate(todo) if todo else np.zeros(0, dtype=int)
+    if not todo.size:
+        return True
+    return bool(np.min(body_clearance(world[todo], cell, stature=stature,
+                                      exact_below=0.01)) > PLACED_MARGIN)
+
+
+def lift_frame(mp: MotionPrimitive, hand: np.ndarray) -> int:
+    """The frame of a grasp primitive from which the part is carried: the first frame
+    after the hold where the hand has risen ``LIFT_RISE`` above its contact height (the
+    part rests on its support until then). The contact frame if the hand never rises.
+
+    Parameters
+    ----------
+    mp : MotionPrimitive
+        With ``meta["contact_frame"]`` and ``meta["hold_frames"]``.
+    hand : ndarray, shape (T, 3)
+        The gripping hand joint over the primitive's frames.
+    """
+    contact = int(mp.meta.get("contact_frame", 0))
+    if contact >= len(hand):
+        return contact
+    hold_end = max(int(mp.meta.get("hold_frames", [contact, contact])[1]), contact)
+    rose = np.flatnonzero(hand[hold_end:, 2] >= hand[contact, 2] + LIFT_RISE)
+    return hold_end + int(rose[0]) if rose.size else contact
 
 
 def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, tuple[str, ...]]:
@@ -187,18 +337,17 @@ class SequencePlanner:
         self.rng = rng
         self.options = options
         self.clearance, self.obstacle_field = clearance_maps(cell)
+        self.stand_map = stand_clearance_map(cell)
         self.overlap = int(library.overlap)
         self.segments: list[PlacedSegment] = []
         self.steps: list[StepPlan] = []
         self.pose: Pose = (0.0, 0.0, 0.0)
         self.gait_state: int | None = None          # None = standing
-        self.seated = False
+        self.seat: np.ndarray | None = None          # the seat sat on (3,); None: standing
         self.held: dict[str, str] = {}               # object -> hand joint
         self.consumed: set[str] = set()
-        self._wait_seconds: float | None = None
-        self.grasp_object: str | None = None
+        self.object_at: dict[str, np.ndarray] = {}   # where parts were put down (3,)
         self.held_offsets: dict[str, np.ndarray] = {}
-        self._carry_stance = False
         self._back_limit = options.reach_tolerance
         self._backs: dict[float, np.ndarray] = {}     # step-back distances per limit
         self.expanded = 0
@@ -212,17 +361,25 @@ class SequencePlanner:
             return np.asarray(cell.region(args[-1]).center, dtype=np.float64)
         if kind in ("grasp",):
             obj = cell.object(args[0])
-            return np.asarray(obj.grasp_points_at(obj.position)[0], dtype=np.float64)
+            return np.asarray(obj.grasp_points_at(self.object_position(args[0]))[0],
+                              dtype=np.float64)
         if kind in ("move",):
             return np.asarray(cell.region(args[1]).center, dtype=np.float64)
         if kind in ("insert", "extract"):
-            return np.asarray(cell.object(args[1]).position, dtype=np.float64)
+            return self.object_position(args[1])
         if kind in ("leftHand", "rightHand", "assemble"):
             return np.asarray(cell.region(args[0]).center, dtype=np.float64)
         if kind == "sit":
             obj = cell.object(args[0])
             return np.asarray(obj.sitting_surface_at(obj.position).center, dtype=np.float64)
         return None
+
+    def object_position(self, name: str) -> np.ndarray:
+        """Where object ``name`` rests now (3,): where the last step put it down, else its
+        supply position in the cell."""
+        at = self.object_at.get(name)
+        return np.asarray(self.cell.object(name).position if at is None else at,
+                          dtype=np.float64)
 
     def _placement(self, kind: str, target: np.ndarray, task: str) -> tuple[float, float]:
         """Where the target should be in the standing root's frame: (ahead, left), metres."""
@@ -292,32 +449,48 @@ class SequencePlanner:
         px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)
         py = target[1] - (s[..., None] * (d + back) + c[..., None] * lat)
         pts = np.stack([px, py], axis=-1).reshape(-1, 2)
-        if room:
-            pts = np.concatenate([pts, np.stack([x, y], axis=-1).reshape(-1, 2)])
-        clear = self._clearance(pts)
-        free = clear[:px.size].reshape(px.shape) > self.options.stand_clearance
+        free = self.stand_map(pts).reshape(px.shape) > self.options.stand_clearance
         k = np.argmax(free, axis=-1)
         pick = np.take_along_axis
         out = (pick(px, k[..., None], -1)[..., 0], pick(py, k[..., None], -1)[..., 0], yaw,
                free.any(axis=-1))
-        return (*out, clear[px.size:].reshape(np.shape(x))) if room else out
+        if not room:
+            return out
+        return (*out, self._clearance(np.stack([x, y], axis=-1).reshape(-1, 2)
+                                      ).reshape(np.shape(x)))
 
     def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
-                    task: str) -> Goal:
-        """Walk until a standing adjustment (a step of at most ``adjust_radius`` and a
-        turn) puts the worker where the goal primitive reaches the target."""
+                    task: str, adjust: float | None = None,
+                    sector: tuple[float, float] | None = None) -> Goal:
+        """Walk until a standing adjustment (a step of at most ``adjust``, default
+        ``options.adjust_radius``, and a turn) puts the worker where the goal primitive
+        reaches the target; with ``sector`` (direction from the target, half width, rad)
+        only from that side."""
         tx, ty = float(target[0]), float(target[1])
+
+        def side(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+            if sector is None:
+                return np.ones(np.shape(x), dtype=bool)
+            return np.abs(wrap_angle(np.arctan2(y - ty, x - tx) - sector[0])) <= sector[1]
+
         tol = self.options.reach_tolerance
         dist = float(np.hypot(*placement))
         offset = float(np.arctan2(placement[1], placement[0]))
-        adjust = self.options.adjust_radius
+        adjust = self.options.adjust_radius if adjust is None else float(adjust)
 
         def ring(xy: np.ndarray) -> np.ndarray:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
-            out = (r >= dist - tol) & (r <= dist + self._back_limit)
+            out = (r >= dist - tol) & (r <= dist + self._back_limit) & side(xy[:, 0], xy[:, 1])
             # The floor clearance only where the distance fits (few of the cells).
-            out[out] = self._clearance(xy[out]) > self.options.stand_clearance
+            out[out] = self.stand_map(xy[out]) > self.options.stand_clearance
             return out
+
+        def near_ring(xy: np.ndarray) -> np.ndarray:
+            # Where a walk may end to step in (a rack: the walking map keeps tall
+            # parts further off than a worker standing at them needs).
+            r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
+            return ((r >= dist - tol) & (r <= dist + self._back_limit + adjust)
+                    & side(xy[:, 0], xy[:, 1]))
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             px, py, pyaw, free, here = self._ideal_placement(target, placement, x, y,
@@ -325,19 +498,21 @@ class SequencePlanner:
             # Turning on the spot needs room for the hips; facing nearly right needs none.
             room = here > self.options.turn_clearance
             facing = np.abs(wrap_angle(pyaw - yaw)) <= self.options.heading_tolerance
-            return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing)
+            return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing) & side(x, y)
 
         # Stand within the reach tolerance where possible; only where an obstacle leaves
         # no such place (a tall worker at a bench) stand up to max_step_back further.
         def ring_key() -> tuple:
             return ("ring", tx, ty, dist, tol, float(self._back_limit),
-                    float(self.options.stand_clearance))
+                    float(self.options.stand_clearance), sector)
 
         self._back_limit = tol
         field = self._field(ring, ring_key())
         if not field.has_goal:
             self._back_limit = self.options.max_step_back
             field = self._field(ring, ring_key())
+        if not field.has_goal:
+            field = self._field(near_ring, ("near", *ring_key(), adjust))
         goal = self._goal_from_field(field, reached, desc, task)
         base_heading = field.heading
 
@@ -358,7 +533,7 @@ class SequencePlanner:
         x, y, yaw = self.pose
         px, py, pyaw, _ = (float(v[0]) for v in self._ideal_placement(
             target, placement, np.array([x]), np.array([y])))
-        carrying = bool(self.held) or self._carry_stance
+        carrying = bool(self.held)
         back_dir = np.array([math.cos(pyaw), math.sin(pyaw)])
         c, s = math.cos(yaw), math.sin(yaw)
         stance = self._stance(carrying)
@@ -397,20 +572,28 @@ class SequencePlanner:
         return False
 
     def _region_goal(self, region, desc: str, task: str) -> Goal:
-        lo, hi = np.asarray(region.lo, dtype=float), np.asarray(region.hi, dtype=float)
-        margin = 0.15
+        """Walk until the standing body enters ``region`` (the verifier's predicate).
 
-        def gap(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-            gx = np.maximum(np.maximum(lo[0] - x, x - hi[0]), 0.0)
-            gy = np.maximum(np.maximum(lo[1] - y, y - hi[1]), 0.0)
-            return np.hypot(gx, gy)
+        The goal cells of the heuristic are the spots with room to turn
+        (``turn_clearance``) from which the standing body enters the region facing some
+        heading; none (a region above a bench, beside a wall) makes the region
+        unreachable on foot (the caller reaches into it by hand).
+        """
+        from ltl_human_motion.scene.occupancy import capsule_radii
+        stature = self.library.skeleton.stature
+        carrying = bool(self.held)
+        entry = RegionEntry(region, self._stance(carrying), self.library.standing_height,
+                            stature, float(capsule_radii(stature).max()))
+        room = self.options.turn_clearance
 
-        def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-            return gap(x, y) <= margin
+        def cells(xy: np.ndarray) -> np.ndarray:
+            out = entry.cells(xy)
+            out[out] = self._clearance(xy[out]) > room
+            return out
 
-        field = self._field(lambda xy: gap(xy[:, 0], xy[:, 1]) <= margin,
-                            ("region", *lo[:2].tolist(), *hi[:2].tolist(), margin))
-        return self._goal_from_field(field, reached, desc, task)
+        field = self._field(cells, ("region", *entry.lo.tolist(), *entry.hi.tolist(),
+                                    stature, carrying, room))
+        return self._goal_from_field(field, entry.enters, desc, task)
 
     # ---------------------------------------------------------------- segments
     def _add(self, mp: MotionPrimitive, pose: Pose, label: int, blend: int) -> int:
@@ -446,6 +629,27 @@ class SequencePlanner:
                 out[sel] = self.obstacle_field.clear(poses[sel], stature, relative=rel)
         return out
 
+    def _sit_still(self, seconds: float) -> MotionPrimitive:
+        """A wait on the seat: the seated pose held (the standing wait model would rebuild
+        the legs for standing)."""
+        pose = self._seated_pose()
+        n = max(round(seconds * self.library.fps), self.overlap + 2)
+        root = np.zeros((n, 4))
+        root[:, :3] = pose[0]
+        rel = np.repeat((pose - pose[0])[None], n, axis=0)
+        return MotionPrimitive(f"sit_still_{seconds:.2f}s", "wait", rel, root,
+                               self.library.fps, "planner: seated wait",
+                               meta={"contact_frame": n - 1, "hand": "none"})
+
+    def _seated_pose(self) -> np.ndarray:
+        """The last frame placed (the worker seated), in the start frame of the current
+        pose (root floor point at the origin, facing +x; heights above the floor), (J, 3)."""
+        x, y, yaw = self.pose
+        last = self.segments[-1].positions[-1]
+        c, s = math.cos(-yaw), math.sin(-yaw)
+        dx, dy = last[:, 0] - x, last[:, 1] - y
+        return np.stack([c * dx - s * dy, s * dx + c * dy, last[:, 2]], axis=-1)
+
     def _stance(self, carrying: bool) -> np.ndarray:
         lib = self.library
         return np.asarray(lib.carry_standing_pose if carrying else lib.standing_pose)
@@ -456,7 +660,29 @@ class SequencePlanner:
         The hands first come in to the body, then go to the other stance (two min-jerk
         legs), so they never sweep through a bench in front of the worker.
         """
+        rel = self._arm_poses(carrying_before)
+        root = np.zeros((len(rel), 4))
+        root[:, 2] = self.library.standing_height
+        mp = MotionPrimitive("arms_to_carry" if not carrying_before else "arms_to_walk", "wait",
+                             rel, root, self.library.fps, "planner: arm transition")
+        if not self._placed_clear(mp, self.pose) and not self._step_back(carrying_before,
+                                                                           label, mp):
+            raise PlanningError(f"bringing the arms {'down' if carrying_before else 'up'} at "
+                                f"({self.pose[0]:.2f}, {self.pose[1]:.2f}) hits an obstacle, "
+                                "also after a step back", reason="blocked")
+        self._add(mp, self.pose, label, self.overlap)
+
+    def _arm_poses(self, carrying_before: bool) -> np.ndarray:
+        """Root-relative poses (T, J, 3) of the arm transition (made once per library and
+        direction: it depends on nothing else)."""
         from ltl_human_motion.motion.ik import min_jerk
+        from ltl_human_motion.motion.retarget import enforce_bone_lengths
+        key = (self._stance(False).tobytes(), self._stance(True).tobytes(),
+               self.library.skeleton.stature, self.library.fps, self.overlap,
+               bool(carrying_before))
+        hit = _ARM_POSES.get(key)
+        if hit is not None:
+            return hit
         a, b = self._stance(carrying_before), self._stance(not carrying_before)
         carry, free = (a, b) if carrying_before else (b, a)
         tucked = carry.copy()
@@ -469,57 +695,139 @@ class SequencePlanner:
             n = max(round(0.3 * self.library.fps), self.overlap + 2)
             s = min_jerk(np.linspace(0.0, 1.0, n))[:, None, None]
             legs.append(p[None] + s * (q - p)[None])
-        rel = np.concatenate([legs[0], legs[1][1:]])
-        root = np.zeros((len(rel), 4))
-        root[:, 2] = self.library.standing_height
-        mp = MotionPrimitive("arms_to_carry" if not carrying_before else "arms_to_walk", "wait",
-                             rel, root, self.library.fps, "planner: arm transition")
-        if not self._placed_clear(mp, self.pose):
-            self._step_back(carrying_before, label)
-        self._add(mp, self.pose, label, self.overlap)
+        # Straight joint paths shorten the arm bones; the pipeline restores their lengths
+        # (moving the hands out), so the transition is checked as it will be played.
+        rel = enforce_bone_lengths(np.concatenate([legs[0], legs[1][1:]]), self.library.skeleton)
+        rel.flags.writeable = False
+        if len(_ARM_POSES) >= 32:
+            _ARM_POSES.clear()
+        _ARM_POSES[key] = rel
+        return rel
 
-    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int = 16,
+    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = None,
                       world: np.ndarray | None = None) -> bool:
         """Whether ``mp`` placed at ``pose`` keeps the body and the objects held (at their
         hand offsets) clear of every obstacle, checked with the exact distances on
-        ``samples`` frames (these checks are few). ``world``: ``world_positions(mp,
-        *pose)`` if already made."""
+        ``samples`` frames (None: every frame, as the verifier checks). ``world``:
+        ``world_positions(mp, *pose)`` if already made."""
         from ltl_human_motion.scene.predicates import body_clearance, object_clearance
         if not self.cell.obstacles:
             return True
-        frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
-        if world is None and self.held:
-            world = world_positions(mp, *pose)
-        body = world_positions(mp, *pose, frames=frames) if world is None else world[frames]
-        # Only clearances up to the 3 mm limit matter: those are exact.
-        d = body_clearance(body, self.cell, stature=self.library.skeleton.stature,
-                           exact_below=0.01)
-        if np.min(d) <= 0.003:
-            return False
+        stature = self.library.skeleton.stature
+        if samples is None:
+            world = world_positions(mp, *pose) if world is None else world
+            if not body_clear_every_frame(world, self.cell, stature):
+                return False
+        else:
+            frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
+            if world is None and self.held:
+                world = world_positions(mp, *pose)
+            body = world_positions(mp, *pose, frames=frames) if world is None else world[frames]
+            # Only clearances up to the PLACED_MARGIN limit matter: those are exact.
+            d = body_clearance(body, self.cell, stature=stature, exact_below=0.01)
+            if np.min(d) <= PLACED_MARGIN:
+                return False
         for name, joint in self.held.items():
-            centre = world[::2, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
+            step = 1 if samples is None else 2
+            centre = world[::step, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
             if np.any(object_clearance(self.cell, name, centre) <= 0.0):
                 return False
         return True
 
-    def _step_back(self, carrying: bool, label: int) -> None:
-        """Step back from an obstacle in front (a step primitive of the gait index)."""
-        task = "carry" if carrying else "walk"
-        for _j, mp in enumerate(self.index.primitives):
-            if mp.task == task and mp.meta.get("step") == [-0.3, 0.0] and not mp.meta.get("turn"):
-                self._add(mp, self.pose, label, self.overlap)
+    def _step_out(self) -> None:
+        """Step back onto walkable floor if the worker stands closer to an obstacle than a
+        walk may start (at a rack, where reaching allowed it): the search could not
+        leave the spot otherwise."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        x, y, yaw = self.pose
+        need = self.options.body_radius + STEP_OUT_MARGIN
+        if float(self._clearance(np.array([[x, y]]))[0]) > need:
+            return
+        carrying = bool(self.held)
+        lib = self.library
+        c, s = math.cos(yaw), math.sin(yaw)
+        for back in STEP_OUT_DISTANCES:
+            if float(self._clearance(np.array([[x - back * c, y - back * s]]))[0]) <= need:
+                continue
+            mp = make_step_primitive(self._stance(carrying), lib.standing_height, -back, 0.0,
+                                     0.0, lib.skeleton, lib.fps,
+                                     "carry" if carrying else "walk")
+            if self._placed_clear(mp, self.pose, samples=None):
+                self._add(mp, self.pose, -1, self.overlap)
                 self.pose = self._hand_over_pose(mp, self.pose)
                 return
 
-    def _walk(self, goal: Goal, task: str, label: int, carry: bool) -> int:
-        """A* from the current pose; appends the gait segments; returns their count."""
-        res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
-                    clearance=self._clearance, body_radius=self.options.body_radius,
-                    heuristic_speed=self.options.heuristic_speed,
-                    turn_rate=self.options.turn_rate, carry=carry,
-                    budget=self.options.budget, rng=self.rng,
-                    cost_noise=self.options.cost_noise, body_clear=self._body_clear)
-        self.expanded += res.expanded
+    def _first_collision(self, primitives: list[int], poses: list[Pose]) -> int | None:
+        """Index of the first gait primitive of a path that comes within the planner's
+        margin of an obstacle on any frame (body or held parts), or None; what
+        :meth:`_placed_clear` checks on every frame, in one pass over the whole path."""
+        from ltl_human_motion.scene.predicates import body_clearance, object_clearance
+        if not self.cell.obstacles or not primitives:
+            return None
+        worlds = [world_positions(self.index.primitives[p], *pose)
+                  for p, pose in zip(primitives, poses)]
+        ends = np.cumsum([len(w) for w in worlds])
+        world = np.concatenate(worlds)
+        bad = body_clearance(world, self.cell, stature=self.library.skeleton.stature,
+                             exact_below=0.01) <= PLACED_MARGIN
+        for name, joint in self.held.items():
+            centre = world[:, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
+            bad |= object_clearance(self.cell, name, centre) <= 0.0
+        if not bad.any():
+            return None
+        return int(np.searchsorted(ends, int(np.argmax(bad)), side="right"))
+
+    def _step_back(self, carrying: bool, label: int, then: MotionPrimitive) -> bool:
+        """Step back from an obstacle in front so that ``then`` is clear afterwards: the
+        gait index's 0.3 m step back, else a model-made step of ``STEP_OUT_DISTANCES``.
+        Returns False (nothing added) when no step and ``then`` are both clear."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        task = "carry" if carrying else "walk"
+        steps = [mp for mp in self.index.primitives
+                 if mp.task == task and mp.meta.get("step") == [-0.3, 0.0]
+                 and not mp.meta.get("turn")][:1]
+        lib = self.library
+        steps += [make_step_primitive(self._stance(carrying), lib.standing_height, -back, 0.0,
+                                      0.0, lib.skeleton, lib.fps, task)
+                  for back in STEP_OUT_DISTANCES]
+        for mp in steps:
+            pose = self._hand_over_pose(mp, self.pose)
+            if self._placed_clear(mp, self.pose) and self._placed_clear(then, pose):
+                self._add(mp, self.pose, label, self.overlap)
+                self.pose = pose
+                return True
+        return False
+
+    def _walk(self, goal: Goal, task: str, label: int, carry: bool,
+              budget: SearchBudget | None = None) -> int:
+        """A* from the current pose; appends the gait segments; returns their count.
+
+        The search checks the body on sampled frames of a distance grid; every frame of
+        the path it returns is then checked as the verifier does (exact capsules, held
+        parts). A primitive that collides is forbidden from its pose and the search runs
+        again (at most ``WALK_REPAIRS`` times)."""
+        forbidden: set[tuple[int, int, int, int]] = set()
+        noise_state = self.rng.bit_generator.state
+        for _repair in range(WALK_REPAIRS + 1):
+            self.rng.bit_generator.state = noise_state      # the same costs every time
+            res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
+                        clearance=self._clearance, body_radius=self.options.body_radius,
+                        heuristic_speed=self.options.heuristic_speed,
+                        turn_rate=self.options.turn_rate, carry=carry,
+                        budget=budget or self.options.budget, rng=self.rng,
+                        cost_noise=self.options.cost_noise, body_clear=self._body_clear,
+                        forbidden=frozenset(forbidden))
+            self.expanded += res.expanded
+            if isinstance(res, SearchFailure):
+                break
+            bad = self._first_collision(res.primitives, res.poses)
+            if bad is None:
+                break
+            forbidden.add((res.primitives[bad], *placement_key(*res.poses[bad])))
+        else:
+            raise PlanningError(f"task {task}: {goal.description}: every path found "
+                                f"({WALK_REPAIRS + 1}) collides on a frame the search did "
+                                "not sample", task=task, reason="blocked")
         if isinstance(res, SearchFailure):
             if res.reason == "budget":
                 why = (f"the search budget ran out ({res.expanded} nodes; closest approach "
@@ -544,101 +852,160 @@ class SequencePlanner:
         for i, (text, name, args) in enumerate(tasks):
             kind, args = task_kind(name, args, self.cell.shorthands)
             first = len(self.segments)
-            step = self._plan_step(i, text, kind, args)
+            facing = self._seated_work(tasks[i + 1:]) if kind == "sit" else None
+            step = self._plan_step(i, text, kind, args, facing=facing)
             step.first_segment = first
             step.last_segment = len(self.segments) - 1
             self.steps.append(step)
-        self._stand_still(-1, 0.3)
+        if self.seat is None:
+            self._stand_still(-1, 0.3)
+        else:                                # the motion ends seated: stay on the seat
+            self._add(self._sit_still(0.3), self.pose, -1, self.overlap)
         return Plan(self.segments, self.steps, start, self.expanded)
 
-    def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...]) -> StepPlan:
+    def _seated_work(self, rest: list[tuple[str, str, tuple[str, ...]]]) -> np.ndarray | None:
+        """Target (3,) of the first hand task done seated after a sit (the tasks in
+        ``rest``, up to the first that needs standing), or None."""
+        for _text, name, args in rest:
+            kind, args = task_kind(name, args, self.cell.shorthands)
+            if kind in SEATED_HAND_TASKS:
+                return self.target_of(kind, args)
+            if kind != "wait":
+                return None
+        return None
+
+    def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
+                   keep_hold: bool = False, facing: np.ndarray | None = None) -> StepPlan:
+        """Plan step ``i`` (``text``) as the goal task ``kind``; ``keep_hold``: a part a
+        move puts into its region stays in hand (carry); ``facing``: for sit, where the
+        seated worker will work (sit facing it)."""
         expanded0 = self.expanded
-        if self.seated and kind not in ("standUp", "wait", "leftHand", "rightHand",
-                                        "assemble", "sit"):
-            self._goal_segment("standUp", None, -1, text)
-            self.seated = False
-        if kind in ("walk", "carry"):
+        if self.seat is None:
+            self._step_out()
+        if self.seat is not None and kind not in ("standUp", "wait", "sit", *SEATED_HAND_TASKS):
+            self._goal_segment("standUp", self.seat, -1, text)
+            self.seat = None
+        if kind == "carry":
+            # carry(O, R) holds when the body enters R with O inside it: the held part is
+            # put into R by hand (so the palm enters R too), and it stays in hand.
+            step = self._plan_step(i, text, "move", args, keep_hold=True)
+            return replace(step, kind="carry (by move)")
+        if kind == "walk":
             region = self.cell.region(args[-1])
-            subs = [self._fetch(i, args[0])] if kind == "carry" and args[0] not in self.held \
-                else []
+            subs: list[StepPlan] = []
             try:
                 goal = self._region_goal(region, f"walk into {region.name}", text)
             except PlanningError as exc:
                 if exc.reason != "unreachable":
                     raise
                 # Nowhere to stand in the region (e.g. a box above a bench). Its entry,
-                # enter(x, R), holds once any body part is in it: reach in with a hand, or
-                # for carry(O, R) put the held part in it.
-                step = self._reach_into(i, text, kind, args, exc)
-                step.sub_steps[:0] = subs
-                return step
+                # enter(x, R), holds once any body part is in it: reach in with a hand.
+                return self._reach_into(i, text, args, exc)
             n = self._walk(goal, text, i, carry=bool(self.held))
             self._stand_still(i, 0.25)
             return StepPlan(text, kind, np.asarray(region.center, dtype=float), walk_segments=n,
                             expanded=self.expanded - expanded0,
                             primitive=f"{n} gait primitives", sub_steps=subs)
+        if kind == "standUp" and self.seat is None:
+            # Already standing (every bend, stoop and kneel ends upright): standUp holds
+            # once the worker stands still for a moment.
+            self._stand_still(i, STAND_UP_IN_PLACE_SECONDS)
+            return StepPlan(text, "standUp (standing)", None, expanded=0, primitive="stand")
+        return self._goal_step(i, text, kind, args, keep_hold, facing, expanded0)
+
+    def _goal_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
+                   keep_hold: bool, facing: np.ndarray | None, expanded0: int) -> StepPlan:
+        """A step done with a goal primitive (hand tasks, postures, sit): fetch the part
+        if needed, walk to the placement, make the primitive (trying the alternatives
+        when it is blocked) and follow its effect on the parts (see :meth:`_plan_step`;
+        ``expanded0``: nodes expanded before the step)."""
         subs = []
-        if kind in ("move", "insert") and args[0] not in self.held:
+        if kind in ("move", "insert", "release") and args[0] not in self.held:
             # The part is fetched first, as for carry(O, R).
             subs.append(self._fetch(i, args[0]))
-        target = self.target_of(kind, args)
-        if kind == "grasp" and args[0] in self.consumed:
+        respawn = kind == "grasp" and args[0] in self.consumed
+        if respawn:
             self.consumed.discard(args[0])           # a fresh part from the supply
+            self.object_at.pop(args[0], None)
+        target = self.seat if kind == "standUp" else self.target_of(kind, args)
+        if kind in ("move", "insert") and args[0] in self.held_offsets:
+            # The hand puts the part's centre (held at its offset) on the target.
+            target = target - self.held_offsets[args[0]]
         walked = 0
-        if target is not None and kind != "release":
+        placement = None
+        if target is not None and kind not in ("release", "standUp") and self.seat is None:
+            # (Seated, the hands work from the seat.)
             placement = self._placement(kind, target, text)
-            goal = self._reach_goal(target, placement, f"reach {text} at "
-                                    f"({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})", text)
-            walked = self._walk(goal, text, -1, carry=bool(self.held))
-            if not self._adjust_to(target, placement, text):
-                # No clear step from where the walk ended: walk on to a spot that needs
-                # (almost) none.
-                adjust = self.options.adjust_radius
-                self.options = replace(self.options, adjust_radius=0.05)
-                try:
-                    goal = self._reach_goal(target, placement, goal.description, text)
-                    walked += self._walk(goal, text, -1, carry=bool(self.held))
-                finally:
-                    self.options = replace(self.options, adjust_radius=adjust)
-                self._adjust_to(target, placement, text)
-        if kind == "release":
-            obj = args[0]
-            c, s = math.cos(self.pose[2]), math.sin(self.pose[2])
-            height = 0.75 * self.library.skeleton.stature / 1.75
-            target = np.array([self.pose[0] + 0.45 * c, self.pose[1] + 0.45 * s, height])
-            if obj not in self.held:
-                raise PlanningError(f"task {text}: {obj} is not held, so it cannot be "
-                                    "released", task=text, reason="precondition")
+            walked = self._approach_facing(target, placement, text, facing)
         carrying_before = bool(self.held)
-        if kind in HAND_TASKS and not carrying_before:
+        raised = kind in HAND_TASKS and not carrying_before and self.seat is None
+        if raised:
             # Raise the arms to the carry stance first: hands then reach from the chest
             # (and a grasped part comes up to it) instead of swinging up from the thighs
             # past the edge of the surface in front.
             self._arm_transition(False, -1)
             carrying_before = True
-            self._carry_stance = True
-        self._wait_seconds = float(args[0]) if kind == "wait" and args else None
-        self.grasp_object = args[0] if kind == "grasp" else None
-        seg, mp = self._goal_segment(kind, target, i, text)
-        self._carry_stance = False
+        tries = self._alternatives(kind, args, target, placement, text, raised)
+        failure = None
+        for k, (target, prepare) in enumerate(tries):
+            try:
+                if prepare is not None:
+                    walked += prepare()
+                seg, mp = self._goal_segment(
+                    kind, target, i, text, carry_stance=carrying_before,
+                    seconds=float(args[0]) if kind == "wait" and args else None,
+                    grasped=args[0] if kind == "grasp" else None,
+                    attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
+                break
+            except PlanningError as exc:
+                if k == 0 and exc.reason != "blocked":
+                    raise
+                failure = failure or exc       # an alternative may fail in any way
+        else:
+            if len(tries) == 1:
+                raise failure
+            raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements "
+                                "tried", task=text, reason="blocked")
         hand = mp.meta.get("hand")
-        effect = self._apply_effects(kind, args, hand)
-        contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
-        for name, joint in effect.get("attach", {}).items():
-            # As the object tracks are made: the part keeps its world offset from the hand.
-            hand_at_contact = self.segments[seg].positions[contact, JOINT_INDEX[joint]]
-            self.held_offsets[name] = np.asarray(self.cell.object(name).position,
-                                                 dtype=np.float64) - hand_at_contact
-        for name in (*effect.get("detach", ()), *effect.get("detach_after", ())):
-            self.held_offsets.pop(name, None)
-        if bool(self.held) != carrying_before:
+        joints = dict(self.held)
+        effect = self._apply_effects(kind, args, hand, keep_hold)
+        if respawn:
+            effect["respawn"] = [args[0]]
+        self._track_objects(effect, joints, seg, mp)
+        if bool(self.held) != carrying_before and self.seat is None:
             self._arm_transition(carrying_before, i)
-        self.seated = kind == "sit" or (self.seated and kind != "standUp")
+        if kind in ("sit", "standUp"):
+            self.seat = target if kind == "sit" else None
+        lift = None
+        if kind == "grasp" and effect.get("attach"):
+            joint = next(iter(effect["attach"].values()))
+            lift = lift_frame(mp, self.segments[seg].positions[:, JOINT_INDEX[joint]])
         return StepPlan(text, kind, target, walk_segments=walked, goal_segment=seg,
                         contact_frame=int(mp.meta.get("contact_frame", mp.n_frames - 1)),
-                        hand=hand, expanded=self.expanded - expanded0,
+                        lift_frame=lift, hand=hand, expanded=self.expanded - expanded0,
                         primitive=mp.name,
                         objects_effect=effect, sub_steps=subs)
+
+    def _track_objects(self, effect: dict, joints: dict[str, str], seg: int,
+                       mp: MotionPrimitive) -> None:
+        """Follow a step's effect on the parts as the object tracks will: a part keeps
+        its world offset from the hand from the contact frame on, and rests where the
+        hand let it go (``joints``: the hands holding parts before the step)."""
+        contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
+        positions = self.segments[seg].positions
+        for name, joint in effect.get("attach", {}).items():
+            joints[name] = joint
+            self.held_offsets[name] = (self.object_position(name)
+                                       - positions[contact, JOINT_INDEX[joint]])
+        for names, frame in ((effect.get("detach", ()), contact),
+                             (effect.get("detach_after", ()),
+                              min(max(mp.n_frames - self.overlap, 0), mp.n_frames - 1))):
+            for name in names:
+                offset = self.held_offsets.pop(name, np.zeros(3))
+                if name in joints:
+                    self.object_at[name] = positions[frame, JOINT_INDEX[joints[name]]] + offset
+        for name in effect.get("consume", ()):
+            self.object_at.pop(name, None)
 
     def _fetch(self, i: int, obj: str) -> StepPlan:
         """Grasp ``obj`` as part of step ``i`` (which needs it in hand)."""
@@ -647,22 +1014,135 @@ class SequencePlanner:
         step.first_segment, step.last_segment = first, len(self.segments) - 1
         return step
 
-    def _reach_into(self, i: int, text: str, kind: str, args: tuple[str, ...],
+    def _reach_into(self, i: int, text: str, args: tuple[str, ...],
                     cause: PlanningError) -> StepPlan:
-        """walk(R) / carry(O, R) for a region nobody can stand in: a hand task into R
-        (rightHand(R), or move(O, R) with the held part). Raises ``cause`` if that fails too.
-        """
-        hand_kind, hand_args = ("move", (args[0], args[-1])) if kind == "carry" \
-            else ("rightHand", (args[-1],))
+        """walk(R) for a region nobody can stand in: rightHand(R) (the palm in R makes
+        enter(x, R) hold). Raises ``cause`` if that fails too."""
         try:
-            step = self._plan_step(i, text, hand_kind, hand_args)
+            step = self._plan_step(i, text, "rightHand", (args[-1],))
         except PlanningError as exc:
             raise PlanningError(f"{cause}; reaching into it instead failed too: {exc}",
                                 task=text, reason=cause.reason) from None
-        return replace(step, kind=f"{kind} (by {hand_kind})")
+        return replace(step, kind="walk (by rightHand)")
+
+    def _approach(self, target: np.ndarray, placement: tuple[float, float], text: str,
+                  sector: tuple[float, float] | None = None,
+                  budget: SearchBudget | None = None) -> int:
+        """Walk to where the goal primitive reaches ``target`` (from ``sector``, see
+        :meth:`_reach_goal`; within ``budget``) and take the standing step there; returns
+        the gait primitives walked."""
+        desc = f"reach {text} at ({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})"
+        goal = self._reach_goal(target, placement, desc, text, sector=sector)
+        walked = self._walk(goal, text, -1, carry=bool(self.held), budget=budget)
+        if not self._adjust_to(target, placement, text):
+            # No clear step from where the walk ended: walk on to a spot that needs
+            # (almost) none.
+            goal = self._reach_goal(target, placement, desc, text, adjust=FINAL_ADJUST_RADIUS,
+                                    sector=sector)
+            walked += self._walk(goal, text, -1, carry=bool(self.held), budget=budget)
+            self._adjust_to(target, placement, text)
+        return walked
+
+    def _approach_facing(self, target: np.ndarray, placement: tuple[float, float],
+                         text: str, facing: np.ndarray | None) -> int:
+        """:meth:`_approach`; with ``facing`` (3,), from the side of the target that makes
+        the worker face it (a seat: sit facing the desk), else from any side."""
+        if facing is not None:
+            ahead = math.atan2(facing[1] - target[1], facing[0] - target[0])
+            # The worker stands ``placement`` from the target: with the target behind
+            # (a seat), the standing spot lies towards what the worker will face.
+            side = ahead if placement[0] < 0 else ahead + math.pi
+            try:
+                return self._approach(target, placement, text,
+                                      sector=(side, APPROACH_HALF_WIDTH),
+                                      budget=SearchBudget(FACING_NODES))
+            except PlanningError:
+                pass
+        return self._approach(target, placement, text)
+
+    def _alternatives(self, kind: str, args: tuple[str, ...], target: np.ndarray | None,
+                      placement: tuple[float, float] | None, text: str, raised: bool
+                      ) -> list[tuple[np.ndarray | None, Callable[[], int] | None]]:
+        """What to try when the goal primitive is blocked, in order: (target, prepare),
+        where ``prepare()`` moves the worker first and returns the primitives walked.
+
+        release: other places to let go; bend/stoop/kneel/wait: a roomier spot; tasks
+        with a target: the other ``ALTERNATE_APPROACHES`` (further back, other sides).
+        """
+        if kind == "release":
+            return [(t, None) for t in self._release_targets(args[0])]
+        if target is None:
+            return [(None, None)] + ([(None, lambda: self._walk_to_room(text))]
+                                     if kind in IN_PLACE_TASKS else [])
+        if placement is None:
+            return [(target, None)]
+        first = math.atan2(self.pose[1] - target[1], self.pose[0] - target[0])
+
+        def approach(turn: float, back: float) -> int:
+            lowered = raised and not self.held
+            if lowered:
+                self._arm_transition(True, -1)
+            walked = self._approach(target, (placement[0] + back, placement[1]), text,
+                                    sector=(first + turn, APPROACH_HALF_WIDTH),
+                                    budget=SearchBudget(ALTERNATIVE_NODES))
+            if lowered:
+                self._arm_transition(False, -1)
+            return walked
+
+        return [(target, None)] + [
+            (target, functools.partial(approach, turn, back))
+            for turn, back in ALTERNATE_APPROACHES]
+
+    def _walk_to_room(self, text: str) -> int:
+        """Walk to the nearest spot with ``IN_PLACE_ROOM`` of floor clearance (a task done
+        where the worker stands hit the furniture there); returns the primitives walked."""
+        room = IN_PLACE_ROOM
+
+        def roomy(x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None = None) -> np.ndarray:
+            return self._clearance(np.stack([x, y], axis=-1)) > room
+
+        field = self._field(lambda xy: roomy(xy[:, 0], xy[:, 1]), ("room", room))
+        goal = self._goal_from_field(field, roomy, f"find room for {text}", text)
+        return self._walk(goal, text, -1, carry=bool(self.held))
+
+    def _release_targets(self, obj: str) -> list[np.ndarray]:
+        """Where the hand holding ``obj`` may let it go, palm positions (3,), in order:
+        ahead of the worker, then turned to either side, then nearer
+        (``RELEASE_PLACES``). Over a table or bench the part is set down on its top;
+        elsewhere it is let go at ``RELEASE_HEIGHT`` of the stature."""
+        x, y, yaw = self.pose
+        stature = self.library.skeleton.stature
+        offset = self.held_offsets.get(obj, np.zeros(3))
+        half = 0.5 * float(np.ptp(self.cell.object(obj).occupancy.aabb(), axis=0)[2])
+        out = []
+        for dist, turn in RELEASE_PLACES:
+            c, s = math.cos(yaw + turn), math.sin(yaw + turn)
+            palm = np.array([x + dist * c, y + dist * s, RELEASE_HEIGHT * stature])
+            top = self._surface_below(palm[:2], RELEASE_SURFACE_MAX * stature)
+            if top is not None:
+                # The part (held at ``offset`` from the palm) comes to rest on the top.
+                palm[2] = max(palm[2], top + half + RELEASE_GAP - float(offset[2]))
+            out.append(palm)
+        return out
+
+    def _surface_below(self, xy: np.ndarray, highest: float) -> float | None:
+        """Height of the highest obstacle top under the floor point ``xy`` (2,) that is
+        no higher than ``highest``, metres; None if none."""
+        tops = [float(part.aabb()[1][2]) for ob in self.cell.obstacles for part in ob.parts
+                if float(part.aabb()[1][2]) <= highest
+                and float(part.footprint().signed_distance(xy[None])[0]) <= 0.0]
+        return max(tops) if tops else None
 
     def _goal_segment(self, kind: str, target: np.ndarray | None, label: int,
-                      text: str) -> tuple[int, MotionPrimitive]:
+                      text: str, *, carry_stance: bool = False, seconds: float | None = None,
+                      grasped: str | None = None, attempts: int | None = None
+                      ) -> tuple[int, MotionPrimitive]:
+        """Make, check and place the goal primitive of ``kind`` for ``target``.
+
+        ``carry_stance``: the arms are already in the carry stance; ``seconds``: how long
+        a wait lasts; ``grasped``: the part a grasp picks up (checked from contact on);
+        ``attempts``: seeded primitives tried (default ``options.goal_attempts``).
+        """
         x, y, yaw = self.pose
         local = None
         if target is not None:
@@ -670,21 +1150,25 @@ class SequencePlanner:
             dx, dy = target[0] - x, target[1] - y
             local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
         hold_hand = next(iter(self.held.values()), None)
+        seated = self.seat is not None and kind != "standUp"
         kwargs = {"rng": self.rng,
-                  "start_pose": self._stance(bool(self.held) or self._carry_stance)}
+                  "start_pose": self._seated_pose() if seated
+                  else self._stance(bool(self.held) or carry_stance)}
         if kind in ("move", "insert", "extract", "release") and hold_hand:
             kwargs["hand"] = hold_hand
-        if kind == "wait" and target is None and self._wait_seconds is not None:
+        if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
-            kwargs["duration"] = self._wait_seconds + (2 * self.overlap + 6) / self.library.fps
+            kwargs["duration"] = seconds + (2 * self.overlap + 6) / self.library.fps
         mp = None
-        for attempt in range(self.options.goal_attempts):
+        attempts = self.options.goal_attempts if attempts is None else attempts
+        for attempt in range(attempts):
             try:
-                candidate = self.library.goal(kind, local, **kwargs)
+                candidate = self._sit_still(kwargs.get("duration", 2.0)) \
+                    if seated and kind == "wait" else self.library.goal(kind, local, **kwargs)
             except ValueError as exc:
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
-            if self._goal_clear(candidate, kind):
+            if self._goal_clear(candidate, grasped):
                 mp = candidate
                 break
             if attempt == 1 and kind in ("grasp", "leftHand", "rightHand", "release"):
@@ -694,31 +1178,37 @@ class SequencePlanner:
                     kwargs["hand"] = other
         if mp is None:
             raise PlanningError(f"task {text}: every {kind} motion tried "
-                                f"({self.options.goal_attempts}) runs into an obstacle; "
+                                f"({attempts}) runs into an obstacle; "
                                 "an obstacle blocks the reach", task=text, reason="blocked")
         seg = self._add(mp, self.pose, label, self.overlap)
         self.pose = self._hand_over_pose(mp, self.pose)
         self.gait_state = None
         return seg, mp
 
-    def _goal_clear(self, mp: MotionPrimitive, kind: str) -> bool:
-        """Whether the body, the objects already in the hands and, for a grasp, the part
-        from its contact frame on keep clear of obstacles."""
+    def _goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
+        """Whether the body, the objects already in the hands and the part being grasped
+        (``grasped``, from the frame the hand lifts it, :func:`lift_frame`) keep clear of
+        obstacles."""
         world = world_positions(mp, *self.pose)
-        if not self._placed_clear(mp, self.pose, samples=24, world=world):
+        if not self._placed_clear(mp, self.pose, samples=None, world=world):
             return False
-        if kind != "grasp" or self.grasp_object is None:
+        if grasped is None:
             return True
         from ltl_human_motion.scene.predicates import object_clearance
         joint = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(mp.meta.get("hand"), "r_hand")
-        hand = world[int(mp.meta.get("contact_frame", 0)):, JOINT_INDEX[joint]]
-        if not hand.size:
+        hand = world[:, JOINT_INDEX[joint]]
+        contact = int(mp.meta.get("contact_frame", 0))
+        lift = lift_frame(mp, hand)
+        if lift >= len(hand):
             return True
-        centre = hand[::4] + (self.cell.object(self.grasp_object).position - hand[0])
-        return not np.any(object_clearance(self.cell, self.grasp_object, centre) <= 0.0)
+        # The part rests on its support until the hand lifts it; carried from then on.
+        centre = hand[lift:] + (self.object_position(grasped) - hand[contact])
+        return not np.any(object_clearance(self.cell, grasped, centre) <= 0.0)
 
-    def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None) -> dict:
-        """Update which objects are held; return the effect for the object tracks."""
+    def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None,
+                       keep_hold: bool = False) -> dict:
+        """Update which objects are held; return the effect for the object tracks
+        (``keep_hold``: a held part that a move puts into its region stays in hand)."""
         hand_joint = {"l_hand": "l_hand", "r_hand": "r_hand", "both": "r_hand",
                       None: "r_hand"}.get(hand, "r_hand")
         if kind == "grasp":
@@ -728,11 +1218,16 @@ class SequencePlanner:
             self.held.pop(args[0], None)
             return {"detach": [args[0]]}
         if kind in ("move", "insert", "extract"):
-            # The part is placed where the hand put it.
             if args[0] not in self.held:
+                # extract takes the part out of its container and keeps it in hand (move
+                # and insert fetch the part first).
                 self.held[args[0]] = hand_joint
-                return {"attach": {args[0]: hand_joint}, "detach_after": [args[0]]}
-            return {}
+                return {"attach": {args[0]: hand_joint}}
+            if kind == "extract" or keep_hold:
+                return {}
+            # move / insert of a held part: it stays where the hand put it.
+            self.held.pop(args[0], None)
+            return {"detach": [args[0]]}
         if kind == "assemble":
             parts = list(self.held)
             self.consumed.update(parts)
