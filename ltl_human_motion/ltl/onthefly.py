@@ -9,7 +9,9 @@ expanded here for one letter at a time and only for the states a search visits:
 * a state is a set of NNF formulas (their conjunction), interned to an int;
 * ``expand(f, letter)`` gives the terms ``(next, promises)`` of ``f`` whose letter
   condition the letter satisfies; it is memoized per (formula, letter), so the many
-  ``F`` conjuncts of a kitting specification share their work across states;
+  ``F`` conjuncts of a kitting specification share their work across states, and
+  letters that agree on the formula's atoms share one expansion (a symbolic set of
+  letters: every step of a task the formula does not name is one class);
 * an edge carries acceptance mark ``e`` (a bit) iff it does not promise eventuality
   ``e``; a run is accepting iff it takes every mark infinitely often.
 
@@ -100,6 +102,11 @@ class LetterTableau:
         self.mark_of = {f: 1 << i for i, f in enumerate(events)}
         self.num_sets = len(events)
         self.full = (1 << self.num_sets) - 1
+        # letters that agree on the formula's atoms behave alike: one expansion per class
+        keys = {a.key for a in subs if isinstance(a, Atom)}
+        classes: dict[frozenset[str], int] = {}
+        self._class = [classes.setdefault(letter & keys, i)
+                       for i, letter in enumerate(self.letters)]
         self.states: list[frozenset[Formula]] = []
         self._ids: dict[frozenset[Formula], int] = {}
         self._memo: dict[tuple[Formula, int], list[_Term]] = {}
@@ -107,6 +114,7 @@ class LetterTableau:
         self._loopable: dict[int, bool] = {}
         self._proper: dict[Formula, frozenset[Formula]] = {}
         self._mentioned: dict[int, frozenset[str]] = {}
+        self._formula_names: dict[Formula, frozenset[str]] = {}
         self.initial = self._intern(_state_key(frozenset({self.formula})))
 
     def _intern(self, state: frozenset[Formula]) -> int:
@@ -118,6 +126,7 @@ class LetterTableau:
 
     def expand(self, f: Formula, i: int) -> list[_Term]:
         """Terms ``(next, promises)`` of ``f`` allowed by letter ``i`` (memoized)."""
+        i = self._class[i]
         key = (f, i)
         hit = self._memo.get(key)
         if hit is not None:
@@ -162,6 +171,7 @@ class LetterTableau:
 
     def successors(self, q: int, i: int) -> tuple[tuple[int, int], ...]:
         """``(state, marks)`` of every edge leaving ``q`` on letter ``i`` (marks: bits)."""
+        i = self._class[i]
         key = (q, i)
         hit = self._succ.get(key)
         if hit is not None:
@@ -238,10 +248,15 @@ class LetterTableau:
         if hit is None:
             names: set[str] = set()
             for f in self.states[q]:
-                for g in _subformulas(f, set()):
-                    if isinstance(g, Atom):
-                        names.update(g.args)
+                names |= self._names(f)
             hit = self._mentioned[q] = frozenset(names)
+        return hit
+
+    def _names(self, f: Formula) -> frozenset[str]:
+        hit = self._formula_names.get(f)
+        if hit is None:
+            hit = self._formula_names[f] = frozenset(
+                n for g in _subformulas(f, set()) if isinstance(g, Atom) for n in g.args)
         return hit
 
     def pending(self, q: int) -> list[Formula]:

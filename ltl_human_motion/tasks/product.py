@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 from ltl_human_motion.ltl.automaton import Automaton, accepting_components
 from ltl_human_motion.ltl.automaton import strongly_connected_components as _sccs
-from ltl_human_motion.ltl.formula import And, Atom, Const, Formula, Not, Or
+from ltl_human_motion.ltl.formula import And, Atom, Const, Finally, Formula, Globally, Not, Or
 from ltl_human_motion.tasks.model import HELD, CellModel, CellState
 
 __all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "seeded_noise"]
@@ -179,7 +179,6 @@ class ProductSearch:
         self.expanded = 0
         self._step: dict[tuple[CellState, int], tuple[CellState, float] | None] = {}
         self._cycles: dict[tuple[int, CellState], tuple[float, tuple[int, ...]] | None] = {}
-        self._need: dict[Formula, tuple[int, ...] | None] = {}
         letters = getattr(automaton, "letters", None)
         self._letters = tuple(letters) if letters is not None else ()
         self._min_dur = [self._duration(t) for t in self.tasks]
@@ -190,6 +189,8 @@ class ProductSearch:
         self._walk = model.walk_time.tolist()
         self._h: dict[tuple[int, CellState], float] = {}
         self._qneeds: dict[int, tuple[float, int, list[tuple]]] = {}
+        self._fneeds: dict[Formula, tuple] = {}
+        self._rules: dict[Formula, tuple | None] = {}
         self._trees: dict[tuple[int, frozenset[int]], float] = {}
         self._tgt = [self._static_target(t) for t in self.tasks]
         self._forget = hasattr(automaton, "mentioned")
@@ -228,7 +229,9 @@ class ProductSearch:
           in hand, over the number of hands (at most that many parts ride along at once);
         * the grasp that fetches such a part when it is not in hand;
         * the hand-freeing steps that two hands force: parts in hand plus parts still to
-          be grasped, minus the hands, minus the pending formulas that free a hand.
+          be grasped, minus the hands, minus the pending formulas that free a hand;
+        * pending formulas include the responses ``F psi`` of ``G(phi -> F psi)`` whose
+          trigger a pending formula will fire (:meth:`_responses`).
         """
         if not self.use_h:
             return 0.0
@@ -237,21 +240,24 @@ class ProductSearch:
         if hit is not None:
             return hit
         base, freeing, needs = self._needs(q)
-        total, far, carried = base, 0.0, 0.0
+        total, far = base, 0.0
+        carried: list[float] = []
         walk = self._walk
         here = s.location
         places: set[int] = set()
         to_grasp = 0
         parts = s.parts
+        grasping = {item[3] for item in needs}
         for opts, carry_part, carry_dest, grasp_part in needs:
             if carry_part is not None:
                 where = parts[carry_part]
                 if where >= 0:
-                    total += self._grasp_dur
+                    if carry_part not in grasping:   # else its grasp is counted already
+                        total += self._grasp_dur
                     places.add(where)
-                    carried += walk[where][carry_dest]
+                    carried.append(walk[where][carry_dest])
                 elif where == HELD:
-                    carried += walk[here][carry_dest]
+                    carried.append(walk[here][carry_dest])
             targets = {self._target(i, s) for i in opts}
             if None in targets:
                 pass
@@ -261,7 +267,9 @@ class ProductSearch:
                 far = max(far, min(walk[here][t] for t in targets))
             if grasp_part is not None and grasp_part not in s.held:
                 to_grasp += self.model._width[grasp_part]
-        total += max(far, self._tree(here, places), carried / self.model.limits.hands)
+        hands = self.model.limits.hands
+        carry = sum(carried) / hands
+        total += max(far, self._tree(here, places), carry)
         if self._free_dur is not None:
             held = sum(self.model._width[p] for p in s.held)
             total += max(0, held + to_grasp - self.model.limits.hands - freeing) \
@@ -291,27 +299,76 @@ class ProductSearch:
             return hit
         base, freeing, needs = 0.0, 0, []
         used: set[int] = set()
-        for f in self.aut.pending(q):
-            need = self._need.get(f, ())
-            if need == ():
-                need = self._need[f] = _propositional_letters(f.arg, self._letters)
+        pending = list(self.aut.pending(q))
+        for f in self._responses(q, pending):
+            if f not in pending:
+                pending.append(f)
+        for f in pending:
+            need, dur, frees, item = self._formula_need(f)
             if not need:
                 continue
             if used.isdisjoint(need):
-                base += min(self._min_dur[i] for i in need)
+                base += dur
                 used.update(need)
-            kinds = {self._kind[i] for i in need}
-            freeing += kinds <= _FREEING
-            carry_part = carry_dest = grasp_part = None
-            if len(need) == 1 and self._kind[need[0]] in _CARRYING \
-                    and self._tgt[need[0]][0] == 0:
-                carry_part = self.model.part_index.get(self.tasks[need[0]].args[0])
-                carry_dest = self._tgt[need[0]][1]
-            heads = {self.tasks[i].args[0] for i in need} if kinds == {"grasp"} else ()
-            if len(heads) == 1:
-                grasp_part = self.model.part_index.get(next(iter(heads)))
-            needs.append((need, carry_part, carry_dest, grasp_part))
+            freeing += frees
+            needs.append(item)
         hit = self._qneeds[q] = (base, freeing, needs)
+        return hit
+
+    def _responses(self, q: int, pending: list[Formula]) -> list[Formula]:
+        """``F psi`` of every ``G(!phi | F psi)`` of ``q`` whose trigger ``phi`` a pending
+        ``F chi`` will make true (every letter of ``chi`` satisfies ``phi``): psi is
+        needed after that step, so it counts too."""
+        out = []
+        states = getattr(self.aut, "states", None)
+        if states is None:
+            return out
+        needs = [n for f in pending if (n := self._formula_need(f)[0])]
+        for g in states[q]:
+            rule = self._rules.get(g, ())
+            if rule == ():
+                rule = self._rules[g] = self._response_rule(g)
+            if rule is not None and any(set(n) <= rule[0] for n in needs):
+                out.append(rule[1])
+        return out
+
+    def _response_rule(self, g: Formula) -> tuple[frozenset[int], Formula] | None:
+        """(trigger letters, ``F psi``) of ``g = G(a | b | ... | F psi)`` with a, b, ...
+        propositional (the trigger: the letters on which they are all false)."""
+        if not isinstance(g, Globally) or not isinstance(g.arg, Or):
+            return None
+        eventual = [a for a in g.arg.args if isinstance(a, Finally)]
+        rest = [a for a in g.arg.args if not isinstance(a, Finally)]
+        if len(eventual) != 1 or not rest:
+            return None
+        holds = _propositional_letters(Or(tuple(rest)) if len(rest) > 1 else rest[0],
+                                       self._letters)
+        if holds is None:
+            return None
+        trigger = frozenset(range(len(self._letters))) - frozenset(holds)
+        return trigger, eventual[0]
+
+    def _formula_need(self, f: Formula) -> tuple:
+        """What the pending ``F phi`` needs: (letters satisfying phi, least duration,
+        whether all of them free a hand, (letters, part carried, destination, part to
+        grasp))."""
+        hit = self._fneeds.get(f)
+        if hit is not None:
+            return hit
+        need = _propositional_letters(f.arg, self._letters)
+        if not need:
+            self._fneeds[f] = ((), 0.0, False, None)
+            return self._fneeds[f]
+        kinds = {self._kind[i] for i in need}
+        carry_part = carry_dest = grasp_part = None
+        if len(need) == 1 and self._kind[need[0]] in _CARRYING and self._tgt[need[0]][0] == 0:
+            carry_part = self.model.part_index.get(self.tasks[need[0]].args[0])
+            carry_dest = self._tgt[need[0]][1]
+        heads = {self.tasks[i].args[0] for i in need} if kinds == {"grasp"} else ()
+        if len(heads) == 1:
+            grasp_part = self.model.part_index.get(next(iter(heads)))
+        hit = self._fneeds[f] = (need, min(self._min_dur[i] for i in need),
+                                 kinds <= _FREEING, (need, carry_part, carry_dest, grasp_part))
         return hit
 
     def _static_target(self, task: Atom) -> tuple[int, int | None]:
@@ -436,6 +493,7 @@ class ProductSearch:
         heapq.heappush(heap, (g0 + self.weight * self.heuristic(*root), -g0, next(tie), 0, 0,
                               ()))
         pops: dict[tuple[int, CellState], int] = {}
+        closed_g: dict[tuple[int, CellState], float] = {}
         out: list[Lasso] = []
         while heap and len(out) < k:
             f, _, _, kind, lab, cycle = heapq.heappop(heap)
@@ -448,8 +506,9 @@ class ProductSearch:
                     out.append(Lasso(prefix, cycle, f, searched_cycle=True))
                 continue
             count = pops.get(node, 0)
-            if count >= k:
-                continue
+            if count >= k and (k > 1 or g >= closed_g[node] - 1e-9):
+                continue  # (k = 1: a cheaper path reopens it; the heuristic is admissible
+                #           but not always consistent)
             if kind == 2:  # pushed with a lower bound of its heuristic: now the real one
                 h = self.heuristic(*node)
                 if g + h > bound:
@@ -458,6 +517,7 @@ class ProductSearch:
                     heapq.heappush(heap, (g + self.weight * h, -g, next(tie), 0, lab, ()))
                     continue
             pops[node] = count + 1
+            closed_g[node] = min(g, closed_g.get(node, g))
             self.expanded += 1
             if self.expanded > self.budget:
                 raise SearchBudgetError(f"product search expanded {self.budget} nodes")
@@ -479,7 +539,7 @@ class ProductSearch:
                 g2 = g + self._cost(node, i, c)
                 for q2, _m in self.aut.successors(q, i):
                     node2 = (q2, self.forget(q2, s2))
-                    if pops.get(node2, 0) >= k:
+                    if pops.get(node2, 0) >= k and (k > 1 or g2 >= closed_g[node2] - 1e-9):
                         continue
                     # consistent heuristic: h(child) >= h(here) - step cost; the real value
                     # is computed only if the child is popped (most never are)
