@@ -157,3 +157,21 @@ def test_cli_tasks_uses_the_cell_model(capsys, tmp_path):
     first = next(line for line in out.splitlines() if line.startswith("1: "))
     assert first.count("grasp(") == 4 and first.count("release(") == 2
     assert "estimated time" in out
+
+
+def test_explicit_automaton_view_gives_the_same_optimum(paper_cell):
+    """The product with an explicit automaton (the built-in translator's, as Spot's would
+    be with backend="spot") finds lassos of the same cost as the on-the-fly tableau."""
+    from ltl_human_motion.ltl import translate
+    from ltl_human_motion.tasks import ExplicitView, ProductSearch
+    from ltl_human_motion.tasks.sequences import task_steps
+    for name in ("S1", "S2"):
+        spec = build_specification(name, paper_cell)
+        model = CellModel.from_cell(paper_cell)
+        tasks, letters = task_steps(spec, model)
+        view = ExplicitView(translate(spec.formula, backend="builtin"), letters)
+        explicit = ProductSearch(view, model, tasks).lassos(1)[0]
+        onthefly, _, _ = product_search(spec, model)
+        assert explicit.cost == pytest.approx(onthefly.lassos(1)[0].cost)
+        assert evaluate_lasso(spec.formula, [letters[i] for i in explicit.prefix],
+                              [letters[i] for i in explicit.cycle])

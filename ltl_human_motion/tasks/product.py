@@ -492,6 +492,7 @@ class ProductSearch:
         labels.append((root, -1, -1, g0))
         heapq.heappush(heap, (g0 + self.weight * self.heuristic(*root), -g0, next(tie), 0, 0,
                               ()))
+        lazy = self.use_h and self.weight > 1.0
         pops: dict[tuple[int, CellState], int] = {}
         closed_g: dict[tuple[int, CellState], float] = {}
         out: list[Lasso] = []
@@ -541,14 +542,19 @@ class ProductSearch:
                     node2 = (q2, self.forget(q2, s2))
                     if pops.get(node2, 0) >= k and (k > 1 or g2 >= closed_g[node2] - 1e-9):
                         continue
-                    # consistent heuristic: h(child) >= h(here) - step cost; the real value
-                    # is computed only if the child is popped (most never are)
-                    h = max(0.0, h_here - c)
+                    if lazy:
+                        # weighted: push with h(here) - step cost (a consistent heuristic's
+                        # bound); the real value only if the child is popped (most never
+                        # are). The optimal search needs the real value: the heuristic is
+                        # admissible but not always consistent.
+                        h = max(0.0, h_here - c)
+                    else:
+                        h = self.heuristic(*node2) if self.use_h else 0.0
                     if g2 + h > bound:
                         continue
                     labels.append((node2, lab, i, g2))
                     heapq.heappush(heap, (g2 + self.weight * h, -g2, next(tie),
-                                          2 if self.use_h else 0, len(labels) - 1, ()))
+                                          2 if lazy else 0, len(labels) - 1, ()))
         return out
 
     def _tail(self, labels: list, lab: int) -> tuple[int, ...]:

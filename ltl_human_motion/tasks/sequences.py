@@ -54,7 +54,7 @@ RANDOM_COST_FACTOR = 1.25
 #: optimal A* first, then weighted A* (at most ``weight`` times the optimum), the last
 #: greedy. Work = nodes expanded times candidate steps (~20-50 us each on this machine),
 #: so a budget bounds the time whatever the number of steps.
-WEIGHT_LADDER = ((1.0, 16_000), (1.2, 20_000), (1.5, 100_000), (3.0, 200_000),
+WEIGHT_LADDER = ((1.0, 8_000), (1.2, 12_000), (1.5, 100_000), (3.0, 200_000),
                  (1e6, 1_000_000))
 
 #: Longest cycle made of a prefix's own last steps that is tried (each try is one
