@@ -3,7 +3,8 @@
 Used by ``bench/task_planning.py``, the tests and ``config/kitting_cell.yaml`` (made
 with :func:`kitting_cell_yaml`). Parts lie along the near edges of two tables left and
 right of the start R0; the kit tray ``kit`` (a fixed object, the container of
-``insert``) lies on a small bench behind the start, in region R1.
+``insert``) fills region R1 behind the start, on a cart that is not modelled (nothing
+below it: the planner releases a part in front of the worker at 0.75 m).
 """
 
 from __future__ import annotations
@@ -63,7 +64,6 @@ def kitting_cell_yaml(n: int, name: str | None = None) -> str:
         "obstacles:",
         *_table("table_left", -1.3, length),
         *_table("table_right", 1.3, length),
-        "  kit_bench: {shape: box, position: [0.0, -2.1, 0.4], size: [0.6, 0.4, 0.8]}",
         "shorthands:",
         "  assemble(R): leftHand(R) & rightHand(R)",
     ]

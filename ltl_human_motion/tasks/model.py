@@ -9,8 +9,9 @@ Preconditions and effects follow Table I of the paper and what the planner does:
 * ``release(O)`` needs O in hand; O is put down where the worker stands.
 * ``move(O, R)``, ``insert(O, C)`` and ``carry(O, R)`` need O in hand, or fetch it
   first (walk to O and grasp it, which needs a free hand), as the planner does.
-  ``move`` leaves O in R and ``insert`` inside C, with the hand free; ``carry`` keeps
-  O in hand and puts the worker in R.
+  ``insert`` leaves O inside C with the hand free. ``move`` puts O into R and, as in
+  the planner, the hand still holds it there (a ``release`` lets go, and O stays in R);
+  ``carry`` keeps O in hand and puts the worker in R.
 * ``extract(O, C)`` needs O inside C and a free hand; O ends in hand.
 * ``assemble(R)`` (the shorthand ``leftHand(R) & rightHand(R)``) uses up the parts in
   hand; a later grasp takes a fresh one from its supply position (paper Fig. 3).
@@ -265,15 +266,12 @@ class CellModel:
             if dest is not None:
                 cost += self._walk[loc][dest]
                 loc = dest
-            if kind != "carry":
+            if kind == "insert":
                 held.remove(p)
-                if kind == "move":
-                    parts[p] = dest if dest is not None else loc
-                else:
-                    c = self.part_index.get(args[1])
-                    if c is None or c == p or state.parts[c] == DONE:
-                        return None
-                    parts[p] = INSIDE - c
+                c = self.part_index.get(args[1])
+                if c is None or c == p or state.parts[c] == DONE:
+                    return None
+                parts[p] = INSIDE - c
         elif kind == "grasp":
             p = self.part_index.get(args[0])
             if p is None or parts[p] == HELD or parts[p] < -1 \

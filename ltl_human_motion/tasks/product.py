@@ -43,7 +43,7 @@ __all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "seede
 TAIL_STEPS = 6
 
 #: Tasks that leave a hand free (the part is put down, placed or used up).
-_FREEING = frozenset({"release", "move", "insert", "assemble"})
+_FREEING = frozenset({"release", "insert", "assemble"})
 
 #: Tasks that take a part somewhere in hand (fetching it first if needed).
 _CARRYING = frozenset({"move", "insert", "carry"})
@@ -229,7 +229,8 @@ class ProductSearch:
           in hand, over the number of hands (at most that many parts ride along at once);
         * the grasp that fetches such a part when it is not in hand;
         * the hand-freeing steps that two hands force: parts in hand plus parts still to
-          be grasped, minus the hands, minus the pending formulas that free a hand;
+          be picked up (grasped, or fetched by a move that keeps them in hand), minus the
+          hands, minus the pending formulas that free a hand;
         * pending formulas include the responses ``F psi`` of ``G(phi -> F psi)`` whose
           trigger a pending formula will fire (:meth:`_responses`).
         """
@@ -245,7 +246,7 @@ class ProductSearch:
         walk = self._walk
         here = s.location
         places: set[int] = set()
-        to_grasp = 0
+        pickups: set[int] = set()
         parts = s.parts
         grasping = {item[3] for item in needs}
         for opts, carry_part, carry_dest, grasp_part in needs:
@@ -266,10 +267,13 @@ class ProductSearch:
             else:
                 far = max(far, min(walk[here][t] for t in targets))
             if grasp_part is not None and grasp_part not in s.held:
-                to_grasp += self.model._width[grasp_part]
+                pickups.add(grasp_part)
+            if carry_part is not None and parts[carry_part] >= 0:
+                pickups.add(carry_part)       # fetched into a hand that move keeps busy
         hands = self.model.limits.hands
         carry = sum(carried) / hands
         total += max(far, self._tree(here, places), carry)
+        to_grasp = sum(self.model._width[p] for p in pickups)
         if self._free_dur is not None:
             held = sum(self.model._width[p] for p in s.held)
             total += max(0, held + to_grasp - self.model.limits.hands - freeing) \
