@@ -111,8 +111,8 @@ def test_move_each_part_to_the_tray_carries_two_at_a_time():
     seqs, _ = plan_sequences(kitting_spec("move_each", 4), _kitting(4), n=1)
     tasks = seqs[0].tasks
     assert sorted(t.args[0] for t in tasks if t.name == "move") == ["P0", "P1", "P2", "P3"]
-    trips = sum(1 for a, b in zip(tasks, (*tasks[1:], None))
-                if a.name == "move" and (b is None or b.name != "move"))
+    trips = sum(1 for prev, t in zip((None, *tasks[:-1]), tasks)   # arrivals at the tray
+                if t.name == "move" and (prev is None or prev.name not in ("move", "release")))
     assert trips == 2                    # two parts per walk to the tray
     _consistent(tasks)
 
