@@ -121,7 +121,7 @@ def plot(results: list[dict], path: Path) -> None:
     ax.axhline(TARGET_SECONDS, color="grey", ls="--", lw=1, label="target at N = 20")
     ax.set_xlabel("parts N")
     ax.set_ylabel("spec + translation + first sequence [s]")
-    ax.set_title("Kitting: first cost-optimal task sequence")
+    ax.set_title("Kitting: first task sequence (2 shared cores, under load)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()

@@ -114,6 +114,7 @@ class LetterTableau:
         self._loopable: dict[int, bool] = {}
         self._proper: dict[Formula, frozenset[Formula]] = {}
         self._mentioned: dict[int, frozenset[str]] = {}
+        self._next_ids: dict[frozenset[Formula], int] = {}
         self._formula_names: dict[Formula, frozenset[str]] = {}
         self.initial = self._intern(_state_key(frozenset({self.formula})))
 
@@ -186,7 +187,10 @@ class LetterTableau:
             promised = 0
             for e in pr:
                 promised |= self.mark_of[e]
-            out.append((self._intern(_state_key(nx)), self.full & ~promised))
+            q2 = self._next_ids.get(nx)
+            if q2 is None:
+                q2 = self._next_ids[nx] = self._intern(_state_key(nx))
+            out.append((q2, self.full & ~promised))
         result = tuple(sorted(set(out)))
         self._succ[key] = result
         return result
@@ -241,6 +245,11 @@ class LetterTableau:
     def mark_set(self, marks: int) -> frozenset[int]:
         """The acceptance sets of a mark bit field."""
         return frozenset(b for b in range(self.num_sets) if marks >> b & 1)
+
+    def settled(self, q: int) -> bool:
+        """Whether state ``q`` owes nothing now: it holds only ``G``, ``R`` and ``W``
+        formulas (no eventuality, atom or next-step obligation is pending)."""
+        return all(isinstance(f, _PERSISTENT) for f in self.states[q])
 
     def mentioned(self, q: int) -> frozenset[str]:
         """Arguments of the atoms of state ``q`` (the objects and regions it names)."""

@@ -12,9 +12,11 @@ must be physically possible from where the prefix ends (and again for each repet
 the cell need not return to its state. The search (A*, or Dijkstra without a heuristic)
 pops prefixes in order of cost; a prefix ends in a goal when
 
-* its last step reads a letter on which its automaton state loops with every mark
-  (then the cycle is that last step: ``F a`` ends right after the ``a``), or
-* from its node a cycle of the automaton back to the same state with every mark is
+* its last steps (up to :data:`TAIL_STEPS`) ran as an accepting cycle of the
+  automaton (S1 ends after ``grasp, assemble``), or its automaton state owes nothing
+  and repeating those steps forever is accepted (``F a`` ends right after the ``a``),
+  or, only when no such lasso exists, from its
+  node a longer cycle of the automaton back to the same state with every mark is
   possible in the cell (a second Dijkstra over ``(state, cell, marks)``, only from
   states that can lie on an accepting cycle, :meth:`LetterTableau.loopable`).
 
@@ -417,11 +419,12 @@ class ProductSearch:
         self._trees[key] = total
         return total
 
-    def _again(self, s: CellState, cycle: Sequence[int]) -> float | None:
-        """Cost (s) of doing the cycle ``repetitions - 1`` more times from ``s``, or None
-        when the cell does not allow it."""
+    def _again(self, s: CellState, cycle: Sequence[int], times: int | None = None
+               ) -> float | None:
+        """Cost (s) of doing the cycle ``times`` (default ``repetitions - 1``) more times
+        from ``s``, or None when the cell does not allow it."""
         total = 0.0
-        for _ in range(self.repetitions - 1):
+        for _ in range(self.repetitions - 1 if times is None else times):
             for i in cycle:
                 nxt = self.step(s, i)
                 if nxt is None:
@@ -469,12 +472,15 @@ class ProductSearch:
 
     # ---------------------------------------------------------------- search
     def lassos(self, k: int = 1, start: tuple[tuple[int, ...], int, CellState, float] | None = None,
-               bound: float = float("inf")) -> list[Lasso]:
+               bound: float = float("inf"), long_cycles: bool = False) -> list[Lasso]:
         """Up to ``k`` cheapest lassos in order of cost (fewer if the product has fewer).
 
         ``start`` = (task indices done, automaton state, cell state, cost) starts the
         search after a given prefix (coverage mode). Nodes whose cost plus heuristic
         exceeds ``bound`` are not expanded (a known lasso's cost proves them useless).
+        Cycles of up to :data:`TAIL_STEPS` steps are found as the tails of paths; only
+        if there is no such lasso is the search repeated with ``long_cycles`` (a cycle
+        search from every node that may lie on an accepting cycle).
 
         Raises
         ------
@@ -493,7 +499,7 @@ class ProductSearch:
         else:
             base, q, s, g0 = start
             root = (q, self.forget(q, s))
-        labels.append((root, -1, -1, g0))
+        labels.append((root, -1, -1, g0, 0))
         heapq.heappush(heap, (g0 + self.weight * self.heuristic(*root), -g0, next(tie), 0, 0,
                               ()))
         lazy = self.use_h and self.weight > 1.0
@@ -502,7 +508,7 @@ class ProductSearch:
         out: list[Lasso] = []
         while heap and len(out) < k:
             f, _, _, kind, lab, cycle = heapq.heappop(heap)
-            node, _parent, task, g = labels[lab]
+            node, _parent, task, g, _marks = labels[lab]
             if kind == 1:
                 prefix = base + self._path(labels, lab)
                 if isinstance(cycle, int):
@@ -529,10 +535,10 @@ class ProductSearch:
             q, s = node
             h_here = self.heuristic(q, s) if self.use_h else 0.0
             if task >= 0:
-                c, again = self._tail_goal(q, s, self._tail(labels, lab))
+                c, again = self._tail_goal(q, s, *self._tail(labels, lab))
                 if c:
                     heapq.heappush(heap, (g + again, -g, next(tie), 1, lab, c))
-            if self.aut.loopable(q):
+            if long_cycles and self.aut.loopable(q):
                 cyc = self.cycle_from(q, s)
                 if cyc is not None:
                     heapq.heappush(heap, (g + cyc[0], -g - cyc[0], next(tie), 1, lab, cyc[1]))
@@ -542,7 +548,7 @@ class ProductSearch:
                     continue
                 s2, c = nxt
                 g2 = g + self._cost(node, i, c)
-                for q2, _m in self.aut.successors(q, i):
+                for q2, m2 in self.aut.successors(q, i):
                     node2 = (q2, self.forget(q2, s2))
                     if pops.get(node2, 0) >= k and (k > 1 or g2 >= closed_g[node2] - 1e-9):
                         continue
@@ -556,30 +562,60 @@ class ProductSearch:
                         h = self.heuristic(*node2) if self.use_h else 0.0
                     if g2 + h > bound:
                         continue
-                    labels.append((node2, lab, i, g2))
+                    labels.append((node2, lab, i, g2, m2))
                     heapq.heappush(heap, (g2 + self.weight * h, -g2, next(tie),
                                           2 if lazy else 0, len(labels) - 1, ()))
+        if not out and not long_cycles:
+            return self.lassos(k, start, bound, long_cycles=True)
         return out
 
-    def _tail(self, labels: list, lab: int) -> tuple[int, ...]:
-        """The last (up to :data:`TAIL_STEPS`) tasks of a label's path."""
-        out = []
-        while lab > 0 and len(out) < TAIL_STEPS:
-            _node, parent, task, _g = labels[lab]
-            out.append(task)
+    def _tail(self, labels: list, lab: int) -> tuple[tuple[int, ...], tuple[int, ...],
+                                                     tuple[int, ...]]:
+        """The last (up to :data:`TAIL_STEPS`) steps of a label's path: their tasks, the
+        automaton state before each, and the marks of each."""
+        tasks, states, marks = [], [], []
+        while lab > 0 and len(tasks) < TAIL_STEPS:
+            _node, parent, task, _g, m = labels[lab]
+            tasks.append(task)
+            marks.append(m)
+            states.append(labels[parent][0][0])
             lab = parent
-        return tuple(reversed(out))
+        return tuple(reversed(tasks)), tuple(reversed(states)), tuple(reversed(marks))
 
-    def _tail_goal(self, q: int, s: CellState, tail: tuple[int, ...]) -> tuple[int, float]:
-        """The shortest ``c`` such that the path's last ``c`` steps, repeated forever from
-        ``q``, are accepted (then the path is a lasso whose cycle is its own tail), and
-        the cost of the further repetitions; ``(0, 0)`` if there is none."""
+    def _tail_goal(self, q: int, s: CellState, tail: tuple[int, ...],
+                   before: tuple[int, ...], marks: tuple[int, ...]) -> tuple[int, float]:
+        """The shortest ``c`` such that the path's last ``c`` steps are its cycle, and the
+        cost of the further repetitions; ``(0, 0)`` if there is none. They are when
+
+        * the path ran them as a cycle of the automaton: from ``q`` back to ``q`` with
+          every mark (the acceptance condition was passed once), or
+        * repeating them forever from ``q`` is accepted, and either ``q`` owes nothing
+          (:meth:`LetterTableau.settled`: ``F a`` ends right after the ``a``, with no
+          extra step) or they passed every mark and the cell allows going round them
+          again (S2's ``grasp, grasp, assemble``: a loop the worker could repeat).
+        """
+        settled = getattr(self.aut, "settled", None)
+        # an explicit automaton's marks on edges off its cycles are arbitrary: there the
+        # word's acceptance and the repeat decide
+        marked = settled is not None
+        settled = settled(q) if settled is not None else False
+        full = self.aut.full
+        acc = 0
         for c in range(1, len(tail) + 1):
             cyc = tail[-c:]
-            key = (q, cyc)
-            ok = self._tails.get(key)
-            if ok is None:
-                ok = self._tails[key] = self._accepts_cycle(q, cyc)
+            acc |= marks[-c]
+            if before[-c] == q and acc == full:
+                ok = True
+            elif settled or acc == full or not marked:
+                key = (q, cyc)
+                ok = self._tails.get(key)
+                if ok is None:
+                    ok = self._tails[key] = self._accepts_cycle(q, cyc)
+                # a loop the worker could go round again, unless nothing is owed
+                ok = ok and (settled or self._again(s, cyc, max(1, self.repetitions - 1))
+                             is not None)
+            else:
+                continue
             again = self._again(s, cyc) if ok else None
             if again is not None:
                 return c, again
@@ -608,7 +644,7 @@ class ProductSearch:
     def _path(labels: list, lab: int) -> tuple[int, ...]:
         out = []
         while lab > 0:
-            _node, parent, task, _g = labels[lab]
+            _node, parent, task, _g, _m = labels[lab]
             out.append(task)
             lab = parent
         return tuple(reversed(out))
