@@ -56,7 +56,7 @@ def kitting_cell_yaml(n: int, name: str | None = None) -> str:
                      "size: [0.06, 0.06, 0.06], grasp_points: [[0.0, 0.0, 0.03]], "
                      "mass: 0.2}")
     lines += [
-        "  kit: {position: [0.0, -1.85, 0.83], shape: box, size: [0.35, 0.25, 0.06], "
+        "  kit: {position: [0.0, -1.85, 0.93], shape: box, size: [0.35, 0.25, 0.06], "
         "movable: false}",
         "regions:",
         "  R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}",
