@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from ltl_human_motion.ltl.automaton import accepting_components
+from ltl_human_motion.ltl.automaton import lasso_accepted
 from ltl_human_motion.ltl.formula import (
     And,
     Atom,
@@ -222,25 +222,11 @@ class LetterTableau:
 
     def accepts_lasso(self, prefix: Sequence[int], cycle: Sequence[int]) -> bool:
         """True iff the automaton accepts ``prefix cycle^omega`` (letter indices)."""
-        if not cycle:
-            raise ValueError("a lasso needs at least one cycle letter, got an empty cycle")
         word = [*prefix, *cycle]
-        n, total = len(prefix), len(word)
-        index = {(self.initial, 0): 0}
-        adj: list[list[tuple[int, frozenset[int]]]] = [[]]
-        stack = [(self.initial, 0)]
-        while stack:
-            q, i = stack.pop()
-            src = index[(q, i)]
-            j = i + 1 if i + 1 < total else n
-            for d, marks in self.successors(q, word[i]):
-                key = (d, j)
-                if key not in index:
-                    index[key] = len(adj)
-                    adj.append([])
-                    stack.append(key)
-                adj[src].append((index[key], self.mark_set(marks)))
-        return bool(accepting_components(adj, self.num_sets))
+        return lasso_accepted(self.initial,
+                              lambda q, i: [(d, self.mark_set(m))
+                                            for d, m in self.successors(q, word[i])],
+                              len(prefix), len(cycle), self.num_sets)
 
     def mark_set(self, marks: int) -> frozenset[int]:
         """The acceptance sets of a mark bit field."""

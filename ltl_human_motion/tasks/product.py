@@ -33,7 +33,7 @@ import random
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from ltl_human_motion.ltl.automaton import Automaton, accepting_components
+from ltl_human_motion.ltl.automaton import Automaton, accepting_components, lasso_accepted
 from ltl_human_motion.ltl.automaton import strongly_connected_components as _sccs
 from ltl_human_motion.ltl.formula import And, Atom, Const, Finally, Formula, Globally, Not, Or
 from ltl_human_motion.tasks.model import HELD, CellModel, CellState
@@ -623,22 +623,11 @@ class ProductSearch:
 
     def _accepts_cycle(self, q0: int, cyc: tuple[int, ...]) -> bool:
         """Whether the automaton accepts ``cyc^omega`` from state ``q0``."""
-        index = {(q0, 0): 0}
-        adj: list[list[tuple[int, frozenset[int]]]] = [[]]
-        stack = [(q0, 0)]
         bits = range(self.aut.full.bit_length())
-        while stack:
-            q, pos = stack.pop()
-            src = index[(q, pos)]
-            nxt_pos = (pos + 1) % len(cyc)
-            for d, m in self.aut.successors(q, cyc[pos]):
-                key = (d, nxt_pos)
-                if key not in index:
-                    index[key] = len(adj)
-                    adj.append([])
-                    stack.append(key)
-                adj[src].append((index[key], frozenset(b for b in bits if m >> b & 1)))
-        return bool(accepting_components(adj, self.aut.full.bit_length()))
+        return lasso_accepted(
+            q0, lambda q, i: [(d, frozenset(b for b in bits if m >> b & 1))
+                              for d, m in self.aut.successors(q, cyc[i])],
+            0, len(cyc), self.aut.full.bit_length())
 
     @staticmethod
     def _path(labels: list, lab: int) -> tuple[int, ...]:
