@@ -115,6 +115,7 @@ class LetterTableau:
         self._proper: dict[Formula, frozenset[Formula]] = {}
         self._mentioned: dict[int, frozenset[str]] = {}
         self._next_ids: dict[frozenset[Formula], int] = {}
+        self._order: dict[int, tuple[Formula, ...]] = {}
         self._formula_names: dict[Formula, frozenset[str]] = {}
         self.initial = self._intern(_state_key(frozenset({self.formula})))
 
@@ -177,8 +178,11 @@ class LetterTableau:
         hit = self._succ.get(key)
         if hit is not None:
             return hit
+        order = self._order.get(q)
+        if order is None:
+            order = self._order[q] = tuple(sorted(self.states[q], key=str))
         terms: list[_Term] = [(_EMPTY, _EMPTY)]
-        for f in sorted(self.states[q], key=str):
+        for f in order:
             terms = _product(terms, self.expand(f, i))
             if not terms:
                 break
