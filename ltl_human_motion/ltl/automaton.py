@@ -21,6 +21,7 @@ __all__ = [
     "accepting_components",
     "degeneralize",
     "direct_simulation",
+    "lasso_accepted",
     "reduce",
     "simulation_reduce",
     "strip_marks",
@@ -173,26 +174,12 @@ class Automaton:
         Builds the product of the automaton with the lasso's positions and looks for a
         reachable strongly connected component that carries every acceptance mark.
         """
-        if not cycle:
-            raise ValueError("a lasso needs at least one cycle letter, got an empty cycle")
         word = [frozenset(x) for x in prefix] + [frozenset(x) for x in cycle]
-        n, total = len(prefix), len(word)
-        index: dict[tuple[int, int], int] = {(self.initial, 0): 0}
-        adj: list[list[tuple[int, frozenset[int]]]] = [[]]
-        stack = [(self.initial, 0)]
-        while stack:
-            q, i = stack.pop()
-            src = index[(q, i)]
-            j = i + 1 if i + 1 < total else n
-            for e in self._out[q]:
-                if e.guard.satisfied_by(word[i]):
-                    key = (e.dst, j)
-                    if key not in index:
-                        index[key] = len(adj)
-                        adj.append([])
-                        stack.append(key)
-                    adj[src].append((index[key], e.acc))
-        return bool(accepting_components(adj, self.num_sets))
+
+        def succ(q: int, i: int):
+            return [(e.dst, e.acc) for e in self._out[q] if e.guard.satisfied_by(word[i])]
+
+        return lasso_accepted(self.initial, succ, len(prefix), len(cycle), self.num_sets)
 
     def is_empty(self) -> bool:
         """True iff the automaton accepts no word (ignoring label satisfiability)."""
@@ -211,6 +198,39 @@ class Automaton:
                     seen.add(e.dst)
                     stack.append(e.dst)
         return seen
+
+
+def lasso_accepted(initial: int, succ, n_prefix: int, n_cycle: int, num_sets: int) -> bool:
+    """Whether an automaton accepts a lasso word: the product of the automaton with the
+    word's positions (prefix ``0..n_prefix-1``, then the cycle) has a reachable strongly
+    connected component carrying all ``num_sets`` marks.
+
+    ``succ(q, i)`` gives the edges ``(state, marks)`` leaving ``q`` on the letter at
+    position ``i``.
+
+    Raises
+    ------
+    ValueError
+        If the cycle is empty.
+    """
+    if n_cycle < 1:
+        raise ValueError("a lasso needs at least one cycle letter, got an empty cycle")
+    total = n_prefix + n_cycle
+    index: dict[tuple[int, int], int] = {(initial, 0): 0}
+    adj: list[list[tuple[int, frozenset[int]]]] = [[]]
+    stack = [(initial, 0)]
+    while stack:
+        q, i = stack.pop()
+        src = index[(q, i)]
+        j = i + 1 if i + 1 < total else n_prefix
+        for dst, acc in succ(q, i):
+            key = (dst, j)
+            if key not in index:
+                index[key] = len(adj)
+                adj.append([])
+                stack.append(key)
+            adj[src].append((index[key], acc))
+    return bool(accepting_components(adj, num_sets))
 
 
 def strongly_connected_components(adj: Sequence[Sequence[tuple[int, object]]]) -> list[int]:
