@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import random
+import tempfile
 
 import pytest
 from hypothesis import settings
@@ -23,6 +24,8 @@ settings.register_profile("explore", deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 os.environ.setdefault("ROS_DOMAIN_ID", str(random.SystemRandom().randint(100, 200)))
+# Motions stored under $ROS_HOME (the synthesis node's default) stay out of the user's home.
+os.environ.setdefault("ROS_HOME", tempfile.mkdtemp(prefix="lhm-test-ros-home-"))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 apply_middleware_defaults()
 
