@@ -138,3 +138,99 @@ def test_ten_thousand_tiny_obstacles_are_refused_with_advice() -> None:
         cell_from_yaml(text)
     assert "merge neighbouring obstacles" in str(info.value)
     assert time.monotonic() - started < 30.0
+
+
+# ------------------------------------------------------------------ motion files
+BVH_DIR = Path("/usr/share/assimp/models/BVH")
+GENUINE_BVH = BVH_DIR / "01_01.bvh"
+
+
+def _mutated_bvh(tmp_path: Path, header: str, value: str) -> Path:
+    lines = GENUINE_BVH.read_text().splitlines()
+    i = next(k for k, line in enumerate(lines) if line.startswith(header))
+    lines[i] = f"{header} {value}"
+    path = tmp_path / "mutated.bvh"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.skipif(not GENUINE_BVH.is_file(), reason="assimp's BVH models are not installed")
+@pytest.mark.parametrize("header, value, message", [
+    ("Frames:", "999999999999", "announces 999999999999 frames"),
+    ("Frame Time:", "1e-300", "MIN_FRAME_TIME"),
+    ("Frame Time:", "1e300", "MAX_FRAME_TIME"),
+])
+def test_absurd_bvh_headers_are_format_errors(tmp_path: Path, header: str, value: str,
+                                              message: str) -> None:
+    from ltl_human_motion.errors import MotionFormatError
+    from ltl_human_motion.motion import bvh
+
+    with pytest.raises(MotionFormatError, match=message):
+        bvh.load_raw(_mutated_bvh(tmp_path, header, value))
+
+
+def test_a_bad_asf_axis_order_is_a_format_error(tmp_path: Path) -> None:
+    from test_motion_loaders import _write_asf
+
+    from ltl_human_motion.errors import MotionFormatError
+    from ltl_human_motion.motion import asfamc
+
+    asf = tmp_path / "t.asf"
+    _write_asf(asf)
+    asf.write_text(asf.read_text().replace("axis 0 0 0 XYZ", "axis 0 0 0 QQQ", 1))
+    with pytest.raises(MotionFormatError, match="permutation of XYZ"):
+        asfamc.parse_asf(asf)
+
+
+def test_amc_files_in_a_source_folder_are_paired_with_their_asf(tmp_path: Path) -> None:
+    from test_motion_loaders import _write_amc, _write_asf
+
+    from ltl_human_motion.motion.library import _source_files, asf_for, load_motion
+
+    _write_asf(tmp_path / "07.asf")
+    _write_amc(tmp_path / "07_01.amc", [{}, {"lfemur": [30, 0, 0]}, {}])
+    assert _source_files(tmp_path) == [tmp_path / "07_01.amc"]
+    assert asf_for(tmp_path / "07_01.amc") == tmp_path / "07.asf"
+    assert load_motion(tmp_path / "07_01.amc").n_frames == 3
+
+
+# ------------------------------------------------------------------ library cache
+def test_a_damaged_library_cache_is_refused_on_load(tmp_path: Path) -> None:
+    import numpy as np
+
+    from ltl_human_motion.motion import library as lib_mod
+    from ltl_human_motion.planning.pipeline import get_library
+
+    key = get_library().key
+    cached = lib_mod.cache_dir() / f"library-{key}.npz"
+    assert cached.is_file()
+    with np.load(cached) as z:
+        arrays = dict(z)
+    for name, damage in (("poses", lambda a: np.where(np.arange(a.size).reshape(a.shape) == 7,
+                                                      np.nan, a)),
+                         ("indices", lambda a: a + 10_000_000)):
+        bad = dict(arrays)
+        bad[name] = damage(arrays[name])
+        path = tmp_path / f"library-{key}.npz"
+        np.savez(path, **bad)
+        with pytest.raises(ValueError, match=r"NaN|indices outside"):
+            lib_mod._load(path, key)
+
+
+# ------------------------------------------------------------------ batch start-up
+def test_a_batch_folder_killed_during_start_up_resumes(tmp_path: Path) -> None:
+    """What a SIGKILL between making the folders and writing dataset.json left: the rerun
+    resumes it instead of refusing "exists, is not empty and is not a dataset"."""
+    from ltl_human_motion.batch.store import DatasetStore
+
+    out = tmp_path / "out"
+    for sub in ("staging", "shards"):
+        (out / sub).mkdir(parents=True)
+    (out / ".lock").touch()
+    (out / "staging" / ".item-0.npz.tmp").write_bytes(b"half")
+    store = DatasetStore(out, {"fingerprint": "f" * 64, "count": 2, "shard_size": 1})
+    assert store.header_path.is_file()
+    (out / "shards" / "stray.txt").write_text("not ours")
+    (out / "dataset.json").unlink()
+    with pytest.raises(Exception, match="is not a dataset"):
+        DatasetStore(tmp_path / "out", {"fingerprint": "f" * 64, "count": 2, "shard_size": 1})
