@@ -14,6 +14,7 @@ file reproduces the positions exactly; it loads back with :func:`load`.
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -157,6 +158,9 @@ def _parse(path: Path, text: str) -> tuple[BvhSkeleton, np.ndarray, float]:
                     from None
             if len(vals) != 3 or len(tok) != 4:
                 raise _err(path, lineno, "OFFSET needs 3 numbers")
+            if not all(math.isfinite(v) and abs(v) <= MAX_OFFSET for v in vals):
+                raise _err(path, lineno, f"OFFSET values must be finite and within "
+                           f"+-{MAX_OFFSET:g} (MAX_OFFSET), got {' '.join(tok[1:])[:60]!r}")
             offsets[stack[-1]] = vals
         elif key == "CHANNELS":
             if not stack:
@@ -282,6 +286,8 @@ def _fk(skel: BvhSkeleton, data: np.ndarray) -> np.ndarray:
 #: 1e-300 s overflowed the frame rate.
 MIN_FRAME_TIME = 1e-4
 MAX_FRAME_TIME = 10.0
+#: Bone offsets (file units: cm, inches or m): a human bone is well under 1e4 of any.
+MAX_OFFSET = 1e4
 
 
 def load_raw(path: str | os.PathLike[str]) -> tuple[BvhSkeleton, np.ndarray, float]:
