@@ -14,6 +14,8 @@ import itertools
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
+from ltl_human_motion.deadline import checkpoint
+
 __all__ = [
     "Automaton",
     "Cube",
@@ -465,6 +467,7 @@ def direct_simulation(aut: Automaton) -> list[set[int]]:
     while changed:
         changed = False
         for q in aut.states:
+            checkpoint("translation")
             for p in list(sim[q]):
                 if p == q:
                     continue
