@@ -129,7 +129,10 @@ def load_yaml_limited(text: str) -> Any:
     if node is None:
         return None
     _expanded_size(node)
+    constructor = loader("")                      # builds the value from the checked graph
     try:
-        return yaml.load(text, Loader=loader)
+        return constructor.construct_document(node)
     except yaml.YAMLError as exc:
         raise YamlLimitError(f"invalid YAML: {exc}") from None
+    finally:
+        constructor.dispose()
