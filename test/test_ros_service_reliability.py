@@ -202,3 +202,23 @@ def test_sigint_mid_synthesis_exits_within_two_seconds(
         output = proc.stdout.read()
         proc.stdout.close()
     assert "Traceback" not in output, output[-3000:]
+
+
+def test_the_motion_store_is_bounded_and_evicts_to_its_folder(tmp_path: Path) -> None:
+    from ltl_human_motion.ros.motion_store import MotionStore, default_store_dir, motion_nbytes
+    from ltl_human_motion.ros.testing import make_test_motion
+
+    motion = make_test_motion()
+    size = motion_nbytes(motion)
+    assert size > 0
+    on_disk = MotionStore(tmp_path / "motions", max_in_memory=3, max_bytes=10 * size)
+    ids = [on_disk.add(motion) for _ in range(6)]
+    assert len(on_disk) == 3 and on_disk.bytes_in_memory == 3 * size
+    assert on_disk.get(ids[0]).motion.n_frames == motion.motion.n_frames   # from the folder
+    by_bytes = MotionStore(None, max_in_memory=100, max_bytes=2 * size + 1)
+    kept = [by_bytes.add(motion) for _ in range(4)]
+    assert len(by_bytes) == 2
+    with pytest.raises(KeyError, match="evicted from memory"):
+        by_bytes.get(kept[0])
+    assert by_bytes.get(kept[-1]) is motion
+    assert default_store_dir() == Path(os.environ["ROS_HOME"]) / "ltl_human_motion" / "motions"
