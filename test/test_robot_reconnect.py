@@ -42,7 +42,13 @@ def test_dropped_connection_goes_to_minimum_and_reconnects(sim: URSimHandle) -> 
         d = feed_and_step(ctl, human_at(1.9), steps=10)[-1]
         assert d.connected and d.mode in ("reduced", "full")
         sim.kill()                                        # controller crash / cable pulled
+        # Detected when the socket closes or robot data freeze for robot_stale_after
+        # (0.5 s): wait in real time (bounded), not a number of steps, which a loaded
+        # machine stretches or squeezes.
+        deadline = time.monotonic() + 5.0
         modes = [d.mode for d in feed_and_step(ctl, human_at(1.9), steps=40)]
+        while modes[-1] != "disconnected" and time.monotonic() < deadline:
+            modes = [d.mode for d in feed_and_step(ctl, human_at(1.9), steps=5)]
         assert modes[-1] == "disconnected"
         lost = [d for d in feed_and_step(ctl, human_at(1.9), steps=5)]
         assert all(x.slider == MIN and not x.connected for x in lost)

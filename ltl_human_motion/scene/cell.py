@@ -38,27 +38,32 @@ are unchanged (the vertical axis maps to the vertical axis).
 
 Every error names the file and the key, e.g.
 ``paper_cell.yaml: objects.O1.position: expected 3 numbers, got 2``.
+
+This module holds the data model (:class:`Cell`, :class:`Region`, :class:`SceneObject`,
+:class:`Obstacle`); the YAML loader, with its named limits, is
+:mod:`ltl_human_motion.scene.cell_yaml`. Its public functions (:func:`load_cell`,
+:func:`cell_from_yaml`, :func:`cell_by_name`, :func:`cell_search_paths`) stay importable
+from here.
 """
 
 from __future__ import annotations
 
-import math
-import os
-import re
-import sys
-from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ltl_human_motion.errors import CellError
 from ltl_human_motion.scene.clearance import EXACT_BELOW, PartSet, part_set
-from ltl_human_motion.scene.frames import ZUP_FROM_YUP, extents_zup_from_yup, zup_from_yup
 from ltl_human_motion.scene.geometry import min_along_segment
-from ltl_human_motion.scene.shapes import Box, Cylinder, Footprint, MeshShape, Shape, Sphere
-from ltl_human_motion.scene.tasks import TASK_ARGUMENTS
+from ltl_human_motion.scene.shapes import Box, Footprint, Shape
+
+if TYPE_CHECKING:   # served lazily by __getattr__ below
+    from ltl_human_motion.scene.cell_yaml import (
+        cell_by_name,
+        cell_from_yaml,
+        cell_search_paths,
+        load_cell,
+    )
 
 __all__ = [
     "Cell",
@@ -71,10 +76,17 @@ __all__ = [
     "load_cell",
 ]
 
-_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
-_SHORTHAND_KEY = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\(([^()]*)\))?\s*$")
-_ATOM = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)\s*\(([^()]*)\)")
-_FRAMES = ("zup", "paper_yup")
+#: Names served by :mod:`.cell_yaml` (imported on first use: it builds these classes).
+_LOADER_NAMES = frozenset({"cell_by_name", "cell_from_yaml", "cell_search_paths", "load_cell",
+                           "MAX_CELL_COORDINATE", "MAX_CELL_ENTRIES", "MAX_WORKSPACE_EXTENT"})
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LOADER_NAMES:
+        from ltl_human_motion.scene import cell_yaml
+
+        return getattr(cell_yaml, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 # --------------------------------------------------------------------------- types
@@ -389,405 +401,3 @@ class Cell:
         if name in self.objects:
             return self.objects[name]
         raise ValueError(f"cell {self.name!r} has no region or object {name!r}")
-
-
-# --------------------------------------------------------------------------- parsing
-
-class _Parser:
-    """Hand-written validation of the YAML mapping; every error names file and key."""
-
-    def __init__(self, source: str, base_dir: Path, frame: str) -> None:
-        self.source = source
-        self.base_dir = base_dir
-        self.frame = frame
-
-    def error(self, key: str, message: str) -> CellError:
-        return CellError(f"{self.source}: {key}: {message}" if key else f"{self.source}: {message}")
-
-    def mapping(self, value: Any, key: str, allowed: set[str] | frozenset[str],
-                required: tuple[str, ...] = ()) -> Mapping[str, Any]:
-        if not isinstance(value, Mapping):
-            raise self.error(key, f"expected a mapping, got {type(value).__name__}")
-        for k in value:
-            if not isinstance(k, str):
-                raise self.error(key, f"keys must be strings, got {k!r}")
-            if k not in allowed:
-                raise self.error(f"{key}.{k}" if key else k,
-                                 f"unknown key; expected one of {', '.join(sorted(allowed))}")
-        for k in required:
-            if k not in value:
-                raise self.error(key, f"missing required key {k!r}")
-        return value
-
-    def number(self, value: Any, key: str) -> float:
-        if isinstance(value, str):
-            # YAML 1.1 reads "1e-3" (no dot) as a string; accept numeric strings.
-            try:
-                value = float(value)
-            except ValueError:
-                raise self.error(key, f"expected a number, got {value!r}") from None
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.error(key, f"expected a number, got {value!r}")
-        if not math.isfinite(float(value)):
-            raise self.error(key, f"expected a finite number, got {value!r}")
-        return float(value)
-
-    def numbers(self, value: Any, key: str, n: int | tuple[int, ...]) -> np.ndarray:
-        counts = (n,) if isinstance(n, int) else n
-        if not isinstance(value, (list, tuple)):
-            raise self.error(key, f"expected {self._count(counts)} numbers, got {value!r}")
-        if len(value) not in counts:
-            raise self.error(key, f"expected {self._count(counts)} numbers, got {len(value)}")
-        return np.array([self.number(v, f"{key}[{i}]") for i, v in enumerate(value)])
-
-    @staticmethod
-    def _count(counts: tuple[int, ...]) -> str:
-        return " or ".join(str(c) for c in counts)
-
-    def point(self, value: Any, key: str) -> np.ndarray:
-        p = self.numbers(value, key, 3)
-        return zup_from_yup(p) if self.frame == "paper_yup" else p
-
-    def bounds(self, lo_v: Any, hi_v: Any, key: str) -> tuple[np.ndarray, np.ndarray]:
-        lo = self.point(lo_v, f"{key}.lo")
-        hi = self.point(hi_v, f"{key}.hi")
-        lo, hi = np.minimum(lo, hi), np.maximum(lo, hi)
-        raw_lo, raw_hi = self.numbers(lo_v, f"{key}.lo", 3), self.numbers(hi_v, f"{key}.hi", 3)
-        if np.any(raw_hi <= raw_lo):
-            raise self.error(key, f"needs lo < hi on every axis, got lo={raw_lo.tolist()}, "
-                                  f"hi={raw_hi.tolist()}")
-        return lo, hi
-
-    def name(self, value: Any, key: str) -> str:
-        if not isinstance(value, str) or not _NAME.match(value):
-            raise self.error(key, f"expected a name (letters, digits, _), got {value!r}")
-        return value
-
-    def color(self, spec: Mapping[str, Any], key: str) -> str | None:
-        c = spec.get("color")
-        if c is not None and not isinstance(c, str):
-            raise self.error(f"{key}.color", f"expected a colour name or #rrggbb, got {c!r}")
-        return c
-
-    def load_mesh(self, value: Any, key: str, scale: float):
-        if not isinstance(value, str) or not value:
-            raise self.error(key, f"expected a file path, got {value!r}")
-        path = Path(value)
-        if not path.is_absolute():
-            path = self.base_dir / path
-        if not path.is_file():
-            raise self.error(key, f"mesh file not found: {path}")
-        import trimesh
-        try:
-            mesh = trimesh.load(str(path), force="mesh")
-        except Exception as exc:  # trimesh raises many types for corrupt files
-            raise self.error(key, f"cannot load mesh {path}: {exc}") from exc
-        if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-            raise self.error(key, f"{path} holds no triangles")
-        mesh = mesh.copy()
-        mesh.apply_scale(scale)
-        if self.frame == "paper_yup":
-            tf = np.eye(4)
-            tf[:3, :3] = ZUP_FROM_YUP
-            mesh.apply_transform(tf)
-        return mesh
-
-    _SHAPE_KEYS = frozenset({"shape", "position", "size", "yaw", "mesh", "scale"})
-
-    def shape(self, spec: Mapping[str, Any], key: str) -> Shape:
-        kind = spec.get("shape", "mesh" if "mesh" in spec else None)
-        if kind not in ("box", "cylinder", "sphere", "mesh"):
-            raise self.error(f"{key}.shape",
-                             f"expected box, cylinder, sphere or mesh, got {kind!r}")
-        if kind != "mesh" and "position" not in spec:
-            raise self.error(key, "missing required key 'position'")
-        position = self.point(spec.get("position", [0, 0, 0]), f"{key}.position")
-        yaw = self.number(spec.get("yaw", 0.0), f"{key}.yaw")
-        if kind == "mesh":
-            if "mesh" not in spec:
-                raise self.error(key, "shape mesh needs a 'mesh' file")
-            for k in ("size",):
-                if k in spec:
-                    raise self.error(f"{key}.{k}", "not allowed for a mesh (use 'scale')")
-            scale = self.number(spec.get("scale", 1.0), f"{key}.scale")
-            if scale <= 0:
-                raise self.error(f"{key}.scale", f"expected a positive number, got {scale}")
-            mesh = self.load_mesh(spec["mesh"], f"{key}.mesh", scale)
-            if yaw:
-                c, s = np.cos(yaw), np.sin(yaw)
-                tf = np.eye(4)
-                tf[:2, :2] = [[c, -s], [s, c]]
-                mesh.apply_transform(tf)
-            return MeshShape(mesh, position)
-        for k in ("mesh", "scale"):
-            if k in spec:
-                raise self.error(f"{key}.{k}", f"only allowed with shape: mesh, not {kind}")
-        if "size" not in spec:
-            raise self.error(key, f"shape {kind} needs a 'size'")
-        skey = f"{key}.size"
-        if kind == "box":
-            size = self.numbers(spec["size"], skey, 3)
-            if self.frame == "paper_yup":
-                size = extents_zup_from_yup(size)
-            if np.any(size <= 0):
-                raise self.error(skey, f"expected positive side lengths, got {size.tolist()}")
-            return Box(position, size, yaw)
-        if yaw:
-            raise self.error(f"{key}.yaw", f"not allowed for a {kind} (it is symmetric)")
-        if kind == "cylinder":
-            size = self.numbers(spec["size"], skey, 2)
-            if np.any(size <= 0):
-                raise self.error(skey, f"expected positive [radius, height], got {size.tolist()}")
-            return Cylinder(position, size[0], size[1])
-        size = self.numbers(spec["size"], skey, 1)
-        if size[0] <= 0:
-            raise self.error(skey, f"expected a positive [radius], got {size.tolist()}")
-        return Sphere(position, size[0])
-
-    def obj(self, name: str, spec: Any) -> SceneObject:
-        key = f"objects.{name}"
-        spec = self.mapping(spec, key, self._SHAPE_KEYS | {"grasp_points", "movable",
-                                                          "sitting_surface", "color",
-                                                          "mass", "two_handed"},
-                            required=("position",))
-        shape = self.shape(spec, key)
-        position = self.point(spec["position"], f"{key}.position")
-        grasp = spec.get("grasp_points", [[0.0, 0.0, 0.0]])
-        if not isinstance(grasp, list) or not grasp:
-            raise self.error(f"{key}.grasp_points", f"expected a list of points, got {grasp!r}")
-        offsets = np.array([self.point(g, f"{key}.grasp_points[{i}]")
-                            for i, g in enumerate(grasp)])
-        movable = spec.get("movable", True)
-        if not isinstance(movable, bool):
-            raise self.error(f"{key}.movable", f"expected true or false, got {movable!r}")
-        sitting = None
-        if "sitting_surface" in spec:
-            skey = f"{key}.sitting_surface"
-            s = self.mapping(spec["sitting_surface"], skey, {"lo", "hi"}, ("lo", "hi"))
-            sitting = np.stack(self.bounds(s["lo"], s["hi"], skey))
-        mass = self.number(spec.get("mass", 1.0), f"{key}.mass")
-        if mass <= 0.0:
-            raise self.error(f"{key}.mass", f"expected a positive mass in kg, got {mass!r}")
-        two_handed = spec.get("two_handed", False)
-        if not isinstance(two_handed, bool):
-            raise self.error(f"{key}.two_handed", f"expected true or false, got {two_handed!r}")
-        return SceneObject(name, position, shape, offsets, movable, sitting,
-                           self.color(spec, key), mass, two_handed)
-
-    def region(self, name: str, spec: Any) -> Region:
-        key = f"regions.{name}"
-        spec = self.mapping(spec, key, {"lo", "hi", "mesh", "scale", "position", "color"})
-        if "mesh" in spec:
-            for k in ("lo", "hi"):
-                if k in spec:
-                    raise self.error(f"{key}.{k}", "give either lo/hi or mesh, not both")
-            scale = self.number(spec.get("scale", 1.0), f"{key}.scale")
-            mesh = self.load_mesh(spec["mesh"], f"{key}.mesh", scale)
-            position = self.point(spec.get("position", [0, 0, 0]), f"{key}.position")
-            return Region(name, MeshShape(mesh, position))
-        for k in ("scale", "position"):
-            if k in spec:
-                raise self.error(f"{key}.{k}", "only allowed for mesh regions")
-        if "lo" not in spec or "hi" not in spec:
-            raise self.error(key, "a region needs lo and hi (a box) or mesh")
-        lo, hi = self.bounds(spec["lo"], spec["hi"], key)
-        return Region(name, Box.from_bounds(lo, hi))
-
-    def obstacle(self, name: str, spec: Any) -> Obstacle:
-        key = f"obstacles.{name}"
-        if isinstance(spec, Mapping) and "parts" in spec:
-            spec = self.mapping(spec, key, {"parts", "color"})
-            parts = spec["parts"]
-            if not isinstance(parts, list) or not parts:
-                raise self.error(f"{key}.parts", "expected a non-empty list of shapes")
-            shapes = []
-            for i, part in enumerate(parts):
-                pkey = f"{key}.parts[{i}]"
-                shapes.append(self.shape(self.mapping(part, pkey, self._SHAPE_KEYS), pkey))
-            return Obstacle(name, tuple(shapes), self.color(spec, key))
-        spec = self.mapping(spec, key, self._SHAPE_KEYS | {"color"})
-        return Obstacle(name, (self.shape(spec, key),), self.color(spec, key))
-
-
-_TOP_KEYS = {"name", "description", "frame", "floor_z", "workspace", "start_region",
-             "final_region", "objects", "regions", "obstacles", "shorthands"}
-
-
-def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Cell:
-    pre = _Parser(source, base_dir, "zup")
-    data = pre.mapping(data, "", _TOP_KEYS, required=("regions", "start_region"))
-    frame = data.get("frame", "zup")
-    if frame not in _FRAMES:
-        raise pre.error("frame", f"expected zup or paper_yup, got {frame!r}")
-    p = _Parser(source, base_dir, frame)
-
-    name = data.get("name", default_name)
-    if not isinstance(name, str) or not name:
-        raise p.error("name", f"expected a non-empty string, got {name!r}")
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise p.error("description", f"expected a string, got {description!r}")
-    floor_z = p.number(data.get("floor_z", 0.0), "floor_z")
-
-    ws = p.mapping(data.get("workspace", {"lo": [-5, -5, 0], "hi": [5, 5, 3]}), "workspace",
-                   {"lo", "hi"}, ("lo", "hi"))
-    ws_lo, ws_hi = p.bounds(ws["lo"], ws["hi"], "workspace")
-
-    def section(key: str) -> Mapping[str, Any]:
-        value = data.get(key) or {}
-        if not isinstance(value, Mapping):
-            raise p.error(key, f"expected a mapping of name to description, got "
-                               f"{type(value).__name__}")
-        for k in value:
-            p.name(k, f"{key}.{k}")
-        return value
-
-    objects = {n: p.obj(n, s) for n, s in section("objects").items()}
-    regions = {n: p.region(n, s) for n, s in section("regions").items()}
-    obstacles = tuple(p.obstacle(n, s) for n, s in section("obstacles").items())
-    clash = sorted(set(objects) & set(regions))
-    if clash:
-        raise p.error("regions", f"names used for both an object and a region: {clash}")
-    for n in list(objects) + list(regions):
-        if n in TASK_ARGUMENTS:
-            raise p.error(f"objects.{n}" if n in objects else f"regions.{n}",
-                          "a task name cannot name an object or a region")
-
-    def region_ref(key: str, required: bool) -> Region | None:
-        value = data.get(key)
-        if value is None:
-            if required:
-                raise p.error(key, "missing")
-            return None
-        if value not in regions:
-            raise p.error(key, f"unknown region {value!r}; regions: {', '.join(regions)}")
-        return regions[value]
-
-    start = region_ref("start_region", True)
-    final = region_ref("final_region", False)
-    inside = (start.lo[:2] >= ws_lo[:2] - 1e-9) & (start.hi[:2] <= ws_hi[:2] + 1e-9)
-    if not np.all(inside):
-        raise p.error("start_region", f"region {start.name!r} lies outside the workspace")
-
-    shorthands: dict[str, tuple[tuple[str, ...], str]] = {}
-    raw = data.get("shorthands") or {}
-    if not isinstance(raw, Mapping):
-        raise p.error("shorthands", "expected a mapping such as 'assemble(R): leftHand(R) & "
-                                    "rightHand(R)'")
-    for k, body in raw.items():
-        key = f"shorthands.{k}"
-        m = _SHORTHAND_KEY.match(str(k))
-        if not m:
-            raise p.error(key, "expected name(param, ...) as the key")
-        sname = m.group(1)
-        params = tuple(x.strip() for x in (m.group(2) or "").split(",") if x.strip())
-        for x in params:
-            if not _NAME.match(x):
-                raise p.error(key, f"bad parameter name {x!r}")
-        if len(set(params)) != len(params):
-            raise p.error(key, "parameter names must differ")
-        if sname in TASK_ARGUMENTS or sname in shorthands:
-            raise p.error(key, f"{sname!r} is already a task or shorthand")
-        if not isinstance(body, str) or not body.strip():
-            raise p.error(key, f"expected the body as a string, got {body!r}")
-        atoms = _ATOM.findall(body)
-        if not atoms:
-            raise p.error(key, f"body {body!r} contains no task")
-        for task, args in atoms:
-            if task not in TASK_ARGUMENTS and task not in shorthands:
-                raise p.error(key, f"unknown task {task!r} in body {body!r}")
-            for arg in (a.strip() for a in args.split(",") if a.strip()):
-                if arg not in params and arg not in objects and arg not in regions:
-                    try:
-                        float(arg)
-                    except ValueError:
-                        raise p.error(key, f"{arg!r} in body {body!r} is neither a parameter "
-                                           f"nor an object or region") from None
-        shorthands[sname] = (params, body.strip())
-
-    return Cell(name=name, source=source, objects=objects, regions=regions,
-                obstacles=obstacles, start_region=start, final_region=final,
-                shorthands=shorthands, floor_z=floor_z, workspace_lo=ws_lo,
-                workspace_hi=ws_hi, frame=frame, description=description)
-
-
-def cell_from_yaml(text: str, source: str = "<inline>",
-                   base_dir: str | os.PathLike[str] | None = None) -> Cell:
-    """Parse a cell from YAML text.
-
-    Parameters
-    ----------
-    text : str
-    source : str
-        Name used in error messages (and ``Cell.source``).
-    base_dir : path, optional
-        Folder that relative mesh paths are resolved against (default: the current one).
-
-    Raises
-    ------
-    CellError
-        Malformed YAML or cell description; the message names ``source`` and the key.
-    """
-    import yaml
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise CellError(f"{source}: invalid YAML: {exc}") from exc
-    default_name = Path(source).stem if source != "<inline>" else "cell"
-    return _parse_cell(data, source, Path(base_dir) if base_dir is not None else Path.cwd(),
-                       default_name)
-
-
-def load_cell(path: str | os.PathLike[str]) -> Cell:
-    """Load a cell from a YAML file; mesh paths are relative to the file."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise CellError(f"{path}: cannot read cell file: {exc.strerror or exc}") from exc
-    return cell_from_yaml(text, source=str(path), base_dir=path.parent)
-
-
-def cell_search_paths() -> list[Path]:
-    """Folders searched by :func:`cell_by_name`, in order.
-
-    The source tree's ``config/`` (beside the package), then ``share/ltl_human_motion/
-    config`` in any ancestor of the installed package (colcon install space), in
-    ``sys.prefix`` and in every ``AMENT_PREFIX_PATH`` entry.
-    """
-    here = Path(__file__).resolve()
-    paths = [here.parents[2] / "config"]
-    for parent in here.parents:
-        paths.append(parent / "share" / "ltl_human_motion" / "config")
-    paths.append(Path(sys.prefix) / "share" / "ltl_human_motion" / "config")
-    for prefix in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
-        if prefix:
-            paths.append(Path(prefix) / "share" / "ltl_human_motion" / "config")
-    seen: list[Path] = []
-    for p in paths:
-        if p not in seen:
-            seen.append(p)
-    return seen
-
-
-def cell_by_name(name: str) -> Cell:
-    """Load the shipped cell ``config/<name>.yaml`` (e.g. ``"paper_cell"``).
-
-    Raises
-    ------
-    CellError
-        No such cell; the message lists the folders searched and the cells found.
-    """
-    if not isinstance(name, str) or not _NAME.match(name.removesuffix(".yaml")):
-        raise CellError(f"cell name must be a plain name such as 'paper_cell', got {name!r}")
-    stem = name.removesuffix(".yaml")
-    found: set[str] = set()
-    for folder in cell_search_paths():
-        candidate = folder / f"{stem}.yaml"
-        if candidate.is_file():
-            return load_cell(candidate)
-        if folder.is_dir():
-            # Other YAML files live there too (bringup parameters, batch specs, robots).
-            found.update(p.stem for p in folder.glob("*.yaml")
-                         if "start_region:" in p.read_text(encoding="utf-8", errors="replace"))
-    raise CellError(f"no cell named {stem!r}; known cells: {', '.join(sorted(found)) or '(none)'}")
