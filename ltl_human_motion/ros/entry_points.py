@@ -54,8 +54,9 @@ def skeleton_publisher(args: list[str] | None = None) -> int:
 
 def occupancy_node(args: list[str] | None = None) -> int:
     """Stream ``occupancy``, following the skeleton publisher's ``task_state``."""
-    from ltl_human_motion.ros.occupancy_node import OccupancyNode
+    from ltl_human_motion.ros.occupancy_node import STREAM_SWITCH_INTERVAL, OccupancyNode
 
+    sys.setswitchinterval(STREAM_SWITCH_INTERVAL)    # the stream thread waits less for the GIL
     return _run_node(OccupancyNode, args)
 
 
