@@ -25,13 +25,18 @@ callbacks of the process cannot delay it and a late tick does not shift the ones
 it). Capsule rows of every frame are computed once when a motion is loaded, so a message
 costs one interpolation and the CDR encoding. A tick that starts a period or more late
 counts as a missed deadline: ``deadlines_missed`` counts them and a warning (throttled to
-one per :data:`MISS_WARNING_PERIOD`) gives the count and the worst delay. With
+one per :data:`MISS_WARNING_PERIOD`) gives the count and the worst delay. On a loaded
+machine the thread's wake-up can wait longer than a period for a CPU, so it asks for a
+real-time priority (``stream_priority``; refused without CAP_SYS_NICE or an ``rtprio``
+limit, and then logged). With
 ``use_sim_time`` the stream follows the ROS clock on an rclpy timer instead.
 
 Parameters: ``human_id`` ("1"), ``world_frame`` ("world"), ``rate`` (100.0 Hz),
 ``prediction_horizon`` (0.0 s = off), ``prediction_step`` (0.1 s), ``marker_rate``
 (10.0 Hz; 0 = off), ``store_dir`` (""), ``catalog_topic`` ("/motion_catalog"),
-``task_state_topic`` ("task_state"), ``markers_topic`` ("/occupancy_markers").
+``task_state_topic`` ("task_state"), ``markers_topic`` ("/occupancy_markers"),
+``stream_priority`` (10: ``SCHED_FIFO`` priority of the stream thread where the process
+may have it; 0 = normal scheduling).
 """
 
 from __future__ import annotations
@@ -69,6 +74,14 @@ MISS_WARNING_PERIOD = 5.0
 #: (``coexistence_node.CONTROL_SWITCH_INTERVAL``, measured there: bench/coexistence_loop.py).
 STREAM_SWITCH_INTERVAL = 0.0002
 _ROWS_KEY = "occupancy_capsule_rows"
+#: SCHED_FIFO priority asked for the stream thread: above normal threads, below the
+#: kernel's own and typical ros2_control loops (which use 50 and up).
+DEFAULT_STREAM_PRIORITY = 10
+
+
+def _priority(value: Any) -> str | None:
+    ok = isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= 99
+    return None if ok else f"expected an integer 0..99, got {value!r}"
 
 
 def occupancy_parameters() -> list[ParamSpec]:
@@ -84,6 +97,10 @@ def occupancy_parameters() -> list[ParamSpec]:
         ParamSpec("marker_rate", 10.0, "Occupancy marker messages per second (0 = none)",
                   non_negative),
         ParamSpec("store_dir", "", "Folder of <motion_id>.npz ('' = use the catalog's)",
+                  read_only=True),
+        ParamSpec("stream_priority", DEFAULT_STREAM_PRIORITY,
+                  "SCHED_FIFO priority of the stream thread (0 = normal scheduling; "
+                  "refused without CAP_SYS_NICE/rtprio, then normal)", _priority,
                   read_only=True),
         ParamSpec("catalog_topic", "/motion_catalog", "Latched MotionCatalog topic",
                   topic_name, read_only=True),
@@ -140,11 +157,16 @@ class OccupancyNode(Node):
         else:
             self._schedule = WallSchedule(1.0 / self.param("rate"), self._tick,
                                           on_miss=self._on_miss, on_error=self._on_error,
-                                          name=f"occupancy-{self.human_id}")
+                                          name=f"occupancy-{self.human_id}",
+                                          priority=self.param("stream_priority"))
+            if self._schedule.priority_error:
+                self.get_logger().info(f"stream thread: {self._schedule.priority_error}")
         self._marker_timer = None
         self._set_marker_timer(self.param("marker_rate"))
         self.add_post_set_parameters_callback(self._on_parameters_set)
         mode = "following task_state" if self.following else "sharing the playback clock"
+        if self._schedule is not None and self._schedule.realtime:
+            mode += f", stream thread SCHED_FIFO {self._schedule.priority}"
         self.get_logger().info(f"occupancy of human {self.human_id} at {self.param('rate'):g} Hz"
                                f" ({mode})")
 
@@ -226,6 +248,8 @@ class OccupancyNode(Node):
         if rows is None:
             return
         sec, nanosec = divmod(now.nanoseconds, 1_000_000_000)
+        if not self.context.ok():            # shutting down (Ctrl-C, SIGTERM)
+            return
         self._pub.publish(encode_occupancy_rows(sec, nanosec, self.world_frame,
                                                 self.human_id, self._names, rows, offsets))
         self.messages_published += 1

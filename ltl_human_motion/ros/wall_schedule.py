@@ -4,11 +4,19 @@ Tick ``k`` is due at ``t0 + k * period`` on ``time.monotonic()``: a late tick do
 delay the ones after it (no drift, unlike sleeping a period after the work). A tick that
 starts one period or more late has missed its deadline; the slots it overran are skipped
 (the stream keeps its phase instead of bursting to catch up) and counted.
+
+On a loaded machine the thread's wake-up can wait for a CPU longer than a period. With
+``priority`` > 0 the thread asks for the real-time policy ``SCHED_FIFO`` at that priority
+(Linux; needs CAP_SYS_NICE or an ``rtprio`` limit, as ros2_control's real-time threads
+do); when that is refused it keeps normal scheduling and says why in
+:attr:`WallSchedule.priority_error`. A tick's work is short and the thread sleeps in
+between, so the policy costs the rest of the machine little.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -30,12 +38,14 @@ class WallSchedule:
         Called with the exception of a failed tick (default: re-raise, ending the thread).
     name : str
         Thread name.
+    priority : int
+        ``SCHED_FIFO`` priority of the thread (1-99); 0 keeps normal scheduling.
     """
 
     def __init__(self, period: float, on_tick: Callable[[], None], *,
                  on_miss: Callable[[int, float], None] | None = None,
                  on_error: Callable[[BaseException], None] | None = None,
-                 name: str = "wall-schedule") -> None:
+                 name: str = "wall-schedule", priority: int = 0) -> None:
         self._check(period)
         self._period = float(period)
         self._on_tick, self._on_miss, self._on_error = on_tick, on_miss, on_error
@@ -45,8 +55,13 @@ class WallSchedule:
         self.ticks = 0
         self.missed = 0
         self.max_late = 0.0
+        self.priority = int(priority)
+        self.realtime = False
+        self.priority_error = ""
+        self._started = threading.Event()
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
+        self._started.wait(timeout=5.0)
 
     @staticmethod
     def _check(period: float) -> None:
@@ -65,7 +80,19 @@ class WallSchedule:
         self._reset.set()
         self._wake.set()
 
+    def _set_priority(self) -> None:
+        if self.priority <= 0:
+            return
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(self.priority))
+            self.realtime = True
+        except (AttributeError, OSError, ValueError) as exc:
+            self.priority_error = (f"SCHED_FIFO priority {self.priority} refused "
+                                   f"({type(exc).__name__}: {exc}); normal scheduling")
+
     def _run(self) -> None:
+        self._set_priority()
+        self._started.set()
         due = time.monotonic() + self._period
         while not self._stop.is_set():
             delay = due - time.monotonic()
@@ -104,3 +131,28 @@ class WallSchedule:
         self._wake.set()
         if self._thread is not threading.current_thread():
             self._thread.join(timeout=timeout)
+
+
+def realtime_process(priority: int) -> str:
+    """Give every thread of this process ``SCHED_FIFO`` at ``priority`` (Linux).
+
+    For a process that runs one time-critical stream and little else (the occupancy node
+    alone): its stream thread needs the GIL after each wake-up, and a GIL holder at normal
+    priority can lose its CPU to other processes while holding it. With all threads at
+    the same real-time priority (threads started later inherit it) no other process
+    preempts them. Returns "" on success, else why it was refused (nothing changed then).
+    """
+    if priority <= 0:
+        return "priority 0: normal scheduling"
+    try:
+        tids = [int(t) for t in os.listdir("/proc/self/task")]
+        param = os.sched_param(int(priority))
+        os.sched_setscheduler(0, os.SCHED_FIFO, param)
+        for tid in tids:
+            try:
+                os.sched_setscheduler(tid, os.SCHED_FIFO, param)
+            except ProcessLookupError:
+                pass                                  # a thread that ended meanwhile
+    except (AttributeError, OSError, ValueError) as exc:
+        return f"SCHED_FIFO priority {priority} refused ({type(exc).__name__}: {exc})"
+    return ""
