@@ -204,13 +204,28 @@ def joint_angles(positions: np.ndarray, skeleton: Skeleton | None = None) -> np.
 
     Not clipped to the limits: forward kinematics reproduces the motion as it is.
     """
-    R = link_rotations(positions, skeleton)
+    return angles_from_rotations(link_rotations(positions, skeleton))
+
+
+def angles_from_rotations(rotations: np.ndarray) -> np.ndarray:
+    """Joint angles (..., 66) from world link rotations (..., J, 3, 3)."""
+    R = np.asarray(rotations, dtype=np.float64)
+    lead = R.shape[:-3]
+    R = R.reshape(-1, *R.shape[-3:])
     out = []
     for c in range(1, len(JOINT_NAMES)):
-        local = np.einsum("tji,tjk->tik", R[:, PARENTS[c]], R[:, c])      # R_p^T R_c
+        local = np.swapaxes(R[:, PARENTS[c]], -1, -2) @ R[:, c]
         bone = _BY_CHILD[JOINT_NAMES[c]]
         out.append(Rotation.from_matrix(local).as_euler(bone.axes.upper()))
-    return np.concatenate(out, axis=1)
+    return np.concatenate(out, axis=1).reshape(*lead, -1)
+
+
+def body_id(human_id: str) -> str:
+    """The REP 155 body id of human ``human_id`` (the suffix of its link names): the id
+    itself, or ``h<id>`` when it starts with a digit, since a ROS name token cannot
+    (``/humans/bodies/1/...`` is no valid topic)."""
+    human_id = str(human_id)
+    return f"h{human_id}" if human_id[:1].isdigit() else human_id
 
 
 def root_poses(positions: np.ndarray, skeleton: Skeleton | None = None) -> np.ndarray:

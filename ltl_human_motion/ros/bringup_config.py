@@ -111,6 +111,15 @@ class BringupConfig:
                 out[self.parameter(spec, "markers_topic", "/markers")] = \
                     "visualization_msgs/msg/MarkerArray"
                 out[f"{ns}/task_state"] = f"{PACKAGE}/msg/TaskState"
+                if self.parameter(spec, "rep155", True):
+                    from ltl_human_motion.motion.urdf import body_id
+
+                    body = f"/humans/bodies/{body_id(spec.parameters.get('human_id', '1'))}"
+                    out["/humans/bodies/tracked"] = "hri_msgs/msg/IdsList"
+                    out[f"{body}/joint_states"] = "sensor_msgs/msg/JointState"
+                    out[f"{body}/urdf"] = "std_msgs/msg/String"
+                    out[f"{body}/position"] = "geometry_msgs/msg/PointStamped"
+                    out[f"{body}/velocity"] = "geometry_msgs/msg/TwistStamped"
             elif spec.executable == "occupancy_node":
                 out[f"{ns}/occupancy"] = f"{PACKAGE}/msg/HumanOccupancy"
                 if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
