@@ -51,7 +51,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, Skeleton
-from ltl_human_motion.planning.exports import _normalize, _swing, _twist, bvh_rotations
+from ltl_human_motion.planning.exports import _CHILDREN, _kabsch, _normalize, _swing, _twist
 from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 #: Degrees of slack on every ROM limit (Euler angles of a ball joint vs clinical planes).
@@ -169,7 +169,8 @@ _LINE_TWIST: dict[str, tuple[str, str]] = {"chest": ("r_clavicle", "l_clavicle")
 def link_rotations(positions: np.ndarray, skeleton: Skeleton | None = None) -> np.ndarray:
     """World rotation of every joint's link per frame: (T, J, 3, 3) from positions (T, J, 3).
 
-    The root's is the BVH exporter's pelvis rotation (a best fit of its three bones).
+    The root's is the BVH exporter's pelvis rotation (a best fit of its three bones,
+    ``planning.exports._kabsch``).
     Every other link ``c`` (parent ``p``) is ``p``'s turned by the smallest rotation that
     puts the rest bone ``rest[c] - rest[p]`` onto the current one (the exporter's swing),
     then, for the chest, upper arms and thighs, turned about the bone by the exporter's
@@ -181,7 +182,8 @@ def link_rotations(positions: np.ndarray, skeleton: Skeleton | None = None) -> n
     pos = np.asarray(positions, dtype=np.float64)
     rest = skeleton.rest_positions()
     R = np.empty((len(pos), len(JOINT_NAMES), 3, 3))
-    R[:, 0] = bvh_rotations(pos, skeleton)[:, 0]
+    kids = list(_CHILDREN[0])              # the BVH exporter's pelvis rotation
+    R[:, 0] = _kabsch(rest[kids] - rest[0], pos[:, kids] - pos[:, :1])
     for c in range(1, len(JOINT_NAMES)):
         p, name = PARENTS[c], JOINT_NAMES[c]
         rest_dir, _ = _normalize(rest[c] - rest[p])
@@ -212,12 +214,19 @@ def angles_from_rotations(rotations: np.ndarray) -> np.ndarray:
     R = np.asarray(rotations, dtype=np.float64)
     lead = R.shape[:-3]
     R = R.reshape(-1, *R.shape[-3:])
-    out = []
-    for c in range(1, len(JOINT_NAMES)):
-        local = np.swapaxes(R[:, PARENTS[c]], -1, -2) @ R[:, c]
-        bone = _BY_CHILD[JOINT_NAMES[c]]
-        out.append(Rotation.from_matrix(local).as_euler(bone.axes.upper()))
-    return np.concatenate(out, axis=1).reshape(*lead, -1)
+    local = np.swapaxes(R[:, _PARENT_INDEX], -1, -2) @ R[:, 1:]          # (N, J-1, 3, 3)
+    out = np.empty((len(R), len(JOINT_NAMES) - 1, 3))
+    for axes, bones in _BONES_BY_AXES.items():      # one scipy call per rotation order
+        out[:, bones] = Rotation.from_matrix(local[:, bones].reshape(-1, 3, 3)).as_euler(
+            axes.upper()).reshape(len(R), len(bones), 3)
+    return out.reshape(*lead, -1)
+
+
+_PARENT_INDEX = np.array(PARENTS[1:])
+#: Bone indices (0 = the bone ending at joint 1) by rotation order.
+_BONES_BY_AXES: dict[str, list[int]] = {}
+for _c in range(1, len(JOINT_NAMES)):
+    _BONES_BY_AXES.setdefault(_BY_CHILD[JOINT_NAMES[_c]].axes, []).append(_c - 1)
 
 
 def body_id(human_id: str) -> str:

@@ -75,10 +75,11 @@ def link_quaternions(positions: np.ndarray, stature: float) -> np.ndarray:
     each on the same hemisphere as the frame before (so frames can be blended)."""
     R = urdf.link_rotations(np.asarray(positions, dtype=np.float64), _skeleton(stature))
     q = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat().reshape(*R.shape[:2], 4)
-    for t in range(1, len(q)):
-        flip = np.sum(q[t] * q[t - 1], axis=-1) < 0
-        q[t, flip] *= -1.0
-    return q
+    # Same hemisphere as the previous frame: flip where the running sign changes.
+    dots = np.sum(q[1:] * q[:-1], axis=-1) < 0                           # (T-1, J)
+    signs = np.concatenate([np.ones((1, q.shape[1])),
+                            np.cumprod(np.where(dots, -1.0, 1.0), axis=0)])
+    return q * signs[..., None]
 
 
 def blend_rotations(quats: np.ndarray, time: float, fps: float) -> np.ndarray:
@@ -107,15 +108,17 @@ def link_transforms(positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
     return out
 
 
-def body_velocity(positions: np.ndarray, stature: float, fps: float) -> np.ndarray:
-    """Per frame, the body frame's linear and angular velocity in the world frame: (T, 6)."""
+def body_velocity(positions: np.ndarray, root_quaternions: np.ndarray, fps: float
+                  ) -> np.ndarray:
+    """Per frame, the body frame's linear and angular velocity in the world frame: (T, 6),
+    from joint positions (T, J, 3) and the root link's quaternions (T, 4)."""
     pos = np.asarray(positions, dtype=np.float64)
     out = np.zeros((len(pos), 6))
     if len(pos) < 2:
         return out
     out[:, :3] = np.gradient(pos[:, 0], axis=0) * fps
-    R = urdf.link_rotations(pos, _skeleton(stature))[:, 0]
-    step = Rotation.from_matrix(R[1:] @ np.swapaxes(R[:-1], -1, -2)).as_rotvec() * fps
+    R = Rotation.from_quat(root_quaternions)
+    step = (R[1:] * R[:-1].inv()).as_rotvec() * fps
     out[1:, 3:] = step
     out[0, 3:] = step[0]
     return out
@@ -202,8 +205,8 @@ class BodyInterface:
         quats = playback.table("rep155_link_quaternions",
                                lambda pos: link_quaternions(pos, stature))
         fps = playback.fps
-        velocity = playback.table("rep155_velocity",
-                                  lambda pos: body_velocity(pos, stature, fps))
+        velocity = None if quats is None else playback.table(
+            "rep155_velocity", lambda pos: body_velocity(pos, quats[:, 0], fps))
         if quats is None or velocity is None:
             return
         self.publish_urdf(stature)
