@@ -25,7 +25,8 @@ token cannot): human ``1`` is body ``h1`` (topics ``/humans/bodies/h1/...``, fra
   ``l_elbow_<id>``, ...) relative to its skeleton parent. Turn ``link_frames`` off when
   ``robot_state_publisher`` turns the URDF and ``joint_states`` into TF itself.
 
-Per-frame link rotations and velocities are computed once per motion (``Playback.table``);
+Per-frame link rotations and velocities are computed once per motion (:meth:`BodyInterface.prepare`,
+before the playback clock starts);
 a tick blends the rotations of the two frames around the playback time and takes the
 interpolated joint positions, so the link frames sit exactly on the ``human_<id>/...``
 joint frames of the same stamp, and joint angles come from the blended rotations.
@@ -58,6 +59,8 @@ TRACKED_TOPIC = f"{BODIES}/tracked"
 TRACKED_TIMEOUT = 0.5
 #: Seconds between two looks for other bodies' joint_states topics.
 DISCOVERY_PERIOD = 2.0
+#: Motions whose tables are kept (a player shows one at a time; a few for switching back).
+MAX_TABLES = 4
 _JOINT_STATES = re.compile(rf"^{BODIES}/([^/]+)/joint_states$")
 
 
@@ -159,6 +162,7 @@ class BodyInterface:
         self.joint_names = urdf.joint_names(self.body_id)
         self.link_names = [urdf.link_name(j, self.body_id) for j in JOINT_NAMES]
         self._urdf_stature: float | None = None
+        self._tables: dict[str, tuple[float, np.ndarray, np.ndarray]] = {}
         self._last_seen: dict[str, float] = {}
         self._subscribed: set[str] = set()
         self.publish_urdf(1.75)
@@ -170,6 +174,21 @@ class BodyInterface:
             return
         self._urdf_stature = stature
         self._urdf_pub.publish(String(data=urdf.worker_urdf(stature, self.body_id)))
+
+    def prepare(self, motion_id: str, motion: Any) -> tuple[float, np.ndarray, np.ndarray]:
+        """Per-frame tables of ``motion`` (a SynthesizedMotion): stature, link quaternions
+        (T, J, 4) and body velocity (T, 6); computed once per motion id and kept (the
+        skeleton publisher calls this before it starts the playback clock)."""
+        if motion_id not in self._tables:
+            body = motion.motion
+            stature = float(getattr(getattr(body, "skeleton", None), "stature", 1.75))
+            positions = np.asarray(body.positions, dtype=np.float64)
+            quats = link_quaternions(positions, stature)
+            velocity = body_velocity(positions, quats[:, 0], float(body.fps))
+            if len(self._tables) >= MAX_TABLES:
+                self._tables.pop(next(iter(self._tables)))
+            self._tables[motion_id] = (stature, quats, velocity)
+        return self._tables[motion_id]
 
     def _discover(self) -> None:
         for topic, _ in self.node.get_topic_names_and_types():
@@ -201,16 +220,14 @@ class BodyInterface:
         self._tracked_pub.publish(tracked)
         if frame is None:
             return
-        stature = playback.stature
-        quats = playback.table("rep155_link_quaternions",
-                               lambda pos: link_quaternions(pos, stature))
-        fps = playback.fps
-        velocity = None if quats is None else playback.table(
-            "rep155_velocity", lambda pos: body_velocity(pos, quats[:, 0], fps))
-        if quats is None or velocity is None:
+        if frame.motion_id in self._tables:
+            stature, quats, velocity = self._tables[frame.motion_id]
+        elif playback.motion is not None:        # played by another node of the process
+            stature, quats, velocity = self.prepare(frame.motion_id, playback.motion)
+        else:
             return
         self.publish_urdf(stature)
-        rotations = blend_rotations(quats, frame.time, fps)
+        rotations = blend_rotations(quats, frame.time, playback.fps)
         joints = JointState(name=self.joint_names,
                             position=urdf.angles_from_rotations(rotations).tolist())
         joints.header.stamp = stamp

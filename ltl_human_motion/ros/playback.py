@@ -217,12 +217,6 @@ class Playback:
     def fps(self) -> float:
         return self._arrays.fps if self._arrays is not None else 0.0
 
-    def table(self, key: str, per_frame: Any) -> np.ndarray | None:
-        """``per_frame(positions (T, J, 3)) -> (T, ...)`` of the loaded motion, computed
-        once per motion and cached under ``key``; None without a motion."""
-        arrays = self._arrays
-        return arrays.table(key, per_frame) if arrays is not None else None
-
     def state(self, now: float) -> str:
         """The state at clock time ``now`` (a motion played once finishes by itself)."""
         with self._lock:

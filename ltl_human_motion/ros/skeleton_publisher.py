@@ -232,6 +232,8 @@ class SkeletonPublisher(Node):
 
     def _play(self, motion_id: str, loop: bool, rate: float) -> None:
         motion = self.source.get(motion_id)
+        if self.body is not None:
+            self.body.prepare(motion_id, motion)    # before the clock starts: may take a while
         self.playback.play(motion_id, motion, now_seconds(self), rate=rate, loop=loop)
         self.get_logger().info(f"playing {motion_id} ({self.playback.duration:.2f} s)")
 
