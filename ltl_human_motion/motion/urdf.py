@@ -215,11 +215,19 @@ def angles_from_rotations(rotations: np.ndarray) -> np.ndarray:
     lead = R.shape[:-3]
     R = R.reshape(-1, *R.shape[-3:])
     local = np.swapaxes(R[:, _PARENT_INDEX], -1, -2) @ R[:, 1:]          # (N, J-1, 3, 3)
-    out = np.empty((len(R), len(JOINT_NAMES) - 1, 3))
+    quats = Rotation.from_matrix(local.reshape(-1, 3, 3)).as_quat()
+    return angles_from_local_quaternions(quats.reshape(len(R), -1, 4)).reshape(*lead, -1)
+
+
+def angles_from_local_quaternions(quats: np.ndarray) -> np.ndarray:
+    """Joint angles (N, 66) from each bone's rotation relative to its parent link, as
+    quaternions x y z w (N, J-1, 4) (bone ``c - 1`` ends at joint ``c``)."""
+    q = np.asarray(quats, dtype=np.float64)
+    out = np.empty((len(q), len(JOINT_NAMES) - 1, 3))
     for axes, bones in _BONES_BY_AXES.items():      # one scipy call per rotation order
-        out[:, bones] = Rotation.from_matrix(local[:, bones].reshape(-1, 3, 3)).as_euler(
-            axes.upper()).reshape(len(R), len(bones), 3)
-    return out.reshape(*lead, -1)
+        out[:, bones] = Rotation.from_quat(q[:, bones].reshape(-1, 4)).as_euler(
+            axes.upper()).reshape(len(q), len(bones), 3)
+    return out.reshape(len(q), -1)
 
 
 _PARENT_INDEX = np.array(PARENTS[1:])

@@ -45,7 +45,6 @@ from rclpy.node import Node
 from scipy.spatial.transform import Rotation
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
-from tf2_msgs.msg import TFMessage
 
 from ltl_human_motion.motion import urdf
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton
@@ -85,29 +84,39 @@ def link_quaternions(positions: np.ndarray, stature: float) -> np.ndarray:
     return q * signs[..., None]
 
 
-def blend_rotations(quats: np.ndarray, time: float, fps: float) -> np.ndarray:
-    """World link rotations (J, 3, 3) at motion ``time`` (s): the quaternions (T, J, 4) of
-    the two frames around it, blended linearly and normalized."""
+def blend_quaternions(quats: np.ndarray, time: float, fps: float) -> np.ndarray:
+    """World link rotations (J, 4: x y z w) at motion ``time`` (s): the quaternions
+    (T, J, 4) of the two frames around it, blended linearly and normalized."""
     f = float(np.clip(time * fps, 0.0, len(quats) - 1))
     i0 = int(np.floor(f))
     i1 = min(i0 + 1, len(quats) - 1)
     q = quats[i0] * (1.0 - (f - i0)) + quats[i1] * (f - i0)
-    return Rotation.from_quat(q / np.linalg.norm(q, axis=-1, keepdims=True)).as_matrix()
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
-def link_transforms(positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+def quaternion_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton products ``a * b`` of quaternions (..., 4: x y z w)."""
+    ax, ay, az, aw = np.moveaxis(a, -1, 0)
+    bx, by, bz, bw = np.moveaxis(b, -1, 0)
+    return np.stack([aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw,
+                     aw * bw - ax * bx - ay * by - az * bz], axis=-1)
+
+
+def link_transforms(positions: np.ndarray, quats: np.ndarray) -> np.ndarray:
     """Transforms (J, 7: x y z qx qy qz qw) of every link relative to its skeleton parent
     (the root's: to the world) for one pose: joint positions (J, 3) and world link
-    rotations (J, 3, 3). The link origins are the joint positions exactly."""
+    rotations (J, 4). The link origins are the joint positions exactly."""
     pos = np.asarray(positions, dtype=np.float64)
-    R = np.asarray(rotations, dtype=np.float64)
+    q = np.asarray(quats, dtype=np.float64)
     parents = np.array(PARENTS[1:])
+    inverse = q[parents] * np.array([-1.0, -1.0, -1.0, 1.0])
+    R_parent = Rotation.from_quat(q[parents]).as_matrix()
     out = np.empty((len(JOINT_NAMES), 7))
-    out[0, :3] = pos[0]
-    out[1:, :3] = np.einsum("kji,kj->ki", R[parents], pos[1:] - pos[parents])
-    relative = R.copy()
-    relative[1:] = np.swapaxes(R[parents], -1, -2) @ R[1:]
-    out[:, 3:] = Rotation.from_matrix(relative).as_quat()
+    out[0, :3], out[0, 3:] = pos[0], q[0]
+    out[1:, :3] = np.einsum("kji,kj->ki", R_parent, pos[1:] - pos[parents])
+    out[1:, 3:] = quaternion_multiply(inverse, q[1:])
     return out
 
 
@@ -137,16 +146,13 @@ class BodyInterface:
     human_id, world_frame : str
     link_frames : bool
         Also put every joint's link frame on TF (see the module docstring).
-    tf_publisher : Publisher
-        The node's ``/tf`` publisher (``tf2_msgs/TFMessage``).
     """
 
-    def __init__(self, node: Node, human_id: str, world_frame: str, link_frames: bool,
-                 tf_publisher: Any) -> None:
+    def __init__(self, node: Node, human_id: str, world_frame: str,
+                 link_frames: bool) -> None:
         self.node, self.human_id, self.world_frame = node, human_id, world_frame
         self.body_id = urdf.body_id(human_id)
         self.link_frames = link_frames
-        self._tf_pub = tf_publisher
         self._tracked_pub = node.create_publisher(IdsList, TRACKED_TOPIC, STREAM_QOS)
         self._joint_pub = node.create_publisher(JointState, body_topic(human_id,
                                                                        "joint_states"),
@@ -212,24 +218,27 @@ class BodyInterface:
             ids.add(self.body_id)
         return sorted(ids)
 
-    def publish(self, frame: Frame | None, playback: Playback, stamp: Any) -> None:
-        """One tick: ``tracked`` always; the body's topics and frames while shown."""
+    def publish(self, frame: Frame | None, playback: Playback, stamp: Any
+                ) -> list[TransformStamped]:
+        """One tick: ``tracked`` always, the body's topics while shown; returns the body's
+        TF transforms (the skeleton publisher sends them with its own, in one message)."""
         tracked = IdsList(ids=self.tracked(frame is not None))
         tracked.header.stamp = stamp
         tracked.header.frame_id = self.world_frame
         self._tracked_pub.publish(tracked)
         if frame is None:
-            return
+            return []
         if frame.motion_id in self._tables:
             stature, quats, velocity = self._tables[frame.motion_id]
         elif playback.motion is not None:        # played by another node of the process
             stature, quats, velocity = self.prepare(frame.motion_id, playback.motion)
         else:
-            return
+            return []
         self.publish_urdf(stature)
-        rotations = blend_rotations(quats, frame.time, playback.fps)
-        joints = JointState(name=self.joint_names,
-                            position=urdf.angles_from_rotations(rotations).tolist())
+        rotations = blend_quaternions(quats, frame.time, playback.fps)
+        rows = link_transforms(frame.positions, rotations)
+        joints = JointState(name=self.joint_names, position=urdf.angles_from_local_quaternions(
+            rows[None, 1:, 3:])[0].tolist())
         joints.header.stamp = stamp
         self._joint_pub.publish(joints)
         i = min(frame.index, len(velocity) - 1)
@@ -246,7 +255,6 @@ class BodyInterface:
                                                                                  v[3:])
         self._velocity_pub.publish(twist)
         count = len(JOINT_NAMES) if self.link_frames else 1
-        rows = link_transforms(frame.positions, rotations)
         transforms = []
         for j in range(count):
             t = TransformStamped()
@@ -258,4 +266,4 @@ class BodyInterface:
             tr.x, tr.y, tr.z = (float(a) for a in row[:3])
             q.x, q.y, q.z, q.w = (float(a) for a in row[3:])
             transforms.append(t)
-        self._tf_pub.publish(TFMessage(transforms=transforms))
+        return transforms
