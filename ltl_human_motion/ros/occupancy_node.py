@@ -159,7 +159,7 @@ class OccupancyNode(Node):
             self._schedule = WallSchedule(1.0 / self.param("rate"), self._tick,
                                           on_miss=self._on_miss, on_error=self._on_error,
                                           name=f"occupancy-{self.human_id}",
-                                          priority=self.param("stream_priority"))
+                                          priority=self._stream_thread_priority())
             if self._schedule.priority_error:
                 self.get_logger().info(f"stream thread: {self._schedule.priority_error}")
         self._marker_timer = None
@@ -182,6 +182,13 @@ class OccupancyNode(Node):
         if rate > 0:
             self._marker_timer = self.create_timer(1.0 / rate, self._publish_markers,
                                                    callback_group=MutuallyExclusiveCallbackGroup())
+
+    def _stream_thread_priority(self) -> int:
+        """``stream_priority`` + 1 for the stream thread: above the rest of its process,
+        which the entry point puts at ``stream_priority`` (equal FIFO priorities do not
+        preempt each other, so the executor thread could keep the stream waiting)."""
+        priority = self.param("stream_priority")
+        return min(priority + 1, 99) if priority > 0 else 0
 
     def _on_miss(self, skipped: int, late: float) -> None:
         self.deadlines_missed += skipped

@@ -139,8 +139,10 @@ def realtime_process(priority: int) -> str:
     For a process that runs one time-critical stream and little else (the occupancy node
     alone): its stream thread needs the GIL after each wake-up, and a GIL holder at normal
     priority can lose its CPU to other processes while holding it. With all threads at
-    the same real-time priority (threads started later inherit it) no other process
-    preempts them. Returns "" on success, else why it was refused (nothing changed then).
+    this real-time priority (threads started later inherit it) no other process preempts
+    them; threads already at a higher ``SCHED_FIFO`` priority (the stream's, one above:
+    threads of equal FIFO priority do not preempt each other) keep theirs. Returns "" on
+    success, else why it was refused (nothing changed then).
     """
     if priority <= 0:
         return "priority 0: normal scheduling"
@@ -150,6 +152,9 @@ def realtime_process(priority: int) -> str:
         os.sched_setscheduler(0, os.SCHED_FIFO, param)
         for tid in tids:
             try:
+                if os.sched_getscheduler(tid) == os.SCHED_FIFO \
+                        and os.sched_getparam(tid).sched_priority >= priority:
+                    continue                          # keep a thread that has more
                 os.sched_setscheduler(tid, os.SCHED_FIFO, param)
             except ProcessLookupError:
                 pass                                  # a thread that ended meanwhile
