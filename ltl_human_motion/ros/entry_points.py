@@ -16,17 +16,18 @@ import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 
-from ltl_human_motion.ros.common import spin_nodes
+from ltl_human_motion.ros.common import DEFAULT_EXECUTOR_THREADS, spin_nodes
 from ltl_human_motion.ros.middleware import apply_middleware_defaults
 
 
-def _run_node(factory: Callable[[], Node], args: list[str] | None) -> int:
+def _run_node(factory: Callable[[], Node], args: list[str] | None,
+              num_threads: int = DEFAULT_EXECUTOR_THREADS) -> int:
     apply_middleware_defaults()
     rclpy.init(args=args)
     node: Node | None = None
     try:
         node = factory()
-        spin_nodes([node])
+        spin_nodes([node], num_threads=num_threads)
         return 0
     except (KeyboardInterrupt, ExternalShutdownException):
         return 0
@@ -37,6 +38,11 @@ def _run_node(factory: Callable[[], Node], args: list[str] | None) -> int:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+
+
+#: Executor threads of a standalone occupancy node: its callbacks (task_state, markers,
+#: parameter services) are short, and two threads let a marker message not delay them.
+OCCUPANCY_EXECUTOR_THREADS = 2
 
 
 def synthesis_node(args: list[str] | None = None) -> int:
@@ -73,7 +79,9 @@ def occupancy_node(args: list[str] | None = None) -> int:
             node.get_logger().info(f"process: all threads SCHED_FIFO {priority}")
         return node
 
-    return _run_node(make, args)
+    # Few executor threads: each one that wakes competes with the stream thread for the
+    # GIL, which CPython hands over without regard to thread priority.
+    return _run_node(make, args, num_threads=OCCUPANCY_EXECUTOR_THREADS)
 
 
 def coexistence_node(args: list[str] | None = None) -> int:
