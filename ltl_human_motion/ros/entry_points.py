@@ -9,6 +9,7 @@ invalid parameters, with the message on stderr).
 
 from __future__ import annotations
 
+import gc
 import sys
 from collections.abc import Callable
 
@@ -16,17 +17,18 @@ import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 
-from ltl_human_motion.ros.common import spin_nodes
+from ltl_human_motion.ros.common import DEFAULT_EXECUTOR_THREADS, spin_nodes
 from ltl_human_motion.ros.middleware import apply_middleware_defaults
 
 
-def _run_node(factory: Callable[[], Node], args: list[str] | None) -> int:
+def _run_node(factory: Callable[[], Node], args: list[str] | None,
+              num_threads: int = DEFAULT_EXECUTOR_THREADS) -> int:
     apply_middleware_defaults()
     rclpy.init(args=args)
     node: Node | None = None
     try:
         node = factory()
-        spin_nodes([node])
+        spin_nodes([node], num_threads=num_threads)
         return 0
     except (KeyboardInterrupt, ExternalShutdownException):
         return 0
@@ -37,6 +39,11 @@ def _run_node(factory: Callable[[], Node], args: list[str] | None) -> int:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+
+
+#: Executor threads of a standalone occupancy node: its callbacks (task_state, markers,
+#: parameter services) are short, and two threads let a marker message not delay them.
+OCCUPANCY_EXECUTOR_THREADS = 2
 
 
 def synthesis_node(args: list[str] | None = None) -> int:
@@ -55,9 +62,27 @@ def skeleton_publisher(args: list[str] | None = None) -> int:
 
 def occupancy_node(args: list[str] | None = None) -> int:
     """Stream ``occupancy``, following the skeleton publisher's ``task_state``."""
-    from ltl_human_motion.ros.occupancy_node import OccupancyNode
+    from ltl_human_motion.ros.occupancy_node import STREAM_SWITCH_INTERVAL, OccupancyNode
+    from ltl_human_motion.ros.wall_schedule import realtime_process
 
-    return _run_node(OccupancyNode, args)
+    sys.setswitchinterval(STREAM_SWITCH_INTERVAL)    # the stream thread waits less for the GIL
+
+    def make() -> OccupancyNode:
+        node = OccupancyNode()
+        # What exists now lives as long as the process: keep it out of the collector's
+        # full passes, which hold the GIL (and so stall the stream) for their duration.
+        gc.freeze()
+        priority = node.get_parameter("stream_priority").value
+        refused = realtime_process(priority) if priority > 0 else ""
+        if refused:
+            node.get_logger().info(f"process: {refused}; normal scheduling")
+        elif priority > 0:
+            node.get_logger().info(f"process: all threads SCHED_FIFO {priority}")
+        return node
+
+    # Few executor threads: each one that wakes competes with the stream thread for the
+    # GIL, which CPython hands over without regard to thread priority.
+    return _run_node(make, args, num_threads=OCCUPANCY_EXECUTOR_THREADS)
 
 
 def coexistence_node(args: list[str] | None = None) -> int:
