@@ -108,7 +108,7 @@ def _live_reference(s1, robot, horizon: float, step: float = 0.1):
                                 clock=clock)
     hseg, hrad = capsules_from_positions(s1.positions, 1.75)
     T = s1.n_frames
-    n = int(round(s1.duration * CONTROL_RATE))
+    n = round(s1.duration * CONTROL_RATE)
     horizons = step * np.arange(1, int(np.floor(horizon / step + 1e-9)) + 1)
     out = []
     for k in range(n):
@@ -138,7 +138,8 @@ def test_offline_makes_the_live_controllers_decisions(s1, robot, horizon):
     # Skipped steps are the far ones: their real separation exceeds S_p + margin.
     sp = SSMParameters().protective_distance
     assert np.all(live_sep[~known] > sp + SSMParameters().margin)
-    assert off.trajectory_time[-2] == pytest.approx(sim.trajectory_time, abs=1e-9)  # before the last step
+    # tau before the last step (the simulated controller has not applied its command).
+    assert off.trajectory_time[-2] == pytest.approx(sim.trajectory_time, abs=1e-9)
     m = off.metrics
     assert m["min_separation"] < sp and m["violations"] and m["time_min_speed"] > 1.0
     assert m["effective_cycle_time"] > traj.cycle_time
