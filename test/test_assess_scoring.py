@@ -185,3 +185,22 @@ def test_niosh_worked_example_floor_to_bench():
     assert o.RWL == pytest.approx(23 * 0.625 * 0.835 * (0.82 + 4.5 / 70) * 0.75 * 0.95)
     assert o.RWL == pytest.approx(7.56, abs=0.01) and o.LI == pytest.approx(1.32, abs=0.01)
     assert d.RWL == pytest.approx(10.97, abs=0.01) and d.LI == pytest.approx(0.91, abs=0.01)
+
+
+# ---------------------------------------------------------------------- OWAS
+def test_owas_codes_and_categories():
+    from ltl_human_motion.assess import owas
+    assert owas.ACTION_CATEGORY.shape == (4, 3, 7, 3)
+    assert set(np.unique(owas.ACTION_CATEGORY)) == {1, 2, 3, 4}
+    assert owas.back_code([0, 30, 0, 30], [0, 0, 30, 30]).tolist() == [1, 2, 3, 4]
+    assert owas.arms_code([0, 100, 100], [0, 0, 120]).tolist() == [1, 2, 3]
+    assert owas.legs_code([0, 40, 40, 40, 0], [0, 40, 0, 0, 0],
+                          one_leg=[False, False, False, True, True]).tolist() == [2, 4, 5, 5, 3]
+    assert owas.legs_code(0, 0, walking=True) == 7 and owas.legs_code(90, 90, kneeling=True) == 6
+    assert owas.load_code([5, 15, 25]).tolist() == [1, 2, 3]
+    # Standing straight, arms down, light load: no action. Bent and twisted, both arms
+    # up, squatting with more than 20 kg: act immediately.
+    assert owas.action_category(1, 1, 2, 1) == 1
+    assert owas.action_category(4, 3, 4, 3) == 4
+    # Bent back, both arms down, standing on both straight legs, < 10 kg: category 2.
+    assert owas.action_category(2, 1, 2, 1) == 2

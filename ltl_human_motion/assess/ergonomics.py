@@ -1,4 +1,4 @@
-"""REBA, RULA and NIOSH lifting of a synthesized motion: per frame, per task, per motion.
+"""REBA, RULA, OWAS and NIOSH lifting of a synthesized motion: per frame, per task, per motion.
 
 Postural thresholds the methods leave to the observer (what counts as "twisted",
 "abducted", "raised", "unilateral") are named below with the value used here.
@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ltl_human_motion.assess import reba, rula
+from ltl_human_motion.assess import owas, reba, rula
 from ltl_human_motion.assess.angles import BodyAngles, body_angles
 from ltl_human_motion.assess.handling import held_masks, lifts
 from ltl_human_motion.assess.niosh import lift as niosh_lift
@@ -73,6 +73,8 @@ class ErgonomicsReport:
     ----------
     reba, rula : ndarray of int, shape (T,)
         Per-frame scores.
+    owas : ndarray of int, shape (T,)
+        Per-frame OWAS action category (1-4).
     load : ndarray, shape (T,)
         kg in hand per frame.
     angles : BodyAngles
@@ -92,6 +94,7 @@ class ErgonomicsReport:
     per_task: list[dict[str, Any]] = field(default_factory=list)
     lifts: list[dict[str, Any]] = field(default_factory=list)
     summary: dict[str, Any] = field(default_factory=dict)
+    owas: np.ndarray | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly summary (no per-frame arrays)."""
@@ -205,12 +208,24 @@ def assess_motion(synth: SynthesizedMotion, masses: Mapping[str, float] | None =
     static = bool(waits) and max(waits) > STATIC_S
     reba_f, rula_f = _frame_scores(a, load, holding, walking, sitting, repeated, static,
                                    settings)
+    kneeling = np.zeros(T, dtype=bool)
+    for seg, kind in zip(synth.timeline, kinds):
+        if kind == "kneel":
+            kneeling[seg.start_frame:seg.end_frame] = True
+    owas_f = owas.action_category(
+        owas.back_code(a.trunk_flexion, a.trunk_twist),
+        owas.arms_code(a.upper_arm_flexion[:, 0], a.upper_arm_flexion[:, 1]),
+        owas.legs_code(a.knee_flexion[:, 0], a.knee_flexion[:, 1],
+                       (a.ankle_height_difference > UNILATERAL_M) & ~walking, sitting,
+                       kneeling, walking),
+        owas.load_code(load))
     per_task = []
     for i, seg in enumerate(synth.timeline):
         sl = slice(seg.start_frame, seg.end_frame)
         per_task.append({"step": i, "task": synth.task_label(i), "kind": kinds[i],
                          "start": seg.start_frame / fps, "duration": seg.n_frames / fps,
-                         "reba": _stats(reba_f[sl], fps), "rula": _stats(rula_f[sl], fps)})
+                         "reba": _stats(reba_f[sl], fps), "rula": _stats(rula_f[sl], fps),
+                         "owas": _stats(owas_f[sl], fps)})
     gait = idx < 0
     per_task.append({"step": -1, "task": "walking", "kind": "walk",
                      "duration": float(gait.sum()) / fps,
@@ -232,6 +247,9 @@ def assess_motion(synth: SynthesizedMotion, masses: Mapping[str, float] | None =
     summary = {
         "frames": T, "fps": fps,
         "reba": _stats(reba_f, fps), "rula": _stats(rula_f, fps),
+        "owas": _stats(owas_f, fps),
+        "owas_time_share_by_category": {str(k): float(np.mean(owas_f == k))
+                                        for k in range(1, 5)},
         "reba_time_share_by_level": {str(k): float(np.mean(levels_reba == k))
                                      for k in range(5)},
         "rula_time_share_by_level": {str(k): float(np.mean(levels_rula == k))
@@ -241,4 +259,4 @@ def assess_motion(synth: SynthesizedMotion, masses: Mapping[str, float] | None =
         "max_load_kg": float(load.max()) if T else 0.0,
         "repeated": bool(repeated), "static": static,
     }
-    return ErgonomicsReport(reba_f, rula_f, load, a, per_task, lift_rows, summary)
+    return ErgonomicsReport(reba_f, rula_f, load, a, per_task, lift_rows, summary, owas_f)
