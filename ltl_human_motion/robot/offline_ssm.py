@@ -106,16 +106,17 @@ def batched_separations(P: np.ndarray, p_radii: np.ndarray, Q: np.ndarray,
     Q : ndarray, shape (M, L, 2, 3)
     q_radii : ndarray, shape (L,)
     """
-    p0 = P[:, :, None, 0]
-    q0 = Q[:, None, :, 0]
-    d1 = P[:, :, None, 1] - p0                                   # (M, K, 1, 3)
-    d2 = Q[:, None, :, 1] - q0                                   # (M, 1, L, 3)
-    r = p0 - q0                                                  # (M, K, L, 3)
-    a = (d1 * d1).sum(-1)
-    e = (d2 * d2).sum(-1)
-    b = (d1 * d2).sum(-1)
-    c = (d1 * r).sum(-1)
-    f = (d2 * r).sum(-1)
+    p0, q0 = P[:, :, 0], Q[:, :, 0]                              # (M, K, 3), (M, L, 3)
+    d1, d2 = P[:, :, 1] - p0, Q[:, :, 1] - q0
+    K = P.shape[1]
+    L = Q.shape[1]
+    # One batched matrix product gives p0.q0, p0.d2, d1.q0 and d1.d2 for all pairs.
+    G = np.concatenate((p0, d1), axis=1) @ np.concatenate((q0, d2), axis=1).transpose(0, 2, 1)
+    p0d2, d1q0, b = G[:, :K, L:], G[:, K:, :L], G[:, K:, L:]
+    a = (d1 * d1).sum(-1)[:, :, None]                            # (M, K, 1)
+    e = (d2 * d2).sum(-1)[:, None, :]                            # (M, 1, L)
+    c = (d1 * p0).sum(-1)[:, :, None] - d1q0                     # d1 . (p0 - q0)
+    f = p0d2 - (d2 * q0).sum(-1)[:, None, :]                     # d2 . (p0 - q0)
     a_s = np.maximum(a, 1e-30)
     e_s = np.maximum(e, 1e-30)
     denom = a * e - b * b
@@ -124,7 +125,8 @@ def batched_separations(P: np.ndarray, p_radii: np.ndarray, Q: np.ndarray,
                                         0.0, 1.0))
     t = np.clip((b * s + f) / e_s, 0.0, 1.0)
     s = np.clip((b * t - c) / a_s, 0.0, 1.0)
-    gap = r + s[..., None] * d1 - t[..., None] * d2
+    gap = (p0[:, :, None] - q0[:, None]) + s[..., None] * d1[:, :, None] \
+        - t[..., None] * d2[:, None]
     dist = np.sqrt((gap * gap).sum(-1))
     return (dist - p_radii[None, :, None] - q_radii[None, None, :]).min(axis=(1, 2))
 
