@@ -149,8 +149,9 @@ class SynthesisNode(Node):
             self.in_flight += 1
         try:
             with self._slots:
-                motions = self._run(request)
+                motions, cell = self._run(request)
             self._fill(response, motions)
+            self._fill_ergonomics(response, motions, cell, int(request.cycles) or 1)
             self.get_logger().info(
                 f"synthesized {len(motions)} motion(s) in {time.perf_counter() - started:.2f} s:"
                 f" {', '.join(response.motion_ids)}")
@@ -168,7 +169,7 @@ class SynthesisNode(Node):
                 self.requests_served += 1
         return response
 
-    def _run(self, request: SynthesizeMotion.Request) -> list:
+    def _run(self, request: SynthesizeMotion.Request) -> tuple[list, Any]:
         spec = request.spec
         if not spec.strip():
             raise SpecError("the specification is empty")
@@ -186,7 +187,7 @@ class SynthesisNode(Node):
         motions = list(self._synthesize(spec, cell, **kwargs))
         if not motions:
             raise ValueError("synthesis returned no motion")
-        return motions
+        return motions, cell
 
     def _fill(self, response: SynthesizeMotion.Response, motions: list) -> None:
         for motion in motions:
@@ -198,6 +199,18 @@ class SynthesisNode(Node):
             response.stats.append(stats_message(getattr(motion, "stats", None), duration))
         response.success = True
         self._publish_catalog()
+
+    @staticmethod
+    def _fill_ergonomics(response: SynthesizeMotion.Response, motions: list, cell: Any,
+                         cycles: int) -> None:
+        """Cycle time and worst REBA/RULA per motion (:mod:`ltl_human_motion.ros.ergonomics`)."""
+        from ltl_human_motion.ros.ergonomics import cell_masses, response_figures
+        masses = cell_masses(cell)
+        for motion in motions:
+            cycle_time, reba_max, rula_max = response_figures(motion, masses, cycles)
+            response.cycle_times.append(cycle_time)
+            response.reba_max.append(reba_max)
+            response.rula_max.append(rula_max)
 
     @staticmethod
     def _fail(response: SynthesizeMotion.Response, exc: Exception) -> None:
