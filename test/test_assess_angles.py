@@ -162,3 +162,11 @@ def test_cycle_breakdown(s1):
     assert two["per_cycle"]["walking"] == pytest.approx(c["total"]["walking"] / 2)
     with pytest.raises(ValueError, match="cycles"):
         cycle_breakdown(s1, cycles=0)
+
+
+def test_settings_are_checked():
+    from ltl_human_motion.assess import ErgonomicsSettings
+    with pytest.raises(ValueError, match="reba_coupling"):
+        ErgonomicsSettings(reba_coupling="great")
+    with pytest.raises(ValueError, match="duration"):
+        ErgonomicsSettings(duration="4h")

@@ -62,7 +62,13 @@ class ErgonomicsSettings:
 
     def __post_init__(self) -> None:
         if self.reba_coupling not in reba.COUPLING:
-            raise ValueError(f"reba_coupling must be one of {sorted(reba.COUPLING)}")
+            raise ValueError(f"reba_coupling must be one of {sorted(reba.COUPLING)}, got "
+                             f"{self.reba_coupling!r}")
+        if self.niosh_coupling not in ("good", "fair", "poor"):
+            raise ValueError(f"niosh_coupling must be good, fair or poor, got "
+                             f"{self.niosh_coupling!r}")
+        if self.duration not in ("1h", "2h", "8h"):
+            raise ValueError(f"duration must be 1h, 2h or 8h, got {self.duration!r}")
 
 
 @dataclass
