@@ -44,6 +44,8 @@ def test_study_json_has_every_items_figures(study):
             s = it["ssm"]
             assert 0 < s["min_separation"] < 2.0
             assert s["effective_cycle_time"] >= s["nominal_cycle_time"] - 1e-9
+            for a, b in s["frames_below_sp"]:
+                assert 0 <= a < b <= it["cycle"]["cycle_time"] * 120 + 1
         assert lay["summary"]["cycle_time"]["n"] == len(lay["items"])
     a = saved["layouts"]["A"]["summary"]["min_separation"]["mean"]
     b = saved["layouts"]["B"]["summary"]["min_separation"]["mean"]

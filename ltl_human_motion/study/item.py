@@ -75,7 +75,8 @@ def assess_item(synth: Any, cell: Any, item: Any, settings: dict[str, Any]) -> d
     -------
     dict
         ``ergonomics`` (summary and per task, lifts), ``cycle`` (breakdown) and ``ssm``
-        (offline SSM metrics, or None without a robot).
+        (offline SSM metrics, or None without a robot; ``frames_below_sp`` as
+        ``[start, end)`` motion-frame ranges).
     """
     masses = {name: float(obj.mass) for name, obj in cell.objects.items()}
     ergo = assess_motion(synth, masses, ErgonomicsSettings(**settings["ergonomics"]),
@@ -95,6 +96,10 @@ def assess_item(synth: Any, cell: Any, item: Any, settings: dict[str, Any]) -> d
             "time_reduced_speed", "time_min_speed", "time_below_sp", "effective_cycle_time",
             "nominal_cycle_time", "throughput_ratio", "duration")}
         out["ssm"]["violations"] = len(m["violations"])
-        out["ssm"]["frames_below_sp"] = len(m["frames_below_sp"])
+        frames = np.asarray(m["frames_below_sp"], dtype=np.int64)
+        breaks = np.flatnonzero(np.diff(frames) > 1)
+        starts = np.concatenate([frames[:1], frames[breaks + 1]])
+        ends = np.concatenate([frames[breaks], frames[-1:]]) + 1
+        out["ssm"]["frames_below_sp"] = [[int(a), int(b)] for a, b in zip(starts, ends)]
     out["ergonomics"]["reba_frames"] = np.bincount(ergo.reba, minlength=16)[1:].tolist()
     return out
