@@ -259,7 +259,10 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
             if sl != guess:
                 guess = sl
                 break
-        look = min(2 * look, _CHUNK) if accepted == len(idx) else _MIN_LOOK
+        if params.min_slider < guess < full:
+            look = 1           # reduced speed follows the separation: it changes every step
+        else:
+            look = min(2 * look, _CHUNK) if accepted == len(idx) else _MIN_LOOK
         k += accepted
     # Exact minimum: the skipped steps whose bound lies below the smallest separation.
     best = np.nanmin(sep) if np.isfinite(sep).any() else math.inf
