@@ -33,7 +33,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--spec", default="S2",
                         help="LTL specification or a paper name (default S2)")
     parser.add_argument("--variants", type=int, default=50,
-                        help="variants per stature and layout (default 50)")
+                        help="variants per stature: each layout gets VARIANTS x "
+                             "len(STATURES) motions, each with a stature drawn from the "
+                             "grid (default 50)")
     parser.add_argument("--statures", type=_statures, default=[1.6, 1.75, 1.9],
                         help="comma-separated body heights in m (default 1.6,1.75,1.9)")
     parser.add_argument("--robot", default=None, metavar="YAML",

@@ -372,8 +372,8 @@ def write_report(layouts: Sequence[dict[str, Any]], out: Path, meta: dict[str, A
                         for lay in layouts)
     parts = [f"<h1>Cell study: {html.escape(meta['spec'])}</h1>",
              f"<p>{names}; "
-             f"{meta['variants']} variants at each stature "
-             f"({', '.join(f'{s:.2f}' for s in meta['statures'])} m) per layout; robot: "
+             f"{meta['variants'] * len(meta['statures'])} variants per layout, each with a "
+             f"stature drawn from {', '.join(f'{s:.2f}' for s in meta['statures'])} m; robot: "
              f"{html.escape(str(meta.get('robot') or 'none'))}; seed {meta['seed']}.</p>",
              "<p>" + "; ".join(f"layout {html.escape(lay['label'])}: {len(lay['items'])} "
                                f"verified motions, {lay['failed']['count']} failed"

@@ -39,7 +39,9 @@ class StudyConfig:
     spec : str
         LTL specification (or a paper name such as ``S2``).
     variants : int
-        Variants per stature and layout.
+        Variants per stature: each layout gets ``variants * len(statures)`` items, and
+        each item draws its stature from the grid (as batch items do), so the statures
+        are equally likely, not equally counted.
     statures : sequence of float
         Body heights (m).
     robot : str or None
