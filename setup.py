@@ -37,6 +37,7 @@ setup(
             "synthesis_node = ltl_human_motion.ros.entry_points:synthesis_node",
             "skeleton_publisher = ltl_human_motion.ros.entry_points:skeleton_publisher",
             "occupancy_node = ltl_human_motion.ros.entry_points:occupancy_node",
+            "ergonomics_node = ltl_human_motion.ros.entry_points:ergonomics_node",
             "coexistence_node = ltl_human_motion.ros.entry_points:coexistence_node",
         ],
     },

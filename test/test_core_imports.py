@@ -14,6 +14,7 @@ CORE_MODULES = [
     "ltl_human_motion.ltl", "ltl_human_motion.motion", "ltl_human_motion.scene",
     "ltl_human_motion.planning", "ltl_human_motion.viz", "ltl_human_motion.robot",
     "ltl_human_motion.batch", "ltl_human_motion.reproduce", "ltl_human_motion.cli",
+    "ltl_human_motion.assess", "ltl_human_motion.study",
 ]
 
 PROBE = r"""

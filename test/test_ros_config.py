@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 LAUNCH_FILE = ROOT / "launch" / "bringup.launch.py"
 CONFIGS = [ROOT / "config" / "bringup.yaml", ROOT / "config" / "bringup_two_humans.yaml"]
 KIND = {"SynthesisNode": "synthesis_node", "SkeletonPublisher": "skeleton_publisher",
-        "OccupancyNode": "occupancy_node"}
+        "OccupancyNode": "occupancy_node", "ErgonomicsNode": "ergonomics_node"}
 
 
 # ------------------------------------------------------------------ launch vs bringup

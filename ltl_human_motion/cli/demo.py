@@ -8,6 +8,9 @@
 3. Robot coexistence: a simulated UR5e speaking RTDE (own process) and the coexistence
    node slowing it down while the worker assembles inside its workspace; commissioning
    metrics as JSON and PNG.
+4. A cell study: S2 in layouts A and B of the paper cell (config/paper_cell.yaml and
+   config/paper_cell_b.yaml, the bench moved), a few variants per stature 1.6/1.75/1.9 m,
+   ergonomics, cycle time and offline SSM against the UR5e; JSON, PNGs and study.html.
 
 Each part writes into its own folder under ``--out`` and the command prints a summary.
 It exits 0 only if every part succeeded.
@@ -26,7 +29,7 @@ from ltl_human_motion.atomic import atomic_write_text
 NAME = "demo"
 HELP = "run the main job: paper reproduction, ROS 2 loop with MCAP recording, robot coexistence"
 
-PARTS = ("paper", "ros", "robot")
+PARTS = ("paper", "ros", "robot", "study")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -39,6 +42,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="skip the GIF animations of the paper part")
     parser.add_argument("--playback-rate", type=float, default=2.0,
                         help="playback speed of the ROS part (default 2x real time)")
+    parser.add_argument("--study-variants", type=int, default=10,
+                        help="variants per stature and layout in the study part (default 10)")
 
 
 def _say(msg: str) -> None:
@@ -72,12 +77,30 @@ def _robot(args: argparse.Namespace) -> dict:
     return {"ok": bool(summary.get("success", summary.get("ok", False))), **summary}
 
 
+def _study(args: argparse.Namespace) -> dict:
+    _say("cell study: layouts A and B of the paper cell, S2, UR5e (offline SSM)")
+    from ltl_human_motion.study.runner import StudyConfig, run_study
+    root = Path(__file__).resolve().parents[2] / "config"
+    cfg = StudyConfig(cells=[str(root / "paper_cell.yaml"), str(root / "paper_cell_b.yaml")],
+                      spec="S2", variants=args.study_variants, statures=(1.6, 1.75, 1.9),
+                      robot=str(root / "ur_pick_place.yaml"), out=args.out / "study",
+                      seed=args.seed)
+    data = run_study(cfg, progress=False)
+    layouts = data["layouts"]
+    return {"ok": all(lay["items"] for lay in layouts.values()),
+            "html": data["report"]["html"],
+            "motions": {k: len(v["items"]) for k, v in layouts.items()},
+            "failed": {k: v["failed"]["count"] for k, v in layouts.items()},
+            "comparison": {k: c for k, c in (data["comparison"] or {}).items()
+                           if c.get("significant")}}
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the selected parts; print and save a summary; 0 if all succeeded."""
     parts = args.only or list(PARTS)
     args.out.mkdir(parents=True, exist_ok=True)
     results: dict = {}
-    runners = {"paper": _paper, "ros": _ros, "robot": _robot}
+    runners = {"paper": _paper, "ros": _ros, "robot": _robot, "study": _study}
     for name in parts:
         t0 = time.perf_counter()
         try:
@@ -102,6 +125,10 @@ def run(args: argparse.Namespace) -> int:
                      f"{r.get('time_reduced_speed', 0.0):.1f} s slowed"
                      for mode, r in runs.items()]
             line += f"  -> {args.out / 'coexistence'} ({'; '.join(parts)})"
+        elif name == "study" and res["ok"]:
+            counts = ", ".join(f"{k}: {n} motions" for k, n in res["motions"].items())
+            line += (f"  -> {res['html']} ({counts}; {len(res['comparison'])} figure(s) "
+                     "differ)")
         elif not res["ok"]:
             line += f"  {res.get('error', '')}"
         print(line)

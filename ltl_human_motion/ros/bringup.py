@@ -115,6 +115,10 @@ class Bringup:
         if spec.executable == "occupancy_node":
             return OccupancyNode(store=self.store, playback=playback, node_name=spec.name,
                                  **kwargs)
+        if spec.executable == "ergonomics_node":
+            from ltl_human_motion.ros.ergonomics import ErgonomicsNode
+            return ErgonomicsNode(store=self.store, playback=playback, node_name=spec.name,
+                                  **kwargs)
         raise ValueError(f"unknown node kind {spec.executable!r}")
 
     def node(self, executable: str, human_id: str | None = None) -> Node:
@@ -123,6 +127,7 @@ class Bringup:
             kind = type(node).__name__
             wanted = {"synthesis_node": "SynthesisNode", "skeleton_publisher":
                       "SkeletonPublisher", "occupancy_node": "OccupancyNode",
+                      "ergonomics_node": "ErgonomicsNode",
                       "coexistence_node": "CoexistenceNode"}[executable]
             if kind == wanted and (human_id is None
                                    or getattr(node, "human_id", None) == human_id):

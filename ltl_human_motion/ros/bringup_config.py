@@ -31,8 +31,9 @@ from ltl_human_motion.atomic import atomic_write_text
 
 PACKAGE = "ltl_human_motion"
 #: Node kinds a bringup can start, in start order.
-NODE_KINDS = ("synthesis_node", "skeleton_publisher", "occupancy_node", "coexistence_node")
-PER_HUMAN = ("skeleton_publisher", "occupancy_node")
+NODE_KINDS = ("synthesis_node", "skeleton_publisher", "occupancy_node", "ergonomics_node",
+              "coexistence_node")
+PER_HUMAN = ("skeleton_publisher", "occupancy_node", "ergonomics_node")
 DEFAULT_CONFIG = Path(__file__).resolve().parents[2] / "config" / "bringup.yaml"
 
 
@@ -125,6 +126,10 @@ class BringupConfig:
                 if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
                     out[self.parameter(spec, "markers_topic", "/occupancy_markers")] = \
                         "visualization_msgs/msg/MarkerArray"
+            elif spec.executable == "ergonomics_node":
+                out[f"{ns}/ergonomics"] = f"{PACKAGE}/msg/ErgonomicsState"
+                out[self.parameter(spec, "markers_topic", "/ergonomics_markers")] = \
+                    "visualization_msgs/msg/MarkerArray"
             elif spec.executable == "coexistence_node":
                 out["/tf"] = out["/tf_static"] = "tf2_msgs/msg/TFMessage"
                 out["/joint_states"] = "sensor_msgs/msg/JointState"

@@ -85,6 +85,13 @@ def occupancy_node(args: list[str] | None = None) -> int:
     return _run_node(make, args, num_threads=OCCUPANCY_EXECUTOR_THREADS)
 
 
+def ergonomics_node(args: list[str] | None = None) -> int:
+    """Publish ``ergonomics`` (REBA/RULA now) during playback, following ``task_state``."""
+    from ltl_human_motion.ros.ergonomics import ErgonomicsNode
+
+    return _run_node(ErgonomicsNode, args)
+
+
 def coexistence_node(args: list[str] | None = None) -> int:
     """Speed and separation monitoring of a UR arm (``robot_host``) against every human's
     ``occupancy``: reads the arm over RTDE, writes its speed slider."""

@@ -112,6 +112,33 @@ def occupancy_parameters() -> list[ParamSpec]:
     ]
 
 
+def follow_task_state(node: Any, msg: TaskState) -> None:
+    """Re-anchor ``node.playback`` on a player's ``TaskState`` (loading the motion from
+    ``node.source`` when it changes; a missing one is warned about once, via
+    ``node._missing_warned``). Shared by the nodes that follow a player."""
+    if msg.playback_state not in STATES or msg.playback_state == STOPPED \
+            or not msg.motion_id:
+        if node.playback.state(now_seconds(node)) != STOPPED:
+            node.playback.stop()
+        return
+    motion = None
+    if msg.motion_id != node.playback.motion_id:
+        try:
+            motion = node.source.get(msg.motion_id)
+        except (KeyError, ValueError, OSError) as exc:
+            if msg.motion_id not in node._missing_warned:
+                node._missing_warned.add(msg.motion_id)
+                node.get_logger().warning(f"cannot follow {msg.motion_id!r} yet: {exc}")
+            return
+        # Loading imported the planning modules and made the motion's objects: keep them
+        # out of the collector's full passes, which would stall a stream (measured: 120 ms
+        # gaps in bench/occupancy_stream.py --layout launch).
+        gc.freeze()
+    node.playback.sync(msg.motion_id, motion, msg.motion_time,
+                       stamp_seconds(msg.header.stamp), msg.rate, msg.loop,
+                       msg.playback_state)
+
+
 class OccupancyNode(Node):
     """Streams ``HumanOccupancy`` for one human.
 
@@ -219,27 +246,7 @@ class OccupancyNode(Node):
                 self._set_marker_timer(p.value)
 
     def _on_task_state(self, msg: TaskState) -> None:
-        if msg.playback_state not in STATES or msg.playback_state == STOPPED \
-                or not msg.motion_id:
-            if self.playback.state(now_seconds(self)) != STOPPED:
-                self.playback.stop()
-            return
-        motion = None
-        if msg.motion_id != self.playback.motion_id:
-            try:
-                motion = self.source.get(msg.motion_id)
-            except (KeyError, ValueError, OSError) as exc:
-                if msg.motion_id not in self._missing_warned:
-                    self._missing_warned.add(msg.motion_id)
-                    self.get_logger().warning(f"cannot follow {msg.motion_id!r} yet: {exc}")
-                return
-            # Loading imported the planning modules and made the motion's objects: keep
-            # them out of the collector's full passes, which would stall the stream
-            # (measured: 120 ms gaps in bench/occupancy_stream.py --layout launch).
-            gc.freeze()
-        self.playback.sync(msg.motion_id, motion, msg.motion_time,
-                           stamp_seconds(msg.header.stamp), msg.rate, msg.loop,
-                           msg.playback_state)
+        follow_task_state(self, msg)
 
     def offsets(self) -> np.ndarray:
         """Clock offsets (s) of the published samples: 0, then the predicted ones."""

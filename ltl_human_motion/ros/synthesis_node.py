@@ -279,8 +279,9 @@ class SynthesisNode(Node):
         with self._jobs_lock:
             self._running.add(job)
         try:
-            motions = self._run(job.request, job.deadline)
+            motions, cell = self._run(job.request, job.deadline)
             self._fill(response, motions)
+            self._fill_ergonomics(response, motions, cell, int(job.request.cycles) or 1)
             self.get_logger().info(
                 f"synthesized {len(motions)} motion(s) in "
                 f"{time.perf_counter() - job.received:.2f} s: {', '.join(response.motion_ids)}")
@@ -312,7 +313,7 @@ class SynthesisNode(Node):
             self.requests_served += 1
             self.requests_refused += int(refused)
 
-    def _run(self, request: SynthesizeMotion.Request, deadline: Deadline) -> list:
+    def _run(self, request: SynthesizeMotion.Request, deadline: Deadline) -> tuple[list, Any]:
         spec = request.spec
         if not spec.strip():
             raise SpecError("the specification is empty")
@@ -330,7 +331,7 @@ class SynthesisNode(Node):
         motions = list(self._synthesize(spec, cell, **kwargs))
         if not motions:
             raise ValueError("synthesis returned no motion")
-        return motions
+        return motions, cell
 
     def _fill(self, response: SynthesizeMotion.Response, motions: list) -> None:
         for motion in motions:
@@ -356,6 +357,18 @@ class SynthesisNode(Node):
         for worker in self._workers:
             worker.join(max(end - time.monotonic(), 0.0))
         super().destroy_node()
+
+    @staticmethod
+    def _fill_ergonomics(response: SynthesizeMotion.Response, motions: list, cell: Any,
+                         cycles: int) -> None:
+        """Cycle time and worst REBA/RULA per motion (:mod:`ltl_human_motion.ros.ergonomics`)."""
+        from ltl_human_motion.ros.ergonomics import cell_masses, response_figures
+        masses = cell_masses(cell)
+        for motion in motions:
+            cycle_time, reba_max, rula_max = response_figures(motion, masses, cycles)
+            response.cycle_times.append(cycle_time)
+            response.reba_max.append(reba_max)
+            response.rula_max.append(rula_max)
 
     @staticmethod
     def _fail(response: SynthesizeMotion.Response, exc: Exception) -> None:
