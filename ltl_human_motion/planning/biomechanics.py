@@ -19,7 +19,9 @@ Limits and where they come from (:class:`BiomechanicsLimits`):
   reaching data put deliberate reaching peaks at 1-2 m/s), 3.5 m/s elsewhere; knees
   2.5 m/s, 2.0 m/s while the pelvis sits, stands up or kneels (sit-to-stand knee
   velocities stay below 1.5 m/s, Schenkman et al. 1990); the swing foot (ankle, toe)
-  at most 10 % over the gait clips' peak; every other joint 3.5 m/s.
+  at most 10 % over the peak of the default gait clips as the library prepares them
+  (120 Hz, toes raised off the floor in swing by ``fix_feet``: ankle 3.76, toe
+  4.47 m/s); every other joint 3.5 m/s.
 * **Range of motion** (degrees; American Academy of Orthopaedic Surgeons, *Joint
   Motion: Method of Measuring and Recording*, 1965, as tabulated by Greene & Heckman,
   *The Clinical Measurement of Joint Motion*, AAOS 1994): knee flexion 0-150 (the
@@ -94,8 +96,8 @@ class BiomechanicsLimits:
     hand_speed: float = 3.5
     knee_speed: float = 2.5
     knee_speed_posture: float = 2.0
-    ankle_speed: float = 3.7          # gait clips' peak 3.4 m/s + 10 %
-    toe_speed: float = 4.3            # gait clips' peak 3.9 m/s + 10 %
+    ankle_speed: float = 4.1          # prepared gait clips' peak 3.76 m/s + 10 %
+    toe_speed: float = 4.9            # prepared gait clips' peak 4.47 m/s + 10 %
     other_speed: float = 3.5
     rom: dict = field(default_factory=lambda: {
         "knee_flexion": (-5.0, 150.0),

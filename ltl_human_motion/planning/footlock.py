@@ -37,7 +37,7 @@ STANCE_SPEED = 0.4
 MAX_CORRECTION_RATE = 1.0
 #: Heading change (rad) of a flat planted foot the lock undoes in full; from there to
 #: twice that it lets the foot pivot (a turn in place turns the feet).
-MAX_TWIST = np.radians(10.0)
+MAX_TWIST = np.radians(25.0)
 #: Largest correction of a stance, m: a foot that would have to be held back further is
 #: stepping, not planted (a slow, low final step of a stop), so its stance ends there.
 MAX_LOCK = 0.05
@@ -130,7 +130,7 @@ def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
         # a flat planted foot keeps its heading (it pivots only with the heel up)
         flat = np.flatnonzero(np.all(h[a:b] <= CONTACT_HEIGHT, axis=1)) + a
         if flat.size:
-            kf = flat[np.argmin(np.abs(flat - k))]
+            kf = flat[0]                 # the heading it landed with: no snap
             ref = joints[kf, 1, :2] - joints[kf, 0, :2]
             heading[a:b] = ref
             cur = joints[flat, 1, :2] - joints[flat, 0, :2]
@@ -145,13 +145,14 @@ def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
             if b + i < T and weight[b + i] < w:
                 offset[b + i] = offset[b - 1] * w
                 weight[b + i] = w
-    sliding = (hc < SWING_CLEARANCE) & ~stance
-    lift = np.where(sliding, SWING_CLEARANCE - hc, 0.0)
+    h_min = h.min(axis=1)
+    sliding = (h_min < SWING_CLEARANCE) & ~stance
+    lift = np.where(sliding, SWING_CLEARANCE - h_min, 0.0)
     if np.any(lift > 0):
         width = max(1, round(LIFT_RAMP * fps))
         smooth = uniform_filter1d(maximum_filter1d(lift, 2 * width + 1), 2 * width + 1)
         lift = np.maximum(smooth, lift)
-    yaw_w = uniform_filter1d(yaw_w, size=9, mode="nearest")
+    yaw_w = np.maximum(yaw_w, uniform_filter1d(yaw_w, size=9, mode="nearest"))
     return np.concatenate([offset, lift[:, None]], axis=1), heading, yaw_w, contact
 
 
