@@ -76,6 +76,9 @@ __all__ = [
 
 _J = JOINT_INDEX
 _FOOT_JOINTS = ("l_ankle", "l_toe", "r_ankle", "r_toe")
+#: Rest heights of the ankle and toe joints above the floor, fractions of stature (the
+#: canonical skeleton's rest pose).
+CONTACT_REST_HEIGHTS = (0.039, 0.010)
 #: Tasks whose motion is the pelvis going down or coming up with the legs loaded.
 POSTURE_TRANSITION_TASKS = ("sit", "standUp", "kneel", "stoop")
 #: Hand goal tasks (the hand moves deliberately to a target).
@@ -318,7 +321,7 @@ def balance_margins(positions: np.ndarray, fps: float, stature: float = DEFAULT_
     feet = [_J[n] for n in _FOOT_JOINTS]
     v = np.linalg.norm(np.diff(p[:, feet, :2], axis=0), axis=-1) * fps
     v = np.vstack([v[:1], v])                                        # (T, 4)
-    rest_h = np.array([0.039, 0.010, 0.039, 0.010]) * stature
+    rest_h = np.tile(CONTACT_REST_HEIGHTS, 2) * stature
     low = np.all(p[:, feet, 2] - floor_z - rest_h <= limits.contact_height, axis=1)
     slow = np.all(v <= limits.planted_speed * stature / limits.reference_stature, axis=1)
     pv = np.linalg.norm(np.diff(p[:, 0], axis=0), axis=-1) * fps
@@ -360,7 +363,7 @@ def foot_skate(positions: np.ndarray, fps: float, stature: float = DEFAULT_STATU
     feet = [_J[n] for n in _FOOT_JOINTS]
     if len(p) < 2:
         return np.zeros(2), np.zeros((0, 2)), np.zeros((0, 2), dtype=bool)
-    rest_h = np.array([0.039, 0.010, 0.039, 0.010]) * stature
+    rest_h = np.tile(CONTACT_REST_HEIGHTS, 2) * stature
     vel = np.linalg.norm(np.diff(p[:, feet, :2], axis=0), axis=-1) * fps       # (T-1, 4)
     h = np.maximum(p[:, feet, 2] - floor_z - rest_h, 0.0)
     h = 0.5 * (h[1:] + h[:-1]) / contact_height
