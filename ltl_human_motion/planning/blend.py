@@ -26,7 +26,7 @@ import numpy as np
 #: Time (s) over which synthesis spreads each junction's pose mismatch on either side of
 #: it (offset blending): long enough that a 5 cm mismatch adds under 0.25 m/s to a joint,
 #: short next to a goal primitive's reach (at least 0.6 s).
-JUNCTION_SPREAD = 0.3
+JUNCTION_SPREAD = 0.2
 
 
 def blend_weights(nf: int) -> np.ndarray:
