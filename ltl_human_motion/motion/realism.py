@@ -31,7 +31,7 @@ import numpy as np
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
 
 __all__ = ["CMU_BVH_DIR", "METRICS", "compare", "motion_samples", "real_clip_samples",
-           "real_sources", "summary"]
+           "real_sources", "realism_summary", "summary"]
 
 #: Genuine CMU BVH takes installed by Debian's assimp-testmodels.
 CMU_BVH_DIR = "/usr/share/assimp/models/BVH"
@@ -193,3 +193,11 @@ def real_clip_samples(kind: str, path: str, stature: float = DEFAULT_STATURE
     p[..., 2] -= float((p[:, feet, 2] - rest).min())
     trim = round(0.1 * m.fps) if kind != "deepmimic" else 0
     return motion_samples(p[trim:], m.fps, stature)
+
+
+def realism_summary(positions: np.ndarray, fps: float, stature: float = DEFAULT_STATURE,
+                    floor_z: float = 0.0) -> dict[str, dict]:
+    """:func:`summary` of every metric of one motion (what a synthesized motion's
+    ``stats["realism"]`` and a dataset item's ``realism`` record hold)."""
+    samples = motion_samples(positions, fps, stature, floor_z)
+    return {m: summary(samples[m]) for m in METRICS}

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from ltl_human_motion.errors import CellError
+from ltl_human_motion.motion.realism import realism_summary
 from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
 from ltl_human_motion.motion.types import Motion
@@ -360,5 +361,6 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
                             for i, s in enumerate(plan.steps)],
         "start_pose": list(plan.start_pose),
         "segments": [[seg.name, int(a), int(b)] for seg, (a, b) in zip(plan.segments, spans)],
+        "realism": realism_summary(positions, library.fps, stature, cell.floor_z),
     }
     return synth
