@@ -23,7 +23,8 @@ from ltl_human_motion.planning.result import SynthesizedMotion
 from ltl_human_motion.planning.verify import verify_motion
 from ltl_human_motion.scene.predicates import collision
 
-CHECKS = ("start", "collision", "termination", "ltl", "smoothness", "feet")
+CHECKS = ("start", "collision", "termination", "ltl", "smoothness", "feet", "joint_speed",
+          "range_of_motion", "self_penetration", "balance", "foot_skate")
 
 
 @pytest.fixture(scope="module")

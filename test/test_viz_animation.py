@@ -28,7 +28,7 @@ def synth(paper):
 def test_gif_frames_follow_the_rate(synth, paper, tmp_path):
     path = tmp_path / "a.gif"
     t0 = time.perf_counter()
-    n = render_animation(synth, paper, path, fps=10.0)
+    n = render_animation(synth, paper, path, fps=10.0, body="stick")
     elapsed = time.perf_counter() - t0
     assert n == int(np.floor(synth.duration * 10.0)) + 1
     with Image.open(path) as im:
@@ -42,10 +42,23 @@ def test_gif_frames_follow_the_rate(synth, paper, tmp_path):
     assert elapsed / n < 0.25                                 # seconds per frame
 
 
+def test_gif_shows_a_shaded_body_by_default(synth, paper, tmp_path):
+    path = tmp_path / "body.gif"
+    n = render_animation(synth, paper, path, fps=10.0, max_frames=6)
+    assert n == 6
+    with Image.open(path) as im:
+        for k in range(n):
+            im.seek(k)
+            px = np.asarray(im.convert("RGB")).astype(int)
+            shirt = (px[..., 2] - px[..., 0] > 50) & (px[..., 2] > 80)
+            skin = (px[..., 0] - px[..., 2] > 40) & (px[..., 0] > 150) & (px[..., 1] > 100)
+            assert shirt.sum() > 100 and skin.sum() > 5
+
+
 def test_gif_with_capsules_and_frame_cap(synth, paper, tmp_path):
     path = tmp_path / "b.gif"
     n = render_animation(synth, paper, path, fps=15.0, capsules=True, max_frames=12,
-                         size=(4.0, 3.0))
+                         size=(4.0, 3.0), body="stick")
     assert n == 12
     with Image.open(path) as im:
         assert im.n_frames == 12 and im.size == (320, 240)

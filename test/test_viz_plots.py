@@ -61,23 +61,34 @@ def test_snapshots_show_worker_in_every_panel(motions, paper, tmp_path):
     path = tmp_path / "snap.png"
     synth = motions[0]
     times = [0.0, synth.duration / 2, synth.duration]
-    render_snapshots(synth, paper, times, path, ncols=3, capsules=False)
+    render_snapshots(synth, paper, times, path, ncols=3, capsules=False, body="stick")
     img = _pixels(path)
     h, w, _ = img.shape
     assert w > 2 * h
     for k in range(3):
         panel = img[:, k * w // 3:(k + 1) * w // 3]
         assert _near(panel, BONE_RGB, 25).sum() > 30           # the bones
-    # With capsules (the default) the body shows as translucent blue in every panel.
-    render_snapshots(synth, paper, times, path, ncols=3)
+    # The stick figure with capsules shows as translucent blue in every panel.
+    render_snapshots(synth, paper, times, path, ncols=3, body="stick")
     img = _pixels(path)
     for k in range(3):
         panel = img[:, k * w // 3:(k + 1) * w // 3]
         blue = (panel[..., 2] - panel[..., 0] > 60) & (panel[..., 2] > 150)
         assert blue.sum() > 300
+    # The default is the shaded body: shirt, trousers and skin in every panel.
+    render_snapshots(synth, paper, times, path, ncols=3)
+    img = _pixels(path)
+    for k in range(3):
+        panel = img[:, k * w // 3:(k + 1) * w // 3]
+        shirt = (panel[..., 2] - panel[..., 0] > 50) & (panel[..., 2] > 80)
+        skin = (panel[..., 0] - panel[..., 2] > 40) & (panel[..., 0] > 150) & (
+            panel[..., 1] > 100)
+        assert shirt.sum() > 150 and skin.sum() > 10
     assert [p.name for p in tmp_path.iterdir()] == ["snap.png"]
     with pytest.raises(ValueError, match="at least one time"):
         render_snapshots(synth, paper, [], path)
+    with pytest.raises(ValueError, match="body must be one of"):
+        render_snapshots(synth, paper, times, path, body="ghost")
 
 
 def test_plot_cell_in_several_formats(paper, tmp_path):

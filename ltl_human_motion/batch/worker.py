@@ -270,7 +270,8 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
                    "duration": float(synth.duration), "n_frames": int(synth.n_frames),
                    "fps": float(synth.fps), "verified": verified, "verification": report,
                    "nodes_expanded": int(synth.stats.get("nodes_expanded", 0)),
-                   "start_pose": _plain(synth.stats.get("start_pose"))})
+                   "start_pose": _plain(synth.stats.get("start_pose")),
+                   "realism": _plain(synth.stats.get("realism"))})
     if verified or job.keep_unverified:
         arrays = _arrays(synth, job.dtype)
         record["motion_sha256"] = motion_sha256(arrays)

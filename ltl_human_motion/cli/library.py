@@ -80,6 +80,30 @@ def _plot(lib, path: Path) -> None:
     plt.close(fig)
 
 
+def _realism(lib, source) -> dict:
+    """Gait primitives (every 8th) vs the real clips installed here and ``source``:
+    :func:`~ltl_human_motion.motion.realism.compare` per metric."""
+    from ltl_human_motion.motion.realism import (
+        compare,
+        motion_samples,
+        real_clip_samples,
+        real_sources,
+    )
+    from ltl_human_motion.motion.types import world_positions
+    ours = [motion_samples(world_positions(mp), mp.fps, lib.stature)
+            for mp in lib.primitives[::8]]
+    extra = [] if source is None else ([source] if isinstance(source, str) else list(source))
+    real, used = [], []
+    for kind, path in real_sources(extra):
+        try:
+            real.append(real_clip_samples(kind, path, lib.stature))
+            used.append(path)
+        except (ValueError, OSError):
+            continue
+    return {"ours": f"{len(ours)} gait primitives", "real": used,
+            "metrics": compare(ours, real)}
+
+
 def run(args: argparse.Namespace) -> int:
     from ltl_human_motion.atomic import atomic_write_text
     from ltl_human_motion.errors import LtlHumanMotionError
@@ -106,6 +130,7 @@ def run(args: argparse.Namespace) -> int:
         quality["ok"] = bool(quality["gait"]["ok"] and quality["goal"]["ok"])
     report = {"summary": summary, "quality": quality}
     if args.report is not None:
+        report["realism"] = _realism(lib, args.source)
         atomic_write_text(args.report, json.dumps(report, indent=2, default=float) + "\n")
     if args.plot is not None:
         _plot(lib, args.plot)
@@ -128,6 +153,13 @@ def run(args: argparse.Namespace) -> int:
                       f"bone {w['bone_length']:.1e} m, floor {w['floor']:+.3f} m, skate "
                       f"{w['foot_skate']:.2f} m/s, speed {w['joint_speed']:.2f} m/s")
         if args.report is not None:
+            print(f"  realism          ours ({report['realism']['ours']}) vs "
+                  f"{len(report['realism']['real'])} real clips: median ours / real, "
+                  f"1-Wasserstein distance")
+            for name, r in report["realism"]["metrics"].items():
+                o, q, w = r["ours"]["median"], r["real"]["median"], r["wasserstein"]
+                if o is not None and q is not None:
+                    print(f"    {name:<12} {o:9.3g} / {q:<9.3g} {r['unit']:<10} W1 {w:.3g}")
             print(f"  report           {args.report}")
         if args.plot is not None:
             print(f"  plot             {args.plot}")

@@ -58,6 +58,11 @@ _J = JOINT_INDEX
 # Palm centres when carrying, in the pelvis heading frame relative to the chest joint,
 # as fractions of stature (forward, left, up).
 CARRY_HAND_OFFSET = np.array([0.17, 0.075, -0.09])
+#: Length of the speed ramp of start and stop primitives, s: gait initiation and
+#: termination take one to two steps, 0.8-1.2 s at a self-selected pace (Jian et al.
+#: 1993, *Gait & Posture* 1:9); a shorter ramp makes the pose blend from the standing
+#: pose sweep the swing foot faster than any real step.
+START_STOP_DURATION = 1.0
 
 
 @dataclass(frozen=True)
@@ -301,7 +306,8 @@ def _transition(clip: GaitClip, skeleton: Skeleton, poses: np.ndarray, stand: np
 
 
 def start_stop_primitives(clip: GaitClip, skeleton: Skeleton, n_phases: int = 4,
-                          duration: float = 0.6, overlap: int = OVERLAP, carry: bool = True,
+                          duration: float = START_STOP_DURATION, overlap: int = OVERLAP,
+                          carry: bool = True,
                           fps: float = LIBRARY_FPS) -> list[MotionPrimitive]:
     """Start (standing to walking) and stop (walking to standing) primitives.
 

@@ -41,7 +41,8 @@ import numpy as np
 from ltl_human_motion.motion.gait import LIBRARY_FPS
 from ltl_human_motion.motion.ik import center_of_mass, min_jerk, two_bone_ik
 from ltl_human_motion.motion.ops import relative_root
-from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
+from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, Skeleton
+from ltl_human_motion.motion.timing import fitts_time, min_move_time
 from ltl_human_motion.motion.types import MotionPrimitive
 
 __all__ = [
@@ -67,6 +68,15 @@ _REACH_FRACTION = 0.93          # hand never further than this fraction of the a
 _ASSEMBLE_HALF_GAP = 0.035      # m, hands either side of an assembly target
 _INSERT_TRAVEL = 0.08           # m, straight push of insert / pull of extract
 _APPROACH_LIFT = 0.08           # m, grasp/release/move come down onto low targets
+#: Peak palm speed of a goal reach, m/s at 1.75 m: under the 2.5 m/s limit of
+#: planning.biomechanics with room for the seeded bow and the body's own motion.
+HAND_GOAL_PEAK_SPEED = 1.8
+#: Length of the arced palm path (slerped about the shoulder, plus the bow and the
+#: approach from above) over the straight distance.
+_ARC_PATH_FACTOR = 1.35
+#: Extra outward bow of the palm path for a target below the hips, fraction of stature
+#: (full up to 0.45 H, none from 0.6 H): the hand passes outside the thigh.
+_LOW_REACH_WIDE = 0.05
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -483,6 +493,10 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     jitter = rng.uniform(0.9, 1.1)
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach = float(np.clip(0.5 + 0.55 * dist + 0.35 * pitch1 + 1.2 * drop1 / H, 0.6, 2.2))
+    # never faster than people reach (Fitts' law) nor than a peak palm speed of
+    # HAND_GOAL_PEAK_SPEED along the arced path (motion.timing)
+    t_reach = max(t_reach, fitts_time(dist), min_move_time(
+        _ARC_PATH_FACTOR * dist, HAND_GOAL_PEAK_SPEED * H / DEFAULT_STATURE) / 0.9)
     t_reach *= jitter
     t_ret = t_reach * rng.uniform(0.95, 1.05)
     holds = {"grasp": 0.3, "release": 0.3, "move": 0.3, "leftHand": 1.0, "rightHand": 1.0,
@@ -549,6 +563,9 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         out_dir = np.array([0.0, 1.0 if k == 0 else -1.0, 0.6])
         out_dir /= np.linalg.norm(out_dir)
         amp = rng.uniform(0.02, 0.05) * min(1.0, dist / 0.5)
+        # a hand going down past the thigh swings wide of it (no hand through the leg)
+        amp += _LOW_REACH_WIDE * H * float(np.clip((0.6 * H - targets[k][2]) / (0.15 * H),
+                                                   0.0, 1.0))
         rel[:, k] += amp * bow[:, None] * out_dir
     # small manipulation movements while the hands are in the region
     if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
@@ -671,9 +688,13 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
                                 toe_z - ankle_z])
         pel1 = hip - (rest[_J[f"{_SIDES[k]}_hip"]] - rest[0])
         # the moving foot lifts while it steps back
-        s_foot = _profile(t, [(0.0, 0.0), (0.55 * t1, 1.0), (t2 + 0.45 * t_up, 1.0),
-                              (total, 0.0)])
-        lift = 0.05 * H * np.sin(np.pi * s_foot) * ((t < 0.55 * t1) | (t > t2 + 0.45 * t_up))
+        # it moves only once lifted and lands before it stops, so it never slides over
+        # the floor (the first and last 15 % of each step are rise and set-down)
+        w0, w1 = 0.55 * t1, total - (t2 + 0.45 * t_up)
+        s_foot = _profile(t, [(0.15 * w0, 0.0), (0.85 * w0, 1.0),
+                              (t2 + 0.45 * t_up + 0.15 * w1, 1.0), (total - 0.15 * w1, 0.0)])
+        tau = np.where(t < w0, t / w0, np.where(t > total - w1, (t - (total - w1)) / w1, 0.0))
+        lift = 0.05 * H * np.sin(np.pi * tau) ** 2
         ankles[:, k] = st.ankles[k] + s_foot[:, None] * (ankle - st.ankles[k])
         ankles[:, k, 2] += lift
         toes[:, k] = st.toes[k] + s_foot[:, None] * (toe - st.toes[k])

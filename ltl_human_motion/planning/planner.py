@@ -20,7 +20,6 @@ where every grasp picks a new part from the floor.
 from __future__ import annotations
 
 import functools
-import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -657,8 +656,9 @@ class SequencePlanner:
     def _arm_transition(self, carrying_before: bool, label: int) -> None:
         """Bring the arms from the walk stance to the carry stance or back.
 
-        The hands first come in to the body, then go to the other stance (two min-jerk
-        legs), so they never sweep through a bench in front of the worker.
+        The palms move beside the body on a smooth curve, timed by Fitts' law with a
+        bounded peak speed (:func:`~ltl_human_motion.motion.arm_transition.
+        arm_transition_poses`).
         """
         rel = self._arm_poses(carrying_before)
         root = np.zeros((len(rel), 4))
@@ -675,7 +675,7 @@ class SequencePlanner:
     def _arm_poses(self, carrying_before: bool) -> np.ndarray:
         """Root-relative poses (T, J, 3) of the arm transition (made once per library and
         direction: it depends on nothing else)."""
-        from ltl_human_motion.motion.ik import min_jerk
+        from ltl_human_motion.motion.arm_transition import arm_transition_poses
         from ltl_human_motion.motion.retarget import enforce_bone_lengths
         key = (self._stance(False).tobytes(), self._stance(True).tobytes(),
                self.library.skeleton.stature, self.library.fps, self.overlap,
@@ -684,20 +684,12 @@ class SequencePlanner:
         if hit is not None:
             return hit
         a, b = self._stance(carrying_before), self._stance(not carrying_before)
-        carry, free = (a, b) if carrying_before else (b, a)
-        tucked = carry.copy()
-        arms = [self.library.skeleton.index(f"{s}_{j}") for s in "lr"
-                for j in ("elbow", "wrist", "hand")]
-        tucked[arms, 0] = np.minimum(carry[arms, 0], free[arms, 0] + 0.08)
-        waypoints = [a, tucked, b]
-        legs = []
-        for p, q in itertools.pairwise(waypoints):
-            n = max(round(0.3 * self.library.fps), self.overlap + 2)
-            s = min_jerk(np.linspace(0.0, 1.0, n))[:, None, None]
-            legs.append(p[None] + s * (q - p)[None])
-        # Straight joint paths shorten the arm bones; the pipeline restores their lengths
-        # (moving the hands out), so the transition is checked as it will be played.
-        rel = enforce_bone_lengths(np.concatenate([legs[0], legs[1][1:]]), self.library.skeleton)
+        rel = arm_transition_poses(a, b, self.library.skeleton, self.library.fps)
+        if len(rel) < self.overlap + 2:
+            rel = np.concatenate([rel, np.repeat(rel[-1:], self.overlap + 2 - len(rel), 0)])
+        # The pipeline restores bone lengths after blending, so the transition is checked
+        # as it will be played.
+        rel = enforce_bone_lengths(rel, self.library.skeleton)
         rel.flags.writeable = False
         if len(_ARM_POSES) >= 32:
             _ARM_POSES.clear()

@@ -21,6 +21,8 @@ STEPS = ((-0.3, 0.0, 0.0), (-0.3, 0.0, 90.0), (-0.3, 0.0, -90.0), (0.0, 0.25, 0.
          (0.0, -0.25, 0.0), (0.15, 0.0, 0.0), (-0.15, 0.0, 0.0), (0.0, 0.12, 0.0),
          (0.0, -0.12, 0.0))
 _FOOT = {"l": ("l_ankle", "l_toe"), "r": ("r_ankle", "r_toe")}
+#: Fraction of a foot's step window at either end where it only rises or sets down.
+_LIFT_LEAD = 0.2
 
 
 def _turned(yaw: np.ndarray, points: np.ndarray, inverse: bool = False) -> np.ndarray:
@@ -58,8 +60,9 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
     """A standing-to-standing primitive: step by (dx, dy) and turn by ``angle``.
 
     The pelvis follows a minimum-jerk path; the feet step one after the other (the
-    foot on the side of the turn or of the step first), each lifted on a sine arc, and
-    the knees follow by two-bone IK.
+    foot on the side of the turn or of the step first), each lifted on a sin^2 arc and
+    moved only once lifted (the first and last fifth of its window are rise and set
+    down), and the knees follow by two-bone IK.
 
     Parameters
     ----------
@@ -83,7 +86,13 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
         Starts and ends in ``stand``; ``root[-1] == (dx, dy, height, angle)``.
     """
     stand = np.asarray(stand, dtype=np.float64)
-    duration = 0.5 + 0.45 * abs(angle) / (np.pi / 2) + 1.2 * np.hypot(dx, dy)
+    # Turns over 90 deg take two steps per foot (one step turning a foot further crosses
+    # the legs), and correspondingly longer.
+    n_steps = 4 if abs(angle) > np.radians(95.0) else 2
+    # (each foot moves only in the middle 60 % of its window, so the windows are longer
+    # than a plain sine step's: knees stay under 2.5 m/s)
+    duration = (0.6 + 0.45 * abs(angle) / (np.pi / 2) + 1.5 * np.hypot(dx, dy)) * (
+        1.4 if n_steps == 4 else 1.0)
     n = round(duration * fps) + 1
     t = np.linspace(0.0, 1.0, n)
     s_root = _progress(t, 0.05, 0.95)
@@ -96,16 +105,28 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
     body[:, :, 2] -= dip[:, None]
     lead = "l" if (angle > 0 or (angle == 0 and dy > 0)) else "r"
     first, second = (lead, "r" if lead == "l" else "l")
-    windows = {first: (0.05, 0.55), second: (0.45, 0.95)}
-    for side, (a, b) in windows.items():
-        s = _progress(t, a, b)
+    # One foot after the other, never both in the air; each lifts before it moves and
+    # lands before the other lifts, so no foot slides over the floor.
+    edges = np.linspace(0.05, 0.95, n_steps + 1)
+    progress = {first: np.zeros(n), second: np.zeros(n)}
+    up = {first: np.zeros(n), second: np.zeros(n)}
+    for i in range(n_steps):
+        side = first if i % 2 == 0 else second
+        a, b = edges[i], edges[i + 1]
+        k0 = (i // 2) / (n_steps // 2)
+        k1 = (i // 2 + 1) / (n_steps // 2)
+        s = _progress(t, a + _LIFT_LEAD * (b - a), b - _LIFT_LEAD * (b - a))
+        progress[side] = np.where(t >= a, k0 + (k1 - k0) * s, progress[side])
+        up[side] += np.sin(np.pi * np.clip((t - a) / (b - a), 0.0, 1.0)) ** 2
+    for side in (first, second):
+        s = progress[side]
         foot_yaw = angle * s
         for name in _FOOT[side]:
             j = JOINT_INDEX[name]
             body[:, j] = _turned(foot_yaw, stand[None, None, j])[:, 0]
             body[:, j, 0] += dx * s
             body[:, j, 1] += dy * s
-            body[:, j, 2] += lift * np.sin(np.pi * s)
+            body[:, j, 2] += lift * up[side]
         hip, knee, ankle = (JOINT_INDEX[f"{side}_{x}"] for x in ("hip", "knee", "ankle"))
         l1 = float(np.linalg.norm(stand[knee] - stand[hip]))
         l2 = float(np.linalg.norm(stand[ankle] - stand[knee]))

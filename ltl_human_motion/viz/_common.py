@@ -115,6 +115,27 @@ def body_quads(positions: np.ndarray, stature: float) -> np.ndarray:
     return np.concatenate([capsule_mesh(s, r) for s, r in zip(seg, rad)])
 
 
+def body_triangles(positions: np.ndarray, stature: float,
+                   light: tuple[float, float, float] = (-0.4, -0.6, 0.7),
+                   detail: tuple[int, int] = (6, 10)) -> tuple[np.ndarray, np.ndarray]:
+    """The shaded body of one pose (J, 3): triangles (F, 3, 3) and their RGBA (F, 4).
+
+    Built by :func:`~ltl_human_motion.scene.body_mesh.body_mesh`; faces are lit by a
+    directional ``light`` (Lambert with an ambient floor) and sorted back to front is
+    left to matplotlib.
+    """
+    from ltl_human_motion.scene.body_mesh import body_mesh
+    v, f, rgb = body_mesh(positions, stature, detail)
+    tri = v[f]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-12)
+    lv = np.asarray(light, dtype=np.float64)
+    lv /= np.linalg.norm(lv)
+    k = 0.45 + 0.55 * np.clip(n @ lv, 0.0, 1.0)
+    rgba = np.concatenate([np.clip(rgb * k[:, None], 0.0, 1.0), np.ones((len(tri), 1))], 1)
+    return tri, rgba
+
+
 def bone_segments(positions: np.ndarray) -> np.ndarray:
     """Bones of one pose (J, 3) as segments, shape (J - 1, 2, 3)."""
     return np.array([[positions[p], positions[j]] for j, p in enumerate(PARENTS) if p >= 0])

@@ -1,8 +1,10 @@
 """Offscreen 3D renderings of a synthesized motion in its cell (paper Fig. 2) and GIFs.
 
-The worker is drawn as bones (lines between joints) and, in snapshots, as the capsules
-of its occupancy (:mod:`ltl_human_motion.scene.occupancy`); obstacles are solid, regions
-dashed wire boxes, objects at their position at that frame.
+The worker is drawn as a shaded body (``body="shaded"``, the default: smooth capsules
+built from its occupancy, sized by stature, :mod:`ltl_human_motion.scene.body_mesh`) or
+as a stick figure (``body="stick"``: bones, with the translucent occupancy capsules if
+``capsules``); obstacles are solid, regions dashed wire boxes, objects at their position
+at that frame.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from ltl_human_motion.scene.cell import Cell
 from ltl_human_motion.viz._common import (
     PathLike,
     body_quads,
+    body_triangles,
     bone_segments,
     cell_bounds,
     draw_static_cell,
@@ -36,9 +39,27 @@ def _frame_title(synth: SynthesizedMotion, frame: int) -> str:
     return f"t = {frame / synth.fps:.2f} s  " + (task if task else "(between tasks)")
 
 
-def _draw_worker(ax, synth: SynthesizedMotion, frame: int, capsules: bool) -> None:
+BODY_STYLES = ("shaded", "stick")
+#: Capsule tessellation of the animated body (latitudes, longitudes): coarser than the
+#: snapshots' so that a GIF frame draws in about 0.1 s.
+_GIF_DETAIL = (5, 8)
+
+
+def _check_body(body: str) -> None:
+    if body not in BODY_STYLES:
+        raise ValueError(f"body must be one of {', '.join(BODY_STYLES)}, got {body!r}")
+
+
+def _draw_worker(ax, synth: SynthesizedMotion, frame: int, capsules: bool,
+                 body: str = "shaded") -> None:
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
     pose = synth.positions[frame]
+    if body == "shaded":
+        tri, rgba = body_triangles(pose, synth.motion.skeleton.stature)
+        # edges in the face colour hide the antialiasing seams between faces
+        ax.add_collection3d(Poly3DCollection(tri, facecolors=rgba, edgecolors=rgba,
+                                             linewidths=0.3))
+        return
     if capsules:
         ax.add_collection3d(Poly3DCollection(body_quads(pose, synth.motion.skeleton.stature),
                                              facecolors="#4a90d9", edgecolors="none",
@@ -48,7 +69,8 @@ def _draw_worker(ax, synth: SynthesizedMotion, frame: int, capsules: bool) -> No
 
 def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float],
                      path: PathLike, ncols: int = 3, capsules: bool = True,
-                     elev: float = 20.0, azim: float = -125.0, dpi: float = 110.0) -> None:
+                     elev: float = 20.0, azim: float = -125.0, dpi: float = 110.0,
+                     body: str = "shaded") -> None:
     """Several 3D panels of the worker in the cell at the given times (paper Fig. 2).
 
     Parameters
@@ -62,12 +84,15 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
     ncols : int
         Panels per row.
     capsules : bool
-        Draw the occupancy capsules in addition to the bones.
+        With ``body="stick"``: draw the occupancy capsules in addition to the bones.
     elev, azim : float
         View angles in degrees.
     dpi : float
+    body : {"shaded", "stick"}
+        A shaded body (default) or the stick figure.
     """
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    _check_body(body)
     times = list(times)
     if not times:
         raise ValueError("need at least one time")
@@ -89,7 +114,7 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
             color = cell.objects[name].color or "tab:orange"
             ax.add_collection3d(Poly3DCollection(tri, facecolors=shaded(tri, color),
                                                  edgecolors="k", linewidths=0.2))
-        _draw_worker(ax, synth, frame, capsules)
+        _draw_worker(ax, synth, frame, capsules, body)
         ax.set_title(_frame_title(synth, frame), fontsize=8)
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.02, top=0.95, wspace=0.0, hspace=0.08)
     save_figure(fig, path)
@@ -98,7 +123,7 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
 def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: float = 15.0,
                      capsules: bool = False, size: tuple[float, float] = (6.4, 4.8),
                      dpi: float = 80.0, elev: float = 20.0, azim: float = -125.0,
-                     max_frames: int | None = None) -> int:
+                     max_frames: int | None = None, body: str = "shaded") -> int:
     """Write an animated GIF of the motion (offscreen, no display needed).
 
     The motion is resampled to ``fps`` (nearest frames); the cell is drawn once and the
@@ -114,13 +139,15 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
     fps : float
         Frame rate of the GIF (at most the motion's).
     capsules : bool
-        Also draw the occupancy capsules (slower).
+        With ``body="stick"``: also draw the occupancy capsules (slower).
     size : (float, float)
         Figure size in inches.
     dpi : float
     elev, azim : float
     max_frames : int, optional
         Cap on the number of GIF frames (the frame rate is lowered to fit).
+    body : {"shaded", "stick"}
+        A shaded body (default) or the stick figure.
 
     Returns
     -------
@@ -134,6 +161,7 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
     if not fps > 0:
         raise ValueError(f"fps must be positive, got {fps!r}")
+    _check_body(body)
     fps = min(float(fps), synth.fps)
     n_out = max(int(np.floor(synth.duration * fps)) + 1, 1)
     if max_frames is not None:
@@ -152,14 +180,21 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
     ax.set_axis_off()                  # ticks and panes cost most of the drawing time
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.94)
     draw_static_cell(ax, cell, lo, hi, grid=0.5)
-    bones = Line3DCollection(bone_segments(synth.positions[0]), colors="#1f3b73",
-                             linewidths=1.8)
-    ax.add_collection3d(bones)
-    body = None
-    if capsules:
-        body = Poly3DCollection(body_quads(synth.positions[0], synth.motion.skeleton.stature),
+    stature = synth.motion.skeleton.stature
+    bones = shell = None
+    if body == "shaded":
+        tri, rgba = body_triangles(synth.positions[0], stature, detail=_GIF_DETAIL)
+        shell = Poly3DCollection(tri, facecolors=rgba, edgecolors=rgba, linewidths=0.3)
+        ax.add_collection3d(shell)
+    else:
+        bones = Line3DCollection(bone_segments(synth.positions[0]), colors="#1f3b73",
+                                 linewidths=1.8)
+        ax.add_collection3d(bones)
+    caps = None
+    if capsules and body == "stick":
+        caps = Poly3DCollection(body_quads(synth.positions[0], stature),
                                 facecolors="#4a90d9", edgecolors="none", alpha=0.35)
-        ax.add_collection3d(body)
+        ax.add_collection3d(caps)
     obj_artists = {}
     base = object_polys(cell)
     for name, tri in base.items():
@@ -174,9 +209,15 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
     palette = None
     for frame in frames:
         pose = synth.positions[frame]
-        bones.set_segments(bone_segments(pose))
-        if body is not None:
-            body.set_verts(body_quads(pose, synth.motion.skeleton.stature))
+        if shell is not None:
+            tri, rgba = body_triangles(pose, stature, detail=_GIF_DETAIL)
+            shell.set_verts(tri)
+            shell.set_facecolor(rgba)
+            shell.set_edgecolor(rgba)
+        if bones is not None:
+            bones.set_segments(bone_segments(pose))
+        if caps is not None:
+            caps.set_verts(body_quads(pose, stature))
         for name, art in obj_artists.items():
             if name in synth.objects:
                 shift = synth.objects[name][frame] - cell.objects[name].position
