@@ -24,6 +24,7 @@ rclpy = pytest.importorskip("rclpy")
 
 from ltl_human_motion.srv import SynthesizeMotion  # noqa: E402
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy  # noqa: E402
+from ros_fakes import SYNTHESIS_ONLY_BRINGUP  # noqa: E402
 
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession  # noqa: E402
@@ -32,7 +33,6 @@ from ltl_human_motion.ros.synthesis_node import (  # noqa: E402
     MAX_VARIANTS,
     SynthesisNode,
 )
-from ltl_human_motion.ros.testing import SYNTHESIS_ONLY_BRINGUP  # noqa: E402
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -205,8 +205,9 @@ def test_sigint_mid_synthesis_exits_within_two_seconds(
 
 
 def test_the_motion_store_is_bounded_and_evicts_to_its_folder(tmp_path: Path) -> None:
+    from ros_fakes import make_test_motion
+
     from ltl_human_motion.ros.motion_store import MotionStore, default_store_dir, motion_nbytes
-    from ltl_human_motion.ros.testing import make_test_motion
 
     motion = make_test_motion()
     size = motion_nbytes(motion)
