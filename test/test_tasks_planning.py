@@ -25,12 +25,13 @@ def _t(text: str) -> Atom:
 
 def _consistent(tasks, two_handed=frozenset(), fixed=frozenset()) -> None:
     """An independent check of the physical rules: two hands, a part is grasped only when
-    not held, released only when held; move/insert/carry fetch a part not held."""
+    not held; release/move/insert/carry fetch a part not held (issue 11: a release of a
+    part not in hand grasps it first)."""
     held: list[str] = []
     for t in tasks:
         part = t.args[0] if t.args else None
         width = lambda p: 2 if p in two_handed else 1  # noqa: E731
-        if t.name in ("grasp", "move", "insert", "carry") and part not in held:
+        if t.name in ("grasp", "move", "insert", "carry", "release") and part not in held:
             assert part not in fixed, f"{t}: a fixed object cannot be held"
             assert sum(map(width, held)) + width(part) <= 2, f"{t}: a third part in two hands"
             held.append(part)
@@ -57,7 +58,9 @@ def test_model_preconditions_and_effects():
         "P3: {position", "P3: {two_handed: true, position"))
     m = CellModel.from_cell(cell)
     s = m.initial_state()
-    assert m.step(s, _t("release(P0)")) is None           # not held
+    fetched = m.step(s, _t("release(P0)"))                 # not held: fetched first
+    assert fetched is not None and fetched[0].held == ()
+    assert fetched[1] > m.step(s, _t("grasp(P0)"))[1] + m.durations["release"]
     s1, c1 = m.step(s, _t("grasp(P0)"))
     assert c1 > m.durations["grasp"] and s1.held == (0,)
     assert m.step(s1, _t("grasp(P0)")) is None            # already in hand

@@ -6,7 +6,9 @@ Preconditions and effects follow Table I of the paper and what the planner does:
 
 * ``grasp(O)`` needs a free hand (both for a ``two_handed`` part) and O not held and
   not inside a container; O is picked up where it lies.
-* ``release(O)`` needs O in hand; O is put down where the worker stands.
+* ``release(O)`` needs O in hand, or fetches it first (as the planner does); O is put
+  down where the worker stands. A part that starts inside a fixed object (a bin) is
+  inside it.
 * ``move(O, R)``, ``insert(O, C)`` and ``carry(O, R)`` need O in hand, or fetch it
   first (walk to O and grasp it, which needs a free hand), as the planner does.
   ``insert`` leaves O inside C with the hand free. ``move`` puts O into R and, as in
@@ -33,7 +35,7 @@ import numpy as np
 
 from ltl_human_motion.ltl.formula import Atom
 
-__all__ = ["DONE", "NOMINAL_DURATION", "WALK_SPEED", "CellModel", "CellState", "Limits"]
+__all__ = ["DONE", "IMPLICIT_FETCH_PENALTY", "NOMINAL_DURATION", "WALK_SPEED", "CellModel", "CellState", "Limits"]
 
 #: Walking speed of the cost estimate, m/s. Slower than free walking (about 1.3 m/s,
 #: Bohannon 1997) because walks in a cell are short and start and stop.
@@ -54,6 +56,9 @@ POSTURES = ("standing", "sitting", "kneeling")
 #: Where a part is: at a location index >= 0, in hand, or inside container ``c``
 #: (encoded as ``INSIDE - c``).
 HELD = -1
+#: Extra cost (s) of a ``release`` that fetches its part first, so that a search prefers
+#: an explicit ``grasp`` wherever the specification allows one (a choice, not a measure).
+IMPLICIT_FETCH_PENALTY = 0.5
 INSIDE = -2
 
 #: Where a part is once the specification no longer mentions it and no hand holds it:
@@ -122,6 +127,8 @@ class CellModel:
     limits : Limits
     durations : mapping
         Task name -> nominal duration, s (default :data:`NOMINAL_DURATION`).
+    inside : tuple of (int or None)
+        Per part (default none): the index of the container part it starts inside.
     """
 
     points: np.ndarray
@@ -132,6 +139,7 @@ class CellModel:
     shorthands: Mapping[str, tuple[tuple[str, ...], str]] = field(default_factory=dict)
     limits: Limits = field(default_factory=Limits)
     durations: Mapping[str, float] = field(default_factory=lambda: dict(NOMINAL_DURATION))
+    inside: tuple[int | None, ...] = ()
 
     def __post_init__(self) -> None:
         pts = np.asarray(self.points, dtype=np.float64)
@@ -148,6 +156,8 @@ class CellModel:
         self._walk = self.walk_time.tolist()
         if not self.movable:
             self.movable = (True,) * len(self.part_names)
+        if not self.inside:
+            self.inside = (None,) * len(self.part_names)
         # a fixed object never fits in the hands
         self._width = tuple(2 if t else 1 if m else self.limits.hands + 1
                             for t, m in zip(self.two_handed, self.movable))
@@ -170,16 +180,19 @@ class CellModel:
                    tuple(bool(getattr(objects[n], "two_handed", False)) for n in parts),
                    tuple(bool(getattr(objects[n], "movable", True)) for n in parts),
                    dict(getattr(cell, "shorthands", {}) or {}), limits or Limits(),
-                   dict(NOMINAL_DURATION if durations is None else durations))
+                   dict(NOMINAL_DURATION if durations is None else durations),
+                   _containers(objects, parts))
 
     def initial_state(self) -> CellState:
-        """The worker at the start, hands empty, parts at their supply positions."""
-        return CellState(0, (), tuple(1 + i for i in range(len(self.part_names))))
+        """The worker at the start, hands empty, parts at their supply positions (or
+        inside the container they start in)."""
+        return CellState(0, (), tuple(1 + i if c is None else INSIDE - c
+                                      for i, c in enumerate(self.inside)))
 
     def with_limits(self, limits: Limits) -> CellModel:
         """The same cell with other physical limits."""
         return CellModel(self.points, self.part_names, self.region_names, self.two_handed,
-                         self.movable, self.shorthands, limits, self.durations)
+                         self.movable, self.shorthands, limits, self.durations, self.inside)
 
     # ---------------------------------------------------------------- locations
     def supply(self, part: int) -> int:
@@ -283,8 +296,15 @@ class CellModel:
             held.append(p)
         elif kind == "release":
             p = self.part_index.get(args[0])
-            if p is None or parts[p] != HELD:
+            if p is None:
                 return None
+            if parts[p] != HELD:                # the planner fetches it first
+                if parts[p] < 0 or self._free_hands(held) < self._width[p]:
+                    return None
+                cost += (self._walk[loc][parts[p]] + self.durations["grasp"]
+                         + IMPLICIT_FETCH_PENALTY)
+                loc = parts[p]
+                held.append(p)
             held.remove(p)
             parts[p] = loc
         elif kind == "extract":
@@ -347,3 +367,18 @@ class CellModel:
         held = ", ".join(self.part_names[p] for p in state.held) or "nothing"
         return f"holding {held}, {POSTURES[state.posture]}"
 
+
+def _containers(objects: Mapping[str, object], parts: Sequence[str]) -> tuple[int | None, ...]:
+    """Per part, the index of the fixed object (a bin) whose box holds its position."""
+    boxes = {}
+    for i, n in enumerate(parts):
+        obj = objects[n]
+        if not getattr(obj, "movable", True) and hasattr(obj, "occupancy"):
+            boxes[i] = obj.occupancy.aabb()
+    out: list[int | None] = []
+    for i, n in enumerate(parts):
+        pos = np.asarray(objects[n].position, dtype=np.float64)
+        hit = next((c for c, (lo, hi) in boxes.items()
+                    if c != i and np.all(pos >= lo) and np.all(pos <= hi)), None)
+        out.append(hit)
+    return tuple(out)
