@@ -147,9 +147,11 @@ def test_real_gait_clips_pass_the_limits_they_calibrate() -> None:
 
 def test_s1_verifies_with_the_biomechanical_checks() -> None:
     from ltl_human_motion.ltl.spec import PAPER_SPECS
-    from ltl_human_motion.planning.pipeline import resolve_cell, synthesize
-
-    synth = synthesize(PAPER_SPECS["S1"], resolve_cell("paper_cell"), stature=1.75, seed=0)[0]
+    from ltl_human_motion.planning.pipeline import SynthesisOptions, resolve_cell, synthesize
+    from ltl_human_motion.planning.verify import VerificationOptions
+    options = SynthesisOptions(verification=VerificationOptions(biomechanics=True))
+    synth = synthesize(PAPER_SPECS["S1"], resolve_cell("paper_cell"), stature=1.75, seed=0,
+                       options=options)[0]
     rep = synth.verification
     for key in ("joint_speed", "range_of_motion", "self_penetration", "balance", "foot_skate"):
         assert rep[key]["passed"], rep[key]["detail"]

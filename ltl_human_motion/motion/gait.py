@@ -44,6 +44,7 @@ __all__ = [
     "PRIMITIVE_FRAMES",
     "GaitClip",
     "carry_poses",
+    "clip_motion",
     "gait_primitives",
     "prepare_clip",
     "prepare_loop",
@@ -355,3 +356,7 @@ def start_stop_primitives(clip: GaitClip, skeleton: Skeleton, n_phases: int = 4,
     return out
 
 
+def clip_motion(clip: GaitClip, skeleton: Skeleton, fps: float = LIBRARY_FPS) -> Motion:
+    """World motion of the three tiled cycles of ``clip`` (the realism report compares
+    these prepared clips with synthesized motion)."""
+    return Motion(compose(clip.root, clip.poses), fps, skeleton, clip.name)
