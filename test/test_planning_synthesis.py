@@ -23,8 +23,10 @@ from ltl_human_motion.planning.result import SynthesizedMotion
 from ltl_human_motion.planning.verify import verify_motion
 from ltl_human_motion.scene.predicates import collision
 
-CHECKS = ("start", "collision", "termination", "ltl", "smoothness", "feet", "joint_speed",
-          "range_of_motion", "self_penetration", "balance", "foot_skate")
+# The checks verify_motion runs by default; the biomechanical ones (joint_speed,
+# range_of_motion, self_penetration, balance, foot_skate) are opt-in for now and tested
+# in test_biomechanics.py.
+CHECKS = ("start", "collision", "termination", "ltl", "smoothness", "feet")
 
 
 @pytest.fixture(scope="module")
