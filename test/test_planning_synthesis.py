@@ -133,9 +133,11 @@ objects:
 regions:
   R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}
 """)
-    with pytest.raises(PlanningError, match=r"grasp\(O1\).*unreachable") as info:
+    # Refused by the early analysis (planning/feasibility.py), before any search.
+    with pytest.raises(PlanningError, match=r"grasp\(O1\).*above the reach of a 1.75 m "
+                                            r"worker") as info:
         synthesize("F grasp(O1)", cell, library=library)
-    assert info.value.reason == "unreachable"
+    assert info.value.reason == "reach"
     assert info.value.task == "grasp(O1)"
 
 

@@ -25,6 +25,7 @@ from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
 from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.blend import concatenate
+from ltl_human_motion.planning.feasibility import check_steps
 from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner, task_kind
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, verify_motion
@@ -288,6 +289,8 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     results = []
     for v in range(variants):
         seq = sequences[v % len(sequences)]
+        # Refuse, before any search, what no worker of this stature can do.
+        check_steps(cell, [(t.name, tuple(t.args)) for t in seq.tasks], float(stature))
         rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, v])
         results.append(_synthesize_one(spec, specification, seq, cell, library, rng, seed, v,
                                        options, t_automaton, t_sequence, t_library,

@@ -1,0 +1,241 @@
+"""How often synthesis works in many cells: the scenario corpus and generated cells.
+
+Runs every labelled (cell, specification) pair of ``scenarios/specs.yaml`` for each
+stature in ``--statures`` and each seed in ``range(--seeds)``, plus ``--generated``
+cells of the seeded random generator (:mod:`ltl_human_motion.scenarios.generator`),
+on a process pool of at most 2 workers, each pair with a time limit. Prints and
+writes ``bench/results/scenarios.json``:
+
+* the verified rate on feasible pairs and the correct-refusal rate on infeasible ones;
+* failures by family (planning: which task and why; verification: which check);
+* median and maximum time per pair;
+* a short table per cell.
+
+Not a test: run ``python bench/scenarios.py`` (``--quick`` for a short look,
+``--cells shelf_heights bins``, ``--limit 50``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+from collections import Counter, defaultdict
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from ltl_human_motion.atomic import atomic_write_text  # noqa: E402
+from ltl_human_motion.scenarios.corpus import default_specs_path, load_corpus  # noqa: E402
+from ltl_human_motion.scenarios.run import judge, run_pair  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from paper_specs import machine  # noqa: E402
+
+#: At most two workers: the machine has two cores, shared with other jobs.
+MAX_WORKERS = 2
+#: Seconds a pair may take before it counts as a timeout (the target is 2 s per pair;
+#: the limit only keeps a hopeless search from stalling the benchmark).
+DEFAULT_TIMEOUT = 10.0
+
+
+def _job(item: dict) -> dict:
+    """Run one (pair, stature, seed) in a worker; returns the item with its outcome."""
+    cell = item["cell_yaml"] if item.get("cell_yaml") else item["cell_file"]
+    outcome = run_pair(item["spec"], cell, item["stature"], item["seed"], item["timeout"])
+    ok, family = judge(item["expect"], item.get("reason"), outcome)
+    out = {k: v for k, v in item.items() if k != "cell_yaml"}
+    out.update(outcome=outcome.as_dict(), ok=ok, family=family)
+    return out
+
+
+def _spread(pairs: list, limit: int) -> list:
+    """At most ``limit`` pairs, taken round-robin over the families (deterministic)."""
+    if limit <= 0 or limit >= len(pairs):
+        return pairs
+    by_family: dict[str, dict[str, list]] = defaultdict(lambda: defaultdict(list))
+    for p in pairs:
+        by_family[p.family][p.cell].append(p)
+    queues = []
+    for per_cell in by_family.values():               # interleave the cells of a family
+        lists = list(per_cell.values())
+        queues.append([q[i] for i in range(max(map(len, lists))) for q in lists if i < len(q)])
+    chosen: list = []
+    while len(chosen) < limit:
+        for q in queues:
+            if q and len(chosen) < limit:
+                chosen.append(q.pop(0))
+    return chosen
+
+
+def _items(args) -> list[dict]:
+    pairs = _spread(load_corpus(args.specs, args.cells), args.limit)
+    items = []
+    for p in pairs:
+        for stature in args.statures:
+            for seed in range(args.seeds):
+                items.append({"source": "corpus", "id": p.id, "cell": p.cell,
+                              "cell_file": p.cell_file, "spec": p.spec, "expect": p.expect,
+                              "reason": p.reason, "family_label": p.family,
+                              "stature": stature, "seed": seed, "timeout": args.timeout})
+    if args.generated > 0:
+        from ltl_human_motion.scenarios.generator import generate_scenarios
+        for scen in generate_scenarios(args.generated, seed=args.generator_seed):
+            for gp in scen.pairs:
+                items.append({"source": "generated", "id": f"{scen.name}/{gp.spec}",
+                              "cell": scen.name, "cell_file": None, "cell_yaml": scen.yaml,
+                              "spec": gp.spec, "expect": gp.expect, "reason": gp.reason,
+                              "family_label": gp.family, "stature": scen.stature,
+                              "seed": 0, "timeout": args.timeout})
+    return items
+
+
+def _rate(num: int, den: int) -> float | None:
+    return None if den == 0 else num / den
+
+
+def summarize(results: list[dict]) -> dict:
+    """Rates, times, failures by family and per-cell rows of a list of job results."""
+    def block(rows: list[dict]) -> dict:
+        feas = [r for r in rows if r["expect"] == "feasible"]
+        infeas = [r for r in rows if r["expect"] != "feasible"]
+        times = [r["outcome"]["seconds"] for r in rows]
+        fam: dict[str, dict] = {}
+        for r in rows:
+            if r["ok"]:
+                continue
+            f = fam.setdefault(r["family"], {"count": 0, "examples": []})
+            f["count"] += 1
+            if len(f["examples"]) < 3:
+                f["examples"].append({"id": r["id"], "stature": r["stature"],
+                                      "seed": r["seed"],
+                                      "message": r["outcome"]["message"][:300]})
+        return {
+            "runs": len(rows),
+            "feasible_runs": len(feas),
+            "verified": sum(r["ok"] for r in feas),
+            "verified_rate": _rate(sum(r["ok"] for r in feas), len(feas)),
+            "infeasible_runs": len(infeas),
+            "refused_correctly": sum(r["ok"] for r in infeas),
+            "refusal_rate": _rate(sum(r["ok"] for r in infeas), len(infeas)),
+            "median_time_s": statistics.median(times) if times else None,
+            "max_time_s": max(times) if times else None,
+            "over_2s": sum(t > 2.0 for t in times),
+            "failures_by_family": dict(sorted(fam.items(), key=lambda kv: -kv[1]["count"])),
+        }
+
+    corpus = [r for r in results if r["source"] == "corpus"]
+    generated = [r for r in results if r["source"] == "generated"]
+    cells = {}
+    for name in sorted({r["cell"] for r in corpus}):
+        rows = [r for r in corpus if r["cell"] == name]
+        b = block(rows)
+        cells[name] = {k: b[k] for k in ("runs", "feasible_runs", "verified", "infeasible_runs",
+                                         "refused_correctly", "median_time_s", "max_time_s")}
+        cells[name]["top_failures"] = Counter(r["family"] for r in rows if not r["ok"]
+                                              ).most_common(3)
+    pair_families = {}
+    for name in sorted({r["family_label"] for r in corpus}):
+        rows = [r for r in corpus if r["family_label"] == name]
+        pair_families[name] = {"runs": len(rows), "ok": sum(r["ok"] for r in rows)}
+    return {"corpus": block(corpus), "generated": block(generated), "cells": cells,
+            "pair_families": pair_families}
+
+
+def _pct(x: float | None) -> str:
+    return "-" if x is None else f"{100 * x:.1f} %"
+
+
+def _print(summary: dict, wall: float) -> None:
+    for name in ("corpus", "generated"):
+        b = summary[name]
+        if not b["runs"]:
+            continue
+        print(f"\n{name}: {b['runs']} runs; verified {b['verified']} of {b['feasible_runs']} "
+              f"feasible ({_pct(b['verified_rate'])}); refused correctly "
+              f"{b['refused_correctly']} of {b['infeasible_runs']} infeasible "
+              f"({_pct(b['refusal_rate'])}); time per pair median "
+              f"{b['median_time_s']:.2f} s, max {b['max_time_s']:.2f} s, "
+              f"{b['over_2s']} over 2 s")
+        if b["failures_by_family"]:
+            print("  failures by family:")
+            for fam, f in b["failures_by_family"].items():
+                ex = f["examples"][0]
+                print(f"    {f['count']:4d}  {fam:42s} e.g. {ex['id']} "
+                      f"({ex['stature']} m): {ex['message'][:110]}")
+    if summary["cells"]:
+        print(f"\n{'cell':18s} {'verified':>12s} {'refused':>9s} {'median s':>9s} "
+              f"{'max s':>7s}  top failure")
+        for name, c in summary["cells"].items():
+            top = c["top_failures"][0][0] if c["top_failures"] else ""
+            print(f"{name:18s} {c['verified']:5d}/{c['feasible_runs']:<6d} "
+                  f"{c['refused_correctly']:3d}/{c['infeasible_runs']:<5d} "
+                  f"{c['median_time_s']:9.2f} {c['max_time_s']:7.2f}  {top}")
+    print(f"\nwall time {wall:.0f} s (measured under load on a shared 2-core machine)")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--specs", type=Path, default=default_specs_path())
+    parser.add_argument("--cells", nargs="+", default=None, help="only these corpus cells")
+    parser.add_argument("--limit", type=int, default=0,
+                        help="at most this many corpus pairs, spread over the families")
+    parser.add_argument("--statures", type=float, nargs="+", default=[1.55, 1.75, 1.95])
+    parser.add_argument("--seeds", type=int, default=2)
+    parser.add_argument("--generated", type=int, default=10,
+                        help="random cells of the generator (each with its pairs)")
+    parser.add_argument("--generator-seed", type=int, default=0)
+    parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT,
+                        help="seconds per pair")
+    parser.add_argument("--workers", type=int, default=MAX_WORKERS)
+    parser.add_argument("--quick", action="store_true",
+                        help="one stature (1.75 m), one seed, 60 pairs, 3 generated cells")
+    parser.add_argument("--out", type=Path,
+                        default=ROOT / "bench" / "results" / "scenarios.json")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.statures, args.seeds = [1.75], 1
+        args.limit = args.limit or 60
+        args.generated = min(args.generated, 3)
+    workers = max(1, min(args.workers, MAX_WORKERS))
+    items = _items(args)
+    print(f"{len(items)} runs on {workers} worker(s), {args.timeout:.0f} s limit per pair")
+    t0 = time.perf_counter()
+    results: list[dict] = []
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = [pool.submit(_job, it) for it in items]
+        for k, fut in enumerate(as_completed(futures), 1):
+            results.append(fut.result())
+            if k % 50 == 0 or k == len(futures):
+                bad = sum(not r["ok"] for r in results)
+                print(f"  {k}/{len(futures)} done, {bad} not ok, "
+                      f"{time.perf_counter() - t0:.0f} s", flush=True)
+    wall = time.perf_counter() - t0
+    results.sort(key=lambda r: (r["source"], r["id"], r["stature"], r["seed"]))
+    summary = summarize(results)
+    report = {"benchmark": "scenarios", "machine": machine(),
+              "load_average": list(os.getloadavg()), "statures": args.statures,
+              "seeds": args.seeds, "timeout_s": args.timeout, "workers": workers,
+              "wall_time_s": wall, "specs": str(args.specs.relative_to(ROOT))
+              if args.specs.resolve().is_relative_to(ROOT) else str(args.specs),
+              "cells_selected": args.cells, "limit": args.limit,
+              "generated_cells": args.generated, "generator_seed": args.generator_seed,
+              **summary,
+              "failures": [{"id": r["id"], "source": r["source"], "stature": r["stature"],
+                            "seed": r["seed"], "family": r["family"],
+                            "seconds": round(r["outcome"]["seconds"], 3),
+                            "message": r["outcome"]["message"][:240]}
+                           for r in results if not r["ok"]]}
+    atomic_write_text(args.out, json.dumps(report, indent=1) + "\n")
+    _print(summary, wall)
+    print(f"written to {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
