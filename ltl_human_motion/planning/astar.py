@@ -88,6 +88,14 @@ class SearchFailure:
     closest: float = field(default=float("inf"))
 
 
+def placement_key(x: float, y: float, yaw: float, grid: float = 0.08, yaw_bins: int = 24
+                  ) -> tuple[int, int, int]:
+    """The closed-set cell of a floor pose: (x, y) on a ``grid`` m lattice, the heading in
+    ``yaw_bins`` bins."""
+    return (round(x / grid), round(y / grid),
+            round(yaw * yaw_bins / (2.0 * np.pi)) % yaw_bins)
+
+
 def _place(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float) -> np.ndarray:
     """End poses of primitives ``ids`` started at (x, y, yaw), shape (M, 3)."""
     c, s = np.cos(yaw), np.sin(yaw)
@@ -124,7 +132,8 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
           budget: SearchBudget = SearchBudget(), rng: np.random.Generator | None = None,
           body_clear: Callable[[np.ndarray], np.ndarray] | None = None,
           near_radius: float = 0.6,
-          cost_noise: float = 0.0, grid: float = 0.08, yaw_bins: int = 24
+          cost_noise: float = 0.0, grid: float = 0.08, yaw_bins: int = 24,
+          forbidden: frozenset[tuple[int, int, int, int]] = frozenset()
           ) -> SearchResult | SearchFailure:
     """Search a sequence of gait primitives from ``start`` until ``goal.reached``.
 
@@ -156,6 +165,9 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         standing primitives (turns, steps) and on primitives whose root path comes within
         ``near_radius`` of an obstacle.
     near_radius : float
+    forbidden : frozenset of (primitive, i, j, k)
+        Primitives never taken from a pose, keyed by :func:`placement_key` of that pose
+        (the caller found them colliding on a closer look).
 
     Returns
     -------
@@ -205,6 +217,9 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
             return SearchFailure("budget", expanded, time.perf_counter() - t0, closest)
         succ = index.starts if prims[node] < 0 else index.successors(prims[node])
         succ = succ[allowed[succ]]
+        if forbidden:
+            here = placement_key(px, py, pyaw, grid, yaw_bins)
+            succ = succ[[(int(p), *here) not in forbidden for p in succ.tolist()]]
         if succ.size == 0:
             continue
         ends = _place(index, succ, px, py, pyaw)

@@ -184,8 +184,8 @@ def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np
         contact = min(start + int(step.contact_frame or 0), T - 1)
         eff = step.objects_effect
         for name, joint in eff.get("attach", {}).items():
-            begin = spans[step.first_segment][0]
-            events.append((begin, order, "respawn", name, None))
+            if name in eff.get("respawn", ()):      # a fresh part after one was assembled
+                events.append((spans[step.first_segment][0], order, "respawn", name, None))
             events.append((contact, order, "attach", name, joint))
         for name in eff.get("detach", []):
             events.append((contact, order, "detach", name, None))

@@ -19,8 +19,10 @@ where every grasp picks a new part from the floor.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -28,12 +30,77 @@ import numpy as np
 from ltl_human_motion.errors import PlanningError
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
-from ltl_human_motion.planning.astar import Goal, SearchBudget, SearchFailure, astar
+from ltl_human_motion.planning.astar import (
+    Goal,
+    SearchBudget,
+    SearchFailure,
+    astar,
+    placement_key,
+)
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.gait_index import gait_index
 from ltl_human_motion.planning.navigation import NavigationField, clearance_maps, floor_grid
+from ltl_human_motion.planning.placement import RegionEntry
 
 Pose = tuple[float, float, float]
+
+#: How long ``standUp`` by a worker already standing stands still, seconds (a short,
+#: visible pause; the blends at both ends take 2 x overlap frames of it).
+STAND_UP_IN_PLACE_SECONDS = 0.4
+
+#: Height of the hand where a held part is let go, as a fraction of the stature (waist
+#: height: 0.75 m for a 1.75 m worker, the planner's value since the first release).
+RELEASE_HEIGHT = 0.75 / 1.75
+
+#: Places a part is let go at, (metres ahead of the root, turn from the heading in
+#: radians), tried in order: straight ahead at a forearm's length, then to either side
+#: and nearer the body when furniture stands in front.
+RELEASE_PLACES: tuple[tuple[float, float], ...] = (
+    (0.45, 0.0), (0.45, math.pi / 4), (0.45, -math.pi / 4), (0.4, math.pi / 2),
+    (0.4, -math.pi / 2), (0.3, 0.0))
+
+#: Seeded primitives tried at each alternative (release place, approach) after the first
+#: (the first gets ``PlannerOptions.goal_attempts``).
+ALTERNATIVE_ATTEMPTS = 2
+
+#: Other ways to stand for a reach whose motions all hit an obstacle, in order: (turn of
+#: the approach direction about the target, rad; extra distance from the target, m).
+#: First a step further back (a knee or thigh at a desk or low shelf front), then the
+#: target's other sides (an arm hitting a crate beside it).
+ALTERNATE_APPROACHES: tuple[tuple[float, float], ...] = (
+    (0.0, 0.08), (math.pi / 3, 0.0), (-math.pi / 3, 0.0))
+
+#: Node budget of the walk to an alternative approach (most are a few steps round the
+#: target; a side that needs a long way round is not worth the search).
+ALTERNATIVE_NODES = 500
+
+#: Half width of the side of the target an alternative approach walks to, rad.
+APPROACH_HALF_WIDTH = math.pi / 6
+
+#: Step left to the standing adjustment when the first one from where a walk ended was
+#: not clear: the walk goes on to a spot that needs almost none, metres.
+FINAL_ADJUST_RADIUS = 0.05
+
+#: Searches run again after the path found collided on a frame the search did not
+#: sample (each forbids the colliding primitive at its pose).
+WALK_REPAIRS = 4
+
+#: Tasks done where the worker stands (no target); when furniture there blocks them,
+#: the worker first walks to a spot with ``IN_PLACE_ROOM`` of floor clearance.
+IN_PLACE_TASKS = ("bend", "stoop", "kneel", "wait")
+
+#: Floor clearance around the root a kneel or stoop needs, metres (the knee goes about
+#: 0.5 m ahead of the root and the head as far when stooping, plus a hand's width).
+IN_PLACE_ROOM = 0.6
+
+#: Tops of furniture a released part is set down on: up to this fraction of the stature
+#: (1.2 m at 1.75 m, about chest height: higher tops are shelves out of a natural
+#: put-down).
+RELEASE_SURFACE_MAX = 1.2 / 1.75
+
+#: Gap between a part set down and the surface under it when it is let go, metres (the
+#: cells' parts rest 1 cm above their tables).
+RELEASE_GAP = 0.01
 
 #: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
@@ -192,13 +259,11 @@ class SequencePlanner:
         self.steps: list[StepPlan] = []
         self.pose: Pose = (0.0, 0.0, 0.0)
         self.gait_state: int | None = None          # None = standing
-        self.seated = False
+        self.seat: np.ndarray | None = None          # the seat sat on (3,); None: standing
         self.held: dict[str, str] = {}               # object -> hand joint
         self.consumed: set[str] = set()
-        self._wait_seconds: float | None = None
-        self.grasp_object: str | None = None
+        self.object_at: dict[str, np.ndarray] = {}   # where parts were put down (3,)
         self.held_offsets: dict[str, np.ndarray] = {}
-        self._carry_stance = False
         self._back_limit = options.reach_tolerance
         self._backs: dict[float, np.ndarray] = {}     # step-back distances per limit
         self.expanded = 0
@@ -212,17 +277,25 @@ class SequencePlanner:
             return np.asarray(cell.region(args[-1]).center, dtype=np.float64)
         if kind in ("grasp",):
             obj = cell.object(args[0])
-            return np.asarray(obj.grasp_points_at(obj.position)[0], dtype=np.float64)
+            return np.asarray(obj.grasp_points_at(self.object_position(args[0]))[0],
+                              dtype=np.float64)
         if kind in ("move",):
             return np.asarray(cell.region(args[1]).center, dtype=np.float64)
         if kind in ("insert", "extract"):
-            return np.asarray(cell.object(args[1]).position, dtype=np.float64)
+            return self.object_position(args[1])
         if kind in ("leftHand", "rightHand", "assemble"):
             return np.asarray(cell.region(args[0]).center, dtype=np.float64)
         if kind == "sit":
             obj = cell.object(args[0])
             return np.asarray(obj.sitting_surface_at(obj.position).center, dtype=np.float64)
         return None
+
+    def object_position(self, name: str) -> np.ndarray:
+        """Where object ``name`` rests now (3,): where the last step put it down, else its
+        supply position in the cell."""
+        at = self.object_at.get(name)
+        return np.asarray(self.cell.object(name).position if at is None else at,
+                          dtype=np.float64)
 
     def _placement(self, kind: str, target: np.ndarray, task: str) -> tuple[float, float]:
         """Where the target should be in the standing root's frame: (ahead, left), metres."""
@@ -303,18 +376,27 @@ class SequencePlanner:
         return (*out, clear[px.size:].reshape(np.shape(x))) if room else out
 
     def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
-                    task: str) -> Goal:
-        """Walk until a standing adjustment (a step of at most ``adjust_radius`` and a
-        turn) puts the worker where the goal primitive reaches the target."""
+                    task: str, adjust: float | None = None,
+                    sector: tuple[float, float] | None = None) -> Goal:
+        """Walk until a standing adjustment (a step of at most ``adjust``, default
+        ``options.adjust_radius``, and a turn) puts the worker where the goal primitive
+        reaches the target; with ``sector`` (direction from the target, half width, rad)
+        only from that side."""
         tx, ty = float(target[0]), float(target[1])
+
+        def side(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+            if sector is None:
+                return np.ones(np.shape(x), dtype=bool)
+            return np.abs(wrap_angle(np.arctan2(y - ty, x - tx) - sector[0])) <= sector[1]
+
         tol = self.options.reach_tolerance
         dist = float(np.hypot(*placement))
         offset = float(np.arctan2(placement[1], placement[0]))
-        adjust = self.options.adjust_radius
+        adjust = self.options.adjust_radius if adjust is None else float(adjust)
 
         def ring(xy: np.ndarray) -> np.ndarray:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
-            out = (r >= dist - tol) & (r <= dist + self._back_limit)
+            out = (r >= dist - tol) & (r <= dist + self._back_limit) & side(xy[:, 0], xy[:, 1])
             # The floor clearance only where the distance fits (few of the cells).
             out[out] = self._clearance(xy[out]) > self.options.stand_clearance
             return out
@@ -325,13 +407,13 @@ class SequencePlanner:
             # Turning on the spot needs room for the hips; facing nearly right needs none.
             room = here > self.options.turn_clearance
             facing = np.abs(wrap_angle(pyaw - yaw)) <= self.options.heading_tolerance
-            return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing)
+            return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing) & side(x, y)
 
         # Stand within the reach tolerance where possible; only where an obstacle leaves
         # no such place (a tall worker at a bench) stand up to max_step_back further.
         def ring_key() -> tuple:
             return ("ring", tx, ty, dist, tol, float(self._back_limit),
-                    float(self.options.stand_clearance))
+                    float(self.options.stand_clearance), sector)
 
         self._back_limit = tol
         field = self._field(ring, ring_key())
@@ -358,7 +440,7 @@ class SequencePlanner:
         x, y, yaw = self.pose
         px, py, pyaw, _ = (float(v[0]) for v in self._ideal_placement(
             target, placement, np.array([x]), np.array([y])))
-        carrying = bool(self.held) or self._carry_stance
+        carrying = bool(self.held)
         back_dir = np.array([math.cos(pyaw), math.sin(pyaw)])
         c, s = math.cos(yaw), math.sin(yaw)
         stance = self._stance(carrying)
@@ -397,20 +479,28 @@ class SequencePlanner:
         return False
 
     def _region_goal(self, region, desc: str, task: str) -> Goal:
-        lo, hi = np.asarray(region.lo, dtype=float), np.asarray(region.hi, dtype=float)
-        margin = 0.15
+        """Walk until the standing body enters ``region`` (the verifier's predicate).
 
-        def gap(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-            gx = np.maximum(np.maximum(lo[0] - x, x - hi[0]), 0.0)
-            gy = np.maximum(np.maximum(lo[1] - y, y - hi[1]), 0.0)
-            return np.hypot(gx, gy)
+        The goal cells of the heuristic are the spots with room to turn
+        (``turn_clearance``) from which the standing body enters the region facing some
+        heading; none (a region above a bench, beside a wall) makes the region
+        unreachable on foot (the caller reaches into it by hand).
+        """
+        from ltl_human_motion.scene.occupancy import capsule_radii
+        stature = self.library.skeleton.stature
+        carrying = bool(self.held)
+        entry = RegionEntry(region, self._stance(carrying), self.library.standing_height,
+                            stature, float(capsule_radii(stature).max()))
+        room = self.options.turn_clearance
 
-        def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-            return gap(x, y) <= margin
+        def cells(xy: np.ndarray) -> np.ndarray:
+            out = entry.cells(xy)
+            out[out] = self._clearance(xy[out]) > room
+            return out
 
-        field = self._field(lambda xy: gap(xy[:, 0], xy[:, 1]) <= margin,
-                            ("region", *lo[:2].tolist(), *hi[:2].tolist(), margin))
-        return self._goal_from_field(field, reached, desc, task)
+        field = self._field(cells, ("region", *entry.lo.tolist(), *entry.hi.tolist(),
+                                    stature, carrying, room))
+        return self._goal_from_field(field, entry.enters, desc, task)
 
     # ---------------------------------------------------------------- segments
     def _add(self, mp: MotionPrimitive, pose: Pose, label: int, blend: int) -> int:
@@ -446,6 +536,27 @@ class SequencePlanner:
                 out[sel] = self.obstacle_field.clear(poses[sel], stature, relative=rel)
         return out
 
+    def _sit_still(self, seconds: float) -> MotionPrimitive:
+        """A wait on the seat: the seated pose held (the standing wait model would rebuild
+        the legs for standing)."""
+        pose = self._seated_pose()
+        n = max(round(seconds * self.library.fps), self.overlap + 2)
+        root = np.zeros((n, 4))
+        root[:, :3] = pose[0]
+        rel = np.repeat((pose - pose[0])[None], n, axis=0)
+        return MotionPrimitive(f"sit_still_{seconds:.2f}s", "wait", rel, root,
+                               self.library.fps, "planner: seated wait",
+                               meta={"contact_frame": n - 1, "hand": "none"})
+
+    def _seated_pose(self) -> np.ndarray:
+        """The last frame placed (the worker seated), in the start frame of the current
+        pose (root floor point at the origin, facing +x; heights above the floor), (J, 3)."""
+        x, y, yaw = self.pose
+        last = self.segments[-1].positions[-1]
+        c, s = math.cos(-yaw), math.sin(-yaw)
+        dx, dy = last[:, 0] - x, last[:, 1] - y
+        return np.stack([c * dx - s * dy, s * dx + c * dy, last[:, 2]], axis=-1)
+
     def _stance(self, carrying: bool) -> np.ndarray:
         lib = self.library
         return np.asarray(lib.carry_standing_pose if carrying else lib.standing_pose)
@@ -478,16 +589,17 @@ class SequencePlanner:
             self._step_back(carrying_before, label)
         self._add(mp, self.pose, label, self.overlap)
 
-    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int = 16,
+    def _placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = 16,
                       world: np.ndarray | None = None) -> bool:
         """Whether ``mp`` placed at ``pose`` keeps the body and the objects held (at their
         hand offsets) clear of every obstacle, checked with the exact distances on
-        ``samples`` frames (these checks are few). ``world``: ``world_positions(mp,
-        *pose)`` if already made."""
+        ``samples`` frames (None: every frame, as the verifier checks). ``world``:
+        ``world_positions(mp, *pose)`` if already made."""
         from ltl_human_motion.scene.predicates import body_clearance, object_clearance
         if not self.cell.obstacles:
             return True
-        frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
+        frames = np.arange(mp.n_frames) if samples is None else \
+            np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
         if world is None and self.held:
             world = world_positions(mp, *pose)
         body = world_positions(mp, *pose, frames=frames) if world is None else world[frames]
@@ -497,10 +609,19 @@ class SequencePlanner:
         if np.min(d) <= 0.003:
             return False
         for name, joint in self.held.items():
-            centre = world[::2, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
+            step = 1 if samples is None else 2
+            centre = world[::step, JOINT_INDEX[joint]] + self.held_offsets.get(name, np.zeros(3))
             if np.any(object_clearance(self.cell, name, centre) <= 0.0):
                 return False
         return True
+
+    def _first_collision(self, primitives: list[int], poses: list[Pose]) -> int | None:
+        """Index of the first gait primitive of a path that comes within the planner's
+        margin of an obstacle on any frame (body or held parts), or None."""
+        for k, (prim_id, pose) in enumerate(zip(primitives, poses)):
+            if not self._placed_clear(self.index.primitives[prim_id], pose, samples=None):
+                return k
+        return None
 
     def _step_back(self, carrying: bool, label: int) -> None:
         """Step back from an obstacle in front (a step primitive of the gait index)."""
@@ -511,15 +632,36 @@ class SequencePlanner:
                 self.pose = self._hand_over_pose(mp, self.pose)
                 return
 
-    def _walk(self, goal: Goal, task: str, label: int, carry: bool) -> int:
-        """A* from the current pose; appends the gait segments; returns their count."""
-        res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
-                    clearance=self._clearance, body_radius=self.options.body_radius,
-                    heuristic_speed=self.options.heuristic_speed,
-                    turn_rate=self.options.turn_rate, carry=carry,
-                    budget=self.options.budget, rng=self.rng,
-                    cost_noise=self.options.cost_noise, body_clear=self._body_clear)
-        self.expanded += res.expanded
+    def _walk(self, goal: Goal, task: str, label: int, carry: bool,
+              budget: SearchBudget | None = None) -> int:
+        """A* from the current pose; appends the gait segments; returns their count.
+
+        The search checks the body on sampled frames of a distance grid; every frame of
+        the path it returns is then checked as the verifier does (exact capsules, held
+        parts). A primitive that collides is forbidden from its pose and the search runs
+        again (at most ``WALK_REPAIRS`` times)."""
+        forbidden: set[tuple[int, int, int, int]] = set()
+        noise_state = self.rng.bit_generator.state
+        for _repair in range(WALK_REPAIRS + 1):
+            self.rng.bit_generator.state = noise_state      # the same costs every time
+            res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
+                        clearance=self._clearance, body_radius=self.options.body_radius,
+                        heuristic_speed=self.options.heuristic_speed,
+                        turn_rate=self.options.turn_rate, carry=carry,
+                        budget=budget or self.options.budget, rng=self.rng,
+                        cost_noise=self.options.cost_noise, body_clear=self._body_clear,
+                        forbidden=frozenset(forbidden))
+            self.expanded += res.expanded
+            if isinstance(res, SearchFailure):
+                break
+            bad = self._first_collision(res.primitives, res.poses)
+            if bad is None:
+                break
+            forbidden.add((res.primitives[bad], *placement_key(*res.poses[bad])))
+        else:
+            raise PlanningError(f"task {task}: {goal.description}: every path found "
+                                f"({WALK_REPAIRS + 1}) collides on a frame the search did "
+                                "not sample", task=task, reason="blocked")
         if isinstance(res, SearchFailure):
             if res.reason == "budget":
                 why = (f"the search budget ran out ({res.expanded} nodes; closest approach "
@@ -551,94 +693,124 @@ class SequencePlanner:
         self._stand_still(-1, 0.3)
         return Plan(self.segments, self.steps, start, self.expanded)
 
-    def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...]) -> StepPlan:
+    def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
+                   keep_hold: bool = False) -> StepPlan:
+        """Plan step ``i`` (``text``) as the goal task ``kind``; ``keep_hold``: a part a
+        move puts into its region stays in hand (carry)."""
         expanded0 = self.expanded
-        if self.seated and kind not in ("standUp", "wait", "leftHand", "rightHand",
-                                        "assemble", "sit"):
-            self._goal_segment("standUp", None, -1, text)
-            self.seated = False
-        if kind in ("walk", "carry"):
+        if self.seat is not None and kind not in ("standUp", "wait", "leftHand", "rightHand",
+                                                  "assemble", "sit"):
+            self._goal_segment("standUp", self.seat, -1, text)
+            self.seat = None
+        if kind == "carry":
+            # carry(O, R) holds when the body enters R with O inside it: the held part is
+            # put into R by hand (so the palm enters R too), and it stays in hand.
+            step = self._plan_step(i, text, "move", args, keep_hold=True)
+            return replace(step, kind="carry (by move)")
+        if kind == "walk":
             region = self.cell.region(args[-1])
-            subs = [self._fetch(i, args[0])] if kind == "carry" and args[0] not in self.held \
-                else []
+            subs: list[StepPlan] = []
             try:
                 goal = self._region_goal(region, f"walk into {region.name}", text)
             except PlanningError as exc:
                 if exc.reason != "unreachable":
                     raise
                 # Nowhere to stand in the region (e.g. a box above a bench). Its entry,
-                # enter(x, R), holds once any body part is in it: reach in with a hand, or
-                # for carry(O, R) put the held part in it.
-                step = self._reach_into(i, text, kind, args, exc)
-                step.sub_steps[:0] = subs
-                return step
+                # enter(x, R), holds once any body part is in it: reach in with a hand.
+                return self._reach_into(i, text, args, exc)
             n = self._walk(goal, text, i, carry=bool(self.held))
             self._stand_still(i, 0.25)
             return StepPlan(text, kind, np.asarray(region.center, dtype=float), walk_segments=n,
                             expanded=self.expanded - expanded0,
                             primitive=f"{n} gait primitives", sub_steps=subs)
+        if kind == "standUp" and self.seat is None:
+            # Already standing (every bend, stoop and kneel ends upright): standUp holds
+            # once the worker stands still for a moment.
+            self._stand_still(i, STAND_UP_IN_PLACE_SECONDS)
+            return StepPlan(text, "standUp (standing)", None, expanded=0, primitive="stand")
         subs = []
-        if kind in ("move", "insert") and args[0] not in self.held:
+        if kind in ("move", "insert", "release") and args[0] not in self.held:
             # The part is fetched first, as for carry(O, R).
             subs.append(self._fetch(i, args[0]))
-        target = self.target_of(kind, args)
-        if kind == "grasp" and args[0] in self.consumed:
+        respawn = kind == "grasp" and args[0] in self.consumed
+        if respawn:
             self.consumed.discard(args[0])           # a fresh part from the supply
+            self.object_at.pop(args[0], None)
+        target = self.seat if kind == "standUp" else self.target_of(kind, args)
+        if kind in ("move", "insert") and args[0] in self.held_offsets:
+            # The hand puts the part's centre (held at its offset) on the target.
+            target = target - self.held_offsets[args[0]]
         walked = 0
-        if target is not None and kind != "release":
+        placement = None
+        if target is not None and kind not in ("release", "standUp") and self.seat is None:
+            # (Seated, the hands work from the seat.)
             placement = self._placement(kind, target, text)
-            goal = self._reach_goal(target, placement, f"reach {text} at "
-                                    f"({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})", text)
-            walked = self._walk(goal, text, -1, carry=bool(self.held))
-            if not self._adjust_to(target, placement, text):
-                # No clear step from where the walk ended: walk on to a spot that needs
-                # (almost) none.
-                adjust = self.options.adjust_radius
-                self.options = replace(self.options, adjust_radius=0.05)
-                try:
-                    goal = self._reach_goal(target, placement, goal.description, text)
-                    walked += self._walk(goal, text, -1, carry=bool(self.held))
-                finally:
-                    self.options = replace(self.options, adjust_radius=adjust)
-                self._adjust_to(target, placement, text)
-        if kind == "release":
-            obj = args[0]
-            c, s = math.cos(self.pose[2]), math.sin(self.pose[2])
-            height = 0.75 * self.library.skeleton.stature / 1.75
-            target = np.array([self.pose[0] + 0.45 * c, self.pose[1] + 0.45 * s, height])
-            if obj not in self.held:
-                raise PlanningError(f"task {text}: {obj} is not held, so it cannot be "
-                                    "released", task=text, reason="precondition")
+            walked = self._approach(target, placement, text)
         carrying_before = bool(self.held)
-        if kind in HAND_TASKS and not carrying_before:
+        raised = kind in HAND_TASKS and not carrying_before and self.seat is None
+        if raised:
             # Raise the arms to the carry stance first: hands then reach from the chest
             # (and a grasped part comes up to it) instead of swinging up from the thighs
             # past the edge of the surface in front.
             self._arm_transition(False, -1)
             carrying_before = True
-            self._carry_stance = True
-        self._wait_seconds = float(args[0]) if kind == "wait" and args else None
-        self.grasp_object = args[0] if kind == "grasp" else None
-        seg, mp = self._goal_segment(kind, target, i, text)
-        self._carry_stance = False
+        tries = self._alternatives(kind, args, target, placement, text, raised)
+        failure = None
+        for k, (target, prepare) in enumerate(tries):
+            try:
+                if prepare is not None:
+                    walked += prepare()
+                seg, mp = self._goal_segment(
+                    kind, target, i, text, carry_stance=carrying_before,
+                    seconds=float(args[0]) if kind == "wait" and args else None,
+                    grasped=args[0] if kind == "grasp" else None,
+                    attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
+                break
+            except PlanningError as exc:
+                if k == 0 and exc.reason != "blocked":
+                    raise
+                failure = failure or exc       # an alternative may fail in any way
+        else:
+            if len(tries) == 1:
+                raise failure
+            raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements "
+                                "tried", task=text, reason="blocked")
         hand = mp.meta.get("hand")
-        effect = self._apply_effects(kind, args, hand)
-        contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
-        for name, joint in effect.get("attach", {}).items():
-            # As the object tracks are made: the part keeps its world offset from the hand.
-            hand_at_contact = self.segments[seg].positions[contact, JOINT_INDEX[joint]]
-            self.held_offsets[name] = np.asarray(self.cell.object(name).position,
-                                                 dtype=np.float64) - hand_at_contact
-        for name in (*effect.get("detach", ()), *effect.get("detach_after", ())):
-            self.held_offsets.pop(name, None)
-        if bool(self.held) != carrying_before:
+        joints = dict(self.held)
+        effect = self._apply_effects(kind, args, hand, keep_hold)
+        if respawn:
+            effect["respawn"] = [args[0]]
+        self._track_objects(effect, joints, seg, mp)
+        if bool(self.held) != carrying_before and self.seat is None:
             self._arm_transition(carrying_before, i)
-        self.seated = kind == "sit" or (self.seated and kind != "standUp")
+        if kind in ("sit", "standUp"):
+            self.seat = target if kind == "sit" else None
         return StepPlan(text, kind, target, walk_segments=walked, goal_segment=seg,
                         contact_frame=int(mp.meta.get("contact_frame", mp.n_frames - 1)),
                         hand=hand, expanded=self.expanded - expanded0,
                         primitive=mp.name,
                         objects_effect=effect, sub_steps=subs)
+
+    def _track_objects(self, effect: dict, joints: dict[str, str], seg: int,
+                       mp: MotionPrimitive) -> None:
+        """Follow a step's effect on the parts as the object tracks will: a part keeps
+        its world offset from the hand from the contact frame on, and rests where the
+        hand let it go (``joints``: the hands holding parts before the step)."""
+        contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
+        positions = self.segments[seg].positions
+        for name, joint in effect.get("attach", {}).items():
+            joints[name] = joint
+            self.held_offsets[name] = (self.object_position(name)
+                                       - positions[contact, JOINT_INDEX[joint]])
+        for names, frame in ((effect.get("detach", ()), contact),
+                             (effect.get("detach_after", ()),
+                              min(max(mp.n_frames - self.overlap, 0), mp.n_frames - 1))):
+            for name in names:
+                offset = self.held_offsets.pop(name, np.zeros(3))
+                if name in joints:
+                    self.object_at[name] = positions[frame, JOINT_INDEX[joints[name]]] + offset
+        for name in effect.get("consume", ()):
+            self.object_at.pop(name, None)
 
     def _fetch(self, i: int, obj: str) -> StepPlan:
         """Grasp ``obj`` as part of step ``i`` (which needs it in hand)."""
@@ -647,22 +819,118 @@ class SequencePlanner:
         step.first_segment, step.last_segment = first, len(self.segments) - 1
         return step
 
-    def _reach_into(self, i: int, text: str, kind: str, args: tuple[str, ...],
+    def _reach_into(self, i: int, text: str, args: tuple[str, ...],
                     cause: PlanningError) -> StepPlan:
-        """walk(R) / carry(O, R) for a region nobody can stand in: a hand task into R
-        (rightHand(R), or move(O, R) with the held part). Raises ``cause`` if that fails too.
-        """
-        hand_kind, hand_args = ("move", (args[0], args[-1])) if kind == "carry" \
-            else ("rightHand", (args[-1],))
+        """walk(R) for a region nobody can stand in: rightHand(R) (the palm in R makes
+        enter(x, R) hold). Raises ``cause`` if that fails too."""
         try:
-            step = self._plan_step(i, text, hand_kind, hand_args)
+            step = self._plan_step(i, text, "rightHand", (args[-1],))
         except PlanningError as exc:
             raise PlanningError(f"{cause}; reaching into it instead failed too: {exc}",
                                 task=text, reason=cause.reason) from None
-        return replace(step, kind=f"{kind} (by {hand_kind})")
+        return replace(step, kind="walk (by rightHand)")
+
+    def _approach(self, target: np.ndarray, placement: tuple[float, float], text: str,
+                  sector: tuple[float, float] | None = None,
+                  budget: SearchBudget | None = None) -> int:
+        """Walk to where the goal primitive reaches ``target`` (from ``sector``, see
+        :meth:`_reach_goal`; within ``budget``) and take the standing step there; returns
+        the gait primitives walked."""
+        desc = f"reach {text} at ({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})"
+        goal = self._reach_goal(target, placement, desc, text, sector=sector)
+        walked = self._walk(goal, text, -1, carry=bool(self.held), budget=budget)
+        if not self._adjust_to(target, placement, text):
+            # No clear step from where the walk ended: walk on to a spot that needs
+            # (almost) none.
+            goal = self._reach_goal(target, placement, desc, text, adjust=FINAL_ADJUST_RADIUS,
+                                    sector=sector)
+            walked += self._walk(goal, text, -1, carry=bool(self.held), budget=budget)
+            self._adjust_to(target, placement, text)
+        return walked
+
+    def _alternatives(self, kind: str, args: tuple[str, ...], target: np.ndarray | None,
+                      placement: tuple[float, float] | None, text: str, raised: bool
+                      ) -> list[tuple[np.ndarray | None, Callable[[], int] | None]]:
+        """What to try when the goal primitive is blocked, in order: (target, prepare),
+        where ``prepare()`` moves the worker first and returns the primitives walked.
+
+        release: other places to let go; bend/stoop/kneel/wait: a roomier spot; tasks
+        with a target: the other ``ALTERNATE_APPROACHES`` (further back, other sides).
+        """
+        if kind == "release":
+            return [(t, None) for t in self._release_targets(args[0])]
+        if target is None:
+            return [(None, None)] + ([(None, lambda: self._walk_to_room(text))]
+                                     if kind in IN_PLACE_TASKS else [])
+        if placement is None:
+            return [(target, None)]
+        first = math.atan2(self.pose[1] - target[1], self.pose[0] - target[0])
+
+        def approach(turn: float, back: float) -> int:
+            lowered = raised and not self.held
+            if lowered:
+                self._arm_transition(True, -1)
+            walked = self._approach(target, (placement[0] + back, placement[1]), text,
+                                    sector=(first + turn, APPROACH_HALF_WIDTH),
+                                    budget=SearchBudget(ALTERNATIVE_NODES))
+            if lowered:
+                self._arm_transition(False, -1)
+            return walked
+
+        return [(target, None)] + [
+            (target, functools.partial(approach, turn, back))
+            for turn, back in ALTERNATE_APPROACHES]
+
+    def _walk_to_room(self, text: str) -> int:
+        """Walk to the nearest spot with ``IN_PLACE_ROOM`` of floor clearance (a task done
+        where the worker stands hit the furniture there); returns the primitives walked."""
+        room = IN_PLACE_ROOM
+
+        def roomy(x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None = None) -> np.ndarray:
+            return self._clearance(np.stack([x, y], axis=-1)) > room
+
+        field = self._field(lambda xy: roomy(xy[:, 0], xy[:, 1]), ("room", room))
+        goal = self._goal_from_field(field, roomy, f"find room for {text}", text)
+        return self._walk(goal, text, -1, carry=bool(self.held))
+
+    def _release_targets(self, obj: str) -> list[np.ndarray]:
+        """Where the hand holding ``obj`` may let it go, palm positions (3,), in order:
+        ahead of the worker, then turned to either side, then nearer
+        (``RELEASE_PLACES``). Over a table or bench the part is set down on its top;
+        elsewhere it is let go at ``RELEASE_HEIGHT`` of the stature."""
+        x, y, yaw = self.pose
+        stature = self.library.skeleton.stature
+        offset = self.held_offsets.get(obj, np.zeros(3))
+        half = 0.5 * float(np.ptp(self.cell.object(obj).occupancy.aabb(), axis=0)[2])
+        out = []
+        for dist, turn in RELEASE_PLACES:
+            c, s = math.cos(yaw + turn), math.sin(yaw + turn)
+            palm = np.array([x + dist * c, y + dist * s, RELEASE_HEIGHT * stature])
+            top = self._surface_below(palm[:2], RELEASE_SURFACE_MAX * stature)
+            if top is not None:
+                # The part (held at ``offset`` from the palm) comes to rest on the top.
+                palm[2] = max(palm[2], top + half + RELEASE_GAP - float(offset[2]))
+            out.append(palm)
+        return out
+
+    def _surface_below(self, xy: np.ndarray, highest: float) -> float | None:
+        """Height of the highest obstacle top under the floor point ``xy`` (2,) that is
+        no higher than ``highest``, metres; None if none."""
+        tops = [float(part.aabb()[1][2]) for ob in self.cell.obstacles for part in ob.parts
+                if float(part.aabb()[1][2]) <= highest
+                and float(part.footprint().signed_distance(xy[None])[0]) <= 0.0]
+        return max(tops) if tops else None
 
     def _goal_segment(self, kind: str, target: np.ndarray | None, label: int,
-                      text: str) -> tuple[int, MotionPrimitive]:
+                      text: str, *, carry_stance: bool = False, seconds: float | None = None,
+                      grasped: str | None = None, attempts: int | None = None
+                      ) -> tuple[int, MotionPrimitive]:
+        """Make, check and place the goal primitive of ``kind`` for ``target``.
+
+        ``carry_stance``: the arms are already in the carry stance; ``seconds``: how long
+        a wait lasts; ``grasped``: the part a grasp picks up (checked from contact on);
+        ``attempts``: seeded primitives tried (default ``options.goal_attempts``).
+        """
         x, y, yaw = self.pose
         local = None
         if target is not None:
@@ -670,21 +938,25 @@ class SequencePlanner:
             dx, dy = target[0] - x, target[1] - y
             local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
         hold_hand = next(iter(self.held.values()), None)
+        seated = self.seat is not None and kind != "standUp"
         kwargs = {"rng": self.rng,
-                  "start_pose": self._stance(bool(self.held) or self._carry_stance)}
+                  "start_pose": self._seated_pose() if seated
+                  else self._stance(bool(self.held) or carry_stance)}
         if kind in ("move", "insert", "extract", "release") and hold_hand:
             kwargs["hand"] = hold_hand
-        if kind == "wait" and target is None and self._wait_seconds is not None:
+        if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
-            kwargs["duration"] = self._wait_seconds + (2 * self.overlap + 6) / self.library.fps
+            kwargs["duration"] = seconds + (2 * self.overlap + 6) / self.library.fps
         mp = None
-        for attempt in range(self.options.goal_attempts):
+        attempts = self.options.goal_attempts if attempts is None else attempts
+        for attempt in range(attempts):
             try:
-                candidate = self.library.goal(kind, local, **kwargs)
+                candidate = self._sit_still(kwargs.get("duration", 2.0)) \
+                    if seated and kind == "wait" else self.library.goal(kind, local, **kwargs)
             except ValueError as exc:
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
-            if self._goal_clear(candidate, kind):
+            if self._goal_clear(candidate, grasped):
                 mp = candidate
                 break
             if attempt == 1 and kind in ("grasp", "leftHand", "rightHand", "release"):
@@ -694,31 +966,33 @@ class SequencePlanner:
                     kwargs["hand"] = other
         if mp is None:
             raise PlanningError(f"task {text}: every {kind} motion tried "
-                                f"({self.options.goal_attempts}) runs into an obstacle; "
+                                f"({attempts}) runs into an obstacle; "
                                 "an obstacle blocks the reach", task=text, reason="blocked")
         seg = self._add(mp, self.pose, label, self.overlap)
         self.pose = self._hand_over_pose(mp, self.pose)
         self.gait_state = None
         return seg, mp
 
-    def _goal_clear(self, mp: MotionPrimitive, kind: str) -> bool:
-        """Whether the body, the objects already in the hands and, for a grasp, the part
-        from its contact frame on keep clear of obstacles."""
+    def _goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
+        """Whether the body, the objects already in the hands and the part being grasped
+        (``grasped``, from its contact frame on) keep clear of obstacles."""
         world = world_positions(mp, *self.pose)
         if not self._placed_clear(mp, self.pose, samples=24, world=world):
             return False
-        if kind != "grasp" or self.grasp_object is None:
+        if grasped is None:
             return True
         from ltl_human_motion.scene.predicates import object_clearance
         joint = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(mp.meta.get("hand"), "r_hand")
         hand = world[int(mp.meta.get("contact_frame", 0)):, JOINT_INDEX[joint]]
         if not hand.size:
             return True
-        centre = hand[::4] + (self.cell.object(self.grasp_object).position - hand[0])
-        return not np.any(object_clearance(self.cell, self.grasp_object, centre) <= 0.0)
+        centre = hand[::4] + (self.object_position(grasped) - hand[0])
+        return not np.any(object_clearance(self.cell, grasped, centre) <= 0.0)
 
-    def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None) -> dict:
-        """Update which objects are held; return the effect for the object tracks."""
+    def _apply_effects(self, kind: str, args: tuple[str, ...], hand: str | None,
+                       keep_hold: bool = False) -> dict:
+        """Update which objects are held; return the effect for the object tracks
+        (``keep_hold``: a held part that a move puts into its region stays in hand)."""
         hand_joint = {"l_hand": "l_hand", "r_hand": "r_hand", "both": "r_hand",
                       None: "r_hand"}.get(hand, "r_hand")
         if kind == "grasp":
@@ -728,11 +1002,16 @@ class SequencePlanner:
             self.held.pop(args[0], None)
             return {"detach": [args[0]]}
         if kind in ("move", "insert", "extract"):
-            # The part is placed where the hand put it.
             if args[0] not in self.held:
+                # extract takes the part out of its container and keeps it in hand (move
+                # and insert fetch the part first).
                 self.held[args[0]] = hand_joint
-                return {"attach": {args[0]: hand_joint}, "detach_after": [args[0]]}
-            return {}
+                return {"attach": {args[0]: hand_joint}}
+            if kind == "extract" or keep_hold:
+                return {}
+            # move / insert of a held part: it stays where the hand put it.
+            self.held.pop(args[0], None)
+            return {"detach": [args[0]]}
         if kind == "assemble":
             parts = list(self.held)
             self.consumed.update(parts)
