@@ -20,6 +20,7 @@ from ltl_human_motion.ltl import (
     task_automaton,
 )
 from ltl_human_motion.ltl.automaton import degeneralize
+from ltl_human_motion.tasks import has_geometry, plan_sequences
 
 NAME = "tasks"
 HELP = "Print task sequences (or the Büchi automaton) satisfying an LTL specification."
@@ -68,11 +69,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``tasks``; errors derive from LtlHumanMotionError (printed by the dispatcher)."""
     cell = args.cell
-    if cell is not None and not (cell.endswith((".yaml", ".yml")) or "/" in cell
-                                 or Path(cell).is_file()):
-        # A cell name or inline YAML needs the scene module; a file path does not.
-        from ltl_human_motion.planning.pipeline import resolve_cell
-        cell = resolve_cell(cell)
+    if cell is not None:
+        try:
+            from ltl_human_motion.planning.pipeline import resolve_cell
+            cell = resolve_cell(cell)
+        except ImportError:   # without the scene module a YAML file still names things
+            pass
     spec = build_specification(args.spec, cell)
     given = _read_hoa(args.hoa) if args.hoa else None
     if args.automaton:
@@ -83,20 +85,31 @@ def run(args: argparse.Namespace) -> int:
         print(text, end="")
         return 0
     n = args.n if args.n is not None else (5 if args.mode == "random" else None)
-    seqs = synthesize_sequences(spec, n=n, seed=args.seed, mode=args.mode,
-                                cycles=args.cycles, min_steps=args.min_steps,
-                                backend=args.backend, max_length=args.max_length,
-                                automaton=given)
+    costs: list[float] = []
+    if given is None and has_geometry(cell):
+        # the cell model: cost-optimal, physically possible sequences first
+        seqs, stats = plan_sequences(spec, cell, n=n, seed=args.seed, mode=args.mode,
+                                     cycles=args.cycles, min_steps=args.min_steps,
+                                     backend=args.backend)
+        costs = stats.costs
+    else:
+        seqs = synthesize_sequences(spec, n=n, seed=args.seed, mode=args.mode,
+                                    cycles=args.cycles, min_steps=args.min_steps,
+                                    backend=args.backend, max_length=args.max_length,
+                                    automaton=given)
     if args.json:
         print(json.dumps({"spec": spec.text, "formula": str(spec.formula), "sequences": [
             {"prefix": list(map(str, s.prefix)), "cycle": list(map(str, s.cycle)),
-             "repetitions": s.repetitions, "tasks": list(map(str, s.tasks))}
-            for s in seqs]}, indent=2))
+             "repetitions": s.repetitions, "tasks": list(map(str, s.tasks)),
+             **({"estimated_seconds": round(costs[i], 3)} if i < len(costs) else {})}
+            for i, s in enumerate(seqs)]}, indent=2))
         return 0
     print(f"# specification: {spec.text}")
     print(f"# with always-on conjuncts: {spec.formula}")
     for i, seq in enumerate(seqs, 1):
         print(f"{i}: {' -> '.join(map(str, seq.tasks))}")
+        if i - 1 < len(costs):
+            print(f"   estimated time {costs[i - 1]:.1f} s (walking and nominal task times)")
         print(f"   prefix [{', '.join(map(str, seq.prefix))}] cycle "
               f"[{', '.join(map(str, seq.cycle))}] x{seq.repetitions}")
     return 0

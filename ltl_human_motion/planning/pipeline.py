@@ -124,31 +124,28 @@ _SEQUENCE_CACHE: dict = {}
 
 def _task_sequences(specification, cell, n: int, seed: int, mode: str, cycles: int,
                     backend: str) -> tuple[list, float, float]:
-    """Task sequences (memoized: they depend only on the formula, the candidate task
-    steps and these arguments) and the seconds spent on the automaton and the sequences.
+    """Task sequences from the cell model's product search (memoized per formula,
+    candidate steps, cell and these arguments) and the seconds spent on the automaton
+    and the sequences.
 
     Returns
     -------
     sequences, automaton_seconds, sequence_seconds
         The times are those of the call that computed the entry (0 on a cache hit).
     """
-    from ltl_human_motion.ltl.sequences import synthesize_sequences, task_automaton
+    from ltl_human_motion.tasks import plan_sequences
     key = (specification.formula, specification.letters, n,
-           seed if mode == "random" else None, mode, cycles, backend)   # only random is seeded
+           seed if mode == "random" else None, mode, cycles, backend, id(cell))
     hit = _SEQUENCE_CACHE.get(key)
-    if hit is not None:
-        return hit, 0.0, 0.0
-    t0 = time.perf_counter()
-    task_automaton(specification, backend=backend)
-    t_automaton = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    sequences = synthesize_sequences(specification, cell, n=n, seed=seed, mode=mode,
-                                     cycles=cycles, backend=backend)
-    # (synthesize_sequences translates the formula again; that is counted here too.)
-    t_sequence = time.perf_counter() - t0
+    if hit is not None and hit[0] is cell:
+        return hit[1], 0.0, 0.0
+    # The cell model's product search builds the automaton on the fly, as it goes.
+    sequences, stats = plan_sequences(specification, cell, n=n, seed=seed, mode=mode,
+                                      cycles=cycles, backend=backend)
+    t_automaton, t_sequence = stats.automaton_seconds, stats.search_seconds
     if len(_SEQUENCE_CACHE) > 256:
         _SEQUENCE_CACHE.clear()
-    _SEQUENCE_CACHE[key] = sequences
+    _SEQUENCE_CACHE[key] = (cell, sequences)
     return sequences, t_automaton, t_sequence
 
 

@@ -1,0 +1,264 @@
+"""On-the-fly translation over a task alphabet: the letters are "which task step".
+
+The specification's always-on exclusivity makes at most one task hold per step, so a
+run reads one of a fixed list of letters (the letter of each candidate task step,
+:func:`~ltl_human_motion.ltl.spec.letter_of`) instead of any subset of atoms. The
+tableau of :mod:`~ltl_human_motion.ltl.translate_builtin` (Couvreur's, FM'99) is
+expanded here for one letter at a time and only for the states a search visits:
+
+* a state is a set of NNF formulas (their conjunction), interned to an int;
+* ``expand(f, letter)`` gives the terms ``(next, promises)`` of ``f`` whose letter
+  condition the letter satisfies; it is memoized per (formula, letter), so the many
+  ``F`` conjuncts of a kitting specification share their work across states, and
+  letters that agree on the formula's atoms share one expansion (a symbolic set of
+  letters: every step of a task the formula does not name is one class);
+* an edge carries acceptance mark ``e`` (a bit) iff it does not promise eventuality
+  ``e``; a run is accepting iff it takes every mark infinitely often.
+
+Nothing is built in full: 20 ``F`` conjuncts have 2**20 states, and a product search
+touches a few hundred of them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from ltl_human_motion.ltl.automaton import accepting_components
+from ltl_human_motion.ltl.formula import (
+    And,
+    Atom,
+    Const,
+    Finally,
+    Formula,
+    Globally,
+    Next,
+    Not,
+    Or,
+    Release,
+    StrongRelease,
+    Until,
+    WeakUntil,
+)
+from ltl_human_motion.ltl.simplify import simplify
+from ltl_human_motion.ltl.translate_builtin import _state_key
+
+__all__ = ["LetterTableau"]
+
+_Term = tuple[frozenset[Formula], frozenset[Formula]]
+_EMPTY: frozenset = frozenset()
+_EVENTUALITIES = (Finally, Until, StrongRelease)
+_PERSISTENT = (Globally, Release, WeakUntil)
+
+
+def _prune(terms: list[_Term]) -> list[_Term]:
+    """Drop duplicates and terms implied by a weaker one (subsets of next and promises)."""
+    unique = sorted(set(terms), key=lambda t: (len(t[0]) + len(t[1]),
+                                               sorted(map(str, t[0])), sorted(map(str, t[1]))))
+    kept: list[_Term] = []
+    for nx, pr in unique:
+        if not any(k[0] <= nx and k[1] <= pr for k in kept):
+            kept.append((nx, pr))
+    return kept
+
+
+def _product(left: list[_Term], right: list[_Term]) -> list[_Term]:
+    if len(left) == 1 and len(right) == 1:
+        (n1, p1), (n2, p2) = left[0], right[0]
+        return [(n1 | n2, p1 | p2)]
+    return _prune([(n1 | n2, p1 | p2) for n1, p1 in left for n2, p2 in right])
+
+
+def _subformulas(f: Formula, out: set[Formula]) -> set[Formula]:
+    if f not in out:
+        out.add(f)
+        for g in f.children():
+            _subformulas(g, out)
+    return out
+
+
+class LetterTableau:
+    """The tableau automaton of ``formula`` over the given letters, explored on demand.
+
+    Parameters
+    ----------
+    formula : Formula
+        Without the exclusivity conjunct (the letters make it true at every step).
+    letters : sequence of frozenset of str
+        Letter ``i`` is the set of atom keys that hold at a step of task ``i``.
+
+    Attributes
+    ----------
+    initial : int
+        The initial state.
+    num_sets : int
+        Number of acceptance marks (eventualities); ``full`` has all their bits set.
+    """
+
+    def __init__(self, formula: Formula, letters: Sequence[frozenset[str]]) -> None:
+        self.formula = simplify(formula)
+        self.letters = tuple(frozenset(x) for x in letters)
+        subs = _subformulas(self.formula, set())
+        events = sorted((f for f in subs if isinstance(f, _EVENTUALITIES)), key=str)
+        self.mark_of = {f: 1 << i for i, f in enumerate(events)}
+        self.num_sets = len(events)
+        self.full = (1 << self.num_sets) - 1
+        # letters that agree on the formula's atoms behave alike: one expansion per class
+        keys = {a.key for a in subs if isinstance(a, Atom)}
+        classes: dict[frozenset[str], int] = {}
+        self._class = [classes.setdefault(letter & keys, i)
+                       for i, letter in enumerate(self.letters)]
+        self.states: list[frozenset[Formula]] = []
+        self._ids: dict[frozenset[Formula], int] = {}
+        self._memo: dict[tuple[Formula, int], list[_Term]] = {}
+        self._succ: dict[tuple[int, int], tuple[tuple[int, int], ...]] = {}
+        self._loopable: dict[int, bool] = {}
+        self._proper: dict[Formula, frozenset[Formula]] = {}
+        self._mentioned: dict[int, frozenset[str]] = {}
+        self._formula_names: dict[Formula, frozenset[str]] = {}
+        self.initial = self._intern(_state_key(frozenset({self.formula})))
+
+    def _intern(self, state: frozenset[Formula]) -> int:
+        q = self._ids.get(state)
+        if q is None:
+            q = self._ids[state] = len(self.states)
+            self.states.append(state)
+        return q
+
+    def expand(self, f: Formula, i: int) -> list[_Term]:
+        """Terms ``(next, promises)`` of ``f`` allowed by letter ``i`` (memoized)."""
+        i = self._class[i]
+        key = (f, i)
+        hit = self._memo.get(key)
+        if hit is not None:
+            return hit
+        letter = self.letters[i]
+        if isinstance(f, Const):
+            r = [(_EMPTY, _EMPTY)] if f.value else []
+        elif isinstance(f, Atom):
+            r = [(_EMPTY, _EMPTY)] if f.key in letter else []
+        elif isinstance(f, Not):
+            r = [] if f.arg.key in letter else [(_EMPTY, _EMPTY)]
+        elif isinstance(f, And):
+            r = [(_EMPTY, _EMPTY)]
+            for g in f.args:
+                r = _product(r, self.expand(g, i))
+                if not r:
+                    break
+        elif isinstance(f, Or):
+            r = _prune([t for g in f.args for t in self.expand(g, i)])
+        elif isinstance(f, Next):
+            r = [(frozenset({f.arg}), _EMPTY)]
+        elif isinstance(f, Finally):
+            r = _prune([*self.expand(f.arg, i), (frozenset({f}), frozenset({f}))])
+        elif isinstance(f, Globally):
+            r = _product(self.expand(f.arg, i), [(frozenset({f}), _EMPTY)])
+        elif isinstance(f, Until):
+            r = _prune(self.expand(f.right, i) + _product(
+                self.expand(f.left, i), [(frozenset({f}), frozenset({f}))]))
+        elif isinstance(f, WeakUntil):
+            r = _prune(self.expand(f.right, i) + _product(
+                self.expand(f.left, i), [(frozenset({f}), _EMPTY)]))
+        elif isinstance(f, Release):
+            r = _prune(_product(self.expand(f.left, i), self.expand(f.right, i)) + _product(
+                self.expand(f.right, i), [(frozenset({f}), _EMPTY)]))
+        elif isinstance(f, StrongRelease):
+            r = _prune(_product(self.expand(f.left, i), self.expand(f.right, i)) + _product(
+                self.expand(f.right, i), [(frozenset({f}), frozenset({f}))]))
+        else:
+            raise TypeError(f"not an NNF formula node: {f!r}")
+        self._memo[key] = r
+        return r
+
+    def successors(self, q: int, i: int) -> tuple[tuple[int, int], ...]:
+        """``(state, marks)`` of every edge leaving ``q`` on letter ``i`` (marks: bits)."""
+        i = self._class[i]
+        key = (q, i)
+        hit = self._succ.get(key)
+        if hit is not None:
+            return hit
+        terms: list[_Term] = [(_EMPTY, _EMPTY)]
+        for f in sorted(self.states[q], key=str):
+            terms = _product(terms, self.expand(f, i))
+            if not terms:
+                break
+        out = []
+        for nx, pr in terms:
+            promised = 0
+            for e in pr:
+                promised |= self.mark_of[e]
+            out.append((self._intern(_state_key(nx)), self.full & ~promised))
+        result = tuple(sorted(set(out)))
+        self._succ[key] = result
+        return result
+
+    def loopable(self, q: int) -> bool:
+        """False if no accepting cycle can pass through ``q`` (a syntactic test).
+
+        On a cycle back to ``q`` every formula of ``q`` must be there again; a formula is
+        kept by itself only if it is a ``G``, ``R`` or ``W`` (an eventuality kept by
+        itself is postponed, which blocks its mark), else it must be regenerated from a
+        larger formula of ``q``.
+        """
+        hit = self._loopable.get(q)
+        if hit is None:
+            state = self.states[q]
+            inner: set[Formula] = set()
+            for g in state:
+                inner |= self._proper_subformulas(g)
+            hit = all(isinstance(f, _PERSISTENT) or f in inner for f in state)
+            self._loopable[q] = hit
+        return hit
+
+    def _proper_subformulas(self, g: Formula) -> frozenset[Formula]:
+        hit = self._proper.get(g)
+        if hit is None:
+            hit = frozenset(_subformulas(g, set()) - {g})
+            self._proper[g] = hit
+        return hit
+
+    def accepts_lasso(self, prefix: Sequence[int], cycle: Sequence[int]) -> bool:
+        """True iff the automaton accepts ``prefix cycle^omega`` (letter indices)."""
+        if not cycle:
+            raise ValueError("a lasso needs at least one cycle letter, got an empty cycle")
+        word = [*prefix, *cycle]
+        n, total = len(prefix), len(word)
+        index = {(self.initial, 0): 0}
+        adj: list[list[tuple[int, frozenset[int]]]] = [[]]
+        stack = [(self.initial, 0)]
+        while stack:
+            q, i = stack.pop()
+            src = index[(q, i)]
+            j = i + 1 if i + 1 < total else n
+            for d, marks in self.successors(q, word[i]):
+                key = (d, j)
+                if key not in index:
+                    index[key] = len(adj)
+                    adj.append([])
+                    stack.append(key)
+                adj[src].append((index[key], self.mark_set(marks)))
+        return bool(accepting_components(adj, self.num_sets))
+
+    def mark_set(self, marks: int) -> frozenset[int]:
+        """The acceptance sets of a mark bit field."""
+        return frozenset(b for b in range(self.num_sets) if marks >> b & 1)
+
+    def mentioned(self, q: int) -> frozenset[str]:
+        """Arguments of the atoms of state ``q`` (the objects and regions it names)."""
+        hit = self._mentioned.get(q)
+        if hit is None:
+            names: set[str] = set()
+            for f in self.states[q]:
+                names |= self._names(f)
+            hit = self._mentioned[q] = frozenset(names)
+        return hit
+
+    def _names(self, f: Formula) -> frozenset[str]:
+        hit = self._formula_names.get(f)
+        if hit is None:
+            hit = self._formula_names[f] = frozenset(
+                n for g in _subformulas(f, set()) if isinstance(g, Atom) for n in g.args)
+        return hit
+
+    def pending(self, q: int) -> list[Formula]:
+        """The ``F phi`` formulas of state ``q``: each needs a later step satisfying phi."""
+        return [f for f in self.states[q] if isinstance(f, Finally)]

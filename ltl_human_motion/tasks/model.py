@@ -1,0 +1,351 @@
+"""A cell model for task planning: what a worker can do next, and what it costs.
+
+The state (:class:`CellState`) holds where the worker is (the start, or the target of
+the last task), what each hand holds, where every movable part is and the posture.
+Preconditions and effects follow Table I of the paper and what the planner does:
+
+* ``grasp(O)`` needs a free hand (both for a ``two_handed`` part) and O not held and
+  not inside a container; O is picked up where it lies.
+* ``release(O)`` needs O in hand; O is put down where the worker stands.
+* ``move(O, R)``, ``insert(O, C)`` and ``carry(O, R)`` need O in hand, or fetch it
+  first (walk to O and grasp it, which needs a free hand), as the planner does.
+  ``move`` leaves O in R and ``insert`` inside C, with the hand free; ``carry`` keeps
+  O in hand and puts the worker in R.
+* ``extract(O, C)`` needs O inside C and a free hand; O ends in hand.
+* ``assemble(R)`` (the shorthand ``leftHand(R) & rightHand(R)``) uses up the parts in
+  hand; a later grasp takes a fresh one from its supply position (paper Fig. 3).
+* ``walk(R)`` needs the worker elsewhere (a walk on the spot is pointless).
+* ``sit(O)`` needs to be standing; ``standUp`` stands up (a no-op when standing);
+  ``kneel`` kneels. Tasks that walk or work away from a seat stand up first, as the
+  planner does.
+
+The cost of a step estimates its time: the straight-line walking distance on the floor
+over :data:`WALK_SPEED`, plus the task's nominal duration (:data:`NOMINAL_DURATION`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ltl_human_motion.ltl.formula import Atom
+
+__all__ = ["DONE", "NOMINAL_DURATION", "WALK_SPEED", "CellModel", "CellState", "Limits"]
+
+#: Walking speed of the cost estimate, m/s. Slower than free walking (about 1.3 m/s,
+#: Bohannon 1997) because walks in a cell are short and start and stop.
+WALK_SPEED = 1.0
+
+#: Nominal task durations, s: the typical lengths of the motion library's goal
+#: primitives of each kind (reach, act and return to the carry stance), rounded.
+NOMINAL_DURATION: Mapping[str, float] = {
+    "grasp": 1.6, "release": 1.2, "move": 1.8, "insert": 2.2, "extract": 2.2,
+    "leftHand": 1.4, "rightHand": 1.4, "assemble": 2.0, "walk": 0.4, "carry": 0.4,
+    "sit": 2.0, "standUp": 1.8, "kneel": 2.0, "bend": 1.8, "stoop": 1.8, "wait": 0.0,
+}
+
+#: Posture codes of :class:`CellState`.
+STANDING, SITTING, KNEELING = 0, 1, 2
+POSTURES = ("standing", "sitting", "kneeling")
+
+#: Where a part is: at a location index >= 0, in hand, or inside container ``c``
+#: (encoded as ``INSIDE - c``).
+HELD = -1
+INSIDE = -2
+
+#: Where a part is once the specification no longer mentions it and no hand holds it:
+#: handling it again would be pointless, so the search forgets its place.
+DONE = -(1 << 30)
+
+#: Tasks the planner performs while seated; any other task stands up first.
+_SEATED_TASKS = frozenset({"standUp", "wait", "leftHand", "rightHand", "assemble", "sit"})
+
+
+@dataclass(frozen=True)
+class CellState:
+    """One state of the cell model (hashable).
+
+    Attributes
+    ----------
+    location : int
+        Index into :attr:`CellModel.points` where the worker is.
+    held : tuple of int
+        Parts in hand (part indices, sorted).
+    parts : tuple of int
+        Per part: a location index, :data:`HELD`, or ``INSIDE - c`` for container c.
+    posture : int
+        :data:`STANDING`, :data:`SITTING` or :data:`KNEELING`.
+    """
+
+    location: int
+    held: tuple[int, ...]
+    parts: tuple[int, ...]
+    posture: int = STANDING
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Physical limits of the model; relaxing one tells which limit blocks a plan.
+
+    Attributes
+    ----------
+    hands : int
+        Hands of the worker (a ``two_handed`` part takes two).
+    posture : bool
+        Whether posture preconditions (``sit`` needs standing) are enforced.
+    """
+
+    hands: int = 2
+    posture: bool = True
+
+
+@dataclass
+class CellModel:
+    """Locations, parts and costs of one cell (see the module docstring).
+
+    Parameters
+    ----------
+    points : ndarray, shape (L, 2)
+        Floor positions of the locations: 0 is the start, then the parts' supply
+        positions, then the regions' centres.
+    part_names : tuple of str
+    region_names : tuple of str
+    two_handed : tuple of bool
+        Per part.
+    movable : tuple of bool
+        Per part (default all): a fixed object is a container or a seat, never held.
+    shorthands : mapping
+        Shorthand name -> (params, body) of the cell.
+    limits : Limits
+    durations : mapping
+        Task name -> nominal duration, s (default :data:`NOMINAL_DURATION`).
+    """
+
+    points: np.ndarray
+    part_names: tuple[str, ...]
+    region_names: tuple[str, ...]
+    two_handed: tuple[bool, ...]
+    movable: tuple[bool, ...] = ()
+    shorthands: Mapping[str, tuple[tuple[str, ...], str]] = field(default_factory=dict)
+    limits: Limits = field(default_factory=Limits)
+    durations: Mapping[str, float] = field(default_factory=lambda: dict(NOMINAL_DURATION))
+
+    def __post_init__(self) -> None:
+        pts = np.asarray(self.points, dtype=np.float64)
+        if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] != 1 + len(self.part_names) \
+                + len(self.region_names):
+            raise ValueError(f"points must have shape (1 + parts + regions, 2) = "
+                             f"({1 + len(self.part_names) + len(self.region_names)}, 2), "
+                             f"got {pts.shape}")
+        self.points = pts
+        self.part_index = {n: i for i, n in enumerate(self.part_names)}
+        self.region_index = {n: i for i, n in enumerate(self.region_names)}
+        diff = pts[:, None, :] - pts[None, :, :]
+        self.walk_time = np.sqrt((diff ** 2).sum(-1)) / WALK_SPEED
+        self._walk = self.walk_time.tolist()
+        if not self.movable:
+            self.movable = (True,) * len(self.part_names)
+        # a fixed object never fits in the hands
+        self._width = tuple(2 if t else 1 if m else self.limits.hands + 1
+                            for t, m in zip(self.two_handed, self.movable))
+        self._kinds: dict[str, tuple[str, tuple[str, ...]]] = {}
+
+    # ---------------------------------------------------------------- building
+    @classmethod
+    def from_cell(cls, cell: object, limits: Limits | None = None,
+                  durations: Mapping[str, float] | None = None) -> CellModel:
+        """The model of a scene :class:`~ltl_human_motion.scene.cell.Cell` (or any object
+        with ``objects`` (name -> .position (3,), .two_handed, .movable), ``regions``
+        (name -> .center (3,)), ``start_region`` and ``shorthands``)."""
+        objects = dict(cell.objects)
+        regions = dict(cell.regions)
+        start = np.asarray(cell.start_region.center, dtype=np.float64)[:2]
+        parts = tuple(objects)
+        pts = [start, *(np.asarray(objects[n].position, dtype=np.float64)[:2] for n in parts),
+               *(np.asarray(regions[r].center, dtype=np.float64)[:2] for r in regions)]
+        return cls(np.array(pts), parts, tuple(regions),
+                   tuple(bool(getattr(objects[n], "two_handed", False)) for n in parts),
+                   tuple(bool(getattr(objects[n], "movable", True)) for n in parts),
+                   dict(getattr(cell, "shorthands", {}) or {}), limits or Limits(),
+                   dict(NOMINAL_DURATION if durations is None else durations))
+
+    def initial_state(self) -> CellState:
+        """The worker at the start, hands empty, parts at their supply positions."""
+        return CellState(0, (), tuple(1 + i for i in range(len(self.part_names))))
+
+    def with_limits(self, limits: Limits) -> CellModel:
+        """The same cell with other physical limits."""
+        return CellModel(self.points, self.part_names, self.region_names, self.two_handed,
+                         self.movable, self.shorthands, limits, self.durations)
+
+    # ---------------------------------------------------------------- locations
+    def supply(self, part: int) -> int:
+        """Location index of a part's supply position."""
+        return 1 + part
+
+    def region_location(self, name: str) -> int:
+        """Location index of a region's centre."""
+        return 1 + len(self.part_names) + self.region_index[name]
+
+    def kind(self, task: Atom) -> tuple[str, tuple[str, ...]]:
+        """The task kind realising a step: a two-hand shorthand is ``assemble``."""
+        hit = self._kinds.get(task.key)
+        if hit is None:
+            hit = (task.name, tuple(task.args))
+            if task.name in self.shorthands:
+                params, body = self.shorthands[task.name]
+                text = body.replace(" ", "")
+                hit = ("shorthand", tuple(task.args))
+                if len(params) == 1 and len(task.args) == 1 and set(text.split("&")) == {
+                        f"leftHand({params[0]})", f"rightHand({params[0]})"}:
+                    hit = ("assemble", tuple(task.args))
+            self._kinds[task.key] = hit
+        return hit
+
+    def target(self, task: Atom, state: CellState) -> int | None:
+        """Location index where ``task`` ends (None: in place)."""
+        kind, args = self.kind(task)
+        if kind in ("walk", "carry", "leftHand", "rightHand", "assemble", "shorthand"):
+            return self._region_or_none(args[-1] if args else None)
+        if kind in ("grasp", "sit"):
+            return self._part_place(args[0], state)
+        if kind == "move":
+            return self._region_or_none(args[1])
+        if kind in ("insert", "extract"):
+            return self._part_place(args[1], state)
+        return None
+
+    def _region_or_none(self, name: str | None) -> int | None:
+        return None if name is None or name not in self.region_index \
+            else self.region_location(name)
+
+    def _part_place(self, name: str, state: CellState) -> int | None:
+        p = self.part_index.get(name)
+        if p is None:
+            return None
+        where = state.parts[p]
+        if where >= 0:
+            return where
+        if where == DONE:
+            return None
+        if where == HELD:
+            return state.location
+        return self._part_place(self.part_names[INSIDE - where], state)
+
+    # ---------------------------------------------------------------- dynamics
+    def _free_hands(self, held: Sequence[int]) -> int:
+        return self.limits.hands - sum(self._width[p] for p in held)
+
+    def step(self, state: CellState, task: Atom) -> tuple[CellState, float] | None:
+        """``(next state, cost in s)`` of doing ``task`` in ``state``, or None when the
+        task is physically impossible or pointless there (see the module docstring)."""
+        kind, args = self.kind(task)
+        cost = 0.0
+        posture = state.posture
+        if posture != STANDING and kind not in _SEATED_TASKS:
+            cost += self.durations["standUp"]
+            posture = STANDING
+        loc = state.location
+        parts = list(state.parts)
+        held = list(state.held)
+        if kind in ("move", "insert", "carry"):
+            p = self.part_index.get(args[0])
+            if p is None:
+                return None
+            if parts[p] != HELD:
+                if parts[p] < 0 or self._free_hands(held) < self._width[p]:
+                    return None
+                cost += self._walk[loc][parts[p]] + self.durations["grasp"]
+                loc = parts[p]
+                parts[p] = HELD
+                held.append(p)
+            dest = self.target(task, state)
+            if dest is not None:
+                cost += self._walk[loc][dest]
+                loc = dest
+            if kind != "carry":
+                held.remove(p)
+                if kind == "move":
+                    parts[p] = dest if dest is not None else loc
+                else:
+                    c = self.part_index.get(args[1])
+                    if c is None or c == p or state.parts[c] == DONE:
+                        return None
+                    parts[p] = INSIDE - c
+        elif kind == "grasp":
+            p = self.part_index.get(args[0])
+            if p is None or parts[p] == HELD or parts[p] < -1 \
+                    or self._free_hands(held) < self._width[p]:
+                return None
+            cost += self._walk[loc][parts[p]]
+            loc = parts[p]
+            parts[p] = HELD
+            held.append(p)
+        elif kind == "release":
+            p = self.part_index.get(args[0])
+            if p is None or parts[p] != HELD:
+                return None
+            held.remove(p)
+            parts[p] = loc
+        elif kind == "extract":
+            p, c = self.part_index.get(args[0]), self.part_index.get(args[1])
+            if p is None or c is None or parts[p] != INSIDE - c \
+                    or self._free_hands(held) < self._width[p]:
+                return None
+            dest = self.target(task, state)
+            if dest is None:
+                return None
+            cost += self._walk[loc][dest]
+            loc = dest
+            parts[p] = HELD
+            held.append(p)
+        elif kind == "assemble":
+            dest = self.target(task, state)
+            if dest is not None:
+                cost += self._walk[loc][dest]
+                loc = dest
+            for p in held:
+                parts[p] = self.supply(p)       # used up; the next grasp takes a new one
+            held = []
+        elif kind == "sit":
+            if self.limits.posture and state.posture != STANDING:
+                return None
+            dest = self.target(task, state)
+            if dest is not None:
+                cost += self._walk[loc][dest]
+                loc = dest
+            posture = SITTING
+        elif kind == "standUp":
+            posture = STANDING
+        elif kind == "kneel":
+            posture = KNEELING
+        else:
+            dest = self.target(task, state)
+            if kind == "walk" and dest == loc:
+                return None                     # already there: a pointless walk
+            if dest is not None:
+                cost += self._walk[loc][dest]
+                loc = dest
+        if kind == "wait":
+            cost += float(args[0]) if args else 0.0
+        else:
+            cost += self.durations.get(kind, self.durations.get("walk", 0.0))
+        return CellState(loc, tuple(sorted(held)), tuple(parts), posture), cost
+
+    def forget(self, state: CellState, keep: frozenset[str]) -> CellState:
+        """``state`` with the place of every part not in ``keep`` and not held set to
+        :data:`DONE` (a product search calls it with the parts its automaton state still
+        mentions)."""
+        parts = state.parts
+        new = tuple(w if w == HELD or self.part_names[p] in keep else DONE
+                    for p, w in enumerate(parts))
+        return state if new == parts else CellState(state.location, state.held, new,
+                                                    state.posture)
+
+    def describe(self, state: CellState) -> str:
+        """A one-line text of a state (for explanations)."""
+        held = ", ".join(self.part_names[p] for p in state.held) or "nothing"
+        return f"holding {held}, {POSTURES[state.posture]}"
+

@@ -1,0 +1,638 @@
+"""The product of a specification automaton with the cell model, searched on the fly.
+
+A product node is ``(automaton state, cell state)``; an edge does one task step: the
+automaton reads the task's letter and the cell model (:class:`~.model.CellModel`) does
+the task, at its estimated time. Nothing is built in full: nodes are made when the
+search reaches them.
+
+A task sequence is a lasso ``prefix . cycle`` whose infinite word ``prefix cycle^w``
+the automaton accepts. As in the paper, the worker performs ``prefix`` and the cycle
+``repetitions`` times, so the acceptance condition is passed at least once; the cycle
+must be physically possible from where the prefix ends (and again for each repetition),
+the cell need not return to its state. The search (A*, or Dijkstra without a heuristic)
+pops prefixes in order of cost; a prefix ends in a goal when
+
+* its last step reads a letter on which its automaton state loops with every mark
+  (then the cycle is that last step: ``F a`` ends right after the ``a``), or
+* from its node a cycle of the automaton back to the same state with every mark is
+  possible in the cell (a second Dijkstra over ``(state, cell, marks)``, only from
+  states that can lie on an accepting cycle, :meth:`LetterTableau.loopable`).
+
+Goals enter the same queue at the cost of prefix plus cycle, so the first goal popped is
+the cost-optimal lasso (with an admissible heuristic and weight 1). Nodes may be popped
+up to ``k`` times, which gives the ``k`` cheapest lassos (k shortest walks).
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import random
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from ltl_human_motion.ltl.automaton import Automaton, accepting_components
+from ltl_human_motion.ltl.automaton import strongly_connected_components as _sccs
+from ltl_human_motion.ltl.formula import And, Atom, Const, Finally, Formula, Globally, Not, Or
+from ltl_human_motion.tasks.model import HELD, CellModel, CellState
+
+__all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "seeded_noise"]
+
+
+#: Longest cycle made of a path's own last steps that the search tries as a goal.
+TAIL_STEPS = 6
+
+#: Tasks that leave a hand free (the part is put down, placed or used up).
+_FREEING = frozenset({"release", "move", "insert", "assemble"})
+
+#: Tasks that take a part somewhere in hand (fetching it first if needed).
+_CARRYING = frozenset({"move", "insert", "carry"})
+
+
+class SearchBudgetError(RuntimeError):
+    """The product search expanded more nodes than its budget allowed."""
+
+
+class ExplicitView:
+    """An explicit :class:`Automaton` (e.g. Spot's) read over the task letters.
+
+    Offers the interface of :class:`~ltl_human_motion.ltl.onthefly.LetterTableau` that
+    the search uses: ``initial``, ``full``, ``successors(q, i)``, ``loopable(q)``.
+    """
+
+    def __init__(self, aut: Automaton, letters: Sequence[frozenset[str]]) -> None:
+        self.aut = aut
+        self.letters = tuple(letters)
+        self.initial = aut.initial
+        self.full = (1 << aut.num_sets) - 1
+        self._succ: dict[tuple[int, int], tuple[tuple[int, int], ...]] = {}
+        adj = [[(d, frozenset(m)) for i in range(len(self.letters))
+                for d, m in self._edges(q, i)] for q in aut.states]
+        comp = _sccs(adj)
+        good = accepting_components(adj, aut.num_sets)
+        self._loop = [comp[q] in good for q in aut.states]
+
+    def _edges(self, q: int, i: int) -> list[tuple[int, list[int]]]:
+        return [(e.dst, sorted(e.acc)) for e in self.aut.successors(q)
+                if e.guard.satisfied_by(self.letters[i])]
+
+    def successors(self, q: int, i: int) -> tuple[tuple[int, int], ...]:
+        """``(state, marks as bits)`` of the edges leaving ``q`` on letter ``i``."""
+        key = (q, i)
+        hit = self._succ.get(key)
+        if hit is None:
+            hit = tuple(sorted({(d, sum(1 << m for m in acc)) for d, acc in self._edges(q, i)}))
+            self._succ[key] = hit
+        return hit
+
+    def loopable(self, q: int) -> bool:
+        """Whether ``q`` lies in an accepting strongly connected component."""
+        return self._loop[q]
+
+    def pending(self, q: int) -> list[Formula]:
+        """No formula view of an explicit automaton: no heuristic."""
+        return []
+
+
+@dataclass(frozen=True)
+class Lasso:
+    """A lasso of task indices with its estimated time.
+
+    Attributes
+    ----------
+    prefix, cycle : tuple of int
+        Indices into the search's task list; ``cycle`` is non-empty.
+    cost : float
+        Estimated seconds of ``prefix`` and the repetitions of ``cycle``.
+    searched_cycle : bool
+        The cycle was found by a cycle search after the prefix (not its last step).
+    """
+
+    prefix: tuple[int, ...]
+    cycle: tuple[int, ...]
+    cost: float
+    searched_cycle: bool = False
+
+
+def _propositional_letters(f: Formula, letters: Sequence[frozenset[str]]) -> tuple[int, ...] | None:
+    """Indices of the letters on which the propositional ``f`` holds (None: temporal)."""
+
+    def ev(g: Formula, letter: frozenset[str]) -> bool | None:
+        if isinstance(g, Atom):
+            return g.key in letter
+        if isinstance(g, Const):
+            return g.value
+        if isinstance(g, Not):
+            v = ev(g.arg, letter)
+            return None if v is None else not v
+        if isinstance(g, (And, Or)):
+            vals = [ev(a, letter) for a in g.args]
+            if any(v is None for v in vals):
+                return None
+            return all(vals) if isinstance(g, And) else any(vals)
+        return None
+
+    out = []
+    for i, letter in enumerate(letters):
+        v = ev(f, letter)
+        if v is None:
+            return None
+        if v:
+            out.append(i)
+    return tuple(out)
+
+
+class ProductSearch:
+    """Searches the product of ``automaton`` and ``model`` for cheap accepting lassos.
+
+    Parameters
+    ----------
+    automaton : LetterTableau or ExplicitView
+        Over the letters of ``tasks`` (same order).
+    model : CellModel
+    tasks : sequence of Atom
+        The candidate task steps.
+    repetitions : int
+        How often the cycle is performed; above 1 the cycle must be possible again
+        from where it ends.
+    weight : float
+        A* weight (1: optimal with the admissible heuristic; larger: faster, at most
+        ``weight`` times the optimum).
+    budget : int
+        Most prefix nodes expanded before :class:`SearchBudgetError`.
+    cost_noise : callable, optional
+        ``(node, task index) -> factor >= 1`` on step costs (seeded random variations).
+    """
+
+    def __init__(self, automaton, model: CellModel, tasks: Sequence[Atom],
+                 repetitions: int = 1, weight: float = 1.0, budget: int = 200_000,
+                 cost_noise: Callable[[tuple, int], float] | None = None,
+                 heuristic: bool = True) -> None:
+        self.aut = automaton
+        self.model = model
+        self.tasks = tuple(tasks)
+        self.repetitions = repetitions
+        self.weight = weight
+        self.budget = budget
+        self.noise = cost_noise
+        self.use_h = heuristic and weight > 0
+        self.expanded = 0
+        self._step: dict[tuple[CellState, int], tuple[CellState, float] | None] = {}
+        self._cycles: dict[tuple[int, CellState], tuple[float, tuple[int, ...]] | None] = {}
+        letters = getattr(automaton, "letters", None)
+        self._letters = tuple(letters) if letters is not None else ()
+        self._min_dur = [self._duration(t) for t in self.tasks]
+        self._kind = [model.kind(t)[0] for t in self.tasks]
+        free = [d for d, k in zip(self._min_dur, self._kind) if k in _FREEING]
+        self._free_dur = min(free) if free else None
+        self._grasp_dur = float(model.durations.get("grasp", 0.0))
+        self._walk = model.walk_time.tolist()
+        self._h: dict[tuple[int, CellState], float] = {}
+        self._qneeds: dict[int, tuple[float, int, list[tuple]]] = {}
+        self._fneeds: dict[Formula, tuple] = {}
+        self._rules: dict[Formula, tuple | None] = {}
+        self._trees: dict[tuple[int, frozenset[int]], float] = {}
+        self._tgt = [self._static_target(t) for t in self.tasks]
+        self._forget = hasattr(automaton, "mentioned")
+        self._tails: dict[tuple[int, tuple[int, ...]], bool] = {}
+
+    def _duration(self, task: Atom) -> float:
+        kind, args = self.model.kind(task)
+        if kind == "wait":
+            return float(args[0]) if args else 0.0
+        return float(self.model.durations.get(kind, 0.0))
+
+    # ---------------------------------------------------------------- pieces
+    def step(self, s: CellState, i: int) -> tuple[CellState, float] | None:
+        """The cell model's step (memoized)."""
+        key = (s, i)
+        if key not in self._step:
+            self._step[key] = self.model.step(s, self.tasks[i])
+        return self._step[key]
+
+    def forget(self, q: int, s: CellState) -> CellState:
+        """``s`` without the places of parts that state ``q`` no longer mentions."""
+        return self.model.forget(s, self.aut.mentioned(q)) if self._forget else s
+
+    def _cost(self, node: tuple, i: int, c: float) -> float:
+        return c * self.noise(node, i) if self.noise is not None else c
+
+    def heuristic(self, q: int, s: CellState) -> float:
+        """A lower bound on the time still needed (admissible):
+
+        * the durations of the tasks the pending ``F`` formulas of ``q`` need, counted
+          once per disjoint set of letters;
+        * the walk through their places: the minimum spanning tree over the worker's
+          place and the places of the formulas with one place (a walk visiting them all
+          is at least as long), or the walk to the farthest other one;
+        * at least the distance each part still to be moved, inserted or carried travels
+          in hand, over the number of hands (at most that many parts ride along at once);
+        * the grasp that fetches such a part when it is not in hand;
+        * the hand-freeing steps that two hands force: parts in hand plus parts still to
+          be grasped, minus the hands, minus the pending formulas that free a hand;
+        * pending formulas include the responses ``F psi`` of ``G(phi -> F psi)`` whose
+          trigger a pending formula will fire (:meth:`_responses`).
+        """
+        if not self.use_h:
+            return 0.0
+        key = (q, s)
+        hit = self._h.get(key)
+        if hit is not None:
+            return hit
+        base, freeing, needs = self._needs(q)
+        total, far = base, 0.0
+        carried: list[float] = []
+        walk = self._walk
+        here = s.location
+        places: set[int] = set()
+        to_grasp = 0
+        parts = s.parts
+        grasping = {item[3] for item in needs}
+        for opts, carry_part, carry_dest, grasp_part in needs:
+            if carry_part is not None:
+                where = parts[carry_part]
+                if where >= 0:
+                    if carry_part not in grasping:   # else its grasp is counted already
+                        total += self._grasp_dur
+                    places.add(where)
+                    carried.append(walk[where][carry_dest])
+                elif where == HELD:
+                    carried.append(walk[here][carry_dest])
+            targets = {self._target(i, s) for i in opts}
+            if None in targets:
+                pass
+            elif len(targets) == 1:
+                places.update(targets)
+            else:
+                far = max(far, min(walk[here][t] for t in targets))
+            if grasp_part is not None and grasp_part not in s.held:
+                to_grasp += self.model._width[grasp_part]
+        hands = self.model.limits.hands
+        carry = sum(carried) / hands
+        total += max(far, self._tree(here, places), carry)
+        if self._free_dur is not None:
+            held = sum(self.model._width[p] for p in s.held)
+            total += max(0, held + to_grasp - self.model.limits.hands - freeing) \
+                * self._free_dur
+        self._h[key] = total
+        return total
+
+    def _target(self, i: int, s: CellState) -> int | None:
+        """Where task ``i`` ends in ``s`` (fast path of :meth:`CellModel.target`)."""
+        kind, value = self._tgt[i]
+        if kind == 0:
+            return value
+        if kind == 1:
+            where = s.parts[value]
+            if where >= 0:
+                return where
+            if where == HELD:
+                return s.location
+        return self.model.target(self.tasks[i], s)
+
+    def _needs(self, q: int) -> tuple[float, int, list[tuple]]:
+        """Per automaton state: the durations of its pending ``F`` formulas (once per
+        disjoint letter set), how many of them free a hand, and per formula (letters,
+        part carried, its destination, part to grasp)."""
+        hit = self._qneeds.get(q)
+        if hit is not None:
+            return hit
+        base, freeing, needs = 0.0, 0, []
+        used: set[int] = set()
+        pending = list(self.aut.pending(q))
+        for f in self._responses(q, pending):
+            if f not in pending:
+                pending.append(f)
+        for f in pending:
+            need, dur, frees, item = self._formula_need(f)
+            if not need:
+                continue
+            if used.isdisjoint(need):
+                base += dur
+                used.update(need)
+            freeing += frees
+            needs.append(item)
+        hit = self._qneeds[q] = (base, freeing, needs)
+        return hit
+
+    def _responses(self, q: int, pending: list[Formula]) -> list[Formula]:
+        """``F psi`` of every ``G(!phi | F psi)`` of ``q`` whose trigger ``phi`` a pending
+        ``F chi`` will make true (every letter of ``chi`` satisfies ``phi``): psi is
+        needed after that step, so it counts too."""
+        out = []
+        states = getattr(self.aut, "states", None)
+        if states is None:
+            return out
+        needs = [n for f in pending if (n := self._formula_need(f)[0])]
+        for g in states[q]:
+            rule = self._rules.get(g, ())
+            if rule == ():
+                rule = self._rules[g] = self._response_rule(g)
+            if rule is not None and any(set(n) <= rule[0] for n in needs):
+                out.append(rule[1])
+        return out
+
+    def _response_rule(self, g: Formula) -> tuple[frozenset[int], Formula] | None:
+        """(trigger letters, ``F psi``) of ``g = G(a | b | ... | F psi)`` with a, b, ...
+        propositional (the trigger: the letters on which they are all false)."""
+        if not isinstance(g, Globally) or not isinstance(g.arg, Or):
+            return None
+        eventual = [a for a in g.arg.args if isinstance(a, Finally)]
+        rest = [a for a in g.arg.args if not isinstance(a, Finally)]
+        if len(eventual) != 1 or not rest:
+            return None
+        holds = _propositional_letters(Or(tuple(rest)) if len(rest) > 1 else rest[0],
+                                       self._letters)
+        if holds is None:
+            return None
+        trigger = frozenset(range(len(self._letters))) - frozenset(holds)
+        return trigger, eventual[0]
+
+    def _formula_need(self, f: Formula) -> tuple:
+        """What the pending ``F phi`` needs: (letters satisfying phi, least duration,
+        whether all of them free a hand, (letters, part carried, destination, part to
+        grasp))."""
+        hit = self._fneeds.get(f)
+        if hit is not None:
+            return hit
+        need = _propositional_letters(f.arg, self._letters)
+        if not need:
+            self._fneeds[f] = ((), 0.0, False, None)
+            return self._fneeds[f]
+        kinds = {self._kind[i] for i in need}
+        carry_part = carry_dest = grasp_part = None
+        if len(need) == 1 and self._kind[need[0]] in _CARRYING and self._tgt[need[0]][0] == 0:
+            carry_part = self.model.part_index.get(self.tasks[need[0]].args[0])
+            carry_dest = self._tgt[need[0]][1]
+        heads = {self.tasks[i].args[0] for i in need} if kinds == {"grasp"} else ()
+        if len(heads) == 1:
+            grasp_part = self.model.part_index.get(next(iter(heads)))
+        hit = self._fneeds[f] = (need, min(self._min_dur[i] for i in need),
+                                 kinds <= _FREEING, (need, carry_part, carry_dest, grasp_part))
+        return hit
+
+    def _static_target(self, task: Atom) -> tuple[int, int | None]:
+        """(0, location) for a task ending at a fixed place, (1, part) for one ending where
+        a part lies (grasp, sit), (2, None) otherwise."""
+        kind, args = self.model.kind(task)
+        if kind in ("walk", "carry", "leftHand", "rightHand", "assemble", "shorthand", "move"):
+            region = args[-1] if args else None
+            if region in self.model.region_index:
+                return 0, self.model.region_location(region)
+            return 0, None
+        if kind in ("grasp", "sit") and args[0] in self.model.part_index:
+            return 1, self.model.part_index[args[0]]
+        if kind in ("wait", "release", "standUp", "kneel", "bend", "stoop"):
+            return 0, None
+        if kind in ("insert", "extract") and args[1] in self.model.part_index:
+            c = self.model.part_index[args[1]]
+            if not self.model.movable[c]:
+                return 0, self.model.supply(c)
+        return 2, None
+
+    def _tree(self, here: int, places: set[int]) -> float:
+        """Length (s) of a minimum spanning tree over ``here`` and ``places`` (Prim)."""
+        places.discard(here)
+        if not places:
+            return 0.0
+        key = (here, frozenset(places))
+        hit = self._trees.get(key)
+        if hit is not None:
+            return hit
+        walk = self._walk
+        rest = list(places)
+        best = [walk[here][t] for t in rest]
+        total = 0.0
+        while rest:
+            j = min(range(len(rest)), key=best.__getitem__)
+            total += best[j]
+            u = rest.pop(j)
+            best.pop(j)
+            row = walk[u]
+            best = [min(b, row[t]) for b, t in zip(best, rest)]
+        self._trees[key] = total
+        return total
+
+    def _again(self, s: CellState, cycle: Sequence[int]) -> float | None:
+        """Cost (s) of doing the cycle ``repetitions - 1`` more times from ``s``, or None
+        when the cell does not allow it."""
+        total = 0.0
+        for _ in range(self.repetitions - 1):
+            for i in cycle:
+                nxt = self.step(s, i)
+                if nxt is None:
+                    return None
+                s, c = nxt
+                total += c
+        return total
+
+    def cycle_from(self, q0: int, s0: CellState, limit: int = 20_000
+                   ) -> tuple[float, tuple[int, ...]] | None:
+        """The cheapest cycle of the automaton from ``q0`` back to ``q0`` with every mark,
+        possible in the cell from ``s0``: (cost, task indices), or None."""
+        key = (q0, s0)
+        if key in self._cycles:
+            return self._cycles[key]
+        full = self.aut.full
+        tie = itertools.count()
+        heap: list = [(0.0, next(tie), q0, s0, 0, ())]
+        done: set[tuple[int, CellState, int]] = set()
+        result = None
+        while heap and len(done) < limit:
+            g, _, q, s, marks, path = heapq.heappop(heap)
+            if path and q == q0 and marks == full:
+                again = self._again(s, path)
+                if again is not None:
+                    result = (g + again, path)
+                    break
+                continue
+            if (q, s, marks) in done:
+                continue
+            done.add((q, s, marks))
+            for i in range(len(self.tasks)):
+                nxt = self.step(s, i)
+                if nxt is None:
+                    continue
+                for q2, m in self.aut.successors(q, i):
+                    if not self.aut.loopable(q2):
+                        continue
+                    s2, c = self.forget(q2, nxt[0]), nxt[1]
+                    m2 = marks | m
+                    if (q2 == q0 and m2 == full) or (q2, s2, m2) not in done:
+                        heapq.heappush(heap, (g + c, next(tie), q2, s2, m2, (*path, i)))
+        self._cycles[key] = result
+        return result
+
+    # ---------------------------------------------------------------- search
+    def lassos(self, k: int = 1, start: tuple[tuple[int, ...], int, CellState, float] | None = None,
+               bound: float = float("inf")) -> list[Lasso]:
+        """Up to ``k`` cheapest lassos in order of cost (fewer if the product has fewer).
+
+        ``start`` = (task indices done, automaton state, cell state, cost) starts the
+        search after a given prefix (coverage mode). Nodes whose cost plus heuristic
+        exceeds ``bound`` are not expanded (a known lasso's cost proves them useless).
+
+        Raises
+        ------
+        SearchBudgetError
+            When more than ``budget`` prefix nodes were expanded.
+        """
+        tie = itertools.count()
+        # labels: (node, parent label, task index, g)
+        labels: list[tuple[tuple[int, CellState], int, int, float]] = []
+        heap: list = []
+        if start is None:
+            root = (self.aut.initial,
+                    self.forget(self.aut.initial, self.model.initial_state()))
+            base: tuple[int, ...] = ()
+            g0 = 0.0
+        else:
+            base, q, s, g0 = start
+            root = (q, self.forget(q, s))
+        labels.append((root, -1, -1, g0))
+        heapq.heappush(heap, (g0 + self.weight * self.heuristic(*root), -g0, next(tie), 0, 0,
+                              ()))
+        lazy = self.use_h and self.weight > 1.0
+        pops: dict[tuple[int, CellState], int] = {}
+        closed_g: dict[tuple[int, CellState], float] = {}
+        out: list[Lasso] = []
+        while heap and len(out) < k:
+            f, _, _, kind, lab, cycle = heapq.heappop(heap)
+            node, _parent, task, g = labels[lab]
+            if kind == 1:
+                prefix = base + self._path(labels, lab)
+                if isinstance(cycle, int):
+                    out.append(Lasso(prefix[:-cycle], prefix[-cycle:], f))
+                else:
+                    out.append(Lasso(prefix, cycle, f, searched_cycle=True))
+                continue
+            count = pops.get(node, 0)
+            if count >= k and (k > 1 or g >= closed_g[node] - 1e-9):
+                continue  # (k = 1: a cheaper path reopens it; the heuristic is admissible
+                #           but not always consistent)
+            if kind == 2:  # pushed with a lower bound of its heuristic: now the real one
+                h = self.heuristic(*node)
+                if g + h > bound:
+                    continue
+                if g + self.weight * h > f + 1e-9:
+                    heapq.heappush(heap, (g + self.weight * h, -g, next(tie), 0, lab, ()))
+                    continue
+            pops[node] = count + 1
+            closed_g[node] = min(g, closed_g.get(node, g))
+            self.expanded += 1
+            if self.expanded > self.budget:
+                raise SearchBudgetError(f"product search expanded {self.budget} nodes")
+            q, s = node
+            h_here = self.heuristic(q, s) if self.use_h else 0.0
+            if task >= 0:
+                c, again = self._tail_goal(q, s, self._tail(labels, lab))
+                if c:
+                    heapq.heappush(heap, (g + again, -g, next(tie), 1, lab, c))
+            if self.aut.loopable(q):
+                cyc = self.cycle_from(q, s)
+                if cyc is not None:
+                    heapq.heappush(heap, (g + cyc[0], -g - cyc[0], next(tie), 1, lab, cyc[1]))
+            for i in range(len(self.tasks)):
+                nxt = self.step(s, i)
+                if nxt is None:
+                    continue
+                s2, c = nxt
+                g2 = g + self._cost(node, i, c)
+                for q2, _m in self.aut.successors(q, i):
+                    node2 = (q2, self.forget(q2, s2))
+                    if pops.get(node2, 0) >= k and (k > 1 or g2 >= closed_g[node2] - 1e-9):
+                        continue
+                    if lazy:
+                        # weighted: push with h(here) - step cost (a consistent heuristic's
+                        # bound); the real value only if the child is popped (most never
+                        # are). The optimal search needs the real value: the heuristic is
+                        # admissible but not always consistent.
+                        h = max(0.0, h_here - c)
+                    else:
+                        h = self.heuristic(*node2) if self.use_h else 0.0
+                    if g2 + h > bound:
+                        continue
+                    labels.append((node2, lab, i, g2))
+                    heapq.heappush(heap, (g2 + self.weight * h, -g2, next(tie),
+                                          2 if lazy else 0, len(labels) - 1, ()))
+        return out
+
+    def _tail(self, labels: list, lab: int) -> tuple[int, ...]:
+        """The last (up to :data:`TAIL_STEPS`) tasks of a label's path."""
+        out = []
+        while lab > 0 and len(out) < TAIL_STEPS:
+            _node, parent, task, _g = labels[lab]
+            out.append(task)
+            lab = parent
+        return tuple(reversed(out))
+
+    def _tail_goal(self, q: int, s: CellState, tail: tuple[int, ...]) -> tuple[int, float]:
+        """The shortest ``c`` such that the path's last ``c`` steps, repeated forever from
+        ``q``, are accepted (then the path is a lasso whose cycle is its own tail), and
+        the cost of the further repetitions; ``(0, 0)`` if there is none."""
+        for c in range(1, len(tail) + 1):
+            cyc = tail[-c:]
+            key = (q, cyc)
+            ok = self._tails.get(key)
+            if ok is None:
+                ok = self._tails[key] = self._accepts_cycle(q, cyc)
+            again = self._again(s, cyc) if ok else None
+            if again is not None:
+                return c, again
+        return 0, 0.0
+
+    def _accepts_cycle(self, q0: int, cyc: tuple[int, ...]) -> bool:
+        """Whether the automaton accepts ``cyc^omega`` from state ``q0``."""
+        index = {(q0, 0): 0}
+        adj: list[list[tuple[int, frozenset[int]]]] = [[]]
+        stack = [(q0, 0)]
+        bits = range(self.aut.full.bit_length())
+        while stack:
+            q, pos = stack.pop()
+            src = index[(q, pos)]
+            nxt_pos = (pos + 1) % len(cyc)
+            for d, m in self.aut.successors(q, cyc[pos]):
+                key = (d, nxt_pos)
+                if key not in index:
+                    index[key] = len(adj)
+                    adj.append([])
+                    stack.append(key)
+                adj[src].append((index[key], frozenset(b for b in bits if m >> b & 1)))
+        return bool(accepting_components(adj, self.aut.full.bit_length()))
+
+    @staticmethod
+    def _path(labels: list, lab: int) -> tuple[int, ...]:
+        out = []
+        while lab > 0:
+            _node, parent, task, _g = labels[lab]
+            out.append(task)
+            lab = parent
+        return tuple(reversed(out))
+
+    def cost_of(self, tasks: Sequence[int]) -> float | None:
+        """Estimated seconds of doing ``tasks`` from the start (None if impossible)."""
+        s = self.model.initial_state()
+        total = 0.0
+        for i in tasks:
+            nxt = self.model.step(s, self.tasks[i])
+            if nxt is None:
+                return None
+            s, c = nxt
+            total += c
+        return total
+
+
+def seeded_noise(seed: int, factor: float) -> Callable[[tuple, int], float]:
+    """Cost factors in ``[1, factor]``, drawn once per (node, task) from ``seed``."""
+    rng = random.Random(seed)
+    drawn: dict[tuple[tuple, int], float] = {}
+
+    def noise(node: tuple, i: int) -> float:
+        key = (node, i)
+        x = drawn.get(key)
+        if x is None:
+            x = drawn[key] = 1.0 + (factor - 1.0) * rng.random()
+        return x
+
+    return noise
+

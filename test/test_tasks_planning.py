@@ -1,0 +1,177 @@
+"""The cell model for task planning and the product search: preconditions, physically
+consistent and cost-optimal first sequences, variations, explanations, the CLI."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from ltl_human_motion.cli import main
+from ltl_human_motion.errors import SpecError
+from ltl_human_motion.ltl import Atom, build_specification, evaluate_lasso
+from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
+from ltl_human_motion.tasks import CellModel, Limits, plan_sequences
+from ltl_human_motion.tasks.kitting import kitting_cell_yaml, kitting_spec
+from ltl_human_motion.tasks.sequences import RANDOM_COST_FACTOR, product_search
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _t(text: str) -> Atom:
+    name, _, rest = text.partition("(")
+    return Atom(name, tuple(a.strip() for a in rest.rstrip(")").split(",") if a.strip()))
+
+
+def _consistent(tasks, two_handed=frozenset(), fixed=frozenset()) -> None:
+    """An independent check of the physical rules: two hands, a part is grasped only when
+    not held, released only when held; move/insert/carry fetch a part not held."""
+    held: list[str] = []
+    for t in tasks:
+        part = t.args[0] if t.args else None
+        width = lambda p: 2 if p in two_handed else 1  # noqa: E731
+        if t.name in ("grasp", "move", "insert", "carry") and part not in held:
+            assert part not in fixed, f"{t}: a fixed object cannot be held"
+            assert sum(map(width, held)) + width(part) <= 2, f"{t}: a third part in two hands"
+            held.append(part)
+        elif t.name == "grasp":
+            raise AssertionError(f"{t}: the part is already in hand")
+        if t.name in ("release", "move", "insert"):
+            assert part in held, f"{t}: the part is not held"
+            held.remove(part)
+        if t.name == "assemble":
+            held.clear()
+
+
+@pytest.fixture(scope="module")
+def paper_cell():
+    return load_cell(ROOT / "config" / "paper_cell.yaml")
+
+
+def _kitting(n: int):
+    return cell_from_yaml(kitting_cell_yaml(n))
+
+
+def test_model_preconditions_and_effects():
+    cell = cell_from_yaml(kitting_cell_yaml(4).replace(
+        "P3: {position", "P3: {two_handed: true, position"))
+    m = CellModel.from_cell(cell)
+    s = m.initial_state()
+    assert m.step(s, _t("release(P0)")) is None           # not held
+    s1, c1 = m.step(s, _t("grasp(P0)"))
+    assert c1 > m.durations["grasp"] and s1.held == (0,)
+    assert m.step(s1, _t("grasp(P0)")) is None            # already in hand
+    s2, _ = m.step(s1, _t("grasp(P1)"))
+    assert m.step(s2, _t("grasp(P2)")) is None            # a third part in two hands
+    assert m.step(s2, _t("move(P2, R1)")) is None         # fetching it needs a free hand
+    assert m.step(s1, _t("grasp(P3)")) is None            # two-handed: both hands
+    s3, _ = m.step(s2, _t("move(P0, R1)"))
+    assert s3.held == (1,) and s3.location == m.region_location("R1")
+    assert m.step(s3, _t("walk(R1)")) is None             # already there
+    assert m.step(s3, _t("grasp(kit)")) is None           # a fixed object
+    s4, _ = m.step(s3, _t("insert(P1, kit)"))
+    assert s4.held == () and m.step(s4, _t("grasp(P1)")) is None   # inside the kit
+    s5, _ = m.step(s4, _t("extract(P1, kit)"))
+    assert s5.held == (1,)
+    seat = m.step(s, _t("sit(P0)"))[0]
+    assert m.step(seat, _t("sit(P0)")) is None            # sit needs standing
+    stand, cost = m.step(seat, _t("standUp"))
+    assert cost == m.durations["standUp"]
+    assert stand.posture == 0 and m.step(s, _t("standUp"))[0].posture == 0
+    assert m.with_limits(Limits(hands=4)).step(s2, _t("grasp(P2)")) is not None
+
+
+@pytest.mark.parametrize("n", [3, 6, 9])
+def test_grasp_each_part_exactly_once_with_the_forced_releases(n):
+    seqs, stats = plan_sequences(kitting_spec("grasp_each", n), _kitting(n), n=1)
+    tasks = seqs[0].tasks
+    grasps = [t for t in tasks if t.name == "grasp"]
+    assert sorted(t.args[0] for t in grasps) == sorted(f"P{i}" for i in range(n))
+    assert sum(t.name == "release" for t in tasks) == max(0, n - 2)
+    _consistent(tasks)
+    assert stats.optimal
+
+
+def test_first_sequence_is_cost_optimal_against_uniform_cost_search():
+    for family, n in (("grasp_each", 4), ("move_each", 3), ("response", 3),
+                      ("precedence", 4)):
+        cell = _kitting(n)
+        seqs, stats = plan_sequences(kitting_spec(family, n), cell, n=1)
+        spec = build_specification(kitting_spec(family, n), cell)
+        exhaustive, _, _ = product_search(spec, CellModel.from_cell(cell), weight=1.0,
+                                             budget=10**6, heuristic=False)
+        best = exhaustive.lassos(1)[0].cost
+        assert stats.costs[0] <= best * 1.01 + 1e-9, family
+        _consistent(seqs[0].tasks, fixed={"kit"})
+
+
+def test_move_each_part_to_the_tray_carries_two_at_a_time():
+    seqs, _ = plan_sequences(kitting_spec("move_each", 4), _kitting(4), n=1)
+    tasks = seqs[0].tasks
+    assert sorted(t.args[0] for t in tasks if t.name == "move") == ["P0", "P1", "P2", "P3"]
+    trips = sum(1 for a, b in zip(tasks, (*tasks[1:], None))
+                if a.name == "move" and (b is None or b.name != "move"))
+    assert trips == 2                    # two parts per walk to the tray
+    _consistent(tasks)
+
+
+def test_paper_specs_give_the_main_loops(paper_cell):
+    s1, _ = plan_sequences("S1", paper_cell, n=1)
+    assert s1[0].tasks == (_t("grasp(O1)"), _t("assemble(R1)"))
+    s2, _ = plan_sequences("S2", paper_cell, n=1)
+    assert set(s2[0].tasks) == {_t("grasp(O1)"), _t("grasp(O2)"), _t("assemble(R1)")}
+    assert len(s2[0].tasks) == 3
+
+
+@pytest.mark.parametrize("mode", ["random", "all", "coverage"])
+def test_variations_are_consistent_checked_and_cheap(paper_cell, mode):
+    seqs, stats = plan_sequences("S2", paper_cell, n=4, mode=mode, seed=5, cycles=2)
+    assert seqs and len(stats.costs) >= len(seqs)
+    spec = build_specification("S2", paper_cell)
+    for s in seqs:
+        assert evaluate_lasso(spec.formula, *s.lasso(paper_cell))
+        _consistent(s.tasks)
+    if mode == "random":
+        assert all(c <= RANDOM_COST_FACTOR * stats.costs[0] + 1e-9 for c in stats.costs)
+    if mode == "all":
+        assert stats.costs[:len(seqs)] == sorted(stats.costs[:len(seqs)])
+    again, _ = plan_sequences("S2", paper_cell, n=4, mode=mode, seed=5, cycles=2)
+    assert [str(s) for s in again] == [str(s) for s in seqs]
+
+
+def test_three_parts_in_hand_is_explained():
+    text = ("F(grasp(P0) & X F(grasp(P1) & X F grasp(P2))) & G !release(P0) & "
+            "G !release(P1) & G !release(P2)")
+    with pytest.raises(SpecError) as err:
+        plan_sequences(text, _kitting(3), n=1)
+    msg = str(err.value)
+    assert "satisfiable" in msg and "2 hands" in msg and "unsatisfiable" not in msg
+    assert "G !release(P0)" in msg and "conjunct" in msg
+
+
+def test_cli_tasks_uses_the_cell_model(capsys, tmp_path):
+    path = tmp_path / "kit.yaml"
+    path.write_text(kitting_cell_yaml(4))
+    assert main(["tasks", kitting_spec("grasp_each", 4), "--cell", str(path), "-n", "1"]) == 0
+    out = capsys.readouterr().out
+    first = next(line for line in out.splitlines() if line.startswith("1: "))
+    assert first.count("grasp(") == 4 and first.count("release(") == 2
+    assert "estimated time" in out
+
+
+def test_explicit_automaton_view_gives_the_same_optimum(paper_cell):
+    """The product with an explicit automaton (the built-in translator's, as Spot's would
+    be with backend="spot") finds lassos of the same cost as the on-the-fly tableau."""
+    from ltl_human_motion.ltl import translate
+    from ltl_human_motion.tasks import ExplicitView, ProductSearch
+    from ltl_human_motion.tasks.sequences import task_steps
+    for name in ("S1", "S2"):
+        spec = build_specification(name, paper_cell)
+        model = CellModel.from_cell(paper_cell)
+        tasks, letters = task_steps(spec, model)
+        view = ExplicitView(translate(spec.formula, backend="builtin"), letters)
+        explicit = ProductSearch(view, model, tasks).lassos(1)[0]
+        onthefly, _, _ = product_search(spec, model)
+        assert explicit.cost == pytest.approx(onthefly.lassos(1)[0].cost)
+        assert evaluate_lasso(spec.formula, [letters[i] for i in explicit.prefix],
+                              [letters[i] for i in explicit.cycle])
