@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 
 
 class LaunchConfiguration:
@@ -46,6 +47,33 @@ def launch_description(monkeypatch: pytest.MonkeyPatch, launch_file: Path) -> li
 
 
 def launched_nodes(description: list, context: dict[str, str]) -> list[dict[str, Any]]:
-    """Keyword arguments of every Node the description's OpaqueFunction creates."""
+    """Keyword arguments of every Node the description's OpaqueFunction creates, with the
+    launch arguments of ``context`` and the declared defaults of the others."""
+    defaults = {a[1]: a[2]["default_value"] for a in description if isinstance(a, tuple)}
     opaque = next(a for a in description if isinstance(a, OpaqueFunction))
-    return opaque.function(context)
+    return opaque.function({**defaults, **context})
+
+
+def launch_ros_command(node: dict[str, Any], folder: Path) -> list[str]:
+    """The ``--ros-args`` a launch_ros ``Node`` with these keyword arguments puts on the
+    command line of its process (launch_ros 0.19+ semantics, reproduced here because
+    launch_ros itself cannot be installed):
+
+    * ``name`` -> ``-r __node:=<name>``, ``namespace`` -> ``-r __ns:=/<namespace>``;
+    * a ``str`` entry of ``parameters`` -> ``--params-file <path>``;
+    * a ``dict`` entry -> a params file that launch_ros writes itself, under the node's
+      full name when both name and namespace are given, else under ``/**``.
+    """
+    args = ["--ros-args", "-r", f"__node:={node['name']}"]
+    namespace = node.get("namespace")
+    if namespace:
+        args += ["-r", f"__ns:=/{namespace.strip('/')}"]
+    for i, entry in enumerate(node.get("parameters") or []):
+        if isinstance(entry, dict):
+            key = f"/{namespace.strip('/')}/{node['name']}" if namespace else "/**"
+            path = folder / f"launch_params_{node['name']}_{i}.yaml"
+            path.write_text(yaml.safe_dump({key: {"ros__parameters": entry}}))
+            args += ["--params-file", str(path)]
+        else:
+            args += ["--params-file", str(entry)]
+    return args

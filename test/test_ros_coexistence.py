@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+import yaml
 
 rclpy = pytest.importorskip("rclpy")
 rtde_receive = pytest.importorskip("rtde_receive")
@@ -361,8 +362,9 @@ def test_launch_file_and_bringup_start_the_same_nodes(monkeypatch: pytest.Monkey
             assert coexistence.get_parameter(name).value == \
                 load_bringup_config(CONFIG).parameter(spec, name)
         launched_coex = next(kw for kw in launched if kw["name"] == "coexistence_node")
-        assert launched_coex["parameters"] == [str(CONFIG.resolve()),
-                                               {"robot_host": "127.0.0.2"}]
+        assert launched_coex["parameters"][0] == str(CONFIG.resolve())
+        override = yaml.safe_load(Path(launched_coex["parameters"][1]).read_text())
+        assert override["coexistence_node"]["ros__parameters"] == {"robot_host": "127.0.0.2"}
     finally:
         bringup.shutdown()
     tree = ast.parse(LAUNCH_FILE.read_text())

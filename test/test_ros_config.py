@@ -69,7 +69,8 @@ def test_launch_file_and_bringup_start_the_same_nodes_with_the_same_parameters(
             assert kw["package"] == "ltl_human_motion"
             assert kw["executable"] == KIND[type(node).__name__]
             assert kw["parameters"][0] == str(config.resolve())
-            extra = kw["parameters"][1] if len(kw["parameters"]) > 1 else {}
+            extra = yaml.safe_load(Path(kw["parameters"][1]).read_text())["/**"][
+                "ros__parameters"] if len(kw["parameters"]) > 1 else {}
             expected = {**_yaml_parameters(data, (kw["namespace"] or ""), kw["name"]), **extra}
             expected.pop("store_dir", None)            # overridden for this test
             declared = {k: v for k, v in expected.items() if node.has_parameter(k)}

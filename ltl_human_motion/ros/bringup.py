@@ -9,6 +9,7 @@ publisher and occupancy node share one :class:`Playback` clock.
 
 from __future__ import annotations
 
+import gc
 import sys
 import threading
 import time
@@ -25,7 +26,7 @@ from ltl_human_motion.ros.bringup_config import BringupConfig, NodeSpec, load_br
 from ltl_human_motion.ros.common import SpinThread
 from ltl_human_motion.ros.middleware import apply_middleware_defaults
 from ltl_human_motion.ros.motion_store import MotionStore
-from ltl_human_motion.ros.occupancy_node import OccupancyNode
+from ltl_human_motion.ros.occupancy_node import STREAM_SWITCH_INTERVAL, OccupancyNode
 from ltl_human_motion.ros.playback import Playback
 from ltl_human_motion.ros.recorder import Recorder
 from ltl_human_motion.ros.skeleton_publisher import SkeletonPublisher
@@ -78,6 +79,11 @@ class Bringup:
                                          context=context)
             for spec in self.config.node_specs():
                 self.nodes.append(self._make(spec, synthesize_fn))
+            if any(isinstance(n, OccupancyNode) for n in self.nodes):
+                # The occupancy stream thread waits less for the GIL, and what exists now
+                # stays out of the collector's full passes (which hold the GIL).
+                sys.setswitchinterval(min(sys.getswitchinterval(), STREAM_SWITCH_INTERVAL))
+                gc.freeze()
         except BaseException:
             self.shutdown()
             raise

@@ -18,11 +18,16 @@ human's nodes run in namespace ``human_<id>`` with parameter ``human_id: <id>``.
 
 from __future__ import annotations
 
+import hashlib
+import tempfile
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import yaml
+
+from ltl_human_motion.atomic import atomic_write_text
 
 PACKAGE = "ltl_human_motion"
 #: Node kinds a bringup can start, in start order.
@@ -80,6 +85,14 @@ class BringupConfig:
                     value = values[name]
         return node.parameters.get(name, value)
 
+    def matching_sections(self, node: NodeSpec) -> list[str]:
+        """Keys of the file's sections that apply to ``node`` (as written in the file),
+        plus ``/**`` and the node's fully qualified name."""
+        keys = ["/**", f"/**/{node.name}", node.name, node.fully_qualified_name,
+                node.fully_qualified_name.lstrip("/")]
+        found = [k for k in keys if isinstance(self.params.get(k), dict)]
+        return list(dict.fromkeys(["/**", *found, node.fully_qualified_name]))
+
     def ros_args(self) -> list[str]:
         """Command-line arguments that hand this file to every node of a context."""
         return ["--ros-args", "--params-file", str(self.path)]
@@ -98,6 +111,15 @@ class BringupConfig:
                 out[self.parameter(spec, "markers_topic", "/markers")] = \
                     "visualization_msgs/msg/MarkerArray"
                 out[f"{ns}/task_state"] = f"{PACKAGE}/msg/TaskState"
+                if self.parameter(spec, "rep155", True):
+                    from ltl_human_motion.motion.urdf import body_id
+
+                    body = f"/humans/bodies/{body_id(spec.parameters.get('human_id', '1'))}"
+                    out["/humans/bodies/tracked"] = "hri_msgs/msg/IdsList"
+                    out[f"{body}/joint_states"] = "sensor_msgs/msg/JointState"
+                    out[f"{body}/urdf"] = "std_msgs/msg/String"
+                    out[f"{body}/position"] = "geometry_msgs/msg/PointStamped"
+                    out[f"{body}/velocity"] = "geometry_msgs/msg/TwistStamped"
             elif spec.executable == "occupancy_node":
                 out[f"{ns}/occupancy"] = f"{PACKAGE}/msg/HumanOccupancy"
                 if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
@@ -150,3 +172,73 @@ def load_bringup_config(path: str | Path | None = None) -> BringupConfig:
         raise ValueError(f"{path}: bringup.executor_threads must be an integer >= 2")
     ordered = tuple(k for k in NODE_KINDS if k in nodes)
     return BringupConfig(path.resolve(), ordered, tuple(humans), threads, data)
+
+
+@dataclass(frozen=True)
+class LaunchArgument:
+    """A ``ros2 launch`` argument that sets one node parameter on top of the file.
+
+    An empty value (the default) keeps the file's value.
+    """
+
+    name: str
+    parameter: str
+    executables: tuple[str, ...]
+    description: str
+
+
+#: The launch arguments of each launch file (besides ``config:=``), by file stem.
+LAUNCH_ARGUMENTS: dict[str, tuple[LaunchArgument, ...]] = {
+    "bringup.launch": (
+        LaunchArgument("store_dir", "store_dir",
+                       ("synthesis_node", "skeleton_publisher", "occupancy_node"),
+                       "folder of <motion_id>.npz ('' = the file's)"),
+    ),
+    "coexistence.launch": (
+        LaunchArgument("robot_host", "robot_host", ("coexistence_node",),
+                       "robot controller address ('' = the file's)"),
+        LaunchArgument("store_dir", "store_dir",
+                       ("synthesis_node", "skeleton_publisher", "occupancy_node"),
+                       "folder of <motion_id>.npz ('' = the file's)"),
+    ),
+}
+
+
+def launch_overrides(arguments: tuple[LaunchArgument, ...], values: Mapping[str, str],
+                     node: NodeSpec) -> dict[str, Any]:
+    """The parameters the launch ``values`` (argument name -> text) set on ``node``."""
+    return {arg.parameter: values[arg.name] for arg in arguments
+            if node.executable in arg.executables and values.get(arg.name, "") != ""}
+
+
+def write_override_params(config: BringupConfig, node: NodeSpec,
+                          overrides: Mapping[str, Any], folder: str | Path | None = None
+                          ) -> Path | None:
+    """A params file that makes ``node.parameters`` and ``overrides`` beat ``config``.
+
+    rcl merges the ``--params-file`` files of a node in order (a later file replaces a
+    value of the same section and name) and then lets a node-specific section win over
+    ``/**``. A dict handed to launch_ros lands in a ``/**`` section of its own, so the
+    file's ``<node>:`` section would still win (issue 14). This file instead repeats the
+    values under every section of ``config`` that applies to the node (and under
+    ``/**`` and the node's full name), so given after ``config`` they win whatever the
+    precedence between sections. Returns None when there is nothing to override.
+    """
+    values = {**node.parameters, **overrides}
+    if not values:
+        return None
+    data = {key: {"ros__parameters": dict(values)} for key in config.matching_sections(node)}
+    folder = Path(folder) if folder is not None else Path(tempfile.gettempdir())
+    tag = node.fully_qualified_name.strip("/").replace("/", "__")
+    text = yaml.safe_dump(data, sort_keys=False)
+    digest = hashlib.sha256(f"{config.path}\n{text}".encode()).hexdigest()[:16]
+    path = folder / f"ltl_human_motion_launch_{tag}_{digest}.yaml"
+    atomic_write_text(path, text)
+    return path
+
+
+def launch_parameters(config: BringupConfig, node: NodeSpec, overrides: Mapping[str, Any],
+                      folder: str | Path | None = None) -> list[str]:
+    """``parameters=`` of a launch_ros Node: the config file, then the override file."""
+    extra = write_override_params(config, node, overrides, folder)
+    return [str(config.path)] + ([str(extra)] if extra is not None else [])

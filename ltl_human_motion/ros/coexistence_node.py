@@ -81,6 +81,7 @@ from ltl_human_motion.ros.params import (
     positive,
     topic_name,
 )
+from ltl_human_motion.ros.rtde_probe import probed_factories
 
 __all__ = ["CONTROL_SWITCH_INTERVAL", "OCCUPANCY_TYPE", "UR_JOINT_NAMES", "CoexistenceNode",
            "OccupancySample", "coexistence_parameters", "decode_human_occupancy",
@@ -96,6 +97,8 @@ OCCUPANCY_TYPE = "ltl_human_motion/msg/HumanOccupancy"
 #: modes with 0.2 ms, against 100 / 39 Hz (reactive / predictive) with 1 ms
 #: (bench/coexistence_loop.py, 2 cores).
 CONTROL_SWITCH_INTERVAL = 0.0002
+#: Seconds between two "robot controller not reachable" warnings.
+REFUSAL_LOG_PERIOD = 10.0
 _MODE_COLORS = {"full": (0.2, 0.8, 0.2), "reduced": (1.0, 0.8, 0.0), "stop": (0.9, 0.1, 0.1),
                 "stale": (0.5, 0.5, 0.5), "disconnected": (0.3, 0.3, 0.3)}
 
@@ -264,7 +267,8 @@ class CoexistenceNode(Node):
             if (record if record is not None else self.metrics_out is not None) else None
         self._extra_on_decision = on_decision
         if receive_factory is None or io_factory is None:
-            default_receive, default_io = ur_rtde_factories(p("robot_host"))
+            default_receive, default_io = probed_factories(
+                ur_rtde_factories(p("robot_host")), p("robot_host"), self._report_refusal)
             receive_factory = receive_factory or default_receive
             io_factory = io_factory or default_io
         self.controller = CoexistenceController(
@@ -306,6 +310,12 @@ class CoexistenceNode(Node):
             f"{self.model.name} at {p('robot_host')}: {mode} SSM at {self.rate:g} Hz, "
             f"S_p = {self.params.protective_distance:.3f} m, occupancy from "
             f"{p('occupancy_topic')}")
+
+    def _report_refusal(self, message: str) -> None:
+        """ur_rtde's bare "connect: Connection refused", as a throttled ROS warning."""
+        self.get_logger().warning(f"{message}; retrying (is the robot, URSim or "
+                                  f"`ltl-human-motion ur-sim` running?)",
+                                  throttle_duration_sec=REFUSAL_LOG_PERIOD)
 
     def param(self, name: str) -> Any:
         return self.get_parameter(name).value

@@ -122,10 +122,14 @@ def body_capsules(positions: np.ndarray, stature: float) -> tuple[np.ndarray, np
 
     Thin adapter over ``scene.occupancy.capsules_from_positions`` and ``BODY_CAPSULES``.
     """
-    occupancy = _occupancy_module()
-    segments, radii = occupancy.capsules_from_positions(positions, stature=stature)
-    names = [str(entry[0]) for entry in occupancy.BODY_CAPSULES]
-    return np.asarray(segments, dtype=np.float64), np.asarray(radii, dtype=np.float64), names
+    segments, radii = _occupancy_module().capsules_from_positions(positions, stature=stature)
+    return (np.asarray(segments, dtype=np.float64), np.asarray(radii, dtype=np.float64),
+            capsule_part_names())
+
+
+def capsule_part_names() -> list[str]:
+    """Part names (K,) of the body capsules, in ``BODY_CAPSULES`` order."""
+    return [str(entry[0]) for entry in _occupancy_module().BODY_CAPSULES]
 
 
 @lru_cache(maxsize=1)

@@ -9,6 +9,7 @@ invalid parameters, with the message on stderr).
 
 from __future__ import annotations
 
+import gc
 import sys
 from collections.abc import Callable
 
@@ -55,9 +56,25 @@ def skeleton_publisher(args: list[str] | None = None) -> int:
 
 def occupancy_node(args: list[str] | None = None) -> int:
     """Stream ``occupancy``, following the skeleton publisher's ``task_state``."""
-    from ltl_human_motion.ros.occupancy_node import OccupancyNode
+    from ltl_human_motion.ros.occupancy_node import STREAM_SWITCH_INTERVAL, OccupancyNode
+    from ltl_human_motion.ros.wall_schedule import realtime_process
 
-    return _run_node(OccupancyNode, args)
+    sys.setswitchinterval(STREAM_SWITCH_INTERVAL)    # the stream thread waits less for the GIL
+
+    def make() -> OccupancyNode:
+        node = OccupancyNode()
+        # What exists now lives as long as the process: keep it out of the collector's
+        # full passes, which hold the GIL (and so stall the stream) for their duration.
+        gc.freeze()
+        priority = node.get_parameter("stream_priority").value
+        refused = realtime_process(priority) if priority > 0 else ""
+        if refused:
+            node.get_logger().info(f"process: {refused}; normal scheduling")
+        elif priority > 0:
+            node.get_logger().info(f"process: all threads SCHED_FIFO {priority}")
+        return node
+
+    return _run_node(make, args)
 
 
 def coexistence_node(args: list[str] | None = None) -> int:

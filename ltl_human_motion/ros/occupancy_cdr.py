@@ -84,9 +84,29 @@ def encode_human_occupancy(sec: int, nanosec: int, frame_id: str, human_id: str,
     if segments.shape[2:] != (2, 3) or radii.shape != (k,) or len(offsets) != n:
         raise ValueError(f"need segments (N, K, 2, 3), radii (K,), offsets (N,); got "
                          f"{segments.shape}, {radii.shape}, {len(offsets)}")
-    # One capsule = a.x a.y a.z b.x b.y b.z radius: 7 float64, no padding in between.
-    rows = np.concatenate([segments.reshape(n, k, 6),
-                           np.broadcast_to(radii[None, :, None], (n, k, 1))], axis=-1)
+    return encode_occupancy_rows(sec, nanosec, frame_id, human_id, part_names,
+                                 capsule_rows(segments, radii), offsets)
+
+
+def capsule_rows(segments: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """Capsules as CDR rows ``a.x a.y a.z b.x b.y b.z radius``: (..., K, 7) from segments
+    (..., K, 2, 3) and radii (K,)."""
+    segments = np.asarray(segments, dtype=np.float64)
+    lead = segments.shape[:-2]
+    radius = np.broadcast_to(np.asarray(radii, dtype=np.float64)[..., None], (*lead, 1))
+    return np.concatenate([segments.reshape(*lead, 6), radius], axis=-1)
+
+
+def encode_occupancy_rows(sec: int, nanosec: int, frame_id: str, human_id: str,
+                          part_names: Sequence[str], rows: np.ndarray,
+                          offsets: np.ndarray) -> bytes:
+    """CDR bytes of a ``HumanOccupancy`` from capsule rows (N, K, 7)
+    (:func:`capsule_rows`) at ``offsets`` (N,); see :func:`encode_human_occupancy`."""
+    rows = np.asarray(rows, dtype=np.float64)
+    n, k = rows.shape[:2]
+    if rows.shape[2:] != (7,) or len(offsets) != n:
+        raise ValueError(f"need rows (N, K, 7) and offsets (N,); got {rows.shape}, "
+                         f"{len(offsets)}")
     buf = _Buffer()
     buf.int32(int(sec))
     buf.uint32(int(nanosec))

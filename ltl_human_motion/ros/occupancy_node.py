@@ -19,10 +19,24 @@ Playback clock, so the occupancy never drifts from the skeleton shown on TF:
   state; the node re-anchors its own playback on it and extrapolates in between. The
   motion itself is loaded by id from the folder named on ``catalog_topic``.
 
+Timing: the stream runs on a :class:`~ltl_human_motion.ros.wall_schedule.WallSchedule`
+thread (an absolute schedule on the monotonic clock, outside the executor, so other
+callbacks of the process cannot delay it and a late tick does not shift the ones after
+it). Capsule rows of every frame are computed once when a motion is loaded, so a message
+costs one interpolation and the CDR encoding. A tick that starts a period or more late
+counts as a missed deadline: ``deadlines_missed`` counts them and a warning (throttled to
+one per :data:`MISS_WARNING_PERIOD`) gives the count and the worst delay. On a loaded
+machine the thread's wake-up can wait longer than a period for a CPU, so it asks for a
+real-time priority (``stream_priority``; refused without CAP_SYS_NICE or an ``rtprio``
+limit, and then logged). With
+``use_sim_time`` the stream follows the ROS clock on an rclpy timer instead.
+
 Parameters: ``human_id`` ("1"), ``world_frame`` ("world"), ``rate`` (100.0 Hz),
 ``prediction_horizon`` (0.0 s = off), ``prediction_step`` (0.1 s), ``marker_rate``
 (10.0 Hz; 0 = off), ``store_dir`` (""), ``catalog_topic`` ("/motion_catalog"),
-``task_state_topic`` ("task_state"), ``markers_topic`` ("/occupancy_markers").
+``task_state_topic`` ("task_state"), ``markers_topic`` ("/occupancy_markers"),
+``stream_priority`` (10: ``SCHED_FIFO`` priority of the stream thread where the process
+may have it; 0 = normal scheduling).
 """
 
 from __future__ import annotations
@@ -39,7 +53,7 @@ from ltl_human_motion.msg import HumanOccupancy, MotionCatalog, TaskState
 from ltl_human_motion.ros import conversions as cv
 from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS, now_seconds, stamp_seconds
 from ltl_human_motion.ros.motion_store import MotionSource, MotionStore
-from ltl_human_motion.ros.occupancy_cdr import encode_human_occupancy
+from ltl_human_motion.ros.occupancy_cdr import capsule_rows, encode_occupancy_rows
 from ltl_human_motion.ros.params import (
     ParamSpec,
     declare_parameters,
@@ -50,6 +64,24 @@ from ltl_human_motion.ros.params import (
     topic_name,
 )
 from ltl_human_motion.ros.playback import STATES, STOPPED, Playback
+from ltl_human_motion.ros.wall_schedule import WallSchedule
+
+#: Seconds between two missed-deadline warnings of one node.
+MISS_WARNING_PERIOD = 5.0
+#: GIL switch interval (s) of a process that runs an occupancy node by itself: the stream
+#: thread waits at most this long for the GIL after its sleep (CPython's default is 5 ms,
+#: half a 100 Hz period). Same value as the coexistence node's control loop
+#: (``coexistence_node.CONTROL_SWITCH_INTERVAL``, measured there: bench/coexistence_loop.py).
+STREAM_SWITCH_INTERVAL = 0.0002
+_ROWS_KEY = "occupancy_capsule_rows"
+#: SCHED_FIFO priority asked for the stream thread: above normal threads, below the
+#: kernel's own and typical ros2_control loops (which use 50 and up).
+DEFAULT_STREAM_PRIORITY = 10
+
+
+def _priority(value: Any) -> str | None:
+    ok = isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= 99
+    return None if ok else f"expected an integer 0..99, got {value!r}"
 
 
 def occupancy_parameters() -> list[ParamSpec]:
@@ -65,6 +97,10 @@ def occupancy_parameters() -> list[ParamSpec]:
         ParamSpec("marker_rate", 10.0, "Occupancy marker messages per second (0 = none)",
                   non_negative),
         ParamSpec("store_dir", "", "Folder of <motion_id>.npz ('' = use the catalog's)",
+                  read_only=True),
+        ParamSpec("stream_priority", DEFAULT_STREAM_PRIORITY,
+                  "SCHED_FIFO priority of the stream thread (0 = normal scheduling; "
+                  "refused without CAP_SYS_NICE/rtprio, then normal)", _priority,
                   read_only=True),
         ParamSpec("catalog_topic", "/motion_catalog", "Latched MotionCatalog topic",
                   topic_name, read_only=True),
@@ -111,12 +147,26 @@ class OccupancyNode(Node):
             self.create_subscription(MotionCatalog, self.param("catalog_topic"),
                                      self.source.on_catalog, LATCHED_QOS)
         self._group = MutuallyExclusiveCallbackGroup()
-        self._timer = self.create_timer(1.0 / self.param("rate"), self._tick,
-                                        callback_group=self._group)
+        self._names = cv.capsule_part_names()
+        self.deadlines_missed = 0
+        self._timer = None
+        self._schedule: WallSchedule | None = None
+        if self.param("use_sim_time"):
+            self._timer = self.create_timer(1.0 / self.param("rate"), self._tick,
+                                            callback_group=self._group)
+        else:
+            self._schedule = WallSchedule(1.0 / self.param("rate"), self._tick,
+                                          on_miss=self._on_miss, on_error=self._on_error,
+                                          name=f"occupancy-{self.human_id}",
+                                          priority=self.param("stream_priority"))
+            if self._schedule.priority_error:
+                self.get_logger().info(f"stream thread: {self._schedule.priority_error}")
         self._marker_timer = None
         self._set_marker_timer(self.param("marker_rate"))
         self.add_post_set_parameters_callback(self._on_parameters_set)
         mode = "following task_state" if self.following else "sharing the playback clock"
+        if self._schedule is not None and self._schedule.realtime:
+            mode += f", stream thread SCHED_FIFO {self._schedule.priority}"
         self.get_logger().info(f"occupancy of human {self.human_id} at {self.param('rate'):g} Hz"
                                f" ({mode})")
 
@@ -132,9 +182,27 @@ class OccupancyNode(Node):
             self._marker_timer = self.create_timer(1.0 / rate, self._publish_markers,
                                                    callback_group=MutuallyExclusiveCallbackGroup())
 
+    def _on_miss(self, skipped: int, late: float) -> None:
+        self.deadlines_missed += skipped
+        self.get_logger().warning(
+            f"occupancy stream of human {self.human_id} missed {self.deadlines_missed} "
+            f"deadline(s) so far (this tick {late * 1e3:.1f} ms late, "
+            f"{skipped} message(s) skipped)", throttle_duration_sec=MISS_WARNING_PERIOD)
+
+    def _on_error(self, exc: BaseException) -> None:
+        self.get_logger().error(f"occupancy tick failed: {type(exc).__name__}: {exc}",
+                                throttle_duration_sec=MISS_WARNING_PERIOD)
+
+    def destroy_node(self) -> None:
+        if self._schedule is not None:
+            self._schedule.stop()
+        super().destroy_node()
+
     def _on_parameters_set(self, params: list[Parameter]) -> None:
         for p in params:
-            if p.name == "rate":
+            if p.name == "rate" and self._schedule is not None:
+                self._schedule.set_period(1.0 / p.value)
+            elif p.name == "rate":
                 self._timer.cancel()
                 self.destroy_timer(self._timer)
                 self._timer = self.create_timer(1.0 / p.value, self._tick,
@@ -167,16 +235,23 @@ class OccupancyNode(Node):
         n = int(np.floor(horizon / step + 1e-9)) if horizon > 0 else 0
         return np.arange(n + 1) * step
 
+    def _rows_per_frame(self, positions: np.ndarray) -> np.ndarray:
+        """Capsule rows (T, K, 7) of every frame of positions (T, J, 3)."""
+        segments, radii, _ = cv.body_capsules(positions, self.playback.stature)
+        return capsule_rows(segments, radii)
+
     def _tick(self) -> None:
         now = self.get_clock().now()
         offsets = self.offsets()
-        positions = self.playback.positions_ahead(now.nanoseconds * 1e-9, offsets)
-        if positions is None:
+        rows = self.playback.sample_ahead(now.nanoseconds * 1e-9, offsets, _ROWS_KEY,
+                                          self._rows_per_frame)
+        if rows is None:
             return
-        segments, radii, names = cv.body_capsules(positions, self.playback.stature)
         sec, nanosec = divmod(now.nanoseconds, 1_000_000_000)
-        self._pub.publish(encode_human_occupancy(sec, nanosec, self.world_frame, self.human_id,
-                                                 names, segments, radii, offsets))
+        if not self.context.ok():            # shutting down (Ctrl-C, SIGTERM)
+            return
+        self._pub.publish(encode_occupancy_rows(sec, nanosec, self.world_frame,
+                                                self.human_id, self._names, rows, offsets))
         self.messages_published += 1
 
     def _publish_markers(self) -> None:

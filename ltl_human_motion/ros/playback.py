@@ -115,6 +115,25 @@ class _MotionArrays:
         yaw = self.yaw[i0] * (1.0 - w) + self.yaw[i1] * w
         return pos, yaw, i0
 
+    def table(self, key: str, per_frame: Any) -> np.ndarray:
+        """``per_frame(positions)`` (T, ...) for this motion, computed once and kept."""
+        cache = self.__dict__.setdefault("_tables", {})
+        if key not in cache:
+            values = np.ascontiguousarray(per_frame(self.positions), dtype=np.float64)
+            if len(values) != self.n_frames:
+                raise ValueError(f"per-frame table {key!r} has {len(values)} rows, the "
+                                 f"motion {self.n_frames} frames")
+            cache[key] = values
+        return cache[key]
+
+    def interpolate_table(self, table: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """Rows of a per-frame ``table`` (T, ...) at motion times (N,): (N, ...)."""
+        f = np.clip(np.asarray(times, dtype=np.float64) * self.fps, 0.0, self.n_frames - 1)
+        i0 = np.floor(f).astype(np.int64)
+        i1 = np.minimum(i0 + 1, self.n_frames - 1)
+        w = (f - i0).reshape((-1,) + (1,) * (table.ndim - 1))
+        return table[i0] * (1.0 - w) + table[i1] * w
+
     def objects_at(self, index: int, w: float) -> dict[str, np.ndarray]:
         i1 = min(index + 1, self.n_frames - 1)
         out = {}
@@ -192,6 +211,10 @@ class Playback:
     @property
     def stature(self) -> float:
         return self._arrays.stature if self._arrays is not None else 1.75
+
+    @property
+    def fps(self) -> float:
+        return self._arrays.fps if self._arrays is not None else 0.0
 
     def state(self, now: float) -> str:
         """The state at clock time ``now`` (a motion played once finishes by itself)."""
@@ -291,6 +314,29 @@ class Playback:
 
         Follows the playback: rate, looping, holding at the end, pausing.
         """
+        ahead = self._times_ahead(now, offsets)
+        if ahead is None:
+            return None
+        arrays, times = ahead
+        return arrays.interpolate(times)[0]
+
+    def sample_ahead(self, now: float, offsets: np.ndarray, key: str,
+                     per_frame: Any) -> np.ndarray | None:
+        """Like :meth:`positions_ahead` for a per-frame table of the motion: rows (N, ...)
+        of ``per_frame(positions (T, J, 3)) -> (T, ...)``, interpolated between frames.
+
+        The table is computed once per loaded motion (cached under ``key``), so a
+        quantity that is linear in the joint positions (capsule end points) costs one
+        interpolation per call. None when stopped.
+        """
+        ahead = self._times_ahead(now, offsets)
+        if ahead is None:
+            return None
+        arrays, times = ahead
+        return arrays.interpolate_table(arrays.table(key, per_frame), times)
+
+    def _times_ahead(self, now: float, offsets: np.ndarray
+                     ) -> tuple[_MotionArrays, np.ndarray] | None:
         offsets = np.asarray(offsets, dtype=np.float64)
         with self._lock:
             t = self.motion_time(now)
@@ -303,7 +349,7 @@ class Playback:
                 times = np.mod(times, arrays.duration)
         else:
             times = np.full(offsets.shape, t)
-        return arrays.interpolate(np.clip(times, 0.0, arrays.duration))[0]
+        return arrays, np.clip(times, 0.0, arrays.duration)
 
     # -- internals ----------------------------------------------------------------------
     def _motion_time(self, now: float) -> float:

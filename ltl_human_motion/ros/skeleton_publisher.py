@@ -20,6 +20,10 @@ Publishes, at ``publish_rate`` (stamps and playback time come from the node cloc
 * ``task_state`` (ltl_human_motion/msg/TaskState): the current task, progress and the
   playback state (``playing``/``paused``/``finished``/``stopped``, rate, loop), which lets
   an occupancy node in another process follow this playback.
+* With ``rep155`` (default true), the REP 155 (ROS4HRI) body interface of
+  :mod:`ltl_human_motion.ros.hri`: ``/humans/bodies/tracked``, ``/humans/bodies/<id>/``
+  ``joint_states``, ``urdf``, ``position``, ``velocity``, and the frames ``body_<id>``,
+  ``head_<id>``, ... (all URDF joint links unless ``rep155_link_frames`` is false).
 
 Service ``play_motion`` (ltl_human_motion/srv/PlayMotion): ``play`` (motion_id, loop,
 rate), ``stop``, ``pause``, ``resume``. Motions come from the shared
@@ -57,6 +61,7 @@ from ltl_human_motion.ros.common import (
     now_seconds,
     resolve_cell,
 )
+from ltl_human_motion.ros.hri import BodyInterface
 from ltl_human_motion.ros.motion_store import MotionSource, MotionStore, check_motion_id
 from ltl_human_motion.ros.params import (
     ParamSpec,
@@ -95,6 +100,11 @@ def skeleton_parameters() -> list[ParamSpec]:
         ParamSpec("catalog_topic", "/motion_catalog", "Latched MotionCatalog topic",
                   topic_name, read_only=True),
         ParamSpec("markers_topic", "/markers", "MarkerArray topic", topic_name, read_only=True),
+        ParamSpec("rep155", True, "Publish the REP 155 body interface (/humans/bodies/...)",
+                  read_only=True),
+        ParamSpec("rep155_link_frames", True, "Put every URDF joint link (body_<id>, "
+                  "head_<id>, ...) on TF; false: only world -> body_<id> (when "
+                  "robot_state_publisher runs with the URDF)", read_only=True),
     ]
 
 
@@ -146,6 +156,9 @@ class SkeletonPublisher(Node):
                                         callback_group=self._timer_group)
         self._scene_timer = self.create_timer(self.param("scene_period"), self._publish_scene,
                                               callback_group=self._timer_group)
+        self.body = BodyInterface(self, self.human_id, self.world_frame,
+                                  self.param("rep155_link_frames"), self._tf_pub) \
+            if self.param("rep155") else None
         self.add_post_set_parameters_callback(self._on_parameters_set)
         self._publish_static_frames()
         self._publish_scene()
@@ -219,6 +232,8 @@ class SkeletonPublisher(Node):
 
     def _play(self, motion_id: str, loop: bool, rate: float) -> None:
         motion = self.source.get(motion_id)
+        if self.body is not None:
+            self.body.prepare(motion_id, motion)    # before the clock starts: may take a while
         self.playback.play(motion_id, motion, now_seconds(self), rate=rate, loop=loop)
         self.get_logger().info(f"playing {motion_id} ({self.playback.duration:.2f} s)")
 
@@ -249,6 +264,8 @@ class SkeletonPublisher(Node):
                 frame.positions, frame.yaw, self.human_id, self.world_frame, stamp)))
             self._publish_markers(frame, stamp)
             self.frames_published += 1
+        if self.body is not None:
+            self.body.publish(frame, self.playback, stamp)
         self._state_pub.publish(self._task_state(frame, stamp))
 
     def _task_state(self, frame: Frame | None, stamp: Any) -> TaskState:

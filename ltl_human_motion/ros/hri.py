@@ -1,0 +1,261 @@
+"""The REP 155 (ROS4HRI) body interface of one synthesized worker.
+
+HRI software written for tracked humans (ROS4HRI's ``hri`` listeners, RViz's humans
+plugins) reads bodies from these topics; the skeleton publisher offers them for its
+worker, alongside its own ``/tf`` frames and markers:
+
+Body ids are the human ids, prefixed with ``h`` when they start with a digit (a ROS name
+token cannot): human ``1`` is body ``h1`` (topics ``/humans/bodies/h1/...``, frames
+``body_h1``, ``head_h1``, ...).
+
+* ``/humans/bodies/tracked`` (``hri_msgs/IdsList``): the ids of the bodies shown now.
+  Every skeleton publisher publishes the whole list: its own id while it plays, plus the
+  ids of the other bodies whose ``joint_states`` arrived within :data:`TRACKED_TIMEOUT`
+  (found by topic discovery every :data:`DISCOVERY_PERIOD`), so the publishers of
+  several humans, in one process or several, agree.
+* ``/humans/bodies/<id>/joint_states`` (``sensor_msgs/JointState``): the 66 revolute
+  joints of the worker's URDF (:mod:`ltl_human_motion.motion.urdf`), radians.
+* ``/humans/bodies/<id>/urdf`` (``std_msgs/String``, transient local): that URDF, for the
+  stature of the motion played (republished when it changes).
+* ``/humans/bodies/<id>/position`` (``geometry_msgs/PointStamped``) and ``/velocity``
+  (``geometry_msgs/TwistStamped``): the body frame's origin and velocity in the world
+  frame.
+* TF: ``<world> -> body_<id>`` (REP 155's body frame, at the pelvis) and, with
+  ``link_frames``, the frame of every skeleton joint named as in the URDF (``head_<id>``,
+  ``l_elbow_<id>``, ...) relative to its skeleton parent. Turn ``link_frames`` off when
+  ``robot_state_publisher`` turns the URDF and ``joint_states`` into TF itself.
+
+Per-frame link rotations and velocities are computed once per motion (:meth:`BodyInterface.prepare`,
+before the playback clock starts);
+a tick blends the rotations of the two frames around the playback time and takes the
+interpolated joint positions, so the link frames sit exactly on the ``human_<id>/...``
+joint frames of the same stamp, and joint angles come from the blended rotations.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from typing import Any
+
+import numpy as np
+from geometry_msgs.msg import PointStamped, TransformStamped, TwistStamped
+from hri_msgs.msg import IdsList
+from rclpy.node import Node
+from scipy.spatial.transform import Rotation
+from sensor_msgs.msg import JointState
+from std_msgs.msg import String
+from tf2_msgs.msg import TFMessage
+
+from ltl_human_motion.motion import urdf
+from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton
+from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS
+from ltl_human_motion.ros.playback import Frame, Playback
+
+BODIES = "/humans/bodies"
+TRACKED_TOPIC = f"{BODIES}/tracked"
+#: Seconds after its last joint_states message that another body still counts as tracked
+#: (a 30 Hz publisher misses ~15 messages before it drops out).
+TRACKED_TIMEOUT = 0.5
+#: Seconds between two looks for other bodies' joint_states topics.
+DISCOVERY_PERIOD = 2.0
+#: Motions whose tables are kept (a player shows one at a time; a few for switching back).
+MAX_TABLES = 4
+_JOINT_STATES = re.compile(rf"^{BODIES}/([^/]+)/joint_states$")
+
+
+def body_topic(human_id: str, name: str) -> str:
+    """``/humans/bodies/<body id>/<name>`` (:func:`~ltl_human_motion.motion.urdf.body_id`)."""
+    return f"{BODIES}/{urdf.body_id(human_id)}/{name}"
+
+
+def _skeleton(stature: float) -> Skeleton:
+    return Skeleton(stature=stature)
+
+
+def link_quaternions(positions: np.ndarray, stature: float) -> np.ndarray:
+    """Per frame, every joint link's world rotation as a quaternion (x y z w): (T, J, 4),
+    each on the same hemisphere as the frame before (so frames can be blended)."""
+    R = urdf.link_rotations(np.asarray(positions, dtype=np.float64), _skeleton(stature))
+    q = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat().reshape(*R.shape[:2], 4)
+    # Same hemisphere as the previous frame: flip where the running sign changes.
+    dots = np.sum(q[1:] * q[:-1], axis=-1) < 0                           # (T-1, J)
+    signs = np.concatenate([np.ones((1, q.shape[1])),
+                            np.cumprod(np.where(dots, -1.0, 1.0), axis=0)])
+    return q * signs[..., None]
+
+
+def blend_rotations(quats: np.ndarray, time: float, fps: float) -> np.ndarray:
+    """World link rotations (J, 3, 3) at motion ``time`` (s): the quaternions (T, J, 4) of
+    the two frames around it, blended linearly and normalized."""
+    f = float(np.clip(time * fps, 0.0, len(quats) - 1))
+    i0 = int(np.floor(f))
+    i1 = min(i0 + 1, len(quats) - 1)
+    q = quats[i0] * (1.0 - (f - i0)) + quats[i1] * (f - i0)
+    return Rotation.from_quat(q / np.linalg.norm(q, axis=-1, keepdims=True)).as_matrix()
+
+
+def link_transforms(positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    """Transforms (J, 7: x y z qx qy qz qw) of every link relative to its skeleton parent
+    (the root's: to the world) for one pose: joint positions (J, 3) and world link
+    rotations (J, 3, 3). The link origins are the joint positions exactly."""
+    pos = np.asarray(positions, dtype=np.float64)
+    R = np.asarray(rotations, dtype=np.float64)
+    parents = np.array(PARENTS[1:])
+    out = np.empty((len(JOINT_NAMES), 7))
+    out[0, :3] = pos[0]
+    out[1:, :3] = np.einsum("kji,kj->ki", R[parents], pos[1:] - pos[parents])
+    relative = R.copy()
+    relative[1:] = np.swapaxes(R[parents], -1, -2) @ R[1:]
+    out[:, 3:] = Rotation.from_matrix(relative).as_quat()
+    return out
+
+
+def body_velocity(positions: np.ndarray, root_quaternions: np.ndarray, fps: float
+                  ) -> np.ndarray:
+    """Per frame, the body frame's linear and angular velocity in the world frame: (T, 6),
+    from joint positions (T, J, 3) and the root link's quaternions (T, 4)."""
+    pos = np.asarray(positions, dtype=np.float64)
+    out = np.zeros((len(pos), 6))
+    if len(pos) < 2:
+        return out
+    out[:, :3] = np.gradient(pos[:, 0], axis=0) * fps
+    R = Rotation.from_quat(root_quaternions)
+    step = (R[1:] * R[:-1].inv()).as_rotvec() * fps
+    out[1:, 3:] = step
+    out[0, 3:] = step[0]
+    return out
+
+
+class BodyInterface:
+    """The REP 155 publishers of one worker, driven by its skeleton publisher's ticks.
+
+    Parameters
+    ----------
+    node : Node
+        The skeleton publisher.
+    human_id, world_frame : str
+    link_frames : bool
+        Also put every joint's link frame on TF (see the module docstring).
+    tf_publisher : Publisher
+        The node's ``/tf`` publisher (``tf2_msgs/TFMessage``).
+    """
+
+    def __init__(self, node: Node, human_id: str, world_frame: str, link_frames: bool,
+                 tf_publisher: Any) -> None:
+        self.node, self.human_id, self.world_frame = node, human_id, world_frame
+        self.body_id = urdf.body_id(human_id)
+        self.link_frames = link_frames
+        self._tf_pub = tf_publisher
+        self._tracked_pub = node.create_publisher(IdsList, TRACKED_TOPIC, STREAM_QOS)
+        self._joint_pub = node.create_publisher(JointState, body_topic(human_id,
+                                                                       "joint_states"),
+                                                STREAM_QOS)
+        self._urdf_pub = node.create_publisher(String, body_topic(human_id, "urdf"),
+                                               LATCHED_QOS)
+        self._position_pub = node.create_publisher(PointStamped,
+                                                   body_topic(human_id, "position"),
+                                                   STREAM_QOS)
+        self._velocity_pub = node.create_publisher(TwistStamped,
+                                                   body_topic(human_id, "velocity"),
+                                                   STREAM_QOS)
+        self.joint_names = urdf.joint_names(self.body_id)
+        self.link_names = [urdf.link_name(j, self.body_id) for j in JOINT_NAMES]
+        self._urdf_stature: float | None = None
+        self._tables: dict[str, tuple[float, np.ndarray, np.ndarray]] = {}
+        self._last_seen: dict[str, float] = {}
+        self._subscribed: set[str] = set()
+        self.publish_urdf(1.75)
+        node.create_timer(DISCOVERY_PERIOD, self._discover)
+
+    def publish_urdf(self, stature: float) -> None:
+        """Latch the URDF for ``stature`` (only when it changes)."""
+        if self._urdf_stature is not None and abs(self._urdf_stature - stature) < 1e-9:
+            return
+        self._urdf_stature = stature
+        self._urdf_pub.publish(String(data=urdf.worker_urdf(stature, self.body_id)))
+
+    def prepare(self, motion_id: str, motion: Any) -> tuple[float, np.ndarray, np.ndarray]:
+        """Per-frame tables of ``motion`` (a SynthesizedMotion): stature, link quaternions
+        (T, J, 4) and body velocity (T, 6); computed once per motion id and kept (the
+        skeleton publisher calls this before it starts the playback clock)."""
+        if motion_id not in self._tables:
+            body = motion.motion
+            stature = float(getattr(getattr(body, "skeleton", None), "stature", 1.75))
+            positions = np.asarray(body.positions, dtype=np.float64)
+            quats = link_quaternions(positions, stature)
+            velocity = body_velocity(positions, quats[:, 0], float(body.fps))
+            if len(self._tables) >= MAX_TABLES:
+                self._tables.pop(next(iter(self._tables)))
+            self._tables[motion_id] = (stature, quats, velocity)
+        return self._tables[motion_id]
+
+    def _discover(self) -> None:
+        for topic, _ in self.node.get_topic_names_and_types():
+            match = _JOINT_STATES.match(topic)
+            if match is None or topic in self._subscribed or match[1] == self.body_id:
+                continue
+            other = match[1]
+            self._subscribed.add(topic)
+            self.node.create_subscription(
+                JointState, topic, lambda _msg, who=other: self._seen(who), STREAM_QOS,
+                raw=True)
+
+    def _seen(self, other: str) -> None:
+        self._last_seen[other] = time.monotonic()
+
+    def tracked(self, playing: bool) -> list[str]:
+        """The body ids shown now (this one while ``playing``), sorted."""
+        now = time.monotonic()
+        ids = {k for k, t in self._last_seen.items() if now - t <= TRACKED_TIMEOUT}
+        if playing:
+            ids.add(self.body_id)
+        return sorted(ids)
+
+    def publish(self, frame: Frame | None, playback: Playback, stamp: Any) -> None:
+        """One tick: ``tracked`` always; the body's topics and frames while shown."""
+        tracked = IdsList(ids=self.tracked(frame is not None))
+        tracked.header.stamp = stamp
+        tracked.header.frame_id = self.world_frame
+        self._tracked_pub.publish(tracked)
+        if frame is None:
+            return
+        if frame.motion_id in self._tables:
+            stature, quats, velocity = self._tables[frame.motion_id]
+        elif playback.motion is not None:        # played by another node of the process
+            stature, quats, velocity = self.prepare(frame.motion_id, playback.motion)
+        else:
+            return
+        self.publish_urdf(stature)
+        rotations = blend_rotations(quats, frame.time, playback.fps)
+        joints = JointState(name=self.joint_names,
+                            position=urdf.angles_from_rotations(rotations).tolist())
+        joints.header.stamp = stamp
+        self._joint_pub.publish(joints)
+        i = min(frame.index, len(velocity) - 1)
+        position = PointStamped()
+        position.header.stamp, position.header.frame_id = stamp, self.world_frame
+        x, y, z = (float(v) for v in frame.positions[0])
+        position.point.x, position.point.y, position.point.z = x, y, z
+        self._position_pub.publish(position)
+        twist = TwistStamped()
+        twist.header.stamp, twist.header.frame_id = stamp, self.world_frame
+        v = velocity[i]
+        twist.twist.linear.x, twist.twist.linear.y, twist.twist.linear.z = map(float, v[:3])
+        twist.twist.angular.x, twist.twist.angular.y, twist.twist.angular.z = map(float,
+                                                                                 v[3:])
+        self._velocity_pub.publish(twist)
+        count = len(JOINT_NAMES) if self.link_frames else 1
+        rows = link_transforms(frame.positions, rotations)
+        transforms = []
+        for j in range(count):
+            t = TransformStamped()
+            t.header.stamp = stamp
+            t.header.frame_id = self.world_frame if j == 0 else self.link_names[PARENTS[j]]
+            t.child_frame_id = self.link_names[j]
+            row = rows[j]
+            tr, q = t.transform.translation, t.transform.rotation
+            tr.x, tr.y, tr.z = (float(a) for a in row[:3])
+            q.x, q.y, q.z, q.w = (float(a) for a in row[3:])
+            transforms.append(t)
+        self._tf_pub.publish(TFMessage(transforms=transforms))

@@ -1,0 +1,172 @@
+"""Launch arguments override the bringup file (issue 14), checked with real rcl.
+
+``launch``/``launch_ros`` are not on PyPI (tried: ``pip download --no-deps ros-launch
+ros-launch-ros launch-ros ros-launch-xml ros-launch-yaml ros-osrf-pycommon``: no
+distribution; PyPI's ``launch`` 0.1.3 is an unrelated 2017 application launcher). So the
+launch files run against the recording stand-ins of ``test/launch_stand_ins.py``, which
+also reproduce how launch_ros turns a ``Node`` into ``--ros-args`` (a dict of parameters
+becomes a ``/**`` params file). This is not the real launch service. What is real: the
+params files, rcl's merging of them and the nodes that read them -- each node's
+parameters are read from a real rclpy context given that command line, and for the
+coexistence launch file from the real node processes, by a plain rclpy client
+(``rcl_interfaces/srv/GetParameters``).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+rclpy = pytest.importorskip("rclpy")
+
+from launch_stand_ins import (  # noqa: E402
+    launch_description,
+    launch_ros_command,
+    launched_nodes,
+)
+from rcl_interfaces.srv import GetParameters  # noqa: E402
+from rclpy.context import Context  # noqa: E402
+from rclpy.node import Node  # noqa: E402
+from rclpy.parameter import parameter_value_to_python  # noqa: E402
+
+from ltl_human_motion.ros.bringup_config import (  # noqa: E402
+    LAUNCH_ARGUMENTS,
+    load_bringup_config,
+)
+from ltl_human_motion.ros.client import ClientSession, call_service  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+ROOT = Path(__file__).resolve().parents[1]
+LAUNCH_FILES = {"bringup.launch": ROOT / "config" / "bringup.yaml",
+                "coexistence.launch": ROOT / "config" / "bringup_coexistence.yaml"}
+#: A value no config file holds, per launch argument. 127.0.0.3: loopback, nothing serves
+#: RTDE there, so the coexistence node cannot command another test's simulated arm.
+OVERRIDES = {"robot_host": "127.0.0.3", "store_dir": "/tmp/ltl_hm_launch_override_motions"}
+
+
+def _launch(monkeypatch: pytest.MonkeyPatch, stem: str, values: dict[str, str]
+            ) -> tuple[list[tuple], list[dict[str, Any]]]:
+    description = launch_description(monkeypatch, ROOT / "launch" / f"{stem}.py")
+    declared = [a for a in description if isinstance(a, tuple)]
+    return declared, launched_nodes(description, values)
+
+
+def _rcl_parameters(args: list[str], name: str, namespace: str | None) -> dict[str, Any]:
+    """The parameters rcl hands node ``name`` for this command line (real rclpy)."""
+    context = Context()
+    rclpy.init(args=args, context=context)
+    try:
+        node = Node(name, namespace=namespace, context=context,
+                    automatically_declare_parameters_from_overrides=True)
+        try:
+            return {n: p.value for n, p in node._parameters.items()}
+        finally:
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
+def test_every_launch_argument_is_declared_and_known() -> None:
+    for stem in LAUNCH_FILES:
+        assert all(a.name in OVERRIDES for a in LAUNCH_ARGUMENTS[stem]), stem
+
+
+@pytest.mark.parametrize("stem", sorted(LAUNCH_FILES))
+def test_each_launch_argument_overrides_the_config_file(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path, stem: str) -> None:
+    config = load_bringup_config(LAUNCH_FILES[stem])
+    specs = {s.fully_qualified_name: s for s in config.node_specs()}
+    declared, _ = _launch(monkeypatch, stem, {})
+    names = [name for _, name, _ in declared]
+    assert names == ["config"] + [a.name for a in LAUNCH_ARGUMENTS[stem]]
+    for argument in LAUNCH_ARGUMENTS[stem]:
+        value = OVERRIDES[argument.name]
+        _, nodes = _launch(monkeypatch, stem, {argument.name: value})
+        targets = 0
+        for kw in nodes:
+            fqn = f"/{kw['namespace']}/{kw['name']}" if kw["namespace"] else f"/{kw['name']}"
+            spec = specs[fqn]
+            got = _rcl_parameters(launch_ros_command(kw, tmp_path), kw["name"],
+                                  kw["namespace"])
+            if spec.executable in argument.executables:
+                targets += 1
+                in_file = config.parameter(spec, argument.parameter)
+                assert in_file != value, f"{argument.name}: pick a value the file lacks"
+                assert got[argument.parameter] == value, (stem, argument.name, fqn)
+            for key, expected in spec.parameters.items():
+                assert got[key] == expected, (fqn, key)
+        assert targets > 0, argument.name
+
+
+@pytest.mark.parametrize("stem", sorted(LAUNCH_FILES))
+def test_without_arguments_the_file_holds(monkeypatch: pytest.MonkeyPatch,
+                                          tmp_path: Path, stem: str) -> None:
+    config = load_bringup_config(LAUNCH_FILES[stem])
+    _, nodes = _launch(monkeypatch, stem, {})
+    for kw, spec in zip(nodes, config.node_specs(), strict=True):
+        got = _rcl_parameters(launch_ros_command(kw, tmp_path), kw["name"], kw["namespace"])
+        for argument in LAUNCH_ARGUMENTS[stem]:
+            if spec.executable in argument.executables:
+                assert got.get(argument.parameter) == config.parameter(spec, argument.parameter)
+
+
+def test_a_dict_under_double_star_loses_to_the_file_as_in_issue_14(tmp_path: Path) -> None:
+    """What the launch file did before: ``parameters=[file, {"robot_host": ...}]``."""
+    config = LAUNCH_FILES["coexistence.launch"]
+    kw = {"name": "coexistence_node", "namespace": None,
+          "parameters": [str(config), {"robot_host": "127.0.0.3"}]}
+    got = _rcl_parameters(launch_ros_command(kw, tmp_path), "coexistence_node", None)
+    assert got["robot_host"] == "127.0.0.1"
+
+
+def _get_parameters(session: ClientSession, fqn: str, names: list[str],
+                    timeout: float) -> dict[str, Any]:
+    client = session.node.create_client(GetParameters, f"{fqn}/get_parameters")
+    response = call_service(client, GetParameters.Request(names=names), timeout=timeout,
+                            wait_for_service=timeout, resend_after=5.0)
+    return {n: parameter_value_to_python(v) for n, v in zip(names, response.values)}
+
+
+def test_coexistence_launch_processes_get_the_launch_arguments(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """The real node executables, started with launch_ros's command line, read back by
+    a plain rclpy client."""
+    stem = "coexistence.launch"
+    _, nodes = _launch(monkeypatch, stem, OVERRIDES)
+    procs = []
+    try:
+        for kw in nodes:
+            code = (f"import sys; from ltl_human_motion.ros.entry_points import "
+                    f"{kw['executable']} as main; sys.exit(main(sys.argv))")
+            procs.append(subprocess.Popen(
+                [sys.executable, "-c", code, *launch_ros_command(kw, tmp_path)],
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        with ClientSession("launch_test_client") as session:
+            for kw in nodes:
+                fqn = f"/{kw['namespace']}/{kw['name']}" if kw["namespace"] \
+                    else f"/{kw['name']}"
+                wanted = [a.parameter for a in LAUNCH_ARGUMENTS[stem]
+                          if kw["executable"] in a.executables]
+                if not wanted:
+                    continue
+                got = _get_parameters(session, fqn, wanted, timeout=90.0)
+                for argument in LAUNCH_ARGUMENTS[stem]:
+                    if kw["executable"] in argument.executables:
+                        assert got[argument.parameter] == OVERRIDES[argument.name], \
+                            (fqn, argument.name)
+    finally:
+        for proc in procs:
+            proc.terminate()
+        deadline = time.monotonic() + 15
+        for proc in procs:
+            try:
+                proc.wait(timeout=max(deadline - time.monotonic(), 0.1))
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
