@@ -21,6 +21,7 @@ if [ "$#" -gt 0 ]; then
   exec python -m pytest "$@"
 fi
 RTDE_TESTS=(test/test_robot_rtde.py test/test_robot_reconnect.py test/test_robot_coexistence.py
+            test/test_study_rtde.py
             test/test_ros_coexistence.py)
 RETRY=(--reruns 1 --only-rerun TimeoutError)
 ignore=()

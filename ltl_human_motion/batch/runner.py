@@ -213,8 +213,8 @@ def run_batch(cell: str | os.PathLike[str], specs: BatchSpecs | str | os.PathLik
               count: int,
               out: str | os.PathLike[str], *, seed: int = 0, workers: int | None = None,
               scheduler: str | None = None, shard_size: int = 100, dtype: str = "float32",
-              progress: bool = True, on_item: Callable[[ItemResult], None] | None = None
-              ) -> BatchSummary:
+              progress: bool = True, on_item: Callable[[ItemResult], None] | None = None,
+              assess: dict[str, Any] | None = None) -> BatchSummary:
     """Generate (or finish) a dataset of ``count`` items in ``out``.
 
     Parameters
@@ -241,6 +241,8 @@ def run_batch(cell: str | os.PathLike[str], specs: BatchSpecs | str | os.PathLik
         Show a tqdm progress bar (rate and ETA) on stderr.
     on_item : callable, optional
         Called with every stored result (e.g. to stop a test run).
+    assess : dict, optional
+        Per-item assessment settings (:attr:`BatchJob.assess`; used by ``study``).
 
     Returns
     -------
@@ -259,6 +261,8 @@ def run_batch(cell: str | os.PathLike[str], specs: BatchSpecs | str | os.PathLik
     if not isinstance(specs, BatchSpecs):
         specs = load_specs(specs)
     job, parsed_cell = make_job(cell, specs, dtype)
+    if assess is not None:
+        job = replace(job, assess=dict(assess))
     store = DatasetStore(out, _header(job, specs, parsed_cell, seed, count, shard_size))
     try:
         return _run_store(store, job, specs, seed, count, workers, scheduler, progress,

@@ -57,6 +57,10 @@ class BatchJob:
         Storage type of positions, yaw and object tracks.
     statures : tuple of float
         The stature grid (libraries are preloaded when it is small).
+    assess : dict or None
+        Settings of a per-item assessment (:func:`ltl_human_motion.study.item.assess_item`:
+        ergonomics, cycle time, offline SSM) whose figures go into ``record["study"]``;
+        None (the default) for none.
     """
 
     cell_yaml: str
@@ -67,6 +71,7 @@ class BatchJob:
     keep_unverified: bool = False
     dtype: str = "float32"
     statures: tuple[float, ...] = (1.75,)
+    assess: dict[str, Any] | None = None
 
     def __post_init__(self) -> None:
         if self.dtype not in DTYPES:
@@ -77,6 +82,8 @@ class BatchJob:
         data = {"cell_sha256": hashlib.sha256(self.cell_yaml.encode("utf-8")).hexdigest(),
                 "options": self.options, "sequence_mode": self.sequence_mode,
                 "keep_unverified": self.keep_unverified, "dtype": self.dtype}
+        if self.assess is not None:
+            data["assess"] = self.assess
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode("utf-8")).hexdigest()
 
     def synthesis_options(self):
@@ -271,6 +278,11 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
     if not verified:
         record["error"] = {"type": "VerificationError", "message": detail,
                            "check": failed_check, "task": None}
+    if job.assess is not None and arrays is not None:
+        from ltl_human_motion.study.item import assess_item
+        t_assess = time.perf_counter()
+        record["study"] = _plain(assess_item(synth, cell, item, job.assess))
+        timing["assess_time"] = time.perf_counter() - t_assess
     timing.update({k: float(v) for k, v in synth.stats.items()
                    if k.endswith("_time") and k != "batch_total_time"})
     timing["compute_time"] = time.perf_counter() - t0

@@ -19,6 +19,7 @@ from ltl_human_motion.errors import LtlHumanMotionError
 
 SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tasks", "library", "synthesize", "paper", "batch", "bringup", "ur_sim", "coexist", "demo",
+    "study",
 )
 
 

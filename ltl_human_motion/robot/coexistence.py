@@ -64,6 +64,7 @@ __all__ = [
     "ControlDecision",
     "IOLike",
     "ReceiveLike",
+    "ssm_command",
     "ur_rtde_factories",
 ]
 
@@ -155,6 +156,16 @@ class CoexistenceConfig:
                 raise ValueError(f"CoexistenceConfig.{name}: expected > 0, got {value}")
         if self.backoff_max < self.backoff_initial:
             raise ValueError("CoexistenceConfig: backoff_max < backoff_initial")
+
+
+def ssm_command(effective_separation: float, params: SSMParameters) -> tuple[float, str]:
+    """Speed-slider command and mode (``"full"``, ``"reduced"``, ``"stop"``) for an
+    effective separation (m): the decision of one control step, without I/O (the live
+    loop and :mod:`.offline_ssm` both use it)."""
+    slider = slider_from_separation(effective_separation, params)
+    mode = ("full" if slider >= params.max_slider
+            else "stop" if slider <= params.min_slider else "reduced")
+    return slider, mode
 
 
 @dataclass(frozen=True)
@@ -492,9 +503,7 @@ class CoexistenceController:
             mode, slider = "stale", self.params.min_slider
         else:
             sep, eff = self._separations(q, occ)
-            slider = slider_from_separation(eff, self.params)
-            mode = ("full" if slider >= self.params.max_slider
-                    else "stop" if slider <= self.params.min_slider else "reduced")
+            slider, mode = ssm_command(eff, self.params)
         with self._lock:
             ceiling = self._ceiling
             capped = ceiling is not None and slider > ceiling

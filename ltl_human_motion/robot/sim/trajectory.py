@@ -96,8 +96,15 @@ class JointTrajectory:
         return self.sample(t)[0]
 
     def positions(self, times: Sequence[float]) -> NDArray[np.float64]:
-        """Joint positions (T, 6) at many trajectory times."""
-        return np.array([self.sample(float(t))[0] for t in times]).reshape(-1, 6)
+        """Joint positions (T, 6) at many trajectory times (vectorized :meth:`position`)."""
+        t = np.asarray(times, dtype=np.float64).reshape(-1)
+        if not np.all(np.isfinite(t)):
+            raise ValueError("trajectory times must be finite")
+        tc = t % self.cycle_time
+        k = np.searchsorted(self._start, tc, side="right") - 1
+        tau = np.minimum((tc - self._start[k]) / self._move[k], 1.0)
+        s = tau ** 3 * (10 - 15 * tau + 6 * tau ** 2)
+        return self._from[k] + s[:, None] * (self._q[k] - self._from[k])
 
 
 def default_pick_and_place() -> JointTrajectory:

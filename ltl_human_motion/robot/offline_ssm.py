@@ -1,0 +1,289 @@
+"""Speed and separation monitoring in simulated time: the live loop's decisions over a
+motion's timeline, at the live loop's 125 Hz, much faster than real time.
+
+Per control step ``k`` (time ``t_k = k / rate``) this does what one
+:meth:`~ltl_human_motion.robot.coexistence.CoexistenceController.step` does against the
+simulated controller (:class:`~ltl_human_motion.robot.sim_state.SimulatedUR`): read the
+arm's joints at its trajectory time ``tau_k``, compute the human-robot capsule separation
+(:func:`~ltl_human_motion.robot.separation.signed_distances`, optionally with predicted
+occupancy through :func:`~ltl_human_motion.robot.ssm.predictive_separation`), turn it into
+a speed-slider command (:func:`~ltl_human_motion.robot.coexistence.ssm_command`), and let
+the arm advance ``tau_{k+1} = tau_k + slider_k / rate`` as the simulated controller does.
+
+Speed comes from evaluating many steps at once. While the command stays the same, the
+arm's trajectory times are known ahead, so a run of steps is evaluated together: the
+separations with :func:`batched_separations` (the live kernel's quantity, vectorized over
+steps; tests check they agree), then the command of each step in order. The first step
+whose command changes ends the run (later steps assumed the old command and are
+evaluated again), so every step's decision is exactly the one a step-by-step loop makes.
+At full speed, steps whose body and arm bounding boxes lie more than S_p + margin apart
+skip the distance (the command is full speed whatever it is).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ltl_human_motion.robot.coexistence import ControlDecision, ssm_command
+from ltl_human_motion.robot.kinematics import URModel, robot_capsules, ur_model
+from ltl_human_motion.robot.metrics import commissioning_metrics
+from ltl_human_motion.robot.ssm import SSMParameters, predictive_separation
+from ltl_human_motion.robot.trajectory import JointTrajectory
+from ltl_human_motion.scene.occupancy import capsules_from_positions
+
+__all__ = ["CONTROL_RATE", "OfflineSSMResult", "batched_separations", "run_offline_ssm"]
+
+#: Hz, the live coexistence loop's rate (UR RTDE at 125 Hz).
+CONTROL_RATE = 125.0
+#: Steps evaluated together while the arm runs at full speed (1 s at 125 Hz).
+_CHUNK = 125
+#: Steps tried ahead after a bulk attempt failed.
+_MIN_LOOK = 4
+
+
+@dataclass
+class OfflineSSMResult:
+    """What an offline run saw and did.
+
+    Attributes
+    ----------
+    time : ndarray, shape (N,)
+        Step times (s) from the start of the motion.
+    slider : ndarray, shape (N,)
+    separation : ndarray, shape (N,)
+        Current separation (m); NaN at full-speed steps whose bounding boxes were more
+        than S_p + margin apart (their separation is larger; the minimum is exact).
+    trajectory_time : ndarray, shape (N + 1,)
+        The arm's trajectory time before each step and at the end (s).
+    mode : ndarray of str, shape (N,)
+    metrics : dict
+        :func:`~ltl_human_motion.robot.metrics.commissioning_metrics` of the run plus
+        ``effective_cycle_time``, ``nominal_cycle_time``, ``throughput_ratio``,
+        ``frames_below_sp`` (motion frames with separation below S_p), ``time_below_sp``,
+        ``evaluated_steps`` (steps evaluated, speculation included).
+    """
+
+    time: np.ndarray
+    slider: np.ndarray
+    separation: np.ndarray
+    trajectory_time: np.ndarray
+    mode: np.ndarray
+    metrics: dict[str, Any] = field(default_factory=dict)
+
+    def decisions(self, protective_distance: float) -> list[ControlDecision]:
+        """The run as live-loop :class:`ControlDecision` records."""
+        return [ControlDecision(float(t), float(s), True, str(m), float(d), float(d),
+                                protective_distance, True)
+                for t, s, m, d in zip(self.time, self.slider, self.mode, self.separation)]
+
+
+def _box_gap(lo_a: np.ndarray, hi_a: np.ndarray, lo_b: np.ndarray, hi_b: np.ndarray
+             ) -> np.ndarray:
+    """Distance between boxes (M, 3) a and b, (M,): a lower bound of their contents'."""
+    gap = np.maximum(np.maximum(lo_a - hi_b, lo_b - hi_a), 0.0)
+    return np.sqrt((gap * gap).sum(axis=-1))
+
+
+def batched_separations(P: np.ndarray, p_radii: np.ndarray, Q: np.ndarray,
+                         q_radii: np.ndarray) -> np.ndarray:
+    """Minimum signed capsule separation per batch entry, shape (M,).
+
+    The same quantity as ``signed_distances(P[i], p_radii, Q[i], q_radii).min()`` for
+    every ``i`` (:mod:`.separation`, the live loop's kernel; the tests check they agree),
+    vectorized over the batch: closest points of two segments after Ericson, *Real-Time
+    Collision Detection* (2005), Sec. 5.1.9, with nearly parallel pairs taken from an end
+    point (as the live kernel does).
+
+    Parameters
+    ----------
+    P : ndarray, shape (M, K, 2, 3)
+    p_radii : ndarray, shape (K,)
+    Q : ndarray, shape (M, L, 2, 3)
+    q_radii : ndarray, shape (L,)
+    """
+    p0 = P[:, :, None, 0]
+    q0 = Q[:, None, :, 0]
+    d1 = P[:, :, None, 1] - p0                                   # (M, K, 1, 3)
+    d2 = Q[:, None, :, 1] - q0                                   # (M, 1, L, 3)
+    r = p0 - q0                                                  # (M, K, L, 3)
+    a = (d1 * d1).sum(-1)
+    e = (d2 * d2).sum(-1)
+    b = (d1 * d2).sum(-1)
+    c = (d1 * r).sum(-1)
+    f = (d2 * r).sum(-1)
+    a_s = np.maximum(a, 1e-30)
+    e_s = np.maximum(e, 1e-30)
+    denom = a * e - b * b
+    parallel = denom <= 1e-9 * a_s * e_s
+    s = np.where(parallel, 0.0, np.clip((b * f - c * e) / np.where(parallel, 1.0, denom),
+                                        0.0, 1.0))
+    t = np.clip((b * s + f) / e_s, 0.0, 1.0)
+    s = np.clip((b * t - c) / a_s, 0.0, 1.0)
+    gap = r + s[..., None] * d1 - t[..., None] * d2
+    dist = np.sqrt((gap * gap).sum(-1))
+    return (dist - p_radii[None, :, None] - q_radii[None, None, :]).min(axis=(1, 2))
+
+
+def _violations(t: np.ndarray, dt: float, below: np.ndarray, sep: np.ndarray,
+                slider: np.ndarray, min_slider: float) -> list[dict[str, Any]]:
+    """Intervals below S_p, as :func:`commissioning_metrics` reports them."""
+    out = []
+    padded = np.concatenate([[False], below, [False]]).astype(np.int8)
+    edges = np.flatnonzero(np.diff(padded))
+    for a, b in zip(edges[::2], edges[1::2]):
+        out.append({"start": float(t[a]), "end": float(t[b - 1] + dt),
+                    "min_separation": float(sep[a:b].min()),
+                    "max_slider": float(slider[a:b].max()),
+                    "slowed_to_min": bool(np.all(slider[a:b] <= min_slider + 1e-9))})
+    return out
+
+
+def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajectory,
+                    model: str | URModel = "ur5e", base: ArrayLike | None = None,
+                    params: SSMParameters | None = None, stature: float = 1.75,
+                    duration: float | None = None, rate: float = CONTROL_RATE,
+                    prediction_horizon: float = 0.0, prediction_step: float = 0.1,
+                    trajectory_start: float = 0.0) -> OfflineSSMResult:
+    """Run SSM over a motion against a robot trajectory in simulated time.
+
+    Parameters
+    ----------
+    positions : array-like, shape (T, 23, 3)
+        The worker's joint positions (world frame), ``fps`` frames per second; the last
+        frame holds after the motion ends.
+    trajectory : JointTrajectory
+        The arm's looping program (trajectory time advances at the slider rate).
+    model, base
+        Arm model and world-from-base transform (4, 4).
+    params : SSMParameters
+    stature : float
+        Worker height (capsule radii).
+    duration : float, optional
+        Seconds to simulate (default: the motion's duration).
+    rate : float
+        Control rate (Hz).
+    prediction_horizon, prediction_step : float
+        Use the motion's own future as predicted occupancy, at ``prediction_step``,
+        2 ``prediction_step``, ... up to ``prediction_horizon`` seconds ahead (as the
+        occupancy node publishes it); 0 = reactive.
+    trajectory_start : float
+        The arm's trajectory time at the start (s).
+    """
+    pos = np.asarray(positions, dtype=np.float64)
+    if pos.ndim != 3 or pos.shape[1:] != (23, 3) or len(pos) < 1:
+        raise ValueError(f"positions must have shape (T, 23, 3), got {pos.shape}")
+    if not (math.isfinite(fps) and fps > 0 and math.isfinite(rate) and rate > 0):
+        raise ValueError(f"fps and rate must be > 0, got {fps}, {rate}")
+    params = params if params is not None else SSMParameters()
+    m = ur_model(model)
+    B = np.eye(4) if base is None else np.asarray(base, dtype=np.float64)
+    T = len(pos)
+    duration = (T - 1) / fps if duration is None else float(duration)
+    n = max(round(duration * rate), 1)
+    dt = 1.0 / rate
+    t = np.arange(n) * dt
+    hseg, hrad = capsules_from_positions(pos, stature)            # (T, K, 2, 3), (K,)
+    frame = np.minimum(np.rint(t * fps).astype(np.int64), T - 1)
+    n_pred = math.floor(prediction_horizon / prediction_step + 1e-9) \
+        if prediction_horizon > 0 else 0
+    horizons = prediction_step * np.arange(1, n_pred + 1)
+    pred_frames = np.minimum(frame[:, None] + np.rint(horizons * fps).astype(np.int64)[None],
+                             T - 1)                               # (n, H)
+    slider = np.empty(n)
+    sep = np.empty(n)
+    modes = np.empty(n, dtype=object)
+    tau = np.empty(n + 1)
+    tau[0] = trajectory_start
+    full = params.max_slider
+    rrad = np.asarray(m.link_radii, dtype=np.float64)
+    sp = params.protective_distance
+    band = sp + params.margin
+    hlo = (hseg.min(axis=2) - hrad[:, None]).min(axis=1)            # (T, 3) body boxes
+    hhi = (hseg.max(axis=2) + hrad[:, None]).max(axis=1)
+    lb = np.full(n, np.inf)
+    n_eval = 0
+    k = 0
+    look = _MIN_LOOK
+    guess = full
+    while k < n:
+        # Speculate that the command stays at ``guess`` for ``look`` steps: the arm's
+        # trajectory times are then known, and the steps are evaluated together. Steps up
+        # to and including the first whose command differs are exact (each one's robot pose
+        # depends only on the commands before it); the rest are discarded.
+        idx = np.arange(k, min(k + look, n))
+        taus = tau[k] + (idx - k) * dt * guess
+        rseg = robot_capsules(trajectory.positions(taus), m, B)[0]
+        M = len(idx)
+        # At full speed, steps whose body boxes lie S_p + margin apart need no distance:
+        # the command is full speed whatever it is (their separations stay NaN).
+        need = np.ones(M, dtype=bool)
+        if guess >= full:
+            rlo = rseg.min(axis=(1, 2)) - rrad.max()
+            rhi = rseg.max(axis=(1, 2)) + rrad.max()
+            lb[idx] = _box_gap(hlo[frame[idx]], hhi[frame[idx]], rlo, rhi)
+            bound = lb[idx]
+            for h in range(n_pred):
+                f = pred_frames[idx, h]
+                bound = np.minimum(bound, _box_gap(hlo[f], hhi[f], rlo, rhi)
+                                   + params.prediction_discount_speed * horizons[h])
+            need = bound < band
+        cur = np.full(M, np.nan)
+        if need.any():
+            cur[need] = batched_separations(hseg[frame[idx[need]]], hrad, rseg[need], rrad)
+        if n_pred and need.any():
+            pf = pred_frames[idx[need]].reshape(-1)
+            rrep = np.repeat(rseg[need], n_pred, axis=0)
+            pred = np.full((M, n_pred), np.nan)
+            pred[need] = batched_separations(hseg[pf], hrad, rrep, rrad).reshape(-1, n_pred)
+        n_eval += int(need.sum())
+        accepted = 0
+        for i in range(len(idx)):
+            if not need[i]:
+                sl, mode = full, "full"
+            elif n_pred:
+                sl, mode = ssm_command(predictive_separation(float(cur[i]), pred[i], horizons,
+                                                             params), params)
+            else:
+                sl, mode = ssm_command(float(cur[i]), params)
+            j = k + i
+            slider[j], modes[j], sep[j] = sl, mode, cur[i]
+            tau[j + 1] = tau[j] + dt * sl
+            accepted = i + 1
+            if sl != guess:
+                guess = sl
+                break
+        look = min(2 * look, _CHUNK) if accepted == len(idx) else _MIN_LOOK
+        k += accepted
+    # Exact minimum: the skipped steps whose bound lies below the smallest separation.
+    best = np.nanmin(sep) if np.isfinite(sep).any() else math.inf
+    todo = np.flatnonzero(np.isnan(sep) & (lb < best))
+    for a in range(0, len(todo), _CHUNK):
+        j = todo[a:a + _CHUNK]
+        sep[j] = batched_separations(hseg[frame[j]], hrad,
+                                     robot_capsules(trajectory.positions(tau[j]), m, B)[0], rrad)
+        n_eval += len(j)
+    result = OfflineSSMResult(t, slider, sep, tau, modes)
+    cycles = np.flatnonzero(np.diff(np.floor(tau / trajectory.cycle_time)) > 0)
+    cycle_times = np.diff(np.concatenate([[0.0], (cycles + 1) * dt])).tolist()
+    metrics = commissioning_metrics(result.decisions(sp), cycle_times,
+                                    trajectory.cycle_time, params.max_slider,
+                                    params.min_slider)
+    ratio = float((tau[-1] - tau[0]) / (n * dt))
+    below = sep < sp
+    metrics["violations"] = _violations(t, dt, below, sep, slider, params.min_slider)
+    metrics.update({
+        "nominal_cycle_time": trajectory.cycle_time,
+        "throughput_ratio": ratio,
+        "effective_cycle_time": trajectory.cycle_time / ratio if ratio > 0 else None,
+        "frames_below_sp": sorted({int(f) for f in frame[below]}),
+        "time_below_sp": float(below.sum() * dt),
+        "evaluated_steps": n_eval,
+        "prediction_horizon": float(prediction_horizon),
+    })
+    result.metrics = metrics
+    return result

@@ -1,0 +1,411 @@
+"""The study report: JSON with every item's figures, PNG plots and one HTML page.
+
+Plots: distributions of cycle time, worst REBA, lifting index and minimum separation
+(layouts overlaid), the cycle-time breakdown, and per layout a floor "spaghetti" plot of
+the worker's paths and a heat map of floor occupancy. The HTML page embeds the PNGs
+(base64) and, with two layouts, shows them side by side with the differences and their
+95 % confidence intervals (Welch's t interval on the difference of means).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ltl_human_motion.atomic import atomic_write_text
+from ltl_human_motion.viz._common import new_figure, save_figure
+
+__all__ = ["METRICS", "compare", "item_metrics", "summarize", "write_report"]
+
+#: Reported figures: key -> (label, unit, better when lower?).
+METRICS: dict[str, tuple[str, str]] = {
+    "cycle_time": ("worker cycle time", "s"),
+    "walking_share": ("walking share of the cycle", ""),
+    "walking_distance": ("walking distance per cycle", "m"),
+    "waiting_share": ("waiting share of the cycle", ""),
+    "value_adding_share": ("value-adding share of the cycle", ""),
+    "reba_max": ("worst REBA", ""),
+    "reba_mean": ("mean REBA", ""),
+    "rula_max": ("worst RULA", ""),
+    "lifting_index": ("highest NIOSH lifting index", ""),
+    "min_separation": ("minimum human-robot separation", "m"),
+    "time_below_sp": ("time below S_p", "s"),
+    "robot_stopped": ("robot at the slider minimum", "s"),
+    "robot_cycle_time": ("robot's effective cycle time", "s"),
+}
+_COLORS = ("tab:blue", "tab:orange")
+
+
+def item_metrics(item: dict[str, Any]) -> dict[str, float | None]:
+    """The :data:`METRICS` of one item (None where not measured, e.g. without a robot)."""
+    cyc, ergo, ssm = item["cycle"], item["ergonomics"]["summary"], item.get("ssm") or {}
+    return {
+        "cycle_time": cyc["cycle_time"],
+        "walking_share": cyc["share"]["walking"],
+        "walking_distance": cyc["per_cycle"]["walking_distance"],
+        "waiting_share": cyc["share"]["waiting"],
+        "value_adding_share": cyc["share"]["value_adding"],
+        "reba_max": ergo["reba"]["max"], "reba_mean": ergo["reba"]["mean"],
+        "rula_max": ergo["rula"]["max"],
+        "lifting_index": ergo["max_lifting_index"] if ergo["lifts"] else None,
+        "min_separation": ssm.get("min_separation"),
+        "time_below_sp": ssm.get("time_below_sp"),
+        "robot_stopped": ssm.get("time_min_speed"),
+        "robot_cycle_time": ssm.get("effective_cycle_time"),
+    }
+
+
+def _values(items: Sequence[dict[str, Any]], key: str) -> np.ndarray:
+    v = [item_metrics(it)[key] for it in items]
+    return np.array([x for x in v if x is not None and math.isfinite(x)], dtype=np.float64)
+
+
+def _t975(dof: float) -> float:
+    from scipy.stats import t
+    return float(t.ppf(0.975, dof))
+
+
+def summarize(items: Sequence[dict[str, Any]]) -> dict[str, dict[str, float | None]]:
+    """Per metric: n, mean, 95 % CI of the mean (t), sd, median, p95, min, max."""
+    out = {}
+    for key in METRICS:
+        x = _values(items, key)
+        if not len(x):
+            out[key] = {"n": 0}
+            continue
+        sd = float(np.std(x, ddof=1)) if len(x) > 1 else 0.0
+        half = _t975(len(x) - 1) * sd / math.sqrt(len(x)) if len(x) > 1 else None
+        out[key] = {"n": len(x), "mean": float(np.mean(x)), "sd": sd,
+                    "ci95": None if half is None else [float(np.mean(x) - half),
+                                                       float(np.mean(x) + half)],
+                    "median": float(np.median(x)), "p95": float(np.percentile(x, 95)),
+                    "min": float(x.min()), "max": float(x.max())}
+    return out
+
+
+def compare(a: Sequence[dict[str, Any]], b: Sequence[dict[str, Any]]
+            ) -> dict[str, dict[str, Any]]:
+    """Per metric: mean of B minus mean of A with Welch's 95 % confidence interval;
+    ``significant`` when the interval excludes 0."""
+    out = {}
+    for key in METRICS:
+        x, y = _values(a, key), _values(b, key)
+        if len(x) < 2 or len(y) < 2:
+            out[key] = {"n_a": len(x), "n_b": len(y)}
+            continue
+        va, vb = np.var(x, ddof=1) / len(x), np.var(y, ddof=1) / len(y)
+        diff = float(np.mean(y) - np.mean(x))
+        se = math.sqrt(va + vb)
+        if se == 0:
+            lo = hi = diff
+        else:
+            dof = (va + vb) ** 2 / (va ** 2 / (len(x) - 1) + vb ** 2 / (len(y) - 1))
+            half = _t975(dof) * se
+            lo, hi = diff - half, diff + half
+        out[key] = {"n_a": len(x), "n_b": len(y), "mean_a": float(np.mean(x)),
+                    "mean_b": float(np.mean(y)), "diff": diff, "ci95": [lo, hi],
+                    "significant": bool(lo > 0 or hi < 0)}
+    return out
+
+
+# ------------------------------------------------------------------------------ plots
+
+def _floor_plan(ax, cell) -> None:
+    from matplotlib.patches import Rectangle
+    for ob in cell.obstacles:
+        for part in ob.parts:
+            lo, hi = part.aabb()
+            ax.add_patch(Rectangle(lo[:2], *(hi[:2] - lo[:2]), color=ob.color or "grey",
+                                   alpha=0.55, lw=0, zorder=3))
+        lo, hi = ob.aabb()
+        ax.text(0.5 * (lo[0] + hi[0]), hi[1] + 0.04, ob.name, ha="center", fontsize=8,
+                zorder=5)
+    for name, reg in cell.regions.items():
+        ax.add_patch(Rectangle(reg.lo[:2], *(reg.hi[:2] - reg.lo[:2]), fill=False,
+                               ls="--", ec="black", lw=0.8, zorder=4))
+        ax.text(reg.lo[0], reg.lo[1] - 0.12, name, fontsize=8, zorder=5)
+    for name, obj in cell.objects.items():
+        ax.plot(*obj.position[:2], "s", color=obj.color or "black", ms=6, zorder=5)
+        ax.text(obj.position[0] + 0.06, obj.position[1] + 0.06, name, fontsize=8, zorder=5)
+
+
+def _robot_base(ax, robot: dict[str, Any] | None) -> None:
+    if robot:
+        x, y = robot["base_xyz"][:2]
+        ax.plot(x, y, "k^", ms=9, zorder=6)
+        ax.text(x + 0.06, y - 0.15, "robot", fontsize=8, zorder=6)
+
+
+def _extent(cell, paths: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    from ltl_human_motion.viz._common import cell_bounds
+    pts = np.concatenate([np.c_[p, np.zeros(len(p))] for p in paths]) if paths else None
+    lo, hi = cell_bounds(cell, pts, margin=0.3)
+    return lo[:2], hi[:2]
+
+
+def plot_spaghetti(cell, paths: Sequence[np.ndarray], path: Path, title: str,
+                   robot: dict[str, Any] | None = None) -> Path:
+    """Floor plan with every worker path (pelvis) of a layout."""
+    fig = new_figure(6.0, 5.6, dpi=110)
+    ax = fig.add_subplot(111)
+    _floor_plan(ax, cell)
+    _robot_base(ax, robot)
+    alpha = float(np.clip(8.0 / max(len(paths), 1), 0.05, 0.6))
+    for p in paths:
+        ax.plot(p[:, 0], p[:, 1], color="tab:blue", lw=0.8, alpha=alpha, zorder=2)
+    lo, hi = _extent(cell, paths)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(f"{title}: worker paths ({len(paths)} motions)")
+    fig.tight_layout()
+    save_figure(fig, path)
+    return path
+
+
+def plot_heatmap(cell, paths: Sequence[np.ndarray], path: Path, title: str,
+                 robot: dict[str, Any] | None = None, cell_size: float = 0.1,
+                 rate: float = 10.0) -> Path:
+    """Floor occupancy: seconds per motion spent in each ``cell_size`` square."""
+    fig = new_figure(6.6, 5.6, dpi=110)
+    ax = fig.add_subplot(111)
+    lo, hi = _extent(cell, paths)
+    bx = np.arange(lo[0], hi[0] + cell_size, cell_size)
+    by = np.arange(lo[1], hi[1] + cell_size, cell_size)
+    pts = np.concatenate(paths) if paths else np.zeros((0, 2))
+    H, _, _ = np.histogram2d(pts[:, 0], pts[:, 1], bins=[bx, by])
+    H = H / rate / max(len(paths), 1)
+    im = ax.imshow(np.where(H > 0, H, np.nan).T, origin="lower", cmap="magma_r",
+                   extent=(bx[0], bx[-1], by[0], by[-1]), zorder=1, interpolation="nearest")
+    fig.colorbar(im, ax=ax, label=f"s per motion in {cell_size * 100:.0f} cm squares",
+                 shrink=0.85)
+    _floor_plan(ax, cell)
+    _robot_base(ax, robot)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(f"{title}: floor occupancy")
+    fig.tight_layout()
+    save_figure(fig, path)
+    return path
+
+
+def plot_distributions(layouts: Sequence[dict[str, Any]], path: Path,
+                       protective_distance: float | None) -> Path:
+    """Histograms of cycle time, worst REBA, lifting index, minimum separation."""
+    fig = new_figure(10.0, 7.0, dpi=110)
+    panels = [("cycle_time", "worker cycle time [s]", None),
+              ("reba_max", "worst REBA per motion (action level bands)", None),
+              ("lifting_index", "highest NIOSH lifting index", 1.0),
+              ("min_separation", "minimum separation to the robot [m]", protective_distance)]
+    for i, (key, label, ref) in enumerate(panels):
+        ax = fig.add_subplot(2, 2, i + 1)
+        data = [_values(lay["items"], key) for lay in layouts]
+        allv = np.concatenate(data) if data else np.zeros(0)
+        if not allv.size:
+            ax.text(0.5, 0.5, "not measured", ha="center", va="center",
+                    transform=ax.transAxes)
+        else:
+            if key == "reba_max":
+                bins = np.arange(0.5, 16.0, 1.0)
+                for (a, b), color in zip(((0.5, 1.5), (1.5, 3.5), (3.5, 7.5), (7.5, 10.5),
+                                          (10.5, 15.5)), ("#e8f5e9", "#fffde7", "#fff3e0",
+                                                           "#ffebee", "#f8bbd0")):
+                    ax.axvspan(a, b, color=color, zorder=0)
+                ax.set_xticks(range(1, 16))
+            else:
+                lo = min(allv.min(), ref) if ref is not None else allv.min()
+                hi = max(allv.max(), ref) if ref is not None else allv.max()
+                span = max(hi - lo, 1e-6)
+                bins = np.linspace(lo - 0.05 * span, hi + 0.05 * span, 31)
+            for lay, x, color in zip(layouts, data, _COLORS):
+                if x.size:
+                    ax.hist(x, bins=bins, alpha=0.55, color=color,
+                            label=f"{lay['label']} (mean {x.mean():.3g})")
+            if ref is not None:
+                ax.axvline(ref, color="red", ls=":", lw=1.5,
+                           label="S_p" if key == "min_separation" else "LI = 1")
+            ax.legend(fontsize=8)
+        ax.set_xlabel(label)
+        ax.set_ylabel("motions")
+    fig.suptitle("Distributions over the study's motions")
+    fig.tight_layout()
+    save_figure(fig, path)
+    return path
+
+
+def plot_breakdown(layouts: Sequence[dict[str, Any]], path: Path) -> Path:
+    """Mean cycle time split into walking, value-adding work and waiting, per layout."""
+    fig = new_figure(6.0, 3.8, dpi=110)
+    ax = fig.add_subplot(111)
+    colors = {"walking": "tab:red", "value_adding": "tab:green", "waiting": "tab:grey"}
+    for i, lay in enumerate(layouts):
+        left = 0.0
+        for cat, color in colors.items():
+            vals = [it["cycle"]["per_cycle"][cat] for it in lay["items"]]
+            v = float(np.mean(vals)) if vals else 0.0
+            ax.barh(i, v, left=left, color=color, label=cat.replace("_", "-") if i == 0
+                    else None)
+            if v > 0.4:
+                ax.text(left + v / 2, i, f"{v:.1f} s", ha="center", va="center",
+                        color="white", fontsize=9)
+            left += v
+    ax.set_yticks(range(len(layouts)), [lay["label"] for lay in layouts])
+    ax.set_xlabel("mean time per cycle [s]")
+    ax.set_title("Cycle time and waste (walking and waiting are waste)")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.28), ncol=3)
+    fig.tight_layout()
+    save_figure(fig, path)
+    return path
+
+
+# ------------------------------------------------------------------------------ HTML
+
+def _fmt(v: Any, digits: int = 3) -> str:
+    if v is None:
+        return "–"
+    if isinstance(v, float):
+        return f"{v:.{digits}g}"
+    return html.escape(str(v))
+
+
+def _img(path: Path, alt: str) -> str:
+    data = base64.b64encode(path.read_bytes()).decode("ascii")
+    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{data}">'
+
+
+def _summary_table(summaries: dict[str, dict[str, Any]], labels: Sequence[str]) -> str:
+    head = "".join(f"<th>{html.escape(lb)} mean [95% CI]</th><th>{html.escape(lb)} max</th>"
+                   for lb in labels)
+    rows = []
+    for key, (label, unit) in METRICS.items():
+        cells = []
+        for lb in labels:
+            s = summaries[lb][key]
+            if not s.get("n"):
+                cells.append("<td>–</td><td>–</td>")
+                continue
+            ci = s["ci95"]
+            ci_txt = f" [{_fmt(ci[0])}, {_fmt(ci[1])}]" if ci else ""
+            cells.append(f"<td>{_fmt(s['mean'])}{ci_txt}</td><td>{_fmt(s['max'])}</td>")
+        rows.append(f"<tr><td>{html.escape(label)}{' [' + unit + ']' if unit else ''}</td>"
+                    + "".join(cells) + "</tr>")
+    return f"<table><tr><th>figure</th>{head}</tr>{''.join(rows)}</table>"
+
+
+def _compare_table(cmp: dict[str, dict[str, Any]], a: str, b: str) -> str:
+    rows = []
+    for key, (label, unit) in METRICS.items():
+        c = cmp[key]
+        if "diff" not in c:
+            continue
+        mark = ' class="sig"' if c["significant"] else ""
+        rows.append(f"<tr{mark}><td>{html.escape(label)}{' [' + unit + ']' if unit else ''}"
+                    f"</td><td>{_fmt(c['mean_a'])}</td><td>{_fmt(c['mean_b'])}</td>"
+                    f"<td>{c['diff']:+.3g}</td><td>[{c['ci95'][0]:+.3g}, {c['ci95'][1]:+.3g}]"
+                    f"</td><td>{'yes' if c['significant'] else 'no'}</td></tr>")
+    return (f"<table><tr><th>figure</th><th>{html.escape(a)}</th><th>{html.escape(b)}</th>"
+            f"<th>{html.escape(b)} − {html.escape(a)}</th><th>95% CI</th>"
+            f"<th>differs</th></tr>{''.join(rows)}</table>")
+
+
+_CSS = """body{font-family:sans-serif;margin:24px;max-width:1400px;color:#222}
+table{border-collapse:collapse;margin:8px 0 20px}td,th{border:1px solid #bbb;padding:4px 8px;
+font-size:14px;text-align:right}td:first-child,th:first-child{text-align:left}
+tr.sig td{background:#fff3cd}.row{display:flex;gap:16px;flex-wrap:wrap}
+.row>div{flex:1;min-width:420px}img{max-width:100%}h2{border-bottom:1px solid #ccc}
+.note{color:#555;font-size:13px}"""
+
+
+def write_report(layouts: Sequence[dict[str, Any]], out: Path, meta: dict[str, Any]
+                 ) -> dict[str, Any]:
+    """Write ``study.json``, the PNGs and ``study.html`` into ``out``; returns the JSON."""
+    from ltl_human_motion.planning.pipeline import resolve_cell
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    labels = [lay["label"] for lay in layouts]
+    cells = {lay["label"]: resolve_cell(lay["cell"]) for lay in layouts}
+    robot = None
+    if meta.get("robot"):
+        from ltl_human_motion.study.item import robot_settings
+        robot = robot_settings(meta["robot"])
+    sp = None
+    for lay in layouts:
+        for it in lay["items"]:
+            if it.get("ssm"):
+                sp = it["ssm"]["protective_distance"]
+                break
+    pngs = {"distributions": plot_distributions(layouts, out / "distributions.png", sp),
+            "breakdown": plot_breakdown(layouts, out / "cycle_breakdown.png")}
+    for lay in layouts:
+        lb = lay["label"]
+        pngs[f"spaghetti_{lb}"] = plot_spaghetti(cells[lb], lay["paths"],
+                                                 out / f"spaghetti_{lb}.png",
+                                                 f"layout {lb}", robot)
+        pngs[f"heatmap_{lb}"] = plot_heatmap(cells[lb], lay["paths"], out / f"heatmap_{lb}.png",
+                                             f"layout {lb}", robot)
+    summaries = {lay["label"]: summarize(lay["items"]) for lay in layouts}
+    comparison = compare(layouts[0]["items"], layouts[1]["items"]) if len(layouts) == 2 \
+        else None
+    data = {"format": "ltl_human_motion.study", "version": 1, **meta,
+            "layouts": {lay["label"]: {"cell": lay["cell"], "items": lay["items"],
+                                       "failed": lay["failed"],
+                                       "summary": summaries[lay["label"]]}
+                        for lay in layouts},
+            "comparison": comparison,
+            "report": {"html": str(out / "study.html"),
+                       "plots": {k: str(v) for k, v in pngs.items()}}}
+    atomic_write_text(out / "study.json", json.dumps(data, indent=1, allow_nan=False,
+                                                     default=_json_default) + "\n")
+    names = " vs ".join(f"layout {html.escape(lay['label'])} ({html.escape(str(lay['cell']))})"
+                        for lay in layouts)
+    parts = [f"<h1>Cell study: {html.escape(meta['spec'])}</h1>",
+             f"<p>{names}; "
+             f"{meta['variants']} variants x statures "
+             f"{', '.join(f'{s:.2f}' for s in meta['statures'])} m per layout; robot: "
+             f"{html.escape(str(meta.get('robot') or 'none'))}; seed {meta['seed']}.</p>",
+             "<p>" + "; ".join(f"layout {html.escape(lay['label'])}: {len(lay['items'])} "
+                               f"verified motions, {lay['failed']['count']} failed"
+                               for lay in layouts) + ".</p>"]
+    if comparison:
+        parts += [f"<h2>{html.escape(labels[1])} against {html.escape(labels[0])}</h2>",
+                  _compare_table(comparison, labels[0], labels[1]),
+                  '<p class="note">Highlighted: the 95 % confidence interval of the '
+                  "difference of means (Welch) excludes 0.</p>"]
+    parts += ["<h2>Figures per layout</h2>", _summary_table(summaries, labels),
+              "<h2>Distributions</h2>", _img(pngs["distributions"], "distributions"),
+              "<h2>Cycle time and waste</h2>", _img(pngs["breakdown"], "cycle breakdown"),
+              "<h2>Worker paths</h2>", '<div class="row">'
+              + "".join(f"<div>{_img(pngs[f'spaghetti_{lb}'], f'paths {lb}')}</div>"
+                        for lb in labels) + "</div>",
+              "<h2>Floor occupancy</h2>", '<div class="row">'
+              + "".join(f"<div>{_img(pngs[f'heatmap_{lb}'], f'heat map {lb}')}</div>"
+                        for lb in labels) + "</div>",
+              '<p class="note">REBA: Hignett &amp; McAtamney (2000); RULA: McAtamney &amp; '
+              "Corlett (1993); lifting index: revised NIOSH equation (Waters et al. 1994), "
+              "every lift from grasp to release; separation: the live SSM controller's "
+              "decisions at 125 Hz in simulated time (ISO/TS 15066 S_p). Walking and "
+              "waiting are waste; every other task is value-adding work.</p>"]
+    page = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>Cell study</title>"
+            f"<style>{_CSS}</style></head><body>{''.join(parts)}</body></html>\n")
+    atomic_write_text(out / "study.html", page)
+    return data
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"not JSON serializable: {type(value).__name__}")
