@@ -5,13 +5,15 @@ keeps discovery on loopback and loads the package's Fast DDS profile, before any
 initializes rclpy; subprocesses inherit all three through ``os.environ``.
 
 Property-based tests draw the same examples on every run (profile ``deterministic``), so
-CI is repeatable; ``HYPOTHESIS_PROFILE=explore`` draws new ones to hunt for bugs.
+CI is repeatable; ``HYPOTHESIS_PROFILE=explore`` draws new ones to hunt for bugs, and
+``--hypothesis-profile=thorough`` runs many more (the fuzz tests scale with it).
 """
 
 from __future__ import annotations
 
 import os
 import random
+import tempfile
 from collections.abc import Iterator
 
 import pytest
@@ -21,9 +23,15 @@ from ltl_human_motion.ros.middleware import apply_middleware_defaults
 
 settings.register_profile("deterministic", derandomize=True, database=None, deadline=None)
 settings.register_profile("explore", deadline=None)
+# The fuzz tests (test_fuzz_*.py) draw settings().max_examples // FUZZ_DIVISOR examples:
+# 25 in CI (deterministic), 500 with --hypothesis-profile=thorough.
+settings.register_profile("thorough", derandomize=False, database=None, deadline=None,
+                          max_examples=2000)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 os.environ.setdefault("ROS_DOMAIN_ID", str(random.SystemRandom().randint(100, 200)))
+# Motions stored under $ROS_HOME (the synthesis node's default) stay out of the user's home.
+os.environ.setdefault("ROS_HOME", tempfile.mkdtemp(prefix="lhm-test-ros-home-"))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 apply_middleware_defaults()
 

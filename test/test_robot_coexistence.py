@@ -89,6 +89,15 @@ def test_stale_occupancy_commands_the_minimum(sim: URSimHandle, receive: object)
     ctl = CoexistenceController(receive_factory, io_factory, "ur5e", params=PARAMS,
                                 config=CoexistenceConfig(stale_after=0.15), clock=clock)
     try:
+        # The test is about staleness, so first wait (real time, bounded) for the RTDE
+        # connection it assumes; the frozen clock moves on so that reconnection backoff
+        # expires. On a loaded machine the first connection can take a while.
+        deadline = time.monotonic() + 20.0
+        while not ctl.connected and time.monotonic() < deadline:
+            clock.t += 0.05
+            ctl.step()
+            time.sleep(0.02)
+        assert ctl.connected, "no RTDE connection to the simulated controller within 20 s"
         assert ctl.step().mode == "stale"             # nothing received yet
         ctl.update_occupancy(*human_at(4.0), stamp=clock())
         assert ctl.step().mode == "full"

@@ -287,6 +287,108 @@ def test_dropped_robot_connection_is_survived(stack: Stack,
     assert stack.node.controller.reconnects > reconnects
 
 
+# ------------------------------------------------------------------ faults of a second human
+FAIL_SAFE_WITHIN = 0.3      # s from a fault to the minimum slider (issue 17's bound)
+FAR_SEGMENTS = np.array([[[4.5, 2.5, 0.0], [4.5, 2.5, 1.6]]])   # ~5 m from the arm
+
+
+def _second_human(stack: Stack, topic: str = "/human_2/occupancy") -> Callable[..., None]:
+    """A publisher of worker 2's occupancy: ``send(offset_s=0.0, segments=FAR_SEGMENTS)``
+    stamps the message ``offset_s`` from now (client clock)."""
+    publisher = stack.session.node.create_publisher(HumanOccupancy, topic, 10)
+    clock = stack.session.node.get_clock()
+
+    def send(offset: float = 0.0, segments: np.ndarray = FAR_SEGMENTS) -> None:
+        ns = clock.now().nanoseconds + int(offset * 1e9)
+        sec, nanosec = divmod(ns, 1_000_000_000)
+        publisher.publish(encode_human_occupancy(sec, nanosec, "world", "2", ["torso"],
+                                                 segments[None], np.array([0.2]),
+                                                 np.zeros(1)))
+    send.publisher = publisher  # type: ignore[attr-defined]
+    return send
+
+
+def _fault_to_minimum(stack: Stack, send: Callable[[], None], what: str) -> float:
+    """Seconds from the first faulty message until the node commands the minimum (the
+    faulty stream keeps coming at 50 Hz meanwhile)."""
+    t0 = time.monotonic()
+
+    def minimum() -> bool:
+        send()
+        d = stack.node.latest
+        return d is not None and d.slider == pytest.approx(MIN) and d.mode == "stale"
+
+    wait_for(minimum, 3.0, f"the slider minimum after {what}",
+             detail=lambda: f"{stack.node.latest}, humans {stack.node.humans}")
+    return time.monotonic() - t0
+
+
+def _hold_minimum(stack: Stack, send: Callable[[], None], seconds: float) -> None:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        send()
+        d = stack.node.latest
+        assert d.slider == pytest.approx(MIN), f"slider rose during a fault: {d}"
+        time.sleep(0.02)
+
+
+def _with_good_worker_2(stack: Stack, send: Callable[..., None]) -> None:
+    """Worker 2 far away with correct stamps: full speed (worker 1 is away too)."""
+    def full() -> bool:
+        send()
+        return stack.node.latest.mode == "full" and len(stack.node.humans) == 2
+    wait_for(full, 8.0, "full speed with worker 2 far away",
+             detail=lambda: f"{stack.node.latest}, humans {stack.node.humans}")
+
+
+def test_future_stamps_of_a_second_human_hold_the_minimum(
+        stack: Stack, motion: tuple[str, float]) -> None:
+    """Issue 17's reproducer: worker 2 stamped 30 s in the future, then silent. The node
+    rejects the stamps (a fault: minimum at once) and never lets them look fresh."""
+    worker_away(stack, motion[0])
+    send = _second_human(stack)
+    try:
+        rejected = stack.node.messages_rejected
+        # (The first samples may go unseen until the node discovers the topic, <= 1 s.)
+        _fault_to_minimum(stack, lambda: send(30.0), "stamps 30 s in the future")
+        assert stack.node.messages_rejected > rejected
+        _hold_minimum(stack, lambda: send(30.0), 1.0)
+        # Silent after the future stamps: still the minimum (until forgotten, 1.5 s).
+        _hold_minimum(stack, lambda: None, 1.0)
+        # A stamp just inside the tolerance is fine; correct stamps resume full speed.
+        _with_good_worker_2(stack, lambda: send(0.5 * stack.node.future_tolerance))
+        # Correct stamps, then silence: stale (judged on the node's receive time).
+        t0 = time.monotonic()
+        wait_for(lambda: stack.node.latest.slider == pytest.approx(MIN), 2.0,
+                 "the minimum once worker 2 fell silent")
+        assert time.monotonic() - t0 < FAIL_SAFE_WITHIN
+        assert stack.node.latest.mode == "stale"
+    finally:
+        stack.session.node.destroy_publisher(send.publisher)  # type: ignore[attr-defined]
+    wait_for(lambda: stack.node.latest.mode == "full", 5.0, "worker 2 forgotten: full again")
+
+
+@pytest.mark.parametrize("fault", ["nan", "absurd", "past"])
+def test_every_occupancy_fault_ends_in_the_minimum(stack: Stack, motion: tuple[str, float],
+                                                   fault: str) -> None:
+    """NaN capsules, coordinates 1 km away and stamps older than stale_after, each from a
+    second worker whose earlier samples were good: the minimum within 0.3 s."""
+    worker_away(stack, motion[0])
+    send = _second_human(stack)
+    try:
+        _with_good_worker_2(stack, send)
+        bad = {"nan": lambda: send(0.0, np.full((1, 2, 3), np.nan)),
+               "absurd": lambda: send(0.0, FAR_SEGMENTS + 1000.0),
+               "past": lambda: send(-2.0)}[fault]
+        assert _fault_to_minimum(stack, bad, fault) < FAIL_SAFE_WITHIN
+        _hold_minimum(stack, bad, 0.5)
+        wait_for(lambda: stack.slider() == pytest.approx(MIN), 1.0, "the minimum over RTDE")
+        _with_good_worker_2(stack, send)                # valid data again: recovers
+    finally:
+        stack.session.node.destroy_publisher(send.publisher)  # type: ignore[attr-defined]
+    wait_for(lambda: stack.node.latest.mode == "full", 5.0, "worker 2 forgotten: full again")
+
+
 # ------------------------------------------------------------------ pieces
 def test_occupancy_decoder_matches_rclpy() -> None:
     rng = np.random.default_rng(3)

@@ -132,18 +132,31 @@ class DatasetStore:
                     f"{self.root}: holds a different dataset (differs in {', '.join(diff)}); "
                     "resuming needs the same cell, specs, seed, count, shard size and dtype. "
                     "Use another --out folder.")
-        elif self.root.exists() and any(p.name not in (".gitkeep", ".lock")
-                                        for p in self.root.iterdir()):
+        elif self.root.exists() and not self._half_started():
             raise BatchConfigError(f"{self.root}: exists, is not empty and is not a dataset "
                                    "(no dataset.json); use an empty or new --out folder")
-        self.staging.mkdir(parents=True, exist_ok=True)
-        self.shards.mkdir(parents=True, exist_ok=True)
+        # The header first: a run killed during start-up leaves a folder that resumes.
+        self.root.mkdir(parents=True, exist_ok=True)
         self._lock()
         if not self.header_path.is_file():
             self._write_header(self.header)
+        self.staging.mkdir(parents=True, exist_ok=True)
+        self.shards.mkdir(parents=True, exist_ok=True)
         for folder in (self.staging, self.shards, self.root):
             for tmp in folder.glob(".*.tmp"):          # left by a killed atomic write
                 tmp.unlink(missing_ok=True)
+
+    def _half_started(self) -> bool:
+        """True when the folder holds only what an interrupted start-up leaves: the lock,
+        and empty staging and shard folders (or temporary files in them)."""
+        for p in self.root.iterdir():
+            if p.name in (".gitkeep", ".lock") or (p.is_file() and p.name.endswith(".tmp")):
+                continue
+            if p in (self.staging, self.shards) and p.is_dir() and all(
+                    q.name.endswith(".tmp") for q in p.iterdir()):
+                continue
+            return False
+        return True
 
     def _lock(self) -> None:
         """Hold an exclusive lock on ``out/.lock`` (released when the process ends)."""

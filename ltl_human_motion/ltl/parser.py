@@ -55,6 +55,7 @@ from ltl_human_motion.ltl.formula import (
     WeakUntil,
     Xor,
 )
+from ltl_human_motion.ltl.limits import MAX_NESTING, MAX_SPEC_CHARS, check_formula_limits
 from ltl_human_motion.ltl.vocabulary import (
     REGION_ATOM,
     TASK_SIGNATURES,
@@ -246,7 +247,7 @@ class _Parser:
 
     def describe(self, tok: _Token) -> str:
         if tok.kind == "eof":
-            return "the end of the specification"
+            return "end of the specification"
         if tok.kind == "string":
             return f'"{tok.value}"'
         return repr(self.text[tok.pos:tok.pos + max(len(tok.value), 1)]) \
@@ -296,6 +297,10 @@ class _Parser:
                 return Next(self.unary())
             inner = self.expression(0)
             close = self.advance()
+            if close.kind == "eof":
+                raise self.error(f"expected ')' to close the '(' at column "
+                                 f"{self._column(tok.pos)} before the end of the "
+                                 "specification", close.pos)
             if close.kind != ")":
                 raise self.error(f"expected ')' to close the '(' at column "
                                  f"{self._column(tok.pos)}, found {self.describe(close)}",
@@ -461,12 +466,17 @@ def parse_spec(text: str, cell: object = None, *, free_atoms: bool = False) -> P
     """
     if not isinstance(text, str):
         raise SpecError(f"a specification must be a string, got {type(text).__name__}")
+    if len(text) > MAX_SPEC_CHARS:
+        raise SpecError(f"the specification has {len(text)} characters; at most "
+                        f"{MAX_SPEC_CHARS} are allowed (MAX_SPEC_CHARS)")
     vocab = vocabulary_from(cell)
     parser = _Parser(text, vocab, free_atoms)
     try:
         formula = parser.parse()
     except RecursionError:
-        raise SpecError("specification nested too deeply", text=text) from None
+        raise SpecError(f"the specification nests operators deeper than {MAX_NESTING} "
+                        "(MAX_NESTING)", text=text) from None
+    check_formula_limits(formula, text)
     return ParsedSpec(text=text, formula=formula, tasks=tuple(parser.tasks))
 
 

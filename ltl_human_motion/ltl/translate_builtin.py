@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 
+from ltl_human_motion.deadline import checkpoint
 from ltl_human_motion.ltl.automaton import (
     TRUE_CUBE,
     Automaton,
@@ -191,6 +192,7 @@ def _tableau_automaton(formula: Formula, name: str | None) -> Automaton:
     todo = [init]
     raw: list[tuple[int, int, Cube, frozenset[Formula]]] = []
     while todo:
+        checkpoint("translation")
         state = todo.pop()
         src = index[state]
         for cube, nxt, promises in tableau.expand_state(state):

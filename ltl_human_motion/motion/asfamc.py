@@ -20,6 +20,7 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -87,6 +88,14 @@ class AsfSkeleton:
         return order
 
 
+def _axis_order(text: str, lineno: int, fail: Any) -> str:
+    """An Euler order such as ``XYZ`` (each axis once), else the ``fail`` error."""
+    order = text.upper()
+    if sorted(order) != ["X", "Y", "Z"]:
+        raise fail(lineno, f"axis order must be a permutation of XYZ, got {text[:20]!r}")
+    return order
+
+
 def _euler(angles: np.ndarray, order: str, unit: str) -> np.ndarray:
     """Fixed-axis rotations applied in ``order``: R = R_o2 @ R_o1 @ R_o0."""
     a = np.asarray(angles, dtype=np.float64)
@@ -152,7 +161,7 @@ def parse_asf(path: str | os.PathLike[str]) -> AsfSkeleton:
                 if tok[0] == "order":
                     root_order = tuple(t.upper() for t in tok[1:])
                 elif tok[0] == "axis":
-                    root_axis = tok[1].upper()
+                    root_axis = _axis_order(tok[1], lineno, fail)
                 elif tok[0] == "position":
                     root_pos = np.array([float(v) for v in tok[1:4]])
                 elif tok[0] == "orientation":
@@ -174,7 +183,10 @@ def parse_asf(path: str | os.PathLike[str]) -> AsfSkeleton:
                     cur["length"] = float(tok[1])
                 elif tok[0] == "axis":
                     cur["axis"] = np.array([float(v) for v in tok[1:4]])
-                    cur["axis_order"] = tok[4].upper() if len(tok) > 4 else "XYZ"
+                    if cur["axis"].shape != (3,):
+                        raise fail(lineno, "axis needs 3 angles and an order such as XYZ")
+                    cur["axis_order"] = _axis_order(tok[4], lineno, fail) if len(tok) > 4 \
+                        else "XYZ"
                 elif tok[0] == "dof":
                     dof = tuple(t.lower() for t in tok[1:])
                     bad = [d for d in dof if d not in ("rx", "ry", "rz", "tx", "ty", "tz", "l")]
@@ -186,6 +198,8 @@ def parse_asf(path: str | os.PathLike[str]) -> AsfSkeleton:
                     continue
                 for child in tok[1:]:
                     parent[child] = tok[0]
+        except MotionFormatError:
+            raise
         except (ValueError, IndexError):
             raise fail(lineno, f"malformed line {line[:60]!r}") from None
     if cur is not None:

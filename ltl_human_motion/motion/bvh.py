@@ -14,6 +14,7 @@ file reproduces the positions exactly; it loads back with :func:`load`.
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -157,6 +158,9 @@ def _parse(path: Path, text: str) -> tuple[BvhSkeleton, np.ndarray, float]:
                     from None
             if len(vals) != 3 or len(tok) != 4:
                 raise _err(path, lineno, "OFFSET needs 3 numbers")
+            if not all(math.isfinite(v) and abs(v) <= MAX_OFFSET for v in vals):
+                raise _err(path, lineno, f"OFFSET values must be finite and within "
+                           f"+-{MAX_OFFSET:g} (MAX_OFFSET), got {' '.join(tok[1:])[:60]!r}")
             offsets[stack[-1]] = vals
         elif key == "CHANNELS":
             if not stack:
@@ -209,6 +213,13 @@ def _parse(path: Path, text: str) -> tuple[BvhSkeleton, np.ndarray, float]:
     if n_frames < 1 or not frame_time > 0:
         raise _err(path, ln, f"need at least one frame and a positive frame time, got "
                    f"{n_frames} frames, {frame_time} s")
+    if not MIN_FRAME_TIME <= frame_time <= MAX_FRAME_TIME:
+        raise _err(path, ln, f"frame time {frame_time:g} s is outside [{MIN_FRAME_TIME:g}, "
+                   f"{MAX_FRAME_TIME:g}] s (MIN_FRAME_TIME, MAX_FRAME_TIME)")
+    if n_frames > n - i:          # each frame takes a line: never allocate for absent ones
+        raise _err(path, n, f"frame {n - i}: the header announces {n_frames} frames but "
+                   f"only {n - i} lines follow "
+                   "(truncated, or a wrong frame count)")
     nch = skel.n_channels
     data = np.empty((n_frames, nch))
     f = 0
@@ -269,6 +280,14 @@ def _fk(skel: BvhSkeleton, data: np.ndarray) -> np.ndarray:
             pos[:, j] = pos[:, p] + np.einsum("tij,tj->ti", rot[:, p], local_t)
             rot[:, j] = rot[:, p] @ local_r
     return pos
+
+
+#: Frame times accepted (s): 10 kHz to one frame per 10 s. Capture runs at 30-480 Hz;
+#: 1e-300 s overflowed the frame rate.
+MIN_FRAME_TIME = 1e-4
+MAX_FRAME_TIME = 10.0
+#: Bone offsets (file units: cm, inches or m): a human bone is well under 1e4 of any.
+MAX_OFFSET = 1e4
 
 
 def load_raw(path: str | os.PathLike[str]) -> tuple[BvhSkeleton, np.ndarray, float]:

@@ -101,9 +101,34 @@ LOADERS = {".bvh": _load_bvh, ".txt": _load_deepmimic, ".json": _load_deepmimic,
            ".npz": _load_npz}
 
 
+def asf_for(amc: Path) -> Path:
+    """The ASF skeleton of an AMC motion, paired by name: ``07_01.amc`` -> ``07_01.asf``,
+    else ``07.asf`` (the CMU layout: one subject's skeleton for all its trials), else the
+    folder's only ASF. MotionFormatError naming what was looked for otherwise."""
+    folder = amc.parent
+    candidates = [folder / f"{amc.stem}.asf", folder / f"{amc.stem.split('_')[0]}.asf"]
+    for c in candidates + [c.with_suffix(".ASF") for c in candidates]:
+        if c.is_file():
+            return c
+    asfs = sorted(folder.glob("*.asf")) + sorted(folder.glob("*.ASF"))
+    if len(asfs) == 1:
+        return asfs[0]
+    raise MotionFormatError(f"{amc}: no ASF skeleton found for it (looked for "
+                            f"{candidates[0].name}, {candidates[1].name}, or a folder with "
+                            f"one .asf; found {len(asfs)})")
+
+
+def _load_amc(path: Path, skeleton: Skeleton) -> Motion:
+    from ltl_human_motion.motion import asfamc
+    return asfamc.load(asf_for(path), path, skeleton=skeleton)
+
+
 def load_motion(path: str | os.PathLike[str], skeleton: Skeleton | None = None) -> Motion:
-    """Load any supported motion file (by suffix) retargeted onto the canonical skeleton."""
+    """Load any supported motion file (by suffix) retargeted onto the canonical skeleton;
+    an ``.amc`` motion is paired with its ``.asf`` by name (:func:`asf_for`)."""
     path = Path(path)
+    if path.suffix.lower() == ".amc":
+        return _load_amc(path, skeleton or Skeleton())
     loader = LOADERS.get(path.suffix.lower())
     if loader is None:
         raise MotionFormatError(
@@ -124,9 +149,11 @@ def _source_files(source: str | os.PathLike[str] | Iterable | None) -> list[Path
         if item.is_dir():
             found = sorted(p for p in item.rglob("*") if p.suffix.lower() in LOADERS
                            and p.is_file())
+            found += [p for p in sorted(item.rglob("*.amc")) + sorted(item.rglob("*.AMC"))
+                      if p.is_file()]
             if not found:
                 raise ValueError(f"source folder {item} holds no motion files "
-                                 f"({', '.join(sorted(LOADERS))})")
+                                 f"({', '.join(sorted(LOADERS))}, or .amc with its .asf)")
             files += found
         elif item.is_file():
             files.append(item)
@@ -460,6 +487,24 @@ def _save(lib: MotionLibrary, path: Path) -> None:
     atomic_write_with(path, writer)
 
 
+def _check_cache_arrays(n: int, poses: np.ndarray, root: np.ndarray, indptr: np.ndarray,
+                        indices: np.ndarray, data: np.ndarray, initial: np.ndarray) -> None:
+    """ValueError unless the cached arrays are finite and the transition matrix (CSR of
+    ``n`` primitives) and initial states index real primitives (a damaged cache is then
+    rebuilt instead of crashing synthesis later)."""
+    if not (np.all(np.isfinite(poses)) and np.all(np.isfinite(root))
+            and np.all(np.isfinite(data))):
+        raise ValueError("cache entry holds NaN or infinite values")
+    if indptr.shape != (n + 1,) or indptr[0] != 0 or np.any(np.diff(indptr) < 0) \
+            or indptr[-1] != indices.size or indices.size != data.size:
+        raise ValueError("cache entry has a malformed transition matrix")
+    for name, ids in (("transition", indices), ("initial", initial)):
+        ids = np.asarray(ids)
+        if ids.size and (not np.issubdtype(ids.dtype, np.integer) or ids.min() < 0
+                         or ids.max() >= n):
+            raise ValueError(f"cache entry has {name} indices outside 0..{n - 1}")
+
+
 def _load(path: Path, key: str) -> MotionLibrary:
     with np.load(path, allow_pickle=False) as z:
         header = json.loads(str(z["header"]))
@@ -471,6 +516,7 @@ def _load(path: Path, key: str) -> MotionLibrary:
     bounds = np.concatenate([[0], np.cumsum(lengths)])
     if bounds[-1] != poses.shape[0] or len(header["primitives"]) != lengths.size:
         raise ValueError("cache entry is inconsistent")
+    _check_cache_arrays(lengths.size, poses, root, indptr, indices, data, initial)
     fps = float(header["fps"])
     prims = [MotionPrimitive(name=h["name"], task=h["task"], poses=poses[a:b], root=root[a:b],
                              fps=fps, source=h["source"], meta=h["meta"])

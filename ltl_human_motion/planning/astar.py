@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ltl_human_motion.deadline import checkpoint
 from ltl_human_motion.planning.gait_index import GaitIndex
 
 Pose = tuple[float, float, float]
@@ -203,6 +204,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     expanded = 0
     closest = float(goal.distance(np.array([sx]), np.array([sy]))[0])
     while open_heap:
+        checkpoint("planning")
         _, node = heapq.heappop(open_heap)
         px, py, pyaw = poses[node]
         key = (round(px / grid), round(py / grid),

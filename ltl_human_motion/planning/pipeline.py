@@ -12,6 +12,7 @@ Stages (timed separately, as in the paper's Tab. III):
 from __future__ import annotations
 
 import functools
+import inspect
 import math
 import time
 from dataclasses import dataclass, field, replace
@@ -20,6 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from ltl_human_motion.deadline import Deadline, checkpoint
+from ltl_human_motion.deadline import active as active_deadline
 from ltl_human_motion.errors import CellError
 from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
@@ -49,6 +52,13 @@ class SynthesisOptions:
         Refuse motions that fail a check (default). False returns them with the report.
     library_source : str or None
         Extra motion files or a folder (e.g. a CMU BVH database) for the gait library.
+    max_seconds : float or None
+        Time budget of each call (s): checked between the stages and in the translator's
+        and the A* search's loops; when spent,
+        :class:`~ltl_human_motion.deadline.BudgetExhaustedError` names the stage.
+    deadline : Deadline or None
+        A :class:`~ltl_human_motion.deadline.Deadline` of the caller's instead (one it
+        can cancel, e.g. a node shutting down); overrides ``max_seconds``.
     """
 
     sequence_mode: str = "all"
@@ -57,14 +67,17 @@ class SynthesisOptions:
     verification: VerificationOptions = field(default_factory=VerificationOptions)
     verify: bool = True
     library_source: str | None = None
+    max_seconds: float | None = None
+    deadline: Deadline | None = field(default=None, compare=False)
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> SynthesisOptions:
         """Options from plain values, e.g. the ROS service's ``options_json``.
 
         Keys: ``sequence_mode``, ``backend``, ``verify``, ``library_source``,
-        ``heuristic_speed``, ``max_nodes``, ``max_seconds``, ``cost_noise``, ``eps``,
-        ``max_joint_speed``. Unknown keys raise ValueError naming them.
+        ``heuristic_speed``, ``max_nodes``, ``max_seconds`` (the time budget of each
+        call, and of each search), ``cost_noise``, ``eps``, ``max_joint_speed``.
+        Unknown keys raise ValueError naming them.
         """
         from ltl_human_motion.planning.astar import SearchBudget
         known = {"sequence_mode", "backend", "verify", "library_source", "heuristic_speed",
@@ -84,6 +97,9 @@ class SynthesisOptions:
                 int(data.get("max_nodes", planner.budget.max_nodes)),
                 None if data.get("max_seconds", planner.budget.max_seconds) is None
                 else float(data.get("max_seconds", planner.budget.max_seconds))))
+        max_seconds = data.get("max_seconds")
+        if max_seconds is not None:
+            Deadline(max_seconds)                          # ValueError unless a number > 0
         ver = base.verification
         if "eps" in data or "max_joint_speed" in data:
             ver = replace(ver, eps=float(data.get("eps", ver.eps)),
@@ -91,7 +107,8 @@ class SynthesisOptions:
         return cls(sequence_mode=str(data.get("sequence_mode", base.sequence_mode)),
                    backend=str(data.get("backend", base.backend)),
                    planner=planner, verification=ver, verify=bool(data.get("verify", True)),
-                   library_source=data.get("library_source"))
+                   library_source=data.get("library_source"),
+                   max_seconds=None if max_seconds is None else float(max_seconds))
 
 
 def resolve_cell(cell):
@@ -224,6 +241,22 @@ def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np
     return tracks, held
 
 
+def _under_deadline(fn):
+    """Run ``fn`` with ``options.deadline`` active (:func:`ltl_human_motion.deadline.active`)."""
+    signature = inspect.signature(fn)
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any):
+        options = signature.bind(*args, **kwargs).arguments.get("options")
+        deadline = getattr(options, "deadline", None)
+        if deadline is None and getattr(options, "max_seconds", None) is not None:
+            deadline = Deadline(options.max_seconds)
+        with active_deadline(deadline):
+            return fn(*args, **kwargs)
+    return wrapper
+
+
+@_under_deadline
 def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
                cycles: int = 1, stature: float = DEFAULT_STATURE,
                options: SynthesisOptions | None = None) -> list[SynthesizedMotion]:
@@ -275,14 +308,17 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     t_all = time.perf_counter()
     cell = resolve_cell(cell)
     specification = build_specification(spec, cell)
+    checkpoint("parsing")
     sequences, t_automaton, t_sequence = _task_sequences(
         specification, cell, variants, seed, options.sequence_mode, cycles, options.backend)
+    checkpoint("sequence")
     if library is None:
         t0 = time.perf_counter()
         library = get_library(float(stature), options.library_source)
         t_library = time.perf_counter() - t0
     else:
         t_library = 0.0
+    checkpoint("library")
     results = []
     for v in range(variants):
         seq = sequences[v % len(sequences)]
@@ -309,6 +345,7 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     t0 = time.perf_counter()
     plan = planner.plan(steps, start)
     t_planning = time.perf_counter() - t0
+    checkpoint("planning")
 
     t0 = time.perf_counter()
     positions, root_yaw, _labels, spans = concatenate(plan.segments)
@@ -329,6 +366,7 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     motion = Motion(positions, library.fps, library.skeleton,
                     name=f"{cell.name}-seed{seed}-v{variant}")
     t_blending = time.perf_counter() - t0
+    checkpoint("blending")
     synth = SynthesizedMotion(motion=motion, root_yaw=root_yaw, task_index=task_index,
                               timeline=timeline, objects=tracks, spec=spec_text,
                               sequence=[s[0] for s in steps], seed=int(seed))
@@ -338,6 +376,7 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
                            options.verification, held=held, stature=stature,
                            blend_frames=library.overlap, raise_on_failure=options.verify)
     t_verify = time.perf_counter() - t0
+    checkpoint("verification")
     compute = time.perf_counter() - t_start + t_automaton + t_sequence
     synth.verification = report
     synth.stats = {

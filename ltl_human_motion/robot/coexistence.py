@@ -13,9 +13,13 @@ Fail-safe behaviour
 * Lost RTDE connection (receive side reports disconnected, robot timestamps freeze, or a
   write fails): the minimum slider is commanded on whatever interface still works, and the
   controller reconnects with exponential backoff, recovering by itself when data returns.
-* A human occupancy with NaN/inf, wrong shapes, negative radii or absurd coordinates is
-  rejected and logged; until the next valid occupancy the command cannot rise above the
-  one in force when the rejection happened.
+* A human occupancy with NaN/inf, wrong shapes, negative radii, absurd coordinates or a
+  stamp in the future is rejected and logged; until the next valid occupancy the command
+  cannot rise above the one in force when the rejection happened, and the occupancy in
+  force turns stale after ``stale_after`` (the minimum).
+* :meth:`CoexistenceController.invalidate_occupancy` (what the ROS node calls when one
+  human's stream faults while others' are fine) drops the occupancy at once: the minimum
+  from the next step until a valid occupancy arrives.
 
 Usage (what the ROS node does)::
 
@@ -286,8 +290,8 @@ class CoexistenceController:
     # ------------------------------------------------------------------ occupancy input
     def update_occupancy(self, segments: ArrayLike, radii: ArrayLike,
                          stamp: float | None = None,
-                         predicted: Sequence[tuple[float, ArrayLike, ArrayLike]] | None = None
-                         ) -> bool:
+                         predicted: Sequence[tuple[float, ArrayLike, ArrayLike]] | None = None,
+                         *, check_order: bool = True) -> bool:
         """Offer the latest human occupancy.
 
         Parameters
@@ -300,6 +304,9 @@ class CoexistenceController:
             time, for sources whose clock differs from the controller's).
         predicted : sequence of (horizon, segments (K_i, 2, 3), radii (K_i,)), optional
             Predicted occupancy ``horizon`` seconds after ``stamp``.
+        check_order : bool
+            Ignore an occupancy older than the current one (default). A caller merging
+            several humans passes False: the merged stamp (the oldest human's) may go back.
 
         Returns
         -------
@@ -323,12 +330,26 @@ class CoexistenceController:
             log.warning("human occupancy rejected (%s); speed held at <= %.3f", exc, cap)
             return False
         with self._lock:
-            if self._occ is not None and occ.stamp < self._occ.stamp:
+            if check_order and self._occ is not None and occ.stamp < self._occ.stamp:
                 log.debug("out-of-order occupancy (%.3f) ignored", occ.stamp)
                 return False
             self._occ = occ
             self._ceiling = None
         return True
+
+    def check_occupancy(self, segments: ArrayLike, radii: ArrayLike, stamp: float,
+                        predicted: Sequence[tuple[float, ArrayLike, ArrayLike]] | None = None
+                        ) -> None:
+        """Raise ValueError saying what is wrong with an occupancy (shapes as in
+        :meth:`update_occupancy`), without offering it."""
+        self._validated(segments, radii, stamp, predicted)
+
+    def invalidate_occupancy(self, reason: str) -> None:
+        """Drop the occupancy in force: the minimum slider until a valid one is offered."""
+        with self._lock:
+            self._occ = None
+            self.rejections += 1
+            self.last_rejection = reason
 
     def _validated(self, segments: ArrayLike, radii: ArrayLike, stamp: float,
                    predicted: Sequence[tuple[float, ArrayLike, ArrayLike]] | None
@@ -340,7 +361,8 @@ class CoexistenceController:
         if not math.isfinite(stamp):
             raise ValueError(f"stamp must be finite, got {stamp}")
         if stamp > self.clock() + self.config.future_tolerance:
-            raise ValueError(f"stamp {stamp:.3f} lies in the future")
+            raise ValueError(f"stamp {stamp:.3f} lies {stamp - self.clock():.3f} s in the "
+                             f"future (tolerance {self.config.future_tolerance:g} s)")
         seg, rad = check_capsules(segments, radii, "human capsules", self.config.max_coordinate)
         if len(seg) > self.config.max_capsules:
             raise ValueError(f"{len(seg)} human capsules exceed {self.config.max_capsules}")

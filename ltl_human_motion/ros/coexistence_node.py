@@ -15,6 +15,13 @@ every known human's stream is fresh: a human whose stream stops holds the arm at
 slider minimum (until ``forget_after`` s of silence, when set, drop them). Predicted
 occupancy is used when ``use_prediction`` is true.
 
+Freshness is judged per human on the node's own clock: a sample's time is its receive time
+less its age (never later than its receipt), so no stamp can make a silent stream look
+fresh. A sample stamped more than ``future_tolerance`` s in the future, one that does not
+decode, or one with NaN, absurd or malformed capsules is a fault of that human: the
+occupancy is dropped at once (slider minimum) until the human sends a valid sample again
+(or is forgotten). A human seen only through faulty samples counts as well.
+
 Publishes (at ``publish_rate``):
 
 * ``/joint_states`` (sensor_msgs/JointState): the six UR joints
@@ -38,6 +45,7 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -159,6 +167,9 @@ def coexistence_parameters() -> list[ParamSpec]:
              "that type (all humans)", _occupancy_topic, read_only=True),
         spec("stale_after", 0.25, "Occupancy older than this (s) is stale: slider minimum",
              positive, read_only=True),
+        spec("future_tolerance", CoexistenceConfig().future_tolerance, "Occupancy stamped "
+             "further than this (s) in the future is a fault: slider minimum", positive,
+             read_only=True),
         spec("forget_after", 0.0, "A human whose stream has been silent this long (s) is "
              "dropped, so the others decide again (0 = never; until then: minimum)",
              non_negative, read_only=True),
@@ -206,6 +217,15 @@ def coexistence_parameters() -> list[ParamSpec]:
     ]
 
 
+@dataclass
+class _Human:
+    """What the node holds of one human: times on the controller's clock (s)."""
+
+    received: float                       # receipt of the latest sample, valid or not
+    fresh_at: float                       # time of the latest valid data; -inf after a fault
+    sample: OccupancySample | None        # None until a valid sample arrives
+
+
 # ---------------------------------------------------------------------- small helpers
 def _transform(parent: str, child: str, T: np.ndarray, stamp: Any) -> TransformStamped:
     tf = TransformStamped()
@@ -246,6 +266,7 @@ class CoexistenceNode(Node):
             self.params = SSMParameters(**{f: float(p(n)) for n, f in _SSM_FIELDS.items()})
             self.config = CoexistenceConfig(
                 stale_after=float(p("stale_after")),
+                future_tolerance=float(p("future_tolerance")),
                 robot_stale_after=float(p("robot_stale_after")),
                 use_prediction=bool(p("use_prediction")))
         except ValueError as exc:
@@ -275,7 +296,9 @@ class CoexistenceNode(Node):
             receive_factory, io_factory, self.model, self.base, self.params, self.config,
             on_decision=self._on_decision)
 
-        self._humans: dict[str, tuple[float, OccupancySample]] = {}   # key -> (ctl stamp, s)
+        self.future_tolerance = float(p("future_tolerance"))
+        self._humans: dict[str, _Human] = {}
+        self._topic_keys: dict[str, str] = {}             # topic -> key of its last sample
         self._humans_lock = threading.Lock()
         self._subscribed: set[str] = set()
         self._latest: ControlDecision | None = None
@@ -342,27 +365,57 @@ class CoexistenceNode(Node):
     def _on_occupancy(self, topic: str, data: bytes) -> None:
         self.messages_received += 1
         ctl_now = self.controller.clock()
+        key = self._topic_keys.get(topic, topic)
         try:
             sample = decode_human_occupancy(data)
+            key = sample.human_id or topic
+            self._topic_keys[topic] = key
+            age = self.get_clock().now().nanoseconds * 1e-9 - sample.stamp
+            if not math.isfinite(age) or age < -self.future_tolerance:
+                raise ValueError(f"stamp lies {-age:.3f} s in the future (tolerance "
+                                 f"{self.future_tolerance:g} s)")
+            fresh_at = ctl_now - max(age, 0.0)
+            self.controller.check_occupancy(sample.segments, sample.radii, fresh_at,
+                                            sample.predicted or None)
         except ValueError as exc:
-            self.messages_rejected += 1
-            self.get_logger().warning(f"{topic}: {exc}", throttle_duration_sec=2.0)
+            self._fault(topic, key, ctl_now, exc)
             return
-        age = self.get_clock().now().nanoseconds * 1e-9 - sample.stamp
-        key = sample.human_id or topic
         with self._humans_lock:
-            self._humans[key] = (ctl_now - age, sample)
-            if self.forget_after > 0:
-                for k in [k for k, (s, _) in self._humans.items()
-                          if ctl_now - s > self.forget_after]:
-                    del self._humans[k]
-                    self.get_logger().warning(f"human {k!r} silent for over "
-                                              f"{self.forget_after:g} s: forgotten")
-            entries = list(self._humans.values())
-        fused = fuse_occupancies(entries, self.use_prediction)
+            self._humans[key] = _Human(ctl_now, fresh_at, sample)
+            self._forget_silent(ctl_now)
+            entries = list(self._humans.items())
+        faulty = [k for k, h in entries if h.sample is None or not math.isfinite(h.fresh_at)]
+        if faulty:
+            self.controller.invalidate_occupancy(f"human {faulty[0]!r} has no valid occupancy")
+            return
+        fused = fuse_occupancies([(h.fresh_at, h.sample) for _, h in entries],  # type: ignore
+                                 self.use_prediction)
         if not self.controller.update_occupancy(fused.segments, fused.radii, fused.stamp,
-                                                fused.predicted):
+                                                fused.predicted, check_order=False):
             self.messages_rejected += 1
+
+    def _fault(self, topic: str, key: str, ctl_now: float, exc: Exception) -> None:
+        """A faulty sample of human ``key``: hold them as faulty, drop the occupancy."""
+        self.messages_rejected += 1
+        with self._humans_lock:
+            human = self._humans.get(key)
+            if human is None:
+                self._humans[key] = _Human(ctl_now, -math.inf, None)
+            else:
+                human.received, human.fresh_at = ctl_now, -math.inf
+            self._forget_silent(ctl_now)
+        self.controller.invalidate_occupancy(f"human {key!r} on {topic}: {exc}")
+        self.get_logger().warning(f"{topic}: occupancy of human {key!r} rejected ({exc}); "
+                                  "slider minimum", throttle_duration_sec=2.0)
+
+    def _forget_silent(self, ctl_now: float) -> None:
+        """Drop humans silent for ``forget_after`` s (caller holds the lock)."""
+        if self.forget_after <= 0:
+            return
+        for k in [k for k, h in self._humans.items() if ctl_now - h.received > self.forget_after]:
+            del self._humans[k]
+            self.get_logger().warning(f"human {k!r} silent for over {self.forget_after:g} s: "
+                                      "forgotten")
 
     # ------------------------------------------------------------------ control
     def _on_decision(self, decision: ControlDecision) -> None:

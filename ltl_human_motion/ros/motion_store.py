@@ -6,10 +6,15 @@ on the same folder (its path is announced on the ``motion_catalog`` topic) and l
 ``<motion_id>.npz`` on demand with ``ltl_human_motion.planning.exports.load_npz``. Files
 are written atomically by ``save_npz`` (temporary file, then rename), so a reader never
 sees half a motion.
+
+Memory is bounded by count (``max_in_memory``) and bytes (``max_bytes``): the oldest
+motions leave memory first; with a directory every motion is on disk and an evicted one
+is loaded again on demand, without one it is gone (``get`` says so).
 """
 
 from __future__ import annotations
 
+import os
 import re
 import threading
 import uuid
@@ -20,6 +25,8 @@ from typing import Any
 
 from ltl_human_motion.ros.playback import task_sequence_text
 
+#: Ids of evicted motions remembered for a clear KeyError (bounded, 100 bytes each).
+_MAX_EVICTED_IDS = 10_000
 _ID_PATTERN = re.compile(r"^[A-Za-z0-9_.-]{1,128}$")
 
 
@@ -42,6 +49,22 @@ def check_motion_id(motion_id: str) -> str:
     return motion_id
 
 
+def default_store_dir() -> Path:
+    """``$ROS_HOME/ltl_human_motion/motions`` (ROS_HOME defaults to ``~/.ros``)."""
+    ros_home = os.environ.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
+    return Path(ros_home) / "ltl_human_motion" / "motions"
+
+
+def motion_nbytes(motion: Any) -> int:
+    """Bytes of the arrays of a SynthesizedMotion (positions, yaw, labels, object tracks)."""
+    total = 0
+    for value in (getattr(getattr(motion, "motion", None), "positions", None),
+                  getattr(motion, "root_yaw", None), getattr(motion, "task_index", None),
+                  *dict(getattr(motion, "objects", None) or {}).values()):
+        total += int(getattr(value, "nbytes", 0))
+    return total
+
+
 def new_motion_id() -> str:
     """A fresh, unique motion id such as ``motion_3f2a9c1b7d4e``."""
     return f"motion_{uuid.uuid4().hex[:12]}"
@@ -57,15 +80,24 @@ class MotionStore:
     max_in_memory : int
         How many motions to keep in memory (oldest are dropped from memory first; with a
         directory they can be loaded again).
+    max_bytes : int
+        Bytes of motion arrays to keep in memory (the newest motion always stays).
     """
 
-    def __init__(self, directory: str | Path | None = None, max_in_memory: int = 256) -> None:
+    def __init__(self, directory: str | Path | None = None, max_in_memory: int = 256,
+                 max_bytes: int = 512_000_000) -> None:
         if max_in_memory < 1:
             raise ValueError(f"max_in_memory must be >= 1, got {max_in_memory}")
+        if max_bytes < 1:
+            raise ValueError(f"max_bytes must be >= 1, got {max_bytes}")
         self._lock = threading.Lock()
         self._motions: OrderedDict[str, Any] = OrderedDict()
+        self._sizes: dict[str, int] = {}
         self._infos: OrderedDict[str, MotionInfo] = OrderedDict()
+        self._evicted: set[str] = set()
         self._max = int(max_in_memory)
+        self.max_bytes = int(max_bytes)
+        self.bytes_in_memory = 0
         self.directory = Path(directory).expanduser().resolve() if directory else None
         if self.directory is not None:
             self.directory.mkdir(parents=True, exist_ok=True)
@@ -85,13 +117,36 @@ class MotionStore:
 
             save_npz(motion, self.path_of(motion_id))
         with self._lock:
-            self._motions[motion_id] = motion
+            self._keep(motion_id, motion)
             self._infos[motion_id] = info
-            while len(self._motions) > self._max:
-                old, _ = self._motions.popitem(last=False)
-                if self.directory is None:
-                    self._infos.pop(old, None)
         return motion_id
+
+    @property
+    def max_in_memory(self) -> int:
+        """How many motions stay in memory."""
+        return self._max
+
+    def __len__(self) -> int:
+        with self._lock:
+            return len(self._motions)
+
+    def _keep(self, motion_id: str, motion: Any) -> None:
+        """Hold ``motion`` in memory and evict the oldest beyond the bounds (lock held)."""
+        if motion_id in self._motions:
+            self.bytes_in_memory -= self._sizes.pop(motion_id, 0)
+            del self._motions[motion_id]
+        self._motions[motion_id] = motion
+        self._sizes[motion_id] = motion_nbytes(motion)
+        self.bytes_in_memory += self._sizes[motion_id]
+        while len(self._motions) > self._max or (
+                self.bytes_in_memory > self.max_bytes and len(self._motions) > 1):
+            old, _ = self._motions.popitem(last=False)
+            self.bytes_in_memory -= self._sizes.pop(old, 0)
+            if self.directory is None:
+                self._infos.pop(old, None)
+                if len(self._evicted) >= _MAX_EVICTED_IDS:
+                    self._evicted.clear()
+                self._evicted.add(old)
 
     def get(self, motion_id: str) -> Any:
         """The motion stored under ``motion_id``; KeyError naming the id if unknown."""
@@ -105,12 +160,14 @@ class MotionStore:
 
             motion = load_npz(self.path_of(motion_id))
             with self._lock:
-                self._motions[motion_id] = motion
+                self._keep(motion_id, motion)
                 self._infos.setdefault(motion_id, MotionInfo(
                     motion_id, task_sequence_text(motion), float(motion.motion.duration)))
-                while len(self._motions) > self._max:
-                    self._motions.popitem(last=False)
             return motion
+        if motion_id in self._evicted:
+            raise KeyError(f"motion id {motion_id!r} was evicted from memory (this store "
+                           f"keeps {self._max} motions and {self.max_bytes / 1e6:g} MB, and "
+                           "has no folder to keep older ones in)")
         where = f" or in {self.directory}" if self.directory is not None else ""
         raise KeyError(f"unknown motion id {motion_id!r} (not in memory{where})")
 

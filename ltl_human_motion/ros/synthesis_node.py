@@ -1,45 +1,83 @@
 """The synthesis service node: LTL specification in, verified motions out.
 
 Service ``synthesize_motion`` (ltl_human_motion/srv/SynthesizeMotion, relative to the
-node's namespace) calls ``ltl_human_motion.planning.synthesize``. The service sits in a
-ReentrantCallbackGroup, so under a MultiThreadedExecutor several requests run at once and
-a long synthesis never blocks the node's other callbacks (``max_concurrent`` bounds how
-many synthesize at the same time; further requests wait for a slot).
+node's namespace) calls ``ltl_human_motion.planning.synthesize``.
+
+Every request gets an answer. The service callback only checks the request against the
+named limits below and queues it; ``max_concurrent`` worker threads of the node's own
+synthesize, and each sends its response when done. A request that finds ``max_queued``
+requests waiting is refused at once with "busy". (The executor's threads are never held
+by a synthesis, so requests are taken from DDS as fast as they come; before, blocked
+threads left them in the service's DDS history of depth 10, where later ones overwrote
+them unanswered.) The service's history is :data:`SERVICE_HISTORY_DEPTH` deep, so a burst
+of requests waits in DDS for the executor rather than being overwritten. Clients that
+send many requests at once should give their own client a deep history too: replies are
+kept in the client's history until its executor takes them.
+
+Each request has a time budget: ``max_seconds`` in ``options_json`` (default
+:data:`~ltl_human_motion.deadline.DEFAULT_MAX_SECONDS`); when it runs out the answer is
+``success: false``, "time budget of N s exhausted in <stage>". Destroying the node
+(Ctrl-C) cancels the running syntheses and answers the queued requests with "shutting
+down", so the process exits within a second or two even mid-synthesis.
 
 Errors the user caused (any ``LtlHumanMotionError`` or ``ValueError``, e.g. a
 ``SpecError`` with line and column) come back as ``success=false`` with the message and
 ``error_line``/``error_column``; anything unexpected is logged with its traceback and
 also returned as ``success=false``. The node keeps serving either way.
 
-Motions go into a :class:`~ltl_human_motion.ros.motion_store.MotionStore` (memory, plus
-``<store_dir>/<id>.npz`` when ``store_dir`` is set), and the ids are announced on the
-latched topic ``motion_catalog`` (ltl_human_motion/msg/MotionCatalog).
+Motions go into a :class:`~ltl_human_motion.ros.motion_store.MotionStore`: in memory up
+to ``max_in_memory`` motions and ``max_memory_mb`` MB (older ones are evicted to
+``<store_dir>/<id>.npz``, where every motion is saved), and the ids are announced on the
+latched topic ``motion_catalog`` (ltl_human_motion/msg/MotionCatalog). ``store_dir`` ""
+(the default) is ``$ROS_HOME/ltl_human_motion/motions`` (``~/.ros/...``); ``:memory:``
+keeps motions in memory only (evicted ones are gone).
 
 Parameters: ``default_cell`` (str, "paper_cell"; used when a request leaves ``cell``
-empty), ``store_dir`` (str, ""; read only), ``max_concurrent`` (int, 4; read only).
+empty), ``store_dir`` (str, ""; read only), ``max_concurrent`` (int, 4; read only),
+``max_queued`` (int, 64; read only), ``max_in_memory`` (int, 32; read only),
+``max_memory_mb`` (float, 256; read only).
 """
 
 from __future__ import annotations
 
 import json
+import math
+import queue
 import threading
 import time
 import traceback
 from collections.abc import Callable
+from dataclasses import dataclass, replace
 from typing import Any
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
+from ltl_human_motion.deadline import DEFAULT_MAX_SECONDS, Deadline
 from ltl_human_motion.errors import LtlHumanMotionError, SpecError
+from ltl_human_motion.ltl.limits import MAX_SPEC_CHARS
+from ltl_human_motion.motion.library import MAX_LIBRARY_STATURE, MIN_LIBRARY_STATURE
 from ltl_human_motion.msg import MotionCatalog, PlanningStats
 from ltl_human_motion.ros.common import LATCHED_QOS, resolve_cell
-from ltl_human_motion.ros.motion_store import MotionStore
+from ltl_human_motion.ros.motion_store import MotionStore, default_store_dir
 from ltl_human_motion.ros.params import ParamSpec, declare_parameters, positive
 from ltl_human_motion.ros.playback import task_sequence_text
 from ltl_human_motion.srv import SynthesizeMotion
 
 SynthesizeFn = Callable[..., list]
+
+#: Limits of one request, each refused with its name (issue 17: ``variants=4294967295``
+#: grew the node to 11 GB). A motion is about 1 MB, so 16 variants stay near 16 MB.
+MAX_VARIANTS = 16
+#: Repetitions of the accepting cycle; each adds a full pass of the task sequence.
+MAX_CYCLES = 8
+#: Characters of ``options_json`` (its keys and values fit in a few hundred).
+MAX_OPTIONS_CHARS = 4096
+#: Characters of an inline cell; the shipped cells are under 10 kB.
+MAX_INLINE_CELL_CHARS = 1_000_000
+#: Depth of the service's DDS request history (the default of 10 overwrote requests).
+SERVICE_HISTORY_DEPTH = 1000
 
 _STATS_FIELDS = ("automaton_time", "sequence_time", "planning_time", "blending_time",
                  "verification_time", "total_time", "real_time_factor")
@@ -66,10 +104,16 @@ def synthesis_options(options_json: str) -> Any:
     text = options_json.strip()
     if not text:
         return None
+    if len(text) > MAX_OPTIONS_CHARS:
+        raise ValueError(f"options_json has {len(text)} characters; at most "
+                         f"{MAX_OPTIONS_CHARS} are allowed (MAX_OPTIONS_CHARS)")
     try:
         values = json.loads(text)
     except json.JSONDecodeError as exc:
         raise ValueError(f"options_json is not valid JSON: {exc}") from None
+    except RecursionError:
+        raise ValueError("options_json nests too deeply; expected a flat JSON object") \
+            from None
     if not isinstance(values, dict):
         raise ValueError(f"options_json must be a JSON object, got {type(values).__name__}")
     options_class = _planning("SynthesisOptions")
@@ -101,6 +145,17 @@ def stats_message(stats: Any, duration: float) -> PlanningStats:
     return msg
 
 
+@dataclass(eq=False)
+class _Job:
+    """A queued request: the executor's response object and, once sent, its header."""
+
+    request: Any
+    response: Any
+    received: float
+    header: Any = None
+    deadline: Deadline | None = None
+
+
 class SynthesisNode(Node):
     """Serves ``synthesize_motion`` and announces stored motions on ``motion_catalog``.
 
@@ -108,7 +163,7 @@ class SynthesisNode(Node):
     ----------
     store : MotionStore, optional
         Share a store with players in the same process; by default one is made from the
-        ``store_dir`` parameter.
+        ``store_dir``, ``max_in_memory`` and ``max_memory_mb`` parameters.
     synthesize_fn : callable, optional
         Replaces ``planning.synthesize`` (same signature).
     """
@@ -120,69 +175,158 @@ class SynthesisNode(Node):
         declare_parameters(self, [
             ParamSpec("default_cell", "paper_cell", "Cell used when a request leaves cell empty",
                       lambda v: None if v.strip() else "expected a cell name"),
-            ParamSpec("store_dir", "", "Folder for <motion_id>.npz ('' keeps motions in memory)",
-                      read_only=True),
+            ParamSpec("store_dir", "", "Folder for <motion_id>.npz ('' = $ROS_HOME/"
+                      "ltl_human_motion/motions, ':memory:' = memory only)", read_only=True),
             ParamSpec("max_concurrent", 4, "Syntheses allowed to run at the same time",
                       positive, read_only=True),
+            ParamSpec("max_queued", 64, "Requests allowed to wait for a slot; more are "
+                      "refused at once with 'busy'", positive, read_only=True),
+            ParamSpec("max_in_memory", 32, "Motions kept in memory (older ones are evicted "
+                      "to store_dir)", positive, read_only=True),
+            ParamSpec("max_memory_mb", 256.0, "Megabytes of motions kept in memory",
+                      positive, read_only=True),
         ])
-        store_dir = self.get_parameter("store_dir").value
-        self.store = store if store is not None else MotionStore(store_dir or None)
+        p = self.get_parameter
+        store_dir = p("store_dir").value
+        if store is None:
+            directory = None if store_dir == ":memory:" else (store_dir or default_store_dir())
+            store = MotionStore(directory, max_in_memory=int(p("max_in_memory").value),
+                                max_bytes=int(float(p("max_memory_mb").value) * 1e6))
+        self.store = store
         self._synthesize = synthesize_fn or planning_synthesize
-        self._slots = threading.BoundedSemaphore(self.get_parameter("max_concurrent").value)
+        self.max_queued = int(p("max_queued").value)
+        self._queue: queue.Queue[_Job | None] = queue.Queue()
+        self._pending: dict[int, _Job] = {}           # id(response) -> job, until sent
+        self._running: set[_Job] = set()
+        self._jobs_lock = threading.Lock()
+        self._stopping = threading.Event()
         self._catalog_lock = threading.Lock()
         self._catalog_pub = self.create_publisher(MotionCatalog, "motion_catalog", LATCHED_QOS)
+        qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=SERVICE_HISTORY_DEPTH,
+                         reliability=ReliabilityPolicy.RELIABLE)
         self._service = self.create_service(SynthesizeMotion, "synthesize_motion",
-                                            self._on_request,
+                                            self._on_request, qos_profile=qos,
                                             callback_group=ReentrantCallbackGroup())
+        # The executor sends what the callback returns; a queued request's response is
+        # sent by the worker instead, once done (see _deferred_send).
+        self._send_now = self._service.send_response
+        self._service.send_response = self._deferred_send  # type: ignore[method-assign]
         self.requests_served = 0
+        self.requests_refused = 0
         self.in_flight = 0
         self._count_lock = threading.Lock()
+        self._workers = [threading.Thread(target=self._work, name=f"synthesis-{i}", daemon=True)
+                         for i in range(int(p("max_concurrent").value))]
+        for worker in self._workers:
+            worker.start()
         self._publish_catalog()
+        where = self.store.directory or "memory only"
         self.get_logger().info(
-            f"serving {self._service.service_name} (store: "
-            f"{self.store.directory or 'memory'})")
+            f"serving {self._service.service_name}; motions stored in {where} (in memory: "
+            f"{self.store.max_in_memory} motions, {self.store.max_bytes / 1e6:g} MB)")
+
+    # ------------------------------------------------------------------ requests
+    @property
+    def queued(self) -> int:
+        """Requests waiting for a worker."""
+        return self._queue.qsize()
 
     def _on_request(self, request: SynthesizeMotion.Request,
                     response: SynthesizeMotion.Response) -> SynthesizeMotion.Response:
-        started = time.perf_counter()
+        """Executor thread: refuse at once (busy, limits) or queue; never synthesize."""
         with self._count_lock:
             self.in_flight += 1
         try:
-            with self._slots:
-                motions = self._run(request)
+            if self._stopping.is_set():
+                raise _RefusalError("the synthesis node is shutting down")
+            _check_limits(request)
+            with self._jobs_lock:
+                if self._queue.qsize() >= self.max_queued:
+                    raise _RefusalError(f"busy: {self._queue.qsize()} requests are waiting "
+                                   f"(max_queued {self.max_queued}); try again later")
+                self._pending[id(response)] = _Job(request, response, time.perf_counter())
+        except (LtlHumanMotionError, ValueError) as exc:
+            self._fail(response, exc)
+            self._finished(refused=isinstance(exc, _RefusalError))
+            self.get_logger().warning(f"synthesis request refused: {exc}",
+                                      throttle_duration_sec=1.0)
+        return response
+
+    def _deferred_send(self, response: SynthesizeMotion.Response, header: Any) -> None:
+        """Executor thread: a queued request's header arrives; hand the job to a worker."""
+        with self._jobs_lock:
+            job = self._pending.pop(id(response), None)
+        if job is None:
+            self._send_now(response, header)              # answered by the callback
+            return
+        job.header = header
+        self._queue.put(job)
+
+    def _work(self) -> None:
+        while True:
+            job = self._queue.get()
+            if job is None:
+                return
+            if self._stopping.is_set():
+                self._fail(job.response, _RefusalError("the synthesis node is shutting down"))
+            else:
+                self._serve(job)
+            self._reply(job)
+
+    def _serve(self, job: _Job) -> None:
+        response = job.response
+        job.deadline = Deadline(_max_seconds(job.request.options_json))
+        with self._jobs_lock:
+            self._running.add(job)
+        try:
+            motions = self._run(job.request, job.deadline)
             self._fill(response, motions)
             self.get_logger().info(
-                f"synthesized {len(motions)} motion(s) in {time.perf_counter() - started:.2f} s:"
-                f" {', '.join(response.motion_ids)}")
+                f"synthesized {len(motions)} motion(s) in "
+                f"{time.perf_counter() - job.received:.2f} s: {', '.join(response.motion_ids)}")
         except (LtlHumanMotionError, ValueError) as exc:
             self._fail(response, exc)
             self.get_logger().warning(f"synthesis request rejected: {exc}")
+        except RecursionError:
+            self._fail(response, ValueError("the request nests too deeply to be read"))
+            self.get_logger().warning("synthesis request rejected: nested too deeply")
         except Exception as exc:   # keep serving; report the failure to the caller
             self.get_logger().error(
                 f"synthesis failed unexpectedly: {exc!r}\n{traceback.format_exc()}")
             response.success = False
             response.error_message = f"internal error ({type(exc).__name__}): {exc}"
         finally:
-            with self._count_lock:
-                self.in_flight -= 1
-                self.requests_served += 1
-        return response
+            with self._jobs_lock:
+                self._running.discard(job)
 
-    def _run(self, request: SynthesizeMotion.Request) -> list:
+    def _reply(self, job: _Job) -> None:
+        try:
+            self._send_now(job.response, job.header)
+        except Exception as exc:   # a destroyed service or a gone client
+            self.get_logger().warning(f"cannot send a synthesis response: {exc}")
+        self._finished(refused=False)
+
+    def _finished(self, refused: bool) -> None:
+        with self._count_lock:
+            self.in_flight -= 1
+            self.requests_served += 1
+            self.requests_refused += int(refused)
+
+    def _run(self, request: SynthesizeMotion.Request, deadline: Deadline) -> list:
         spec = request.spec
         if not spec.strip():
             raise SpecError("the specification is empty")
         cell_text = request.cell.strip() or self.get_parameter("default_cell").value
         cell = resolve_cell(cell_text)
+        deadline.check("reading the cell")
         kwargs: dict[str, Any] = {
             "variants": int(request.variants) or 1,
             "seed": int(request.seed),
             "cycles": int(request.cycles) or 1,
             "stature": float(request.stature) or 1.75,
         }
-        options = synthesis_options(request.options_json)
-        if options is not None:
-            kwargs["options"] = options
+        options = synthesis_options(request.options_json) or _planning("SynthesisOptions")()
+        kwargs["options"] = replace(options, deadline=deadline)
         motions = list(self._synthesize(spec, cell, **kwargs))
         if not motions:
             raise ValueError("synthesis returned no motion")
@@ -198,6 +342,20 @@ class SynthesisNode(Node):
             response.stats.append(stats_message(getattr(motion, "stats", None), duration))
         response.success = True
         self._publish_catalog()
+
+    def destroy_node(self) -> None:
+        """Cancel running syntheses, answer queued requests ("shutting down"), stop."""
+        self._stopping.set()
+        with self._jobs_lock:
+            for job in self._running:
+                if job.deadline is not None:
+                    job.deadline.cancel("cancelled: the synthesis node is shutting down")
+        for _ in self._workers:
+            self._queue.put(None)
+        end = time.monotonic() + SHUTDOWN_WAIT
+        for worker in self._workers:
+            worker.join(max(end - time.monotonic(), 0.0))
+        super().destroy_node()
 
     @staticmethod
     def _fail(response: SynthesizeMotion.Response, exc: Exception) -> None:
@@ -218,3 +376,50 @@ class SynthesisNode(Node):
                 msg.durations.append(info.duration)
             msg.store_dir = str(self.store.directory or "")
             self._catalog_pub.publish(msg)
+
+
+#: Seconds destroy_node waits for the workers (issue 17: exit within 2 s of SIGINT); a
+#: synthesis stage without checkpoints may outlast it, and its daemon thread then dies
+#: with the process.
+SHUTDOWN_WAIT = 1.0
+
+
+class _RefusalError(ValueError):
+    """A request refused before any work: busy, or the node shutting down."""
+
+
+def _max_seconds(options_json: str) -> float:
+    """The request's time budget: ``max_seconds`` of ``options_json``, else the default."""
+    try:
+        value = json.loads(options_json).get("max_seconds") if options_json.strip() else None
+    except (ValueError, AttributeError, RecursionError):
+        value = None          # the options are reported properly by synthesis_options
+    if isinstance(value, int | float) and not isinstance(value, bool) and value > 0 \
+            and math.isfinite(value):
+        return float(value)
+    return DEFAULT_MAX_SECONDS
+
+
+def _check_limits(request: Any) -> None:
+    """Refuse a request beyond the named limits (ValueError naming the limit)."""
+    def refuse(what: str, value: object, limit: str, bound: object) -> None:
+        raise ValueError(f"{what} {value} exceeds {limit} = {bound}")
+
+    if not 0 <= request.variants <= MAX_VARIANTS:
+        refuse("variants", request.variants, "MAX_VARIANTS", MAX_VARIANTS)
+    if not 0 <= request.cycles <= MAX_CYCLES:
+        refuse("cycles", request.cycles, "MAX_CYCLES", MAX_CYCLES)
+    if len(request.spec) > MAX_SPEC_CHARS:
+        refuse("a specification of", f"{len(request.spec)} characters", "MAX_SPEC_CHARS",
+               MAX_SPEC_CHARS)
+    if len(request.cell) > MAX_INLINE_CELL_CHARS:
+        refuse("a cell of", f"{len(request.cell)} characters", "MAX_INLINE_CELL_CHARS",
+               MAX_INLINE_CELL_CHARS)
+    if len(request.options_json) > MAX_OPTIONS_CHARS:
+        refuse("options_json of", f"{len(request.options_json)} characters",
+               "MAX_OPTIONS_CHARS", MAX_OPTIONS_CHARS)
+    stature = float(request.stature)
+    if stature != 0.0 and not (math.isfinite(stature) and
+                               MIN_LIBRARY_STATURE <= stature <= MAX_LIBRARY_STATURE):
+        raise ValueError(f"stature {stature} m is outside [{MIN_LIBRARY_STATURE}, "
+                         f"{MAX_LIBRARY_STATURE}] m (MIN/MAX_LIBRARY_STATURE; 0 = 1.75 m)")

@@ -59,6 +59,8 @@ from ltl_human_motion.scene.frames import ZUP_FROM_YUP, extents_zup_from_yup, zu
 from ltl_human_motion.scene.geometry import min_along_segment
 from ltl_human_motion.scene.shapes import Box, Cylinder, Footprint, MeshShape, Shape, Sphere
 from ltl_human_motion.scene.tasks import TASK_ARGUMENTS
+from ltl_human_motion.scene.yaml_limits import YamlLimitError, load_yaml_limited
+from ltl_human_motion.scene.yaml_limits import short_repr as _r
 
 __all__ = [
     "Cell",
@@ -75,6 +77,21 @@ _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _SHORTHAND_KEY = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\(([^()]*)\))?\s*$")
 _ATOM = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)\s*\(([^()]*)\)")
 _FRAMES = ("zup", "paper_yup")
+#: Any number of a cell (metres, or a size, a scale): a production cell is tens of metres
+#: across; beyond this, grids and meshes overflow (issue 17: x = 1e300).
+MAX_CELL_COORDINATE = 1000.0
+#: Floor extent of the workspace per axis (m): the clearance maps sample it every 5 cm,
+#: so 100 m is 2000 x 2000 cells (32 MB); +-1e6 m asked for 17.8 PiB.
+MAX_WORKSPACE_EXTENT = 100.0
+#: Entries per section. The shipped cells have under 20 of each; 10,000 tiny obstacles
+#: took minutes of clearance maps.
+MAX_CELL_ENTRIES = {"objects": 200, "regions": 200, "obstacles": 500}
+_SIMPLIFY = {
+    "objects": "Keep the objects the tasks handle; others can be obstacles.",
+    "regions": "Merge regions that the tasks treat alike.",
+    "obstacles": "Simplify the cell: merge neighbouring obstacles into boxes that cover "
+                 "them, and drop those smaller than about 5 cm (below the body's scale).",
+}
 
 
 # --------------------------------------------------------------------------- types
@@ -410,13 +427,13 @@ class _Parser:
             raise self.error(key, f"expected a mapping, got {type(value).__name__}")
         for k in value:
             if not isinstance(k, str):
-                raise self.error(key, f"keys must be strings, got {k!r}")
+                raise self.error(key, f"keys must be strings, got {_r(k)}")
             if k not in allowed:
                 raise self.error(f"{key}.{k}" if key else k,
                                  f"unknown key; expected one of {', '.join(sorted(allowed))}")
         for k in required:
             if k not in value:
-                raise self.error(key, f"missing required key {k!r}")
+                raise self.error(key, f"missing required key {_r(k)}")
         return value
 
     def number(self, value: Any, key: str) -> float:
@@ -425,17 +442,20 @@ class _Parser:
             try:
                 value = float(value)
             except ValueError:
-                raise self.error(key, f"expected a number, got {value!r}") from None
+                raise self.error(key, f"expected a number, got {_r(value)}") from None
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.error(key, f"expected a number, got {value!r}")
+            raise self.error(key, f"expected a number, got {_r(value)}")
         if not math.isfinite(float(value)):
-            raise self.error(key, f"expected a finite number, got {value!r}")
+            raise self.error(key, f"expected a finite number, got {_r(value)}")
+        if abs(float(value)) > MAX_CELL_COORDINATE:
+            raise self.error(key, f"{float(value):g} lies beyond +-{MAX_CELL_COORDINATE:g} "
+                                  "(MAX_CELL_COORDINATE, metres)")
         return float(value)
 
     def numbers(self, value: Any, key: str, n: int | tuple[int, ...]) -> np.ndarray:
         counts = (n,) if isinstance(n, int) else n
         if not isinstance(value, (list, tuple)):
-            raise self.error(key, f"expected {self._count(counts)} numbers, got {value!r}")
+            raise self.error(key, f"expected {self._count(counts)} numbers, got {_r(value)}")
         if len(value) not in counts:
             raise self.error(key, f"expected {self._count(counts)} numbers, got {len(value)}")
         return np.array([self.number(v, f"{key}[{i}]") for i, v in enumerate(value)])
@@ -460,18 +480,18 @@ class _Parser:
 
     def name(self, value: Any, key: str) -> str:
         if not isinstance(value, str) or not _NAME.match(value):
-            raise self.error(key, f"expected a name (letters, digits, _), got {value!r}")
+            raise self.error(key, f"expected a name (letters, digits, _), got {_r(value)}")
         return value
 
     def color(self, spec: Mapping[str, Any], key: str) -> str | None:
         c = spec.get("color")
         if c is not None and not isinstance(c, str):
-            raise self.error(f"{key}.color", f"expected a colour name or #rrggbb, got {c!r}")
+            raise self.error(f"{key}.color", f"expected a colour name or #rrggbb, got {_r(c)}")
         return c
 
     def load_mesh(self, value: Any, key: str, scale: float):
         if not isinstance(value, str) or not value:
-            raise self.error(key, f"expected a file path, got {value!r}")
+            raise self.error(key, f"expected a file path, got {_r(value)}")
         path = Path(value)
         if not path.is_absolute():
             path = self.base_dir / path
@@ -498,7 +518,7 @@ class _Parser:
         kind = spec.get("shape", "mesh" if "mesh" in spec else None)
         if kind not in ("box", "cylinder", "sphere", "mesh"):
             raise self.error(f"{key}.shape",
-                             f"expected box, cylinder, sphere or mesh, got {kind!r}")
+                             f"expected box, cylinder, sphere or mesh, got {_r(kind)}")
         if kind != "mesh" and "position" not in spec:
             raise self.error(key, "missing required key 'position'")
         position = self.point(spec.get("position", [0, 0, 0]), f"{key}.position")
@@ -554,12 +574,12 @@ class _Parser:
         position = self.point(spec["position"], f"{key}.position")
         grasp = spec.get("grasp_points", [[0.0, 0.0, 0.0]])
         if not isinstance(grasp, list) or not grasp:
-            raise self.error(f"{key}.grasp_points", f"expected a list of points, got {grasp!r}")
+            raise self.error(f"{key}.grasp_points", f"expected a list of points, got {_r(grasp)}")
         offsets = np.array([self.point(g, f"{key}.grasp_points[{i}]")
                             for i, g in enumerate(grasp)])
         movable = spec.get("movable", True)
         if not isinstance(movable, bool):
-            raise self.error(f"{key}.movable", f"expected true or false, got {movable!r}")
+            raise self.error(f"{key}.movable", f"expected true or false, got {_r(movable)}")
         sitting = None
         if "sitting_surface" in spec:
             skey = f"{key}.sitting_surface"
@@ -567,10 +587,10 @@ class _Parser:
             sitting = np.stack(self.bounds(s["lo"], s["hi"], skey))
         mass = self.number(spec.get("mass", 1.0), f"{key}.mass")
         if mass <= 0.0:
-            raise self.error(f"{key}.mass", f"expected a positive mass in kg, got {mass!r}")
+            raise self.error(f"{key}.mass", f"expected a positive mass in kg, got {_r(mass)}")
         two_handed = spec.get("two_handed", False)
         if not isinstance(two_handed, bool):
-            raise self.error(f"{key}.two_handed", f"expected true or false, got {two_handed!r}")
+            raise self.error(f"{key}.two_handed", f"expected true or false, got {_r(two_handed)}")
         return SceneObject(name, position, shape, offsets, movable, sitting,
                            self.color(spec, key), mass, two_handed)
 
@@ -618,20 +638,24 @@ def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Ce
     data = pre.mapping(data, "", _TOP_KEYS, required=("regions", "start_region"))
     frame = data.get("frame", "zup")
     if frame not in _FRAMES:
-        raise pre.error("frame", f"expected zup or paper_yup, got {frame!r}")
+        raise pre.error("frame", f"expected zup or paper_yup, got {_r(frame)}")
     p = _Parser(source, base_dir, frame)
 
     name = data.get("name", default_name)
     if not isinstance(name, str) or not name:
-        raise p.error("name", f"expected a non-empty string, got {name!r}")
+        raise p.error("name", f"expected a non-empty string, got {_r(name)}")
     description = data.get("description", "")
     if not isinstance(description, str):
-        raise p.error("description", f"expected a string, got {description!r}")
+        raise p.error("description", f"expected a string, got {_r(description)}")
     floor_z = p.number(data.get("floor_z", 0.0), "floor_z")
 
     ws = p.mapping(data.get("workspace", {"lo": [-5, -5, 0], "hi": [5, 5, 3]}), "workspace",
                    {"lo", "hi"}, ("lo", "hi"))
     ws_lo, ws_hi = p.bounds(ws["lo"], ws["hi"], "workspace")
+    if np.any(ws_hi[:2] - ws_lo[:2] > MAX_WORKSPACE_EXTENT):
+        raise p.error("workspace", f"spans {(ws_hi - ws_lo)[:2].tolist()} m; at most "
+                                   f"{MAX_WORKSPACE_EXTENT:g} m per floor axis are allowed "
+                                   "(MAX_WORKSPACE_EXTENT): a cell, not a factory")
 
     def section(key: str) -> Mapping[str, Any]:
         value = data.get(key) or {}
@@ -642,6 +666,10 @@ def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Ce
             p.name(k, f"{key}.{k}")
         return value
 
+    for key in ("objects", "regions", "obstacles"):
+        if len(section(key)) > MAX_CELL_ENTRIES[key]:
+            raise p.error(key, f"{len(section(key))} entries; at most {MAX_CELL_ENTRIES[key]} "
+                               f"are allowed (MAX_CELL_ENTRIES). {_SIMPLIFY[key]}")
     objects = {n: p.obj(n, s) for n, s in section("objects").items()}
     regions = {n: p.region(n, s) for n, s in section("regions").items()}
     obstacles = tuple(p.obstacle(n, s) for n, s in section("obstacles").items())
@@ -659,8 +687,9 @@ def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Ce
             if required:
                 raise p.error(key, "missing")
             return None
-        if value not in regions:
-            raise p.error(key, f"unknown region {value!r}; regions: {', '.join(regions)}")
+        if not isinstance(value, str) or value not in regions:
+            raise p.error(key, f"unknown region {_r(value)}; expected a region name: "
+                               f"{', '.join(regions)}")
         return regions[value]
 
     start = region_ref("start_region", True)
@@ -683,25 +712,25 @@ def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Ce
         params = tuple(x.strip() for x in (m.group(2) or "").split(",") if x.strip())
         for x in params:
             if not _NAME.match(x):
-                raise p.error(key, f"bad parameter name {x!r}")
+                raise p.error(key, f"bad parameter name {_r(x)}")
         if len(set(params)) != len(params):
             raise p.error(key, "parameter names must differ")
         if sname in TASK_ARGUMENTS or sname in shorthands:
-            raise p.error(key, f"{sname!r} is already a task or shorthand")
+            raise p.error(key, f"{_r(sname)} is already a task or shorthand")
         if not isinstance(body, str) or not body.strip():
-            raise p.error(key, f"expected the body as a string, got {body!r}")
+            raise p.error(key, f"expected the body as a string, got {_r(body)}")
         atoms = _ATOM.findall(body)
         if not atoms:
-            raise p.error(key, f"body {body!r} contains no task")
+            raise p.error(key, f"body {_r(body)} contains no task")
         for task, args in atoms:
             if task not in TASK_ARGUMENTS and task not in shorthands:
-                raise p.error(key, f"unknown task {task!r} in body {body!r}")
+                raise p.error(key, f"unknown task {_r(task)} in body {_r(body)}")
             for arg in (a.strip() for a in args.split(",") if a.strip()):
                 if arg not in params and arg not in objects and arg not in regions:
                     try:
                         float(arg)
                     except ValueError:
-                        raise p.error(key, f"{arg!r} in body {body!r} is neither a parameter "
+                        raise p.error(key, f"{_r(arg)} in body {_r(body)} is neither a parameter "
                                            f"nor an object or region") from None
         shorthands[sname] = (params, body.strip())
 
@@ -728,11 +757,10 @@ def cell_from_yaml(text: str, source: str = "<inline>",
     CellError
         Malformed YAML or cell description; the message names ``source`` and the key.
     """
-    import yaml
     try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise CellError(f"{source}: invalid YAML: {exc}") from exc
+        data = load_yaml_limited(text)
+    except YamlLimitError as exc:
+        raise CellError(f"{source}: {exc}") from None
     default_name = Path(source).stem if source != "<inline>" else "cell"
     return _parse_cell(data, source, Path(base_dir) if base_dir is not None else Path.cwd(),
                        default_name)
@@ -745,6 +773,9 @@ def load_cell(path: str | os.PathLike[str]) -> Cell:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise CellError(f"{path}: cannot read cell file: {exc.strerror or exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise CellError(f"{path}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at "
+                        f"offset {exc.start}); save the cell file as UTF-8") from None
     return cell_from_yaml(text, source=str(path), base_dir=path.parent)
 
 
@@ -779,7 +810,7 @@ def cell_by_name(name: str) -> Cell:
         No such cell; the message lists the folders searched and the cells found.
     """
     if not isinstance(name, str) or not _NAME.match(name.removesuffix(".yaml")):
-        raise CellError(f"cell name must be a plain name such as 'paper_cell', got {name!r}")
+        raise CellError(f"cell name must be a plain name such as 'paper_cell', got {_r(name)}")
     stem = name.removesuffix(".yaml")
     found: set[str] = set()
     for folder in cell_search_paths():

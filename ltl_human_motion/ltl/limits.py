@@ -1,0 +1,80 @@
+"""Named size limits of a specification, checked once, up front, before any translation.
+
+A specification beyond them is refused with a :class:`~ltl_human_motion.errors.SpecError`
+naming the limit, instead of a RecursionError from a recursive pass or minutes of
+translation (issue 17: 12 ``GF`` terms took 39 s, ``X^300`` 113 s, 200 nested ``->`` a
+RecursionError). The translator also checks the active time budget in its main loop
+(:func:`ltl_human_motion.deadline.checkpoint`).
+"""
+
+from __future__ import annotations
+
+from ltl_human_motion.errors import SpecError
+from ltl_human_motion.ltl.formula import (
+    Finally,
+    Formula,
+    Globally,
+    Next,
+    Release,
+    StrongRelease,
+    Until,
+    WeakUntil,
+)
+
+__all__ = ["MAX_NESTING", "MAX_SPEC_CHARS", "MAX_TEMPORAL_OPERATORS", "check_formula_limits",
+           "nesting_depth", "temporal_operators"]
+
+#: Characters of specification text. Table I's and the batch corpus's longest specs are
+#: under 400 characters; 20,000 leaves room for generated ones.
+MAX_SPEC_CHARS = 20_000
+#: Operator nesting depth. The paper's specs nest at most ~12 deep (S2 with its
+#: shorthands); the recursive passes (nnf, equality, rendering) stay far below Python's
+#: recursion limit of 1000 at 100.
+MAX_NESTING = 100
+#: Temporal operators (X, F, G, U, R, W, M) after shorthand expansion. The tableau grows
+#: exponentially with them: 24 (12 ``GF`` terms) took 39 s on a 2-core machine, while the
+#: largest spec of the batch corpus has about 20; 32 refuses what the 30 s budget of the
+#: service could not finish anyway.
+MAX_TEMPORAL_OPERATORS = 32
+
+_TEMPORAL = (Next, Finally, Globally, Until, Release, WeakUntil, StrongRelease)
+
+
+def nesting_depth(f: Formula) -> int:
+    """Depth of the formula tree of ``f`` (an atom is 1), without recursion."""
+    deepest = 0
+    stack = [(f, 1)]
+    while stack:
+        g, d = stack.pop()
+        deepest = max(deepest, d)
+        stack.extend((c, d + 1) for c in g.children())
+    return deepest
+
+
+def temporal_operators(f: Formula) -> int:
+    """Number of temporal operator nodes in ``f`` (shared subformulas counted once per
+    occurrence), without recursion."""
+    count = 0
+    stack = [f]
+    while stack:
+        g = stack.pop()
+        if isinstance(g, _TEMPORAL):
+            count += 1
+        stack.extend(g.children())
+    return count
+
+
+def check_formula_limits(f: Formula, text: str = "") -> None:
+    """Raise SpecError when ``f`` nests deeper than :data:`MAX_NESTING` or has more than
+    :data:`MAX_TEMPORAL_OPERATORS` temporal operators."""
+    depth = nesting_depth(f)
+    if depth > MAX_NESTING:
+        raise SpecError(f"the specification nests operators {depth} deep; at most "
+                        f"{MAX_NESTING} are allowed (MAX_NESTING)", text=text)
+    temporal = temporal_operators(f)
+    if temporal > MAX_TEMPORAL_OPERATORS:
+        raise SpecError(f"the specification has {temporal} temporal operators; at most "
+                        f"{MAX_TEMPORAL_OPERATORS} are allowed (MAX_TEMPORAL_OPERATORS), "
+                        "beyond which translation takes minutes; split the task or "
+                        "remove repeated terms", text=text)
+

@@ -1,0 +1,204 @@
+"""The synthesis service under bad luck (issue 17): real DDS, the real pipeline.
+
+Every request is answered (success, a clean error, or an immediate "busy"); named limits
+refuse absurd requests before any work; the time budget ends a request with "time budget
+of N s exhausted in <stage>"; the node process exits within 2 s of SIGINT mid-synthesis.
+A module of its own: no other synthesis server may answer on ``/synthesize_motion``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+rclpy = pytest.importorskip("rclpy")
+
+from ltl_human_motion.srv import SynthesizeMotion  # noqa: E402
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy  # noqa: E402
+
+from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
+from ltl_human_motion.ros.client import ClientSession  # noqa: E402
+from ltl_human_motion.ros.synthesis_node import (  # noqa: E402
+    MAX_CYCLES,
+    MAX_VARIANTS,
+    SynthesisNode,
+)
+from ltl_human_motion.ros.testing import SYNTHESIS_ONLY_BRINGUP  # noqa: E402
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
+SERVICE = "/synthesize_motion"
+MAX_QUEUED = 8                      # small, so that 100 requests must meet "busy"
+
+
+@pytest.fixture(scope="module")
+def served(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[SynthesisNode,
+                                                                        ClientSession]]:
+    path = tmp_path_factory.mktemp("config") / "synthesis_only.yaml"
+    path.write_text(SYNTHESIS_ONLY_BRINGUP)
+    store = tmp_path_factory.mktemp("motions")
+    bringup = Bringup(path, overrides={"store_dir": str(store), "max_queued": MAX_QUEUED,
+                                       "max_in_memory": 4}).start()
+    with ClientSession("test_reliability_client") as session:
+        # Warm up the library and the sequence cache: later S1 requests take ~0.1 s.
+        response = session.call(SynthesizeMotion, SERVICE,
+                                SynthesizeMotion.Request(spec="S1", cell="paper_cell"),
+                                timeout=180.0)
+        assert response.success, response.error_message
+        yield bringup.node("synthesis_node"), session  # type: ignore[misc]
+    bringup.shutdown()
+
+
+def call(session: ClientSession, timeout: float = 60.0, **fields: object
+         ) -> SynthesizeMotion.Response:
+    fields.setdefault("cell", "paper_cell")
+    return session.call(SynthesizeMotion, SERVICE, SynthesizeMotion.Request(**fields),
+                        timeout=timeout)
+
+
+def _answers(session: ClientSession, requests: list[SynthesizeMotion.Request],
+             qos: QoSProfile | None, timeout: float) -> list[SynthesizeMotion.Response | None]:
+    """Send all ``requests`` at once from a fresh client; the responses (None: none)."""
+    node = session.node
+    client = node.create_client(SynthesizeMotion, SERVICE, **({"qos_profile": qos} if qos
+                                                               else {}))
+    try:
+        assert client.wait_for_service(timeout_sec=10.0)
+        futures = [client.call_async(r) for r in requests]
+        end = time.monotonic() + timeout
+        while time.monotonic() < end and not all(f.done() for f in futures):
+            time.sleep(0.05)          # the session spins its node on a thread of its own
+        return [f.result() if f.done() else None for f in futures]
+    finally:
+        node.destroy_client(client)
+
+
+def test_twenty_concurrent_requests_are_all_answered(
+        served: tuple[SynthesisNode, ClientSession]) -> None:
+    """Issue 17's reproducer, with the default client QoS: 20 S1 requests at once."""
+    _, session = served
+    requests = [SynthesizeMotion.Request(spec="S1", cell="paper_cell", seed=i)
+                for i in range(20)]
+    answers = _answers(session, requests, None, 120.0)
+    assert sum(a is not None for a in answers) == 20
+    busy = [a for a in answers if a is not None and a.error_message.startswith("busy")]
+    assert all(a.success for a in answers if a not in busy), \
+        [a.error_message for a in answers if not a.success]
+
+
+def test_a_hundred_concurrent_requests_are_all_accounted_for(
+        served: tuple[SynthesisNode, ClientSession]) -> None:
+    node, session = served
+    requests = [SynthesizeMotion.Request(spec="S1" if i % 3 else "grasp(O1) & (F",
+                                         cell="paper_cell", seed=i) for i in range(100)]
+    deep = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
+                      reliability=ReliabilityPolicy.RELIABLE)
+    refused = node.requests_refused
+    answers = _answers(session, requests, deep, 180.0)
+    missing = [i for i, a in enumerate(answers) if a is None]
+    assert not missing, f"{len(missing)} of 100 unanswered: {missing[:10]}"
+    busy = [a for a in answers if a.error_message.startswith("busy")]
+    ok = [a for a in answers if a.success]
+    bad = [a for a in answers if not a.success and a not in busy]
+    assert busy, "100 requests against max_queued 8 must meet 'busy'"
+    assert ok and bad
+    assert all(a.error_line == 1 for a in bad), [a.error_message for a in bad]
+    assert len(busy) + len(ok) + len(bad) == 100
+    assert node.requests_refused - refused == len(busy)
+    assert node.in_flight == 0 and node.queued == 0
+    assert len(node.store) <= 4                         # max_in_memory: bounded memory
+
+
+@pytest.mark.parametrize("fields, limit", [
+    ({"variants": 4294967295}, "MAX_VARIANTS"),
+    ({"variants": MAX_VARIANTS + 1}, "MAX_VARIANTS"),
+    ({"cycles": MAX_CYCLES + 1}, "MAX_CYCLES"),
+    ({"stature": 99.0}, "MAX_LIBRARY_STATURE"),
+    ({"stature": float("nan")}, "MAX_LIBRARY_STATURE"),
+    ({"spec": "grasp(O1) & " * 5000 + "grasp(O1)"}, "MAX_SPEC_CHARS"),
+    ({"spec": "X " * 300 + "grasp(O1)"}, "MAX_NESTING"),
+    ({"spec": "grasp(O1) -> " * 200 + "grasp(O1)"}, "MAX_NESTING"),
+    ({"spec": " & ".join(f"G F (grasp(O1) & {'X ' * k}grasp(O2))" for k in range(1, 13))},
+     "MAX_TEMPORAL_OPERATORS"),
+    ({"options_json": "[" * 100_000}, "MAX_OPTIONS_CHARS"),
+    ({"options_json": "[" * 2000 + "]" * 2000}, "nests too deeply"),
+])
+def test_limits_are_refused_naming_the_limit(served: tuple[SynthesisNode, ClientSession],
+                                             fields: dict, limit: str) -> None:
+    _, session = served
+    fields.setdefault("spec", "S1")
+    started = time.monotonic()
+    response = call(session, **fields)
+    assert not response.success
+    assert limit in response.error_message, response.error_message
+    assert "internal error" not in response.error_message
+    assert time.monotonic() - started < 10.0
+
+
+def test_time_budget_ends_the_request_naming_the_stage(
+        served: tuple[SynthesisNode, ClientSession]) -> None:
+    _, session = served
+    response = call(session, spec="S2", seed=11, options_json=json.dumps({"max_seconds": 1e-4}))
+    assert not response.success
+    assert response.error_message.startswith("time budget of 0.0001 s exhausted in "), \
+        response.error_message
+    assert call(session, spec="S1", seed=12).success        # and the node keeps serving
+
+
+def test_deep_inline_cell_is_a_clean_error(served: tuple[SynthesisNode, ClientSession]
+                                           ) -> None:
+    _, session = served
+    response = call(session, spec="S1", cell="a:\n  " + "[" * 100_000)
+    assert not response.success
+    assert "internal error" not in response.error_message, response.error_message
+
+
+SERVER_CODE = textwrap.dedent("""
+    import sys
+    from ltl_human_motion.ros.entry_points import synthesis_node
+    sys.exit(synthesis_node(["--ros-args", "-p", "store_dir:=" + sys.argv[1],
+                             "-r", "__ns:=/sigint"]))
+""")
+
+
+def test_sigint_mid_synthesis_exits_within_two_seconds(
+        tmp_path: Path, served: tuple[SynthesisNode, ClientSession]) -> None:
+    """A server in its own process (namespace /sigint), busy building the motion library
+    of a new stature in an empty cache (tens of seconds), stops within 2 s of SIGINT."""
+    _, session = served
+    env = {**os.environ, "LTL_HUMAN_MOTION_CACHE": str(tmp_path / "cache"),
+           "ROS_HOME": str(tmp_path)}
+    proc = subprocess.Popen([sys.executable, "-c", SERVER_CODE, str(tmp_path / "motions")],
+                            env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    client = session.node.create_client(SynthesizeMotion, "/sigint/synthesize_motion")
+    try:
+        if not client.wait_for_service(timeout_sec=60.0):
+            proc.kill()
+            pytest.fail(f"the /sigint server never came up: {proc.stdout.read()[-3000:]}")
+        client.call_async(SynthesizeMotion.Request(spec="S1", cell="paper_cell",
+                                                   stature=1.62))
+        time.sleep(3.0)                                       # mid-synthesis
+        assert proc.poll() is None
+        started = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        proc.wait(timeout=15.0)
+        elapsed = time.monotonic() - started
+        assert elapsed < 2.0, f"the server took {elapsed:.2f} s to exit after SIGINT"
+    finally:
+        session.node.destroy_client(client)
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        output = proc.stdout.read()
+        proc.stdout.close()
+    assert "Traceback" not in output, output[-3000:]
