@@ -11,7 +11,11 @@ Checks on every primitive (world positions of the primitive started at the origi
   ball = toe) is the contact point; the larger of the two feet is reported;
 * ``joint_speed``: largest speed (m/s) of any joint between two frames (no jumps); the
   swing foot of normal walking peaks near 5 m/s and hands in fast reaching reach 5 to
-  7 m/s, so the limit is 7 m/s.
+  7 m/s, so the limit is 7 m/s;
+* ``self_penetration``: deepest entry (m) of a body capsule's bone axis into another,
+  non-neighbouring capsule (:func:`~ltl_human_motion.planning.biomechanics.
+  self_penetration`); must be <= 0 (a foot through the other shank, an arm through the
+  trunk). Loops whose processing makes the feet cross are dropped by this.
 
 The gait library drops the (few) primitives that fail, so every primitive it holds passes.
 """
@@ -40,6 +44,7 @@ class QualityThresholds:
     contact_height: float = 0.02
     foot_skate: float = 0.50
     joint_speed: float = 7.0
+    self_penetration: float = 0.0
 
 
 def primitive_metrics(positions: np.ndarray, fps: float, skeleton: Skeleton,
@@ -85,10 +90,13 @@ def primitive_metrics(positions: np.ndarray, fps: float, skeleton: Skeleton,
         speed = float((np.linalg.norm(np.diff(p, axis=0), axis=-1) * fps).max())
     else:
         speed = 0.0
+    from ltl_human_motion.planning.biomechanics import self_penetration
+    pen = float(self_penetration(p, skeleton.stature)[0].max()) if len(p) else 0.0
     passed = (bone_dev <= thresholds.bone_length and floor >= -thresholds.floor_tolerance
-              and skate <= thresholds.foot_skate and speed <= thresholds.joint_speed)
+              and skate <= thresholds.foot_skate and speed <= thresholds.joint_speed
+              and pen <= thresholds.self_penetration)
     return {"bone_length": bone_dev, "floor": floor, "foot_skate": skate,
-            "joint_speed": speed, "passed": bool(passed)}
+            "joint_speed": speed, "self_penetration": pen, "passed": bool(passed)}
 
 
 def check_primitives(primitives: Iterable[MotionPrimitive], skeleton: Skeleton,
@@ -107,18 +115,21 @@ def check_primitives(primitives: Iterable[MotionPrimitive], skeleton: Skeleton,
         m = primitive_metrics(world_positions(mp), mp.fps, skeleton, thresholds)
         m["task"] = mp.task
         per[mp.name] = m
-    worst = {"bone_length": 0.0, "floor": float("inf"), "foot_skate": 0.0, "joint_speed": 0.0}
+    worst = {"bone_length": 0.0, "floor": float("inf"), "foot_skate": 0.0, "joint_speed": 0.0,
+             "self_penetration": -float("inf")}
     by_task: dict[str, dict] = {}
     for m in per.values():
         worst["bone_length"] = max(worst["bone_length"], m["bone_length"])
         worst["floor"] = min(worst["floor"], m["floor"])
         worst["foot_skate"] = max(worst["foot_skate"], m["foot_skate"])
         worst["joint_speed"] = max(worst["joint_speed"], m["joint_speed"])
+        worst["self_penetration"] = max(worst["self_penetration"], m["self_penetration"])
         t = by_task.setdefault(m["task"], {"count": 0, "passed": 0})
         t["count"] += 1
         t["passed"] += int(m["passed"])
     if not per:
         worst["floor"] = 0.0
+        worst["self_penetration"] = 0.0
     report = {
         "kind": kind, "thresholds": asdict(thresholds), "count": len(per),
         "passed": sum(int(m["passed"]) for m in per.values()),

@@ -27,8 +27,9 @@ from ltl_human_motion.errors import CellError
 from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
 from ltl_human_motion.motion.types import Motion
-from ltl_human_motion.planning.blend import concatenate
+from ltl_human_motion.planning.blend import JUNCTION_SPREAD, concatenate
 from ltl_human_motion.planning.feasibility import check_steps
+from ltl_human_motion.planning.footlock import lock_feet
 from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner, task_kind
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, verify_motion
@@ -348,9 +349,11 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     checkpoint("planning")
 
     t0 = time.perf_counter()
-    positions, root_yaw, _labels, spans = concatenate(plan.segments)
+    positions, root_yaw, _labels, spans = concatenate(
+        plan.segments, spread=round(JUNCTION_SPREAD * library.fps))
     # Linear blends of joint positions shorten bones between unlike poses; restore them.
     positions = enforce_bone_lengths(positions, library.skeleton)
+    positions = lock_feet(positions, library.fps, library.skeleton, cell.floor_z)
     tracks, held = _object_tracks(cell, plan, spans, positions, library.overlap)
     timeline = []
     for step in plan.steps:

@@ -20,7 +20,6 @@ where every grasp picks a new part from the floor.
 from __future__ import annotations
 
 import functools
-import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -564,23 +563,15 @@ class SequencePlanner:
     def _arm_transition(self, carrying_before: bool, label: int) -> None:
         """Bring the arms from the walk stance to the carry stance or back.
 
-        The hands first come in to the body, then go to the other stance (two min-jerk
-        legs), so they never sweep through a bench in front of the worker.
+        The palms move beside the body on a smooth curve, timed by Fitts' law with a
+        bounded peak speed (:func:`~ltl_human_motion.motion.arm_transition.
+        arm_transition_poses`).
         """
-        from ltl_human_motion.motion.ik import min_jerk
+        from ltl_human_motion.motion.arm_transition import arm_transition_poses
         a, b = self._stance(carrying_before), self._stance(not carrying_before)
-        carry, free = (a, b) if carrying_before else (b, a)
-        tucked = carry.copy()
-        arms = [self.library.skeleton.index(f"{s}_{j}") for s in "lr"
-                for j in ("elbow", "wrist", "hand")]
-        tucked[arms, 0] = np.minimum(carry[arms, 0], free[arms, 0] + 0.08)
-        waypoints = [a, tucked, b]
-        legs = []
-        for p, q in itertools.pairwise(waypoints):
-            n = max(round(0.3 * self.library.fps), self.overlap + 2)
-            s = min_jerk(np.linspace(0.0, 1.0, n))[:, None, None]
-            legs.append(p[None] + s * (q - p)[None])
-        rel = np.concatenate([legs[0], legs[1][1:]])
+        rel = arm_transition_poses(a, b, self.library.skeleton, self.library.fps)
+        if len(rel) < self.overlap + 2:
+            rel = np.concatenate([rel, np.repeat(rel[-1:], self.overlap + 2 - len(rel), 0)])
         root = np.zeros((len(rel), 4))
         root[:, 2] = self.library.standing_height
         mp = MotionPrimitive("arms_to_carry" if not carrying_before else "arms_to_walk", "wait",

@@ -9,17 +9,29 @@ Checks (each a key of the report):
                  specification (with the always-on conjuncts), checked by the
                  independent lasso evaluator;
 ``smoothness``   no joint moves faster than a human can (no jumps);
-``feet``         the feet never go below the floor and never all leave it for long.
+``feet``         the feet never go below the floor and never all leave it for long;
+``joint_speed``, ``range_of_motion``, ``self_penetration``, ``balance``, ``foot_skate``
+                 biomechanical plausibility of the whole blended motion (per-joint speed
+                 limits by body part and activity, anatomical range of motion, no body
+                 part through another, static balance, foot skate): see
+                 :mod:`~ltl_human_motion.planning.biomechanics` for the limits and their
+                 sources. On by default (``VerificationOptions.biomechanics``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ltl_human_motion.errors import VerificationError
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, MAX_STATURE
+from ltl_human_motion.planning.biomechanics import (
+    BiomechanicsLimits,
+    check_biomechanics,
+    frame_labels,
+    seated_frames,
+)
 from ltl_human_motion.scene.geometry import point_bounds
 from ltl_human_motion.scene.occupancy import capsule_radii
 
@@ -42,6 +54,10 @@ class VerificationOptions:
     max_flight : float
         Longest time both feet may be more than ``flight_height`` above the floor, s.
     flight_height : float
+    biomechanics : bool
+        Run the biomechanical checks (default on).
+    limits : BiomechanicsLimits
+        Their limits (:mod:`~ltl_human_motion.planning.biomechanics`).
     """
 
     eps: float = 0.05
@@ -49,6 +65,8 @@ class VerificationOptions:
     floor_tolerance: float = 0.02
     max_flight: float = 0.15
     flight_height: float = 0.12
+    biomechanics: bool = True
+    limits: BiomechanicsLimits = field(default_factory=BiomechanicsLimits)
 
 
 #: Largest body capsule radius (m) at the tallest stature (0.162 m).
@@ -229,6 +247,12 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
     feet_ok = lowest >= -options.floor_tolerance and longest / fps <= options.max_flight
     report["feet"] = _check(feet_ok, f"lowest foot joint {lowest:+.3f} m, longest flight "
                             f"{longest / fps:.2f} s", lowest=lowest, flight=longest / fps)
+
+    if options.biomechanics:
+        report.update(check_biomechanics(
+            pos, fps, stature=stature, labels=frame_labels(len(pos), synth.timeline),
+            floor_z=cell.floor_z, seated=seated_frames(len(pos), synth.timeline),
+            limits=options.limits))
 
     report["passed"] = all(c["passed"] for c in report.values() if isinstance(c, dict))
     if raise_on_failure and not report["passed"]:

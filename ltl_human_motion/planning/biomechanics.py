@@ -1,0 +1,521 @@
+"""Biomechanical plausibility of a whole motion: speeds, range of motion, self-penetration,
+static balance and foot skate.
+
+Every function takes world joint positions of the canonical skeleton, shape (T, J, 3)
+(z up, metres) and the frame rate; :func:`check_biomechanics` runs all five checks and
+returns report entries in the format of :func:`~ltl_human_motion.planning.verify.
+verify_motion`, each failure naming the joint (or body part), the frame and the value.
+
+Limits and where they come from (:class:`BiomechanicsLimits`):
+
+* **Joint speeds** (m/s at the reference stature 1.75 m; scaled by ``H / 1.75`` because
+  retargeted motions scale geometrically at the same cadence; measured as displacements
+  over :data:`SPEED_WINDOW` = 1/30 s, the clips' frame interval). Calibrated on the real
+  clips installed here (``bench/realism.py`` prints them): in the DeepMimic walking clips
+  of pybullet (``walker/*.txt``, ``humanoid3d_walk.txt``) hands peak at 2.4-3.3 m/s,
+  knees at 1.9-2.1 m/s, ankles at 3.1-3.4 m/s and toes at 3.6-3.9 m/s; in the CMU BVH
+  takes 01_01/01_03 (assimp-testmodels) the 99th percentiles are hands 3.3-4.5, knees
+  2.1-2.5 m/s. Hands: 2.5 m/s within hand goal tasks (ISO/TR 23049 and Bosch-era
+  reaching data put deliberate reaching peaks at 1-2 m/s), 3.5 m/s elsewhere; knees
+  2.5 m/s, 2.0 m/s while the pelvis sits, stands up or kneels (sit-to-stand knee
+  velocities stay below 1.5 m/s, Schenkman et al. 1990); the swing foot (ankle, toe)
+  at most 10 % over the gait clips' peak; every other joint 3.5 m/s.
+* **Range of motion** (degrees; American Academy of Orthopaedic Surgeons, *Joint
+  Motion: Method of Measuring and Recording*, 1965, as tabulated by Greene & Heckman,
+  *The Clinical Measurement of Joint Motion*, AAOS 1994): knee flexion 0-150 (the
+  issue's bound; AAOS 135-150) with 5 of hyperextension tolerated (the mean knee
+  extension of healthy adults is 1-2 degrees of hyperextension, Soucie et al. 2011,
+  *Haemophilia* 17:500); elbow flexion 0-150; hip flexion 125 (AAOS 120 + 5 measurement
+  tolerance), extension 30, abduction 45, adduction 30; shoulder extension 60;
+  thoracolumbar flexion 80, extension 25, lateral bending 35, rotation 45; cervical
+  flexion 45, extension 45, lateral bending 45.
+* **Self-penetration**: the bone axis of one body capsule
+  (:data:`~ltl_human_motion.scene.occupancy.BODY_CAPSULES`) must not enter another,
+  non-neighbouring capsule (axis distance below the thicker capsule's radius): an arm
+  segment through the trunk, head or a thigh, an arm through the other arm, a thigh
+  through the other thigh, a shank or foot through the other.
+* **Static balance**: in frames where both feet are planted (every foot joint within
+  ``contact_height`` of the floor, moving under ``planted_speed``) and the pelvis moves
+  slower than ``static_pelvis_speed``, the centre of mass (Winter's segment masses,
+  :func:`~ltl_human_motion.motion.ik.center_of_mass`) projects inside the support
+  polygon of the feet (heel 0.035 H behind the ankle, 0.01 H past the toe joint, half a
+  foot breadth 0.0275 H either side; Drillis & Contini foot proportions) grown by
+  ``balance_margin`` (2 cm, the foot outline's uncertainty). Seated frames (from the
+  start of a ``sit`` to the end of the following ``standUp``) are skipped: the seat
+  carries the body.
+* **Foot skate** (Zhang et al., MOJO, 2021; the measure of :mod:`~ltl_human_motion.motion
+  .quality`): the mean weighted horizontal speed of each foot's contact point over its
+  contact frames is at most 0.03 m/s, and no frame with the contact point on the floor
+  (below half the contact height) slides faster than 0.15 m/s (the issue's bounds; the
+  real gait clips measure 0.01-0.03 m/s mean).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ltl_human_motion.motion.ik import center_of_mass
+from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, JOINT_NAMES
+from ltl_human_motion.scene.geometry import segment_segment_distance
+from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
+
+__all__ = [
+    "BiomechanicsLimits",
+    "balance_margins",
+    "check_biomechanics",
+    "foot_skate",
+    "joint_angles",
+    "joint_speeds",
+    "self_penetration",
+]
+
+_J = JOINT_INDEX
+_FOOT_JOINTS = ("l_ankle", "l_toe", "r_ankle", "r_toe")
+#: Tasks whose motion is the pelvis going down or coming up with the legs loaded.
+POSTURE_TRANSITION_TASKS = ("sit", "standUp", "kneel", "stoop")
+#: Hand goal tasks (the hand moves deliberately to a target).
+HAND_GOAL_TASKS = ("grasp", "release", "move", "leftHand", "rightHand", "assemble",
+                   "insert", "extract")
+
+
+@dataclass(frozen=True)
+class BiomechanicsLimits:
+    """Limits of the biomechanical checks (module docstring gives the sources).
+
+    Speeds are m/s at ``reference_stature`` (scaled by ``stature / reference_stature``);
+    angles are degrees; lengths metres.
+    """
+
+    reference_stature: float = DEFAULT_STATURE
+    hand_speed_goal: float = 2.5
+    hand_speed: float = 3.5
+    knee_speed: float = 2.5
+    knee_speed_posture: float = 2.0
+    ankle_speed: float = 3.7          # gait clips' peak 3.4 m/s + 10 %
+    toe_speed: float = 4.3            # gait clips' peak 3.9 m/s + 10 %
+    other_speed: float = 3.5
+    rom: dict = field(default_factory=lambda: {
+        "knee_flexion": (-5.0, 150.0),
+        "elbow_flexion": (0.0, 150.0),
+        "hip_flexion": (-30.0, 125.0),
+        "hip_abduction": (-30.0, 45.0),
+        "shoulder_extension": (-180.0, 60.0),
+        "trunk_flexion": (-25.0, 80.0),
+        "trunk_lateral": (-35.0, 35.0),
+        "trunk_rotation": (-45.0, 45.0),
+        "neck_flexion": (-45.0, 45.0),
+        "neck_lateral": (-45.0, 45.0),
+    })
+    contact_height: float = 0.02
+    planted_speed: float = 0.05
+    static_pelvis_speed: float = 0.05
+    balance_margin: float = 0.02
+    skate_mean: float = 0.03
+    skate_peak: float = 0.15
+
+
+# ----------------------------------------------------------------------- speeds
+#: Time base of the speed limits, s: speeds are displacements over this interval, the
+#: frame interval of the 30 Hz clips the limits are calibrated on (at 120 Hz a per-frame
+#: difference would see the same motion's peaks 10-15 % higher than the clips can).
+SPEED_WINDOW = 1.0 / 30.0
+
+
+def joint_speeds(positions: np.ndarray, fps: float, window: float = SPEED_WINDOW
+                 ) -> np.ndarray:
+    """Speed of every joint over ``window`` seconds, m/s, shape (T-w, J).
+
+    Row ``t`` is the displacement from frame ``t`` to frame ``t + w``, ``w = round(window
+    * fps)`` (at least 1), divided by ``w / fps``.
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    w = max(1, round(window * float(fps)))
+    if len(p) <= w:
+        return np.zeros((0, p.shape[1]))
+    return np.linalg.norm(p[w:] - p[:-w], axis=-1) * (float(fps) / w)
+
+
+def _speed_limits(n: int, labels: Sequence[str], lim: BiomechanicsLimits,
+                  scale: float) -> np.ndarray:
+    """Per-interval, per-joint speed limit (n, J) from the activity label of each frame."""
+    out = np.full((n, len(JOINT_NAMES)), lim.other_speed)
+    lab = np.asarray(labels[:n], dtype=object)
+    hand_goal = np.isin(lab, HAND_GOAL_TASKS)
+    posture = np.isin(lab, POSTURE_TRANSITION_TASKS)
+    for s in "lr":
+        out[:, _J[f"{s}_hand"]] = np.where(hand_goal, lim.hand_speed_goal, lim.hand_speed)
+        out[:, _J[f"{s}_wrist"]] = np.where(hand_goal, lim.hand_speed_goal, lim.hand_speed)
+        out[:, _J[f"{s}_knee"]] = np.where(posture, lim.knee_speed_posture, lim.knee_speed)
+        out[:, _J[f"{s}_ankle"]] = lim.ankle_speed
+        out[:, _J[f"{s}_toe"]] = lim.toe_speed
+    return out * scale
+
+
+# ---------------------------------------------------------------------- angles
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+
+
+def _frame(lateral: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Orthonormal (forward, left, up) axes (T, 3) each from a lateral and an up vector."""
+    left = _unit(lateral)
+    u = _unit(up - np.sum(up * left, -1, keepdims=True) * left)
+    return np.cross(left, u), left, u
+
+
+def joint_angles(positions: np.ndarray) -> dict[str, np.ndarray]:
+    """Anatomical joint angles of every frame, degrees.
+
+    Keys (each an array of shape (T,)): ``{l,r}_knee_flexion`` (signed about the knee's
+    hinge axis, which is normal to the shank and the foot; negative = hyperextension),
+    ``{l,r}_elbow_flexion``, ``{l,r}_hip_flexion`` and ``{l,r}_hip_abduction`` (thigh in
+    the pelvis frame), ``{l,r}_shoulder_extension`` (upper arm behind the chest's frontal
+    plane), ``trunk_flexion``, ``trunk_lateral``, ``trunk_rotation`` (chest frame relative
+    to the pelvis frame), ``neck_flexion``, ``neck_lateral`` (head relative to the chest).
+
+    Parameters
+    ----------
+    positions : array-like, shape (T, J, 3)
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    deg = np.degrees
+    out: dict[str, np.ndarray] = {}
+    fwd, left, up = _frame(p[:, _J["l_hip"]] - p[:, _J["r_hip"]],
+                           p[:, _J["spine"]] - p[:, _J["pelvis"]])
+    cf, cl, cu = _frame(p[:, _J["l_shoulder"]] - p[:, _J["r_shoulder"]],
+                        p[:, _J["neck"]] - p[:, _J["chest"]])
+    for s, side in (("l", 1.0), ("r", -1.0)):
+        hip, knee, ank, toe = (p[:, _J[f"{s}_{n}"]] for n in ("hip", "knee", "ankle", "toe"))
+        thigh, shank, foot = knee - hip, ank - knee, toe - ank
+        axis = _unit(-np.cross(shank, foot))
+        cr = np.sum(np.cross(thigh, shank) * axis, -1)
+        out[f"{s}_knee_flexion"] = deg(np.arctan2(cr, np.sum(thigh * shank, -1)))
+        t = _unit(thigh)
+        out[f"{s}_hip_flexion"] = deg(np.arctan2(np.sum(t * fwd, -1), -np.sum(t * up, -1)))
+        out[f"{s}_hip_abduction"] = deg(np.arcsin(np.clip(side * np.sum(t * left, -1), -1, 1)))
+        sh, el, wr = (p[:, _J[f"{s}_{n}"]] for n in ("shoulder", "elbow", "wrist"))
+        ua, fa = _unit(el - sh), _unit(wr - el)
+        out[f"{s}_elbow_flexion"] = deg(np.arccos(np.clip(np.sum(ua * fa, -1), -1, 1)))
+        out[f"{s}_shoulder_extension"] = deg(np.arcsin(np.clip(-np.sum(ua * cf, -1), -1, 1)))
+    out["trunk_flexion"] = deg(np.arctan2(np.sum(cu * fwd, -1), np.sum(cu * up, -1)))
+    out["trunk_lateral"] = deg(np.arcsin(np.clip(np.sum(cu * left, -1), -1, 1)))
+    out["trunk_rotation"] = deg(np.arctan2(np.sum(cl * -fwd, -1), np.sum(cl * left, -1)))
+    h = _unit(p[:, _J["head"]] - p[:, _J["neck"]])
+    out["neck_flexion"] = deg(np.arctan2(np.sum(h * cf, -1), np.sum(h * cu, -1)))
+    out["neck_lateral"] = deg(np.arcsin(np.clip(np.sum(h * cl, -1), -1, 1)))
+    return out
+
+
+def _rom_key(name: str) -> str:
+    return name[2:] if name[:2] in ("l_", "r_") else name
+
+
+# ---------------------------------------------------------------- self-penetration
+_ARM_PARTS = ("upper_arm", "lower_arm", "hand")
+
+
+def _penetration_pairs() -> list[tuple[int, int]]:
+    """Capsule index pairs checked for self-penetration (no shared joint)."""
+    names = [c[0] for c in BODY_CAPSULES]
+    idx = {n: i for i, n in enumerate(names)}
+    pairs: set[tuple[int, int]] = set()
+    trunk = ("head", "abdomen", "torso", "pelvis", "l_thigh", "r_thigh")
+    for s, o in (("l", "r"), ("r", "l")):
+        for a in _ARM_PARTS:
+            for b in trunk:
+                pairs.add((idx[f"{s}_{a}"], idx[b]))
+            for b in ("upper_arm", "lower_arm"):
+                pairs.add(tuple(sorted((idx[f"{s}_{a}"], idx[f"{o}_{b}"]))))
+    for a, b in (("l_thigh", "r_thigh"), ("l_shank", "r_shank"), ("l_foot", "r_foot"),
+                 ("l_shank", "r_foot"), ("r_shank", "l_foot")):
+        pairs.add((idx[a], idx[b]))
+    ends = {i: {c[1], c[2]} for i, c in enumerate(BODY_CAPSULES)}
+    return sorted(p for p in pairs if not ends[p[0]] & ends[p[1]])
+
+
+_PAIRS = _penetration_pairs()
+
+
+def self_penetration(positions: np.ndarray, stature: float = DEFAULT_STATURE
+                     ) -> tuple[np.ndarray, list[tuple[str, str]]]:
+    """Depth by which a capsule's bone axis is inside another (non-neighbour) capsule.
+
+    Parameters
+    ----------
+    positions : array-like, shape (T, J, 3)
+    stature : float
+
+    Returns
+    -------
+    depth : ndarray, shape (T, P)
+        ``max(r_a, r_b) - axis distance``; positive = penetration.
+    pairs : list of (part_a, part_b), length P
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    r = capsule_radii(stature)
+    ia = np.array([_J[c[1]] for c in BODY_CAPSULES])
+    ib = np.array([_J[c[2]] for c in BODY_CAPSULES])
+    a = np.array([i for i, _ in _PAIRS])
+    b = np.array([j for _, j in _PAIRS])
+    d = segment_segment_distance(p[:, ia[a]], p[:, ib[a]], p[:, ia[b]], p[:, ib[b]])
+    depth = np.maximum(r[a], r[b])[None] - d
+    names = [(BODY_CAPSULES[i][0], BODY_CAPSULES[j][0]) for i, j in _PAIRS]
+    return depth, names
+
+
+# ------------------------------------------------------------------------ balance
+def _foot_outline(ankle: np.ndarray, toe: np.ndarray, stature: float) -> np.ndarray:
+    """Corners (T, 4, 2) of a foot's sole on the floor plane."""
+    a, t = ankle[:, :2], toe[:, :2]
+    d = _unit(t - a)
+    n = np.stack([-d[:, 1], d[:, 0]], -1)
+    heel = a - 0.035 * stature * d
+    front = t + 0.01 * stature * d
+    w = 0.0275 * stature
+    return np.stack([heel - w * n, front - w * n, front + w * n, heel + w * n], 1)
+
+
+def _hull_distance(points: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Signed distance (T,) of ``p`` (T, 2) to the convex hull of ``points`` (T, V, 2)."""
+    from scipy.spatial import ConvexHull
+    out = np.empty(len(p))
+    for i in range(len(p)):
+        eq = ConvexHull(points[i]).equations          # (F, 3): n . x + c <= 0 inside
+        out[i] = float(np.max(eq[:, :2] @ p[i] + eq[:, 2]))
+    return out
+
+
+def balance_margins(positions: np.ndarray, fps: float, stature: float = DEFAULT_STATURE,
+                    floor_z: float = 0.0, skip: np.ndarray | None = None,
+                    limits: BiomechanicsLimits = BiomechanicsLimits()
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Static frames and the centre of mass's distance outside their support polygon.
+
+    Parameters
+    ----------
+    positions : array-like, shape (T, J, 3)
+    fps, stature, floor_z : float
+    skip : ndarray of bool, shape (T,), optional
+        Frames not to check (seated).
+
+    Returns
+    -------
+    frames : ndarray of int, shape (S,)
+        The static, double-support frames.
+    outside : ndarray, shape (S,)
+        Signed horizontal distance of the centre of mass outside the support polygon, m
+        (negative = inside).
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    T = len(p)
+    if T < 2:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    feet = [_J[n] for n in _FOOT_JOINTS]
+    v = np.linalg.norm(np.diff(p[:, feet, :2], axis=0), axis=-1) * fps
+    v = np.vstack([v[:1], v])                                        # (T, 4)
+    rest_h = np.array([0.039, 0.010, 0.039, 0.010]) * stature
+    low = np.all(p[:, feet, 2] - floor_z - rest_h <= limits.contact_height, axis=1)
+    slow = np.all(v <= limits.planted_speed * stature / limits.reference_stature, axis=1)
+    pv = np.linalg.norm(np.diff(p[:, 0], axis=0), axis=-1) * fps
+    pv = np.concatenate([pv[:1], pv])
+    static = low & slow & (pv <= limits.static_pelvis_speed)
+    if skip is not None:
+        static &= ~np.asarray(skip, dtype=bool)
+    frames = np.flatnonzero(static)
+    if frames.size == 0:
+        return frames, np.zeros(0)
+    q = p[frames]
+    poly = np.concatenate([_foot_outline(q[:, _J["l_ankle"]], q[:, _J["l_toe"]], stature),
+                           _foot_outline(q[:, _J["r_ankle"]], q[:, _J["r_toe"]], stature)], 1)
+    com = center_of_mass(q)[:, :2]
+    return frames, _hull_distance(poly, com)
+
+
+# -------------------------------------------------------------------------- skate
+def foot_skate(positions: np.ndarray, fps: float, stature: float = DEFAULT_STATURE,
+               floor_z: float = 0.0, contact_height: float = 0.02
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """MOJO foot skate of each foot over a whole motion.
+
+    Per foot the contact point is the joint (ankle = heel, toe = ball) nearer its rest
+    height above the floor; a frame counts with weight ``2 - 2**(h / c)`` while the
+    contact point is within ``c = contact_height`` of its rest height.
+
+    Returns
+    -------
+    mean : ndarray, shape (2,)
+        Mean weighted horizontal speed of the left and right foot's contact point over its
+        contact frames, m/s.
+    speed : ndarray, shape (T-1, 2)
+        Horizontal speed of each foot's contact point, m/s.
+    grounded : ndarray of bool, shape (T-1, 2)
+        Frames where the contact point is within half the contact height (on the floor).
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    feet = [_J[n] for n in _FOOT_JOINTS]
+    if len(p) < 2:
+        return np.zeros(2), np.zeros((0, 2)), np.zeros((0, 2), dtype=bool)
+    rest_h = np.array([0.039, 0.010, 0.039, 0.010]) * stature
+    vel = np.linalg.norm(np.diff(p[:, feet, :2], axis=0), axis=-1) * fps       # (T-1, 4)
+    h = np.maximum(p[:, feet, 2] - floor_z - rest_h, 0.0)
+    h = 0.5 * (h[1:] + h[:-1]) / contact_height
+    h2 = h.reshape(-1, 2, 2)
+    pick = np.argmin(h2, axis=2)
+    h_c = np.take_along_axis(h2, pick[..., None], 2)[..., 0]
+    v_c = np.take_along_axis(vel.reshape(-1, 2, 2), pick[..., None], 2)[..., 0]
+    weight = np.where(h_c < 1.0, 2.0 - np.exp2(h_c), 0.0)
+    counts = (h_c < 1.0).sum(0)
+    mean = np.where(counts > 0, (v_c * weight).sum(0) / np.maximum(counts, 1), 0.0)
+    return mean, v_c, h_c < 0.5
+
+
+# --------------------------------------------------------------------- the checks
+def _entry(passed: bool, detail: str, **values: object) -> dict:
+    return {"passed": bool(passed), "detail": detail, **values}
+
+
+def frame_labels(n_frames: int, timeline: Sequence, default: str = "walk") -> list[str]:
+    """Activity of every frame: the task of the timeline segment holding it, else walk.
+
+    ``timeline`` holds objects with ``task``, ``start_frame`` and ``end_frame``.
+    """
+    lab = [default] * n_frames
+    for seg in timeline:
+        for f in range(max(0, seg.start_frame), min(n_frames, seg.end_frame)):
+            lab[f] = seg.task
+    return lab
+
+
+def seated_frames(n_frames: int, timeline: Sequence) -> np.ndarray:
+    """Frames from the start of each ``sit`` to the end of the next ``standUp``, (T,)."""
+    out = np.zeros(n_frames, dtype=bool)
+    start = None
+    for seg in timeline:
+        if seg.task == "sit" and start is None:
+            start = seg.start_frame
+        elif seg.task == "standUp":
+            out[seg.start_frame if start is None else start:seg.end_frame] = True
+            start = None
+    if start is not None:
+        out[start:] = True
+    return out
+
+
+def check_biomechanics(positions: np.ndarray, fps: float, *, stature: float = DEFAULT_STATURE,
+                       labels: Sequence[str] | None = None, floor_z: float = 0.0,
+                       seated: np.ndarray | None = None,
+                       limits: BiomechanicsLimits = BiomechanicsLimits()) -> dict:
+    """The five biomechanical checks of a whole motion.
+
+    Parameters
+    ----------
+    positions : array-like, shape (T, J, 3)
+    fps, stature, floor_z : float
+    labels : sequence of str, length T, optional
+        The activity of every frame (a Table I task name, or ``"walk"``); default walk.
+    seated : ndarray of bool, shape (T,), optional
+        Frames where a seat carries the body (skipped by the balance check).
+    limits : BiomechanicsLimits
+
+    Returns
+    -------
+    dict
+        ``{"joint_speed", "range_of_motion", "self_penetration", "balance",
+        "foot_skate"}``, each ``{"passed", "detail", ...}``; a failure's detail names the
+        joint or part, the frame and the value.
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    T = len(p)
+    labels = list(labels) if labels is not None else ["walk"] * T
+    if len(labels) != T:
+        raise ValueError(f"labels must have one entry per frame ({T}), got {len(labels)}")
+    scale = float(stature) / limits.reference_stature
+    out: dict = {}
+
+    speed = joint_speeds(p, fps)
+    if speed.size:
+        w = T - len(speed)
+        # an interval is limited by the stricter of its two end frames' activities
+        lim_a = _speed_limits(T - w, labels[:T - w], limits, scale)
+        lim_b = _speed_limits(T - w, labels[w:], limits, scale)
+        ratio = speed / np.minimum(lim_a, lim_b)
+        f0, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+        lim = min(lim_a[f0, j], lim_b[f0, j])
+        ok = bool(ratio[f0, j] <= 1.0)
+        jf = int(np.argmax(speed.max(axis=0)))
+        f = int(f0) + w // 2
+        out["joint_speed"] = _entry(
+            ok, (f"{JOINT_NAMES[j]} at frame {f} ({f / fps:.2f} s, {labels[f]}) moves "
+                 f"at {speed[f0, j]:.2f} m/s, over its limit {lim:.2f} m/s") if not ok else
+            f"fastest joint {JOINT_NAMES[jf]} at {speed[:, jf].max():.2f} m/s; every joint "
+            f"within its limit (closest: {JOINT_NAMES[j]} at {100 * ratio[f0, j]:.0f} %)",
+            max_speed=float(speed.max()), joint=JOINT_NAMES[j], frame=f,
+            value=float(speed[f0, j]), limit=float(lim))
+    else:
+        out["joint_speed"] = _entry(True, "a single frame has no speed", max_speed=0.0)
+
+    angles = joint_angles(p)
+    worst = (0.0, "", 0, 0.0, (0.0, 0.0))
+    for name, a in angles.items():
+        lo, hi = limits.rom[_rom_key(name)]
+        excess = np.maximum(lo - a, a - hi)
+        f = int(np.argmax(excess))
+        if excess[f] > worst[0]:
+            worst = (float(excess[f]), name, f, float(a[f]), (lo, hi))
+    ok = worst[0] <= 0.0
+    out["range_of_motion"] = _entry(
+        ok, "every joint angle within its range of motion" if ok else
+        f"{worst[1]} at frame {worst[2]} ({worst[2] / fps:.2f} s, {labels[worst[2]]}) is "
+        f"{worst[3]:.1f} deg, outside [{worst[4][0]:.0f}, {worst[4][1]:.0f}] deg",
+        joint=worst[1], frame=worst[2], value=worst[3],
+        extremes={k: [float(v.min()), float(v.max())] for k, v in angles.items()})
+
+    depth, names = self_penetration(p, stature)
+    f, k = np.unravel_index(int(np.argmax(depth)), depth.shape) if depth.size else (0, 0)
+    dmax = float(depth[f, k]) if depth.size else -1.0
+    ok = dmax <= 0.0
+    a, b = names[k] if names else ("", "")
+    out["self_penetration"] = _entry(
+        ok, f"no body part passes through another (closest: {a} and {b}, "
+            f"{-dmax * 100:.1f} cm apart)" if ok else
+        f"{a} passes through {b} at frame {f} ({f / fps:.2f} s, {labels[f]}) by "
+        f"{dmax * 100:.1f} cm", joint=a, other=b, frame=int(f), value=dmax)
+
+    frames, outside = balance_margins(p, fps, stature, floor_z, seated, limits)
+    i = int(np.argmax(outside)) if outside.size else 0
+    worst_out = float(outside[i]) if outside.size else -np.inf
+    ok = worst_out <= limits.balance_margin
+    fr = int(frames[i]) if frames.size else 0
+    out["balance"] = _entry(
+        ok, (f"{frames.size} static frames, the centre of mass at most "
+             f"{100 * worst_out:+.1f} cm outside the support polygon (limit "
+             f"{100 * limits.balance_margin:.0f} cm)") if frames.size and ok else
+        "no static double-support frame" if ok else
+        f"centre of mass at frame {fr} ({fr / fps:.2f} s, {labels[fr]}) is "
+        f"{100 * worst_out:.1f} cm outside the support polygon of the feet (limit "
+        f"{100 * limits.balance_margin:.0f} cm)", joint="center_of_mass", frame=fr,
+        value=worst_out if frames.size else None, static_frames=int(frames.size))
+
+    mean, v, grounded = foot_skate(p, fps, stature, floor_z, limits.contact_height)
+    vg = np.where(grounded, v, 0.0)
+    f, k = np.unravel_index(int(np.argmax(vg)), vg.shape) if vg.size else (0, 0)
+    peak = float(vg[f, k]) if vg.size else 0.0
+    foot = ("left foot", "right foot")
+    worst_mean = int(np.argmax(mean))
+    ok_mean = bool(mean.max() <= limits.skate_mean)
+    ok_peak = peak <= limits.skate_peak
+    if not ok_mean:
+        detail = (f"{foot[worst_mean]} skates at {mean[worst_mean]:.3f} m/s on average over "
+                  f"its contact frames (limit {limits.skate_mean} m/s)")
+    elif not ok_peak:
+        detail = (f"{foot[k]} slides at {peak:.2f} m/s on the floor at frame {f} "
+                  f"({f / fps:.2f} s, {labels[f]}) (limit {limits.skate_peak} m/s)")
+    else:
+        detail = (f"mean foot skate {mean.max():.3f} m/s, fastest planted slide "
+                  f"{peak:.2f} m/s")
+    out["foot_skate"] = _entry(ok_mean and ok_peak, detail, joint=foot[k], frame=int(f),
+                               value=peak, mean=float(mean.max()))
+    return out
