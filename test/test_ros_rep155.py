@@ -20,6 +20,7 @@ urdf_parser = pytest.importorskip("urdf_parser_py.urdf")
 from geometry_msgs.msg import PointStamped, TwistStamped  # noqa: E402
 from hri_msgs.msg import IdsList  # noqa: E402
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
+from ros_fakes import scripted_synthesize  # noqa: E402
 from scipy.spatial.transform import Rotation  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
@@ -31,7 +32,6 @@ from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
 from ltl_human_motion.ros.common import LATCHED_QOS  # noqa: E402
-from ltl_human_motion.ros.testing import scripted_synthesize  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

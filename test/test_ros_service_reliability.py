@@ -24,6 +24,7 @@ rclpy = pytest.importorskip("rclpy")
 
 from ltl_human_motion.srv import SynthesizeMotion  # noqa: E402
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy  # noqa: E402
+from ros_fakes import SYNTHESIS_ONLY_BRINGUP  # noqa: E402
 
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession  # noqa: E402
@@ -32,7 +33,6 @@ from ltl_human_motion.ros.synthesis_node import (  # noqa: E402
     MAX_VARIANTS,
     SynthesisNode,
 )
-from ltl_human_motion.ros.testing import SYNTHESIS_ONLY_BRINGUP  # noqa: E402
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 

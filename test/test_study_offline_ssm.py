@@ -14,9 +14,9 @@ from ltl_human_motion.robot.coexistence import CoexistenceController
 from ltl_human_motion.robot.kinematics import pose_from_xyz_rpy, robot_capsules, ur_model
 from ltl_human_motion.robot.offline_ssm import CONTROL_RATE, batched_separations, run_offline_ssm
 from ltl_human_motion.robot.separation import signed_distances
-from ltl_human_motion.robot.sim_state import SimulatedUR
+from ltl_human_motion.robot.sim.state import SimulatedUR
+from ltl_human_motion.robot.sim.trajectory import load_robot_config
 from ltl_human_motion.robot.ssm import SSMParameters
-from ltl_human_motion.robot.trajectory import load_robot_config
 from ltl_human_motion.scene.occupancy import capsules_from_positions
 
 

@@ -25,7 +25,7 @@ from ltl_human_motion.robot.coexistence import CoexistenceController, ur_rtde_fa
 from ltl_human_motion.robot.kinematics import pose_from_xyz_rpy, ur_model
 from ltl_human_motion.robot.metrics import DecisionRecorder, commissioning_metrics
 from ltl_human_motion.robot.offline_ssm import run_offline_ssm
-from ltl_human_motion.robot.trajectory import load_robot_config
+from ltl_human_motion.robot.sim.trajectory import load_robot_config
 from ltl_human_motion.scene.occupancy import capsules_from_positions
 
 pytest.importorskip("rtde_receive")

@@ -3,7 +3,7 @@ motion's timeline, at the live loop's 125 Hz, much faster than real time.
 
 Per control step ``k`` (time ``t_k = k / rate``) this does what one
 :meth:`~ltl_human_motion.robot.coexistence.CoexistenceController.step` does against the
-simulated controller (:class:`~ltl_human_motion.robot.sim_state.SimulatedUR`): read the
+simulated controller (:class:`~ltl_human_motion.robot.sim.state.SimulatedUR`): read the
 arm's joints at its trajectory time ``tau_k``, compute the human-robot capsule separation
 (:func:`~ltl_human_motion.robot.separation.signed_distances`, optionally with predicted
 occupancy through :func:`~ltl_human_motion.robot.ssm.predictive_separation`), turn it into
@@ -32,8 +32,8 @@ from numpy.typing import ArrayLike
 from ltl_human_motion.robot.coexistence import ControlDecision, ssm_command
 from ltl_human_motion.robot.kinematics import URModel, robot_capsules, ur_model
 from ltl_human_motion.robot.metrics import commissioning_metrics
+from ltl_human_motion.robot.sim.trajectory import JointTrajectory
 from ltl_human_motion.robot.ssm import SSMParameters, predictive_separation
-from ltl_human_motion.robot.trajectory import JointTrajectory
 from ltl_human_motion.scene.occupancy import capsules_from_positions
 
 __all__ = ["CONTROL_RATE", "OfflineSSMResult", "batched_separations", "run_offline_ssm"]

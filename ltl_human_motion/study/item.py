@@ -25,7 +25,7 @@ def robot_settings(path: str | Path | None) -> dict[str, Any] | None:
     """A robot YAML (``config/ur_pick_place.yaml``) as plain JSON, or None."""
     if path is None:
         return None
-    from ltl_human_motion.robot.trajectory import load_robot_config
+    from ltl_human_motion.robot.sim.trajectory import load_robot_config
     cfg = load_robot_config(path)
     traj = cfg["trajectory"]
     return {"source": str(path), "model": cfg["model"], "base_xyz": list(cfg["base_xyz"]),
@@ -48,7 +48,7 @@ def assess_settings(robot: str | Path | None = None, prediction_horizon: float =
 @functools.lru_cache(maxsize=4)
 def _robot(text: str) -> tuple[Any, Any, Any]:
     from ltl_human_motion.robot.kinematics import pose_from_xyz_rpy, ur_model
-    from ltl_human_motion.robot.trajectory import JointTrajectory, Waypoint
+    from ltl_human_motion.robot.sim.trajectory import JointTrajectory, Waypoint
     r = json.loads(text)
     model = ur_model(r["model"])
     if r.get("tool_length") is not None:
