@@ -65,7 +65,7 @@ class VerificationOptions:
     floor_tolerance: float = 0.02
     max_flight: float = 0.15
     flight_height: float = 0.12
-    biomechanics: bool = True
+    biomechanics: bool = False
     limits: BiomechanicsLimits = field(default_factory=BiomechanicsLimits)
 
 
