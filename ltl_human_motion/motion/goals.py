@@ -67,6 +67,13 @@ _REACH_FRACTION = 0.93          # hand never further than this fraction of the a
 _ASSEMBLE_HALF_GAP = 0.035      # m, hands either side of an assembly target
 _INSERT_TRAVEL = 0.08           # m, straight push of insert / pull of extract
 _APPROACH_LIFT = 0.08           # m, grasp/release/move come down onto low targets
+#: Nominal length of sitting down and of standing up from a seat, s (each varied by
+#: +-8 %). Healthy adults take 1.5-2.5 s for a sit-to-stand at a self-selected pace
+#: and a little longer for the controlled stand-to-sit (Kerr et al. 1997, Clin Biomech
+#: 12(4); Janssen et al. 2002, Phys Ther 82(9)); below 1.5 s the knees outrun the
+#: posture-transition speed limit of planning/biomechanics.py.
+SIT_DOWN_SECONDS = 1.8
+STAND_UP_SECONDS = 1.9
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -716,8 +723,10 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
 
 
 def _sit(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: float | None,
-         fps: float, target: np.ndarray | None) -> tuple[np.ndarray, dict, np.ndarray]:
-    """World frames of sitting down onto the seat point ``target`` (start frame)."""
+         fps: float, target: np.ndarray | None, nominal: float = SIT_DOWN_SECONDS
+         ) -> tuple[np.ndarray, dict, np.ndarray]:
+    """World frames (T, J, 3) of sitting down onto the seat point ``target`` (start
+    frame), over ``duration`` or, if None, ``nominal`` seconds varied by +-8 %."""
     H = skeleton.stature
     lo, hi = seat_height_range(skeleton)
     if target is None:
@@ -739,7 +748,7 @@ def _sit(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: flo
             raise ValueError(f"sit: seat point {np.round(target, 3).tolist()} cannot be reached "
                              f"from the start position; it must be behind the worker within "
                              f"reach (see reach_placement)")
-    t_down = (1.5 if duration is None else float(duration)) * (
+    t_down = (nominal if duration is None else float(duration)) * (
         rng.uniform(0.92, 1.08) if duration is None else 1.0)
     if t_down < 0.6:
         raise ValueError(f"sit: duration {t_down:.2f} s is too short (at least 0.6 s)")
@@ -838,7 +847,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     H = skeleton.stature
     seat_z = 0.26 * H if target is None else float(np.asarray(target, dtype=np.float64)[2])
     dist, _ = reach_placement("sit", seat_z, skeleton)
-    world, meta, tgt = _sit(skeleton, st, rng, duration, fps, np.array([dist, 0.0, seat_z]))
+    world, meta, tgt = _sit(skeleton, st, rng, duration, fps, np.array([dist, 0.0, seat_z]),
+                            nominal=STAND_UP_SECONDS)
     world = world[::-1].copy()
     world[..., :2] -= world[0, 0, :2]
     # Table I's condition (head above chest height) already holds for an upright seated

@@ -681,7 +681,12 @@ class SequencePlanner:
             step.first_segment = first
             step.last_segment = len(self.segments) - 1
             self.steps.append(step)
-        self._stand_still(-1, 0.3)
+        if self.seat is not None:
+            # A motion ending seated stays seated: a standing hold here would lift the
+            # pelvis from the seat to standing height within one blend.
+            self._add(self._sit_still(0.3), self.pose, -1, self.overlap)
+        else:
+            self._stand_still(-1, 0.3)
         return Plan(self.segments, self.steps, start, self.expanded)
 
     def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
