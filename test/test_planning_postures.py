@@ -61,3 +61,25 @@ def test_body_transition_verifies_and_moves_like_a_person(cell: str, spec: str,
             seconds = (b - a) / fps
             assert STAND_UP_SECONDS[0] <= seconds <= STAND_UP_SECONDS[1], (
                 f"standing up from the seat takes {seconds:.2f} s")
+
+
+@pytest.mark.parametrize("stature", STATURES)
+def test_sit_on_the_seat_already_sat_on_stays_seated(stature: float) -> None:
+    """sit(stool) twice in a row: the second holds the seated pose (it was refused: the
+    seat is not behind a seated worker); the walk after it stands up first."""
+    from ltl_human_motion.planning.pipeline import get_library, resolve_cell
+    from ltl_human_motion.planning.planner import SequencePlanner
+
+    cell = resolve_cell("demo_cell")
+    planner = SequencePlanner(cell, get_library(stature), np.random.default_rng(1))
+    start = (float(cell.start_region.center[0]), float(cell.start_region.center[1]), 0.0)
+    steps = [("sit(stool)", "sit", ("stool",)), ("sit(stool)", "sit", ("stool",)),
+             ("walk(R1)", "walk", ("R1",))]
+    plan = planner.plan(steps, start)
+    first, second, walk = plan.steps
+    assert second.kind == "sit (seated)"
+    sat = plan.segments[first.goal_segment].positions[-1, 0, 2]
+    held = plan.segments[second.goal_segment].positions[:, 0, 2]
+    assert np.abs(held - sat).max() < 1e-6
+    names = [s.name for s in plan.segments[second.last_segment + 1:walk.last_segment + 1]]
+    assert names[0].startswith("standUp_"), names
