@@ -83,3 +83,28 @@ def test_sit_on_the_seat_already_sat_on_stays_seated(stature: float) -> None:
     assert np.abs(held - sat).max() < 1e-6
     names = [s.name for s in plan.segments[second.last_segment + 1:walk.last_segment + 1]]
     assert names[0].startswith("standUp_"), names
+
+
+def test_biomechanics_reads_the_task_of_a_step_with_arguments() -> None:
+    """Timeline tasks are written with their arguments ("sit(stool)"): the seated frames
+    run from the start of the sit, and sit frames get the posture-transition knee limit."""
+    from ltl_human_motion.planning.biomechanics import (
+        BiomechanicsLimits,
+        _speed_limits,
+        seated_frames,
+    )
+    from ltl_human_motion.planning.result import TaskSegment
+
+    timeline = [TaskSegment("walk(R1)", 0, 10, "walk", None),
+                TaskSegment("sit(stool)", 10, 20, "sit", None),
+                TaskSegment("wait(2.0)", 20, 30, "wait", None),
+                TaskSegment("standUp", 30, 40, "standUp", None)]
+    seated = seated_frames(50, timeline)
+    assert not seated[:10].any() and seated[10:40].all() and not seated[40:].any()
+
+    lim = BiomechanicsLimits()
+    labels = ["walk(R1)"] * 10 + ["sit(stool)"] * 10 + ["grasp(O1)"] * 10
+    out = _speed_limits(30, labels, lim, 1.0)
+    assert np.all(out[10:20, JOINT_INDEX["l_knee"]] == lim.knee_speed_posture)
+    assert np.all(out[:10, JOINT_INDEX["l_knee"]] == lim.knee_speed)
+    assert np.all(out[20:, JOINT_INDEX["r_hand"]] == lim.hand_speed_goal)
