@@ -684,12 +684,10 @@ class SequencePlanner:
             step.first_segment = first
             step.last_segment = len(self.segments) - 1
             self.steps.append(step)
-        if self.seat is not None:
-            # A motion ending seated stays seated: a standing hold here would lift the
-            # pelvis from the seat to standing height within one blend.
-            self._add(self._sit_still(0.3), self.pose, -1, self.overlap)
-        else:
+        if self.seat is None:
             self._stand_still(-1, 0.3)
+        else:                                # the motion ends seated: stay on the seat
+            self._add(self._sit_still(0.3), self.pose, -1, self.overlap)
         return Plan(self.segments, self.steps, start, self.expanded)
 
     def _plan_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
@@ -706,9 +704,10 @@ class SequencePlanner:
                                 self.overlap)
                 return StepPlan(text, "sit (seated)", self.seat, goal_segment=seg,
                                 contact_frame=0, primitive=self.segments[seg].name)
+            self._goal_segment("standUp", self.seat, -1, text)     # to sit on another seat
+            self.seat = None
         if self.seat is not None and kind not in ("standUp", "wait", "leftHand", "rightHand",
-                                                  "assemble"):
-            # (A sit on another seat stands up first too.)
+                                                  "assemble", "sit"):
             self._goal_segment("standUp", self.seat, -1, text)
             self.seat = None
         if kind == "carry":
