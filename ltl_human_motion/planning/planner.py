@@ -695,6 +695,10 @@ class SequencePlanner:
         """Plan step ``i`` (``text``) as the goal task ``kind``; ``keep_hold``: a part a
         move puts into its region stays in hand (carry)."""
         expanded0 = self.expanded
+        if self.seat is not None and kind not in ("standUp", "wait", "leftHand", "rightHand",
+                                                  "assemble", "sit"):
+            self._goal_segment("standUp", self.seat, -1, text)
+            self.seat = None
         if kind == "sit" and self.seat is not None:
             seat = self.target_of(kind, args)
             if seat is not None and float(np.linalg.norm(seat - self.seat)) <= SAME_SEAT_DISTANCE:
@@ -705,10 +709,6 @@ class SequencePlanner:
                 return StepPlan(text, "sit (seated)", self.seat, goal_segment=seg,
                                 contact_frame=0, primitive=self.segments[seg].name)
             self._goal_segment("standUp", self.seat, -1, text)     # to sit on another seat
-            self.seat = None
-        if self.seat is not None and kind not in ("standUp", "wait", "leftHand", "rightHand",
-                                                  "assemble", "sit"):
-            self._goal_segment("standUp", self.seat, -1, text)
             self.seat = None
         if kind == "carry":
             # carry(O, R) holds when the body enters R with O inside it: the held part is
