@@ -67,13 +67,6 @@ _REACH_FRACTION = 0.93          # hand never further than this fraction of the a
 _ASSEMBLE_HALF_GAP = 0.035      # m, hands either side of an assembly target
 _INSERT_TRAVEL = 0.08           # m, straight push of insert / pull of extract
 _APPROACH_LIFT = 0.08           # m, grasp/release/move come down onto low targets
-#: Nominal length of sitting down and of standing up from a seat, s (each varied by
-#: +-8 %). Healthy adults take 1.5-2.5 s for a sit-to-stand at a self-selected pace
-#: and a little longer for the controlled stand-to-sit (Kerr et al. 1997, Clin Biomech
-#: 12(4); Janssen et al. 2002, Phys Ther 82(9)); below 1.5 s the knees outrun the
-#: posture-transition speed limit of planning/biomechanics.py.
-SIT_DOWN_SECONDS = 1.8
-STAND_UP_SECONDS = 1.9
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -720,6 +713,14 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
             "posture": "kneel" if task == "kneel" else _posture_name(world[f1], skeleton)}
     return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
                    f"goals.make_goal_primitive({task!r})", meta)
+
+
+#: Nominal length of sitting down and of standing up from a seat, s (each varied by
+#: +-8 %): a self-paced sit-to-stand of a healthy adult takes about 1.5-2.5 s (the
+#: studies reviewed in Janssen et al. 2002, Phys Ther 82(9):866), the lowering to the
+#: seat about as long; the earlier 1.5 s (1.38-1.62 s) was at the fast end.
+SIT_DOWN_SECONDS = 1.8
+STAND_UP_SECONDS = 1.9
 
 
 def _sit(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: float | None,
