@@ -736,9 +736,19 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
                    f"goals.make_goal_primitive({task!r})", meta)
 
 
+#: Nominal length of sitting down and of standing up from a seat, s (each varied by
+#: +-8 %): a self-paced sit-to-stand of a healthy adult takes about 1.5-2.5 s (the
+#: studies reviewed in Janssen et al. 2002, Phys Ther 82(9):866), the lowering to the
+#: seat about as long; the earlier 1.5 s (1.38-1.62 s) was at the fast end.
+SIT_DOWN_SECONDS = 1.8
+STAND_UP_SECONDS = 1.9
+
+
 def _sit(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: float | None,
-         fps: float, target: np.ndarray | None) -> tuple[np.ndarray, dict, np.ndarray]:
-    """World frames of sitting down onto the seat point ``target`` (start frame)."""
+         fps: float, target: np.ndarray | None, nominal: float = SIT_DOWN_SECONDS
+         ) -> tuple[np.ndarray, dict, np.ndarray]:
+    """World frames (T, J, 3) of sitting down onto the seat point ``target`` (start
+    frame), over ``duration`` or, if None, ``nominal`` seconds varied by +-8 %."""
     H = skeleton.stature
     lo, hi = seat_height_range(skeleton)
     if target is None:
@@ -760,7 +770,7 @@ def _sit(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: flo
             raise ValueError(f"sit: seat point {np.round(target, 3).tolist()} cannot be reached "
                              f"from the start position; it must be behind the worker within "
                              f"reach (see reach_placement)")
-    t_down = (1.5 if duration is None else float(duration)) * (
+    t_down = (nominal if duration is None else float(duration)) * (
         rng.uniform(0.92, 1.08) if duration is None else 1.0)
     if t_down < 0.6:
         raise ValueError(f"sit: duration {t_down:.2f} s is too short (at least 0.6 s)")
@@ -859,7 +869,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     H = skeleton.stature
     seat_z = 0.26 * H if target is None else float(np.asarray(target, dtype=np.float64)[2])
     dist, _ = reach_placement("sit", seat_z, skeleton)
-    world, meta, tgt = _sit(skeleton, st, rng, duration, fps, np.array([dist, 0.0, seat_z]))
+    world, meta, tgt = _sit(skeleton, st, rng, duration, fps, np.array([dist, 0.0, seat_z]),
+                            nominal=STAND_UP_SECONDS)
     world = world[::-1].copy()
     world[..., :2] -= world[0, 0, :2]
     # Table I's condition (head above chest height) already holds for an upright seated

@@ -143,11 +143,16 @@ def joint_speeds(positions: np.ndarray, fps: float, window: float = SPEED_WINDOW
     return np.linalg.norm(p[w:] - p[:-w], axis=-1) * (float(fps) / w)
 
 
+def _kind(label: str) -> str:
+    """The task of an activity label: ``"sit(stool)"`` -> ``"sit"``."""
+    return str(label).split("(", 1)[0]
+
+
 def _speed_limits(n: int, labels: Sequence[str], lim: BiomechanicsLimits,
                   scale: float) -> np.ndarray:
     """Per-interval, per-joint speed limit (n, J) from the activity label of each frame."""
     out = np.full((n, len(JOINT_NAMES)), lim.other_speed)
-    lab = np.asarray(labels[:n], dtype=object)
+    lab = np.asarray([_kind(x) for x in labels[:n]], dtype=object)
     hand_goal = np.isin(lab, HAND_GOAL_TASKS)
     posture = np.isin(lab, POSTURE_TRANSITION_TASKS)
     for s in "lr":
@@ -399,9 +404,9 @@ def seated_frames(n_frames: int, timeline: Sequence) -> np.ndarray:
     out = np.zeros(n_frames, dtype=bool)
     start = None
     for seg in timeline:
-        if seg.task == "sit" and start is None:
+        if _kind(seg.task) == "sit" and start is None:
             start = seg.start_frame
-        elif seg.task == "standUp":
+        elif _kind(seg.task) == "standUp":
             out[seg.start_frame if start is None else start:seg.end_frame] = True
             start = None
     if start is not None:

@@ -51,6 +51,9 @@ Pose = tuple[float, float, float]
 #: How long ``standUp`` by a worker already standing stands still, seconds (a short,
 #: visible pause; the blends at both ends take 2 x overlap frames of it).
 STAND_UP_IN_PLACE_SECONDS = 0.4
+#: A sit on a seat no further than this from the one the worker sits on stays seated,
+#: metres (a seat point is exact to the cell model; 5 cm is a buttock's settling).
+SAME_SEAT_DISTANCE = 0.05
 
 #: Height of the hand where a held part is let go, as a fraction of the stature (waist
 #: height: 0.75 m for a 1.75 m worker, the planner's value since the first release).
@@ -876,6 +879,17 @@ class SequencePlanner:
             self._step_out()
         if self.seat is not None and kind not in ("standUp", "wait", "sit", *SEATED_HAND_TASKS):
             self._goal_segment("standUp", self.seat, -1, text)
+            self.seat = None
+        if kind == "sit" and self.seat is not None:
+            seat = self.target_of(kind, args)
+            if seat is not None and float(np.linalg.norm(seat - self.seat)) <= SAME_SEAT_DISTANCE:
+                # Already on this seat: sit holds while the worker stays seated (standing
+                # up to sit down again would be a needless double transition).
+                seg = self._add(self._sit_still(STAND_UP_IN_PLACE_SECONDS), self.pose, i,
+                                self.overlap)
+                return StepPlan(text, "sit (seated)", self.seat, goal_segment=seg,
+                                contact_frame=0, primitive=self.segments[seg].name)
+            self._goal_segment("standUp", self.seat, -1, text)     # to sit on another seat
             self.seat = None
         if kind == "carry":
             # carry(O, R) holds when the body enters R with O inside it: the held part is
