@@ -357,11 +357,16 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     checkpoint("planning")
 
     t0 = time.perf_counter()
+    # Offset blending of junctions and foot locking (the biomechanical work) move poses
+    # after the planner checked them, so they run only with the biomechanical checks on
+    # (opt-in) until the planner checks the post-processed motion.
+    realism = options.verification.biomechanics
     positions, root_yaw, _labels, spans = concatenate(
-        plan.segments, spread=round(JUNCTION_SPREAD * library.fps))
+        plan.segments, spread=round(JUNCTION_SPREAD * library.fps) if realism else 0)
     # Linear blends of joint positions shorten bones between unlike poses; restore them.
     positions = enforce_bone_lengths(positions, library.skeleton)
-    positions = lock_feet(positions, library.fps, library.skeleton, cell.floor_z)
+    if realism:
+        positions = lock_feet(positions, library.fps, library.skeleton, cell.floor_z)
     tracks, held = _object_tracks(cell, plan, spans, positions, library.overlap)
     timeline = []
     for step in plan.steps:
