@@ -138,7 +138,7 @@ def test_part_on_a_rack_shelf_at_waist_height():
     """The rack's tall side panels keep walks further off than a worker standing at the
     shelf needs: the worker steps in to reach, and steps out again before walking on."""
     motion = _verified("F grasp(O_waist)", "scenarios/cells/shelf_heights.yaml")
-    assert motion.sequence[0] == "grasp(O_waist)"
+    assert "grasp(O_waist)" in motion.sequence
 
 
 def test_motion_ending_seated_stays_seated():
@@ -169,5 +169,6 @@ def test_part_resting_on_a_table_is_carried_once_lifted():
     assert float(object_clearance(cell, "O1", cell.object("O1").position)) <= 0.0
     motion = _verified("F(carry(O1, R1))", "scenarios/cells/stations.yaml")
     r1 = cell.region("R1")
-    end = motion.objects["O1"][motion.timeline[0].end_frame - 1]
+    carry = next(s for s in motion.timeline if s.task == "carry(O1, R1)")
+    end = motion.objects["O1"][carry.end_frame - 1]
     assert np.all(end >= r1.lo) and np.all(end <= r1.hi)

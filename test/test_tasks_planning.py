@@ -79,7 +79,8 @@ def test_model_preconditions_and_effects():
     s5, _ = m.step(s4, _t("extract(P1, kit)"))
     assert s5.held == (0, 1)
     seat = m.step(s, _t("sit(P0)"))[0]
-    assert m.step(seat, _t("sit(P0)")) is None            # sit needs standing
+    again = m.step(seat, _t("sit(P0)"))                   # sitting again: stays seated
+    assert again is not None and again[0].posture == seat.posture
     stand, cost = m.step(seat, _t("standUp"))
     assert cost == m.durations["standUp"]
     assert stand.posture == 0 and m.step(s, _t("standUp"))[0].posture == 0

@@ -104,7 +104,10 @@ def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None =
         out = Outcome("verification", 0.0, exc.check, None, str(exc))
     except SpecError as exc:
         text = str(exc)
-        unsat = "unsatisfiable" in text or "admits no sequence" in text
+        # refused by the specification layer before any motion search: unsatisfiable, or
+        # satisfiable but physically impossible in the cell model (tasks/)
+        unsat = ("unsatisfiable" in text or "admits no sequence" in text
+                 or "no sequence of task steps is physically possible" in text)
         out = Outcome("spec", 0.0, "unsatisfiable" if unsat else "error", None, text)
     except CellError as exc:
         out = Outcome("cell", 0.0, "error", None, str(exc))

@@ -18,9 +18,9 @@ Preconditions and effects follow Table I of the paper and what the planner does:
 * ``assemble(R)`` (the shorthand ``leftHand(R) & rightHand(R)``) uses up the parts in
   hand; a later grasp takes a fresh one from its supply position (paper Fig. 3).
 * ``walk(R)`` needs the worker elsewhere (a walk on the spot is pointless).
-* ``sit(O)`` needs to be standing; ``standUp`` stands up (a no-op when standing);
-  ``kneel`` kneels. Tasks that walk or work away from a seat stand up first, as the
-  planner does.
+* ``sit(O)`` needs to be standing, or seated already (the worker stays seated);
+  ``standUp`` stands up (a no-op when standing); ``kneel`` kneels. Tasks that walk or
+  work away from a seat stand up first, as the planner does.
 
 The cost of a step estimates its time: the straight-line walking distance on the floor
 over :data:`WALK_SPEED`, plus the task's nominal duration (:data:`NOMINAL_DURATION`).
@@ -35,7 +35,8 @@ import numpy as np
 
 from ltl_human_motion.ltl.formula import Atom
 
-__all__ = ["DONE", "IMPLICIT_FETCH_PENALTY", "NOMINAL_DURATION", "WALK_SPEED", "CellModel", "CellState", "Limits"]
+__all__ = ["DONE", "IMPLICIT_FETCH_PENALTY", "NOMINAL_DURATION", "WALK_SPEED", "CellModel",
+           "CellState", "Limits"]
 
 #: Walking speed of the cost estimate, m/s. Slower than free walking (about 1.3 m/s,
 #: Bohannon 1997) because walks in a cell are short and start and stop.
@@ -249,6 +250,21 @@ class CellModel:
         return self._part_place(self.part_names[INSIDE - where], state)
 
     # ---------------------------------------------------------------- dynamics
+    def _fetch_place(self, p: int, state: CellState, held: Sequence[int]) -> int | None:
+        """Where part ``p`` is picked up when a step fetches it first (from its place, or
+        out of the container it lies in), or None when it cannot be: no free hand, a
+        part no longer mentioned."""
+        if self._free_hands(held) < self._width[p]:
+            return None
+        where = state.parts[p]
+        if where >= 0:
+            return where
+        if where <= INSIDE and where != DONE:
+            c = INSIDE - where                  # a fixed container: its place never changes
+            place = self._part_place(self.part_names[c], state)
+            return self.supply(c) if place is None else place
+        return None
+
     def _free_hands(self, held: Sequence[int]) -> int:
         return self.limits.hands - sum(self._width[p] for p in held)
 
@@ -269,10 +285,11 @@ class CellModel:
             if p is None:
                 return None
             if parts[p] != HELD:
-                if parts[p] < 0 or self._free_hands(held) < self._width[p]:
+                at = self._fetch_place(p, state, held)
+                if at is None:
                     return None
-                cost += self._walk[loc][parts[p]] + self.durations["grasp"]
-                loc = parts[p]
+                cost += self._walk[loc][at] + self.durations["grasp"]
+                loc = at
                 parts[p] = HELD
                 held.append(p)
             dest = self.target(task, state)
@@ -299,11 +316,11 @@ class CellModel:
             if p is None:
                 return None
             if parts[p] != HELD:                # the planner fetches it first
-                if parts[p] < 0 or self._free_hands(held) < self._width[p]:
+                at = self._fetch_place(p, state, held)
+                if at is None:
                     return None
-                cost += (self._walk[loc][parts[p]] + self.durations["grasp"]
-                         + IMPLICIT_FETCH_PENALTY)
-                loc = parts[p]
+                cost += self._walk[loc][at] + self.durations["grasp"] + IMPLICIT_FETCH_PENALTY
+                loc = at
                 held.append(p)
             held.remove(p)
             parts[p] = loc
@@ -328,8 +345,8 @@ class CellModel:
                 parts[p] = self.supply(p)       # used up; the next grasp takes a new one
             held = []
         elif kind == "sit":
-            if self.limits.posture and state.posture != STANDING:
-                return None
+            if self.limits.posture and state.posture == KNEELING:
+                return None                     # sitting again while seated: stay seated
             dest = self.target(task, state)
             if dest is not None:
                 cost += self._walk[loc][dest]
