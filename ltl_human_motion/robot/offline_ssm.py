@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ltl_human_motion.kernel.segments import min_signed_distance
 from ltl_human_motion.robot.coexistence import ControlDecision, ssm_command
 from ltl_human_motion.robot.kinematics import URModel, robot_capsules, ur_model
 from ltl_human_motion.robot.metrics import commissioning_metrics
@@ -93,11 +94,9 @@ def batched_separations(P: np.ndarray, p_radii: np.ndarray, Q: np.ndarray,
                          q_radii: np.ndarray) -> np.ndarray:
     """Minimum signed capsule separation per batch entry, shape (M,).
 
-    The same quantity as ``signed_distances(P[i], p_radii, Q[i], q_radii).min()`` for
-    every ``i`` (:mod:`.separation`, the live loop's kernel; the tests check they agree),
-    vectorized over the batch: closest points of two segments after Ericson, *Real-Time
-    Collision Detection* (2005), Sec. 5.1.9, with nearly parallel pairs taken from an end
-    point (as the live kernel does).
+    ``min_signed_distance(P[i], p_radii, Q[i], q_radii)`` for every ``i``, with the one
+    exact kernel the live loop uses (:mod:`ltl_human_motion.kernel.segments`), so offline
+    and live decisions see the same numbers.
 
     Parameters
     ----------
@@ -106,29 +105,8 @@ def batched_separations(P: np.ndarray, p_radii: np.ndarray, Q: np.ndarray,
     Q : ndarray, shape (M, L, 2, 3)
     q_radii : ndarray, shape (L,)
     """
-    p0, q0 = P[:, :, 0], Q[:, :, 0]                              # (M, K, 3), (M, L, 3)
-    d1, d2 = P[:, :, 1] - p0, Q[:, :, 1] - q0
-    K = P.shape[1]
-    L = Q.shape[1]
-    # One batched matrix product gives p0.q0, p0.d2, d1.q0 and d1.d2 for all pairs.
-    G = np.concatenate((p0, d1), axis=1) @ np.concatenate((q0, d2), axis=1).transpose(0, 2, 1)
-    p0d2, d1q0, b = G[:, :K, L:], G[:, K:, :L], G[:, K:, L:]
-    a = (d1 * d1).sum(-1)[:, :, None]                            # (M, K, 1)
-    e = (d2 * d2).sum(-1)[:, None, :]                            # (M, 1, L)
-    c = (d1 * p0).sum(-1)[:, :, None] - d1q0                     # d1 . (p0 - q0)
-    f = p0d2 - (d2 * q0).sum(-1)[:, None, :]                     # d2 . (p0 - q0)
-    a_s = np.maximum(a, 1e-30)
-    e_s = np.maximum(e, 1e-30)
-    denom = a * e - b * b
-    parallel = denom <= 1e-9 * a_s * e_s
-    s = np.where(parallel, 0.0, np.clip((b * f - c * e) / np.where(parallel, 1.0, denom),
-                                        0.0, 1.0))
-    t = np.clip((b * s + f) / e_s, 0.0, 1.0)
-    s = np.clip((b * t - c) / a_s, 0.0, 1.0)
-    gap = (p0[:, :, None] - q0[:, None]) + s[..., None] * d1[:, :, None] \
-        - t[..., None] * d2[:, None]
-    dist = np.sqrt((gap * gap).sum(-1))
-    return (dist - p_radii[None, :, None] - q_radii[None, None, :]).min(axis=(1, 2))
+    return np.array([min_signed_distance(P[i], p_radii, Q[i], q_radii)
+                     for i in range(len(P))], dtype=np.float64).reshape(len(P))
 
 
 def _violations(t: np.ndarray, dt: float, below: np.ndarray, sep: np.ndarray,
