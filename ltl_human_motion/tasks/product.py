@@ -7,14 +7,21 @@ search reaches them.
 
 A task sequence is a lasso ``prefix . cycle`` whose infinite word ``prefix cycle^w``
 the automaton accepts. As in the paper, the worker performs ``prefix`` and the cycle
-``repetitions`` times, so the acceptance condition is passed at least once; the cycle
-must be physically possible from where the prefix ends (and again for each repetition),
-the cell need not return to its state. The search (A*, or Dijkstra without a heuristic)
-pops prefixes in order of cost; a prefix ends in a goal when
+``repetitions`` times, and that finite motion must pass the acceptance condition at
+least once: prefix plus the first pass of the cycle (:meth:`ProductSearch.witnessed`),
+not only a later pass of the infinite word. The cycle must be physically possible from
+where the prefix ends (and again for each repetition); the cell need not return to its
+state. The search (A*, or Dijkstra without a heuristic) pops prefixes in order of cost;
+a prefix ends in a goal when
 
 * its last steps (up to :data:`TAIL_STEPS`) ran as an accepting cycle of the
-  automaton (S1 ends after ``grasp, assemble``), or its automaton state owes nothing
-  and repeating those steps forever is accepted (``F a`` ends right after the ``a``),
+  automaton (back to the same state with every mark), or its automaton state owes
+  nothing and repeating those steps forever is accepted (``F a`` ends right after the
+  ``a``), or those steps passed every mark into a state that can lie on an accepting
+  cycle, from which repeating them is accepted (S1 ends after ``grasp, assemble``:
+  the tableau's initial state still holds the first ``grasp``, so the pass ends in the
+  accepting component rather than where it began; a pass ending in ``sit`` with
+  ``X wait`` still owed ends outside it and is no goal),
   or, only when no such lasso exists, from its
   node a longer cycle of the automaton back to the same state with every mark is
   possible in the cell (a second Dijkstra over ``(state, cell, marks)``, only from
