@@ -7,14 +7,21 @@ search reaches them.
 
 A task sequence is a lasso ``prefix . cycle`` whose infinite word ``prefix cycle^w``
 the automaton accepts. As in the paper, the worker performs ``prefix`` and the cycle
-``repetitions`` times, so the acceptance condition is passed at least once; the cycle
-must be physically possible from where the prefix ends (and again for each repetition),
-the cell need not return to its state. The search (A*, or Dijkstra without a heuristic)
-pops prefixes in order of cost; a prefix ends in a goal when
+``repetitions`` times, and that finite motion must pass the acceptance condition at
+least once: prefix plus the first pass of the cycle (:meth:`ProductSearch.witnessed`),
+not only a later pass of the infinite word. The cycle must be physically possible from
+where the prefix ends (and again for each repetition); the cell need not return to its
+state. The search (A*, or Dijkstra without a heuristic) pops prefixes in order of cost;
+a prefix ends in a goal when
 
 * its last steps (up to :data:`TAIL_STEPS`) ran as an accepting cycle of the
-  automaton (S1 ends after ``grasp, assemble``), or its automaton state owes nothing
-  and repeating those steps forever is accepted (``F a`` ends right after the ``a``),
+  automaton (back to the same state with every mark), or its automaton state owes
+  nothing and repeating those steps forever is accepted (``F a`` ends right after the
+  ``a``), or those steps passed every mark into a state that can lie on an accepting
+  cycle, from which repeating them is accepted (S1 ends after ``grasp, assemble``:
+  the tableau's initial state still holds the first ``grasp``, so the pass ends in the
+  accepting component rather than where it began; a pass ending in ``sit`` with
+  ``X wait`` still owed ends outside it and is no goal),
   or, only when no such lasso exists, from its
   node a longer cycle of the automaton back to the same state with every mark is
   possible in the cell (a second Dijkstra over ``(state, cell, marks)``, only from
@@ -73,6 +80,7 @@ class ExplicitView:
         comp = _sccs(adj)
         good = accepting_components(adj, aut.num_sets)
         self._loop = [comp[q] in good for q in aut.states]
+        self._sink: dict[int, bool] = {}
 
     def _edges(self, q: int, i: int) -> list[tuple[int, list[int]]]:
         return [(e.dst, sorted(e.acc)) for e in self.aut.successors(q)
@@ -94,6 +102,15 @@ class ExplicitView:
     def pending(self, q: int) -> list[Formula]:
         """No formula view of an explicit automaton: no heuristic."""
         return []
+
+    def sink(self, q: int) -> bool:
+        """Whether ``q`` loops to itself on every letter with every mark (it accepts
+        every continuation: reaching it passes the acceptance condition)."""
+        hit = self._sink.get(q)
+        if hit is None:
+            hit = self._sink[q] = all((q, self.full) in self.successors(q, i)
+                                      for i in range(len(self.letters)))
+        return hit
 
 
 @dataclass(frozen=True)
@@ -585,34 +602,36 @@ class ProductSearch:
     def _tail_goal(self, q: int, s: CellState, tail: tuple[int, ...],
                    before: tuple[int, ...], marks: tuple[int, ...]) -> tuple[int, float]:
         """The shortest ``c`` such that the path's last ``c`` steps are its cycle, and the
-        cost of the further repetitions; ``(0, 0)`` if there is none. They are when
+        cost of the further repetitions; ``(0, 0)`` if there is none. The path is what the
+        worker performs for one pass, so that pass must pass the acceptance condition
+        itself (finite-trace semantics, :meth:`witnessed`). They are when
 
         * the path ran them as a cycle of the automaton: from ``q`` back to ``q`` with
           every mark (the acceptance condition was passed once), or
         * repeating them forever from ``q`` is accepted, and either ``q`` owes nothing
-          (:meth:`LetterTableau.settled`: ``F a`` ends right after the ``a``, with no
-          extra step) or they passed every mark and the cell allows going round them
-          again (S2's ``grasp, grasp, assemble``: a loop the worker could repeat).
+          (:meth:`done`: ``F a`` ends right after the ``a``, with no extra step) or they
+          passed every mark into a state ``q`` that may lie on an accepting cycle and the
+          cell allows going round them again (S1's ``grasp, assemble``: a loop the worker
+          could repeat; a pass ending in ``sit`` with ``X wait`` still owed is not one).
         """
-        settled = getattr(self.aut, "settled", None)
-        # an explicit automaton's marks on edges off its cycles are arbitrary: there the
-        # word's acceptance and the repeat decide
-        marked = settled is not None
-        settled = settled(q) if settled is not None else False
+        done = self.done(q)
         full = self.aut.full
+        # an explicit automaton's marks on edges off its cycles are arbitrary: there the
+        # accepting component and the word's acceptance decide
+        marked = hasattr(self.aut, "settled")
         acc = 0
         for c in range(1, len(tail) + 1):
             cyc = tail[-c:]
             acc |= marks[-c]
             if before[-c] == q and acc == full:
                 ok = True
-            elif settled or acc == full or not marked:
+            elif done or ((acc == full or not marked) and self.aut.loopable(q)):
                 key = (q, cyc)
                 ok = self._tails.get(key)
                 if ok is None:
                     ok = self._tails[key] = self._accepts_cycle(q, cyc)
                 # a loop the worker could go round again, unless nothing is owed
-                ok = ok and (settled or self._again(s, cyc, max(1, self.repetitions - 1))
+                ok = ok and (done or self._again(s, cyc, max(1, self.repetitions - 1))
                              is not None)
             else:
                 continue
@@ -620,6 +639,42 @@ class ProductSearch:
             if again is not None:
                 return c, again
         return 0, 0.0
+
+    def done(self, q: int) -> bool:
+        """Whether reaching ``q`` passes the acceptance condition for good: the tableau's
+        ``q`` owes nothing (:meth:`LetterTableau.settled`), or an explicit automaton's
+        ``q`` accepts every continuation (:meth:`ExplicitView.sink`)."""
+        settled = getattr(self.aut, "settled", None)
+        return settled(q) if settled is not None else self.aut.sink(q)
+
+    def witnessed(self, prefix: Sequence[int], cycle: Sequence[int]) -> bool:
+        """Whether the motion ``prefix`` plus one pass of ``cycle`` (task indices, from
+        the initial state) passes the acceptance condition itself, as the worker performs
+        it (finite-trace semantics): some run of the automaton on it reaches a state that
+        is :meth:`done`, or passes every mark during the pass of the cycle and ends in a
+        state that may lie on an accepting cycle (:meth:`LetterTableau.loopable`) from
+        which repeating the cycle forever is accepted. (A cycle rotated so that its
+        acceptance comes only in a later pass fails: the run ends owing a step.)"""
+        full = self.aut.full
+        q0 = self.aut.initial
+        if self.done(q0):
+            return True
+        # (state, marks passed during the cycle; see _tail_goal for explicit automata)
+        runs = {(q0, 0 if hasattr(self.aut, "settled") else full)}
+        n = len(prefix)
+        for k, i in enumerate((*prefix, *cycle)):
+            nxt: set[tuple[int, int]] = set()
+            for q, acc in runs:
+                for q2, m in self.aut.successors(q, i):
+                    if self.done(q2):
+                        return True
+                    nxt.add((q2, acc | m if k >= n else acc))
+            runs = nxt
+            if not runs:
+                return False
+        cyc = tuple(cycle)
+        return any(acc == full and self.aut.loopable(q) and self._accepts_cycle(q, cyc)
+                   for q, acc in runs)
 
     def _accepts_cycle(self, q0: int, cyc: tuple[int, ...]) -> bool:
         """Whether the automaton accepts ``cyc^omega`` from state ``q0``."""

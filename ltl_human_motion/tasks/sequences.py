@@ -175,13 +175,17 @@ class _Emitter:
 
     def _shrink(self, lasso: Lasso) -> tuple[tuple[int, ...], tuple[int, ...]]:
         """The same prefix with a cycle made of its own last steps, when the word still
-        satisfies the specification (then the extra cycle is not performed)."""
+        satisfies the specification and the motion performed (prefix and the passes of
+        the cycle) still passes the acceptance condition (then the extra cycle is not
+        performed)."""
         u = lasso.prefix
         if not lasso.searched_cycle:
             return lasso.prefix, lasso.cycle
         for c in range(1, min(len(u), SHRINK_STEPS) + 1):
             pre, cyc = u[:-c], u[-c:]
-            if self.search.cost_of(pre + cyc * self.reps) is not None and self._holds(pre, cyc):
+            executed = pre + cyc * self.reps
+            if self.search.cost_of(executed) is not None and self._holds(pre, cyc) \
+                    and self.search.witnessed(pre, cyc):
                 return pre, cyc
         return lasso.prefix, lasso.cycle
 
@@ -199,6 +203,11 @@ class _Emitter:
             raise VerificationError(f"internal error: lasso {key} of '{self.spec.text}' is "
                                     "accepted by the product but violates the "
                                     "specification", check="ltl")
+        if not self.search.witnessed(pre, cyc):
+            raise VerificationError(f"internal error: the motion of lasso {key} of "
+                                    f"'{self.spec.text}' (prefix and one pass of the cycle) "
+                                    "does not pass the acceptance condition",
+                                    check="ltl")
         self.seen.update({key, tuple(executed)})
         used = sorted(set(pre) | set(cyc))
         self.out.append(TaskSequence(tuple(self.tasks[i] for i in pre),
