@@ -37,7 +37,7 @@ def _consistent(tasks, two_handed=frozenset(), fixed=frozenset()) -> None:
             held.append(part)
         elif t.name == "grasp":
             raise AssertionError(f"{t}: the part is already in hand")
-        if t.name in ("release", "insert"):       # move keeps the part in hand
+        if t.name in ("release", "move", "insert"):   # move sets the part down in R
             assert part in held, f"{t}: the part is not held"
             held.remove(part)
         if t.name == "assemble":
@@ -68,16 +68,15 @@ def test_model_preconditions_and_effects():
     assert m.step(s2, _t("grasp(P2)")) is None            # a third part in two hands
     assert m.step(s2, _t("move(P2, R1)")) is None         # fetching it needs a free hand
     assert m.step(s1, _t("grasp(P3)")) is None            # two-handed: both hands
-    s3, _ = m.step(s2, _t("move(P0, R1)"))              # in R1, still in hand
-    assert s3.held == (0, 1) and s3.location == m.region_location("R1")
+    s3, _ = m.step(s2, _t("move(P0, R1)"))              # set down in R1, hand free
+    assert s3.held == (1,) and s3.location == m.region_location("R1")
     assert m.step(s3, _t("walk(R1)")) is None             # already there
     assert m.step(s3, _t("grasp(kit)")) is None           # a fixed object
-    placed, _ = m.step(s3, _t("release(P0)"))
-    assert placed.held == (1,) and placed.parts[0] == m.region_location("R1")
+    assert s3.parts[0] == m.region_location("R1")
     s4, _ = m.step(s3, _t("insert(P1, kit)"))
-    assert s4.held == (0,) and m.step(s4, _t("grasp(P1)")) is None   # inside the kit
+    assert s4.held == () and m.step(s4, _t("grasp(P1)")) is None     # inside the kit
     s5, _ = m.step(s4, _t("extract(P1, kit)"))
-    assert s5.held == (0, 1)
+    assert s5.held == (1,)
     seat = m.step(s, _t("sit(P0)"))[0]
     again = m.step(seat, _t("sit(P0)"))                   # sitting again: stays seated
     assert again is not None and again[0].posture == seat.posture

@@ -11,9 +11,8 @@ Preconditions and effects follow Table I of the paper and what the planner does:
   inside it.
 * ``move(O, R)``, ``insert(O, C)`` and ``carry(O, R)`` need O in hand, or fetch it
   first (walk to O and grasp it, which needs a free hand), as the planner does.
-  ``insert`` leaves O inside C with the hand free. ``move`` puts O into R and, as in
-  the planner, the hand still holds it there (a ``release`` lets go, and O stays in R);
-  ``carry`` keeps O in hand and puts the worker in R.
+  ``move`` sets O down in R and ``insert`` inside C, with the hand free (as the
+  planner does); ``carry`` keeps O in hand and puts the worker in R.
 * ``extract(O, C)`` needs O inside C and a free hand; O ends in hand.
 * ``assemble(R)`` (the shorthand ``leftHand(R) & rightHand(R)``) uses up the parts in
   hand; a later grasp takes a fresh one from its supply position (paper Fig. 3).
@@ -296,7 +295,10 @@ class CellModel:
             if dest is not None:
                 cost += self._walk[loc][dest]
                 loc = dest
-            if kind == "insert":
+            if kind == "move":                  # the planner sets the part down in R
+                held.remove(p)
+                parts[p] = dest if dest is not None else loc
+            elif kind == "insert":
                 held.remove(p)
                 c = self.part_index.get(args[1])
                 if c is None or c == p or state.parts[c] == DONE:
