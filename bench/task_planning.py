@@ -63,7 +63,7 @@ def consistent(tasks, fixed: frozenset[str] = frozenset({"kit"})) -> str | None:
             held.append(part)
         elif t.name == "grasp":
             return f"{t}: grasp of a part in hand"
-        if t.name in ("release", "insert"):       # move keeps the part in hand
+        if t.name in ("release", "move", "insert"):   # move sets the part down in R
             if part not in held:
                 return f"{t}: the part is not held"
             held.remove(part)

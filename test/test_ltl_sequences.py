@@ -174,7 +174,8 @@ def test_cli_prints_sequences_json_and_automata(capsys, paper_cell):
     assert "1: grasp(O1) -> assemble(R1)\n" in out
     assert main(["tasks", "S2", "--cell", cell, "-n", "3", "--json", "--mode", "coverage"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert len(data["sequences"]) == 3 and "assemble(R1)" in data["sequences"][0]["tasks"]
+    # a covering set of at most n (S2's product is covered by two lassos)
+    assert 1 <= len(data["sequences"]) <= 3 and "assemble(R1)" in data["sequences"][0]["tasks"]
     assert main(["tasks", "S1", "--cell", cell, "--automaton", "hoa", "--backend",
                  "builtin"]) == 0
     assert capsys.readouterr().out.startswith("HOA: v1")

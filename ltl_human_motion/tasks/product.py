@@ -52,7 +52,7 @@ __all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "seede
 TAIL_STEPS = 6
 
 #: Tasks that leave a hand free (the part is put down, placed or used up).
-_FREEING = frozenset({"release", "insert", "assemble"})
+_FREEING = frozenset({"release", "move", "insert", "assemble"})
 
 #: Tasks that take a part somewhere in hand (fetching it first if needed).
 _CARRYING = frozenset({"move", "insert", "carry"})
@@ -288,7 +288,7 @@ class ProductSearch:
             if grasp_part is not None and grasp_part not in s.held:
                 pickups.add(grasp_part)
             if carry_part is not None and parts[carry_part] >= 0:
-                pickups.add(carry_part)       # fetched into a hand that move keeps busy
+                pickups.add(carry_part)       # fetched into a hand first
         hands = self.model.limits.hands
         carry = sum(carried) / hands
         total += max(far, self._tree(here, places), carry)

@@ -101,17 +101,23 @@ def has_geometry(cell: object) -> bool:
 
 
 def task_steps(spec: Specification, model: CellModel) -> tuple[list[Atom], list[frozenset[str]]]:
-    """Candidate steps: the specification's, plus ``grasp``/``release`` of every part a
-    step handles (a worker picks parts up and puts them down between the tasks the
-    specification names), with their letters."""
+    """Candidate steps: the specification's, plus ``grasp`` of every part a step handles,
+    and ``release`` of it when the hands cannot hold them all (a worker picks parts up
+    and puts them down between the tasks the specification names), with their letters."""
     tasks = list(spec.tasks)
-    for t in spec.tasks:
-        if t.name in _PART_TASKS and len(t.args) > _PART_TASKS[t.name] \
-                and t.args[0] in model.part_index:
-            for helper in ("grasp", "release"):
-                a = Atom(helper, (t.args[0],))
-                if a not in tasks:
-                    tasks.append(a)
+    handled = [t.args[0] for t in spec.tasks if t.name in _PART_TASKS
+               and len(t.args) > _PART_TASKS[t.name] and t.args[0] in model.part_index]
+    handled = list(dict.fromkeys(handled))
+    # A release the specification does not name is only a candidate when the hands cannot
+    # hold every part it handles at once: otherwise a search may put a part down to have
+    # it nearer next time (S2 over several cycles put O2 down beside O1, never assembling it).
+    width = sum(2 if model.two_handed[model.part_index[p]] else 1 for p in handled)
+    helpers = ("grasp", "release") if width > model.limits.hands else ("grasp",)
+    for part in handled:
+        for helper in helpers:
+            a = Atom(helper, (part,))
+            if a not in tasks:
+                tasks.append(a)
     letters = [*spec.letters, *(letter_of(t, spec.vocabulary) for t in tasks[len(spec.tasks):])]
     return tasks, letters
 
