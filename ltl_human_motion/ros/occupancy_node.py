@@ -35,8 +35,8 @@ Parameters: ``human_id`` ("1"), ``world_frame`` ("world"), ``rate`` (100.0 Hz),
 ``prediction_horizon`` (0.0 s = off), ``prediction_step`` (0.1 s), ``marker_rate``
 (10.0 Hz; 0 = off), ``store_dir`` (""), ``catalog_topic`` ("/motion_catalog"),
 ``task_state_topic`` ("task_state"), ``markers_topic`` ("/occupancy_markers"),
-``stream_priority`` (0 by default; e.g. 10: ``SCHED_FIFO`` priority of the stream thread where the process
-may have it; 0 = normal scheduling).
+``stream_priority`` (0 by default = normal scheduling; e.g. 10: ``SCHED_FIFO`` priority of
+the stream thread where the process may have it).
 """
 
 from __future__ import annotations
