@@ -1,4 +1,4 @@
-"""Start a whole node set in one process (a MultiThreadedExecutor), optionally recording.
+"""Start a whole node set in one process (one multi-threaded executor), optionally recording.
 
 ``Bringup`` reads a bringup file (:mod:`~ltl_human_motion.ros.bringup_config`), hands it
 to its rclpy context as ``--params-file`` (as ``ros2 launch`` does for each node), and

@@ -12,11 +12,12 @@ import rclpy
 from rclpy.executors import (
     Executor,
     ExternalShutdownException,
-    MultiThreadedExecutor,
     SingleThreadedExecutor,
 )
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+from ltl_human_motion.ros.executors import PoolExecutor, spin_once_tolerant
 
 #: /tf as tf2_ros.TransformBroadcaster publishes it.
 TF_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST,
@@ -76,15 +77,16 @@ def _named_cell(name: str) -> Any:
 def spin_nodes(nodes: Sequence[Node], num_threads: int = DEFAULT_EXECUTOR_THREADS,
                context: Any = None, until: Callable[[], bool] | None = None,
                timeout: float | None = None) -> None:
-    """Spin ``nodes`` in one MultiThreadedExecutor until Ctrl-C, shutdown, ``until()`` or
-    ``timeout`` seconds; always removes the nodes from the executor and shuts it down."""
-    executor = MultiThreadedExecutor(num_threads=num_threads, context=context)
+    """Spin ``nodes`` in one :class:`~ltl_human_motion.ros.executors.PoolExecutor` until
+    Ctrl-C, shutdown, ``until()`` or ``timeout`` seconds; always removes the nodes from the
+    executor and shuts it down."""
+    executor = PoolExecutor(num_threads=num_threads, context=context)
     for node in nodes:
         executor.add_node(node)
     stop_at = None if timeout is None else time.monotonic() + timeout
     try:
         while (context or rclpy.get_default_context()).ok():
-            executor.spin_once(timeout_sec=0.1)
+            spin_once_tolerant(executor, 0.1)
             if until is not None and until():
                 break
             if stop_at is not None and time.monotonic() >= stop_at:
@@ -118,19 +120,22 @@ def shutdown_executor(executor: Executor, timeout: float = 5.0) -> None:
 class SpinThread:
     """Spin nodes on a background thread (for in-process use).
 
-    ``num_threads`` > 1 uses a MultiThreadedExecutor; 1 a SingleThreadedExecutor, which
-    runs callbacks inline (best for many short callbacks, such as a recorder's).
+    ``num_threads`` > 1 uses a :class:`~ltl_human_motion.ros.executors.PoolExecutor`; 1 a
+    SingleThreadedExecutor, which runs callbacks inline (best for many short callbacks,
+    such as a recorder's). An entity destroyed while the executor waits does not end the
+    thread (see :func:`~ltl_human_motion.ros.executors.spin_once_tolerant`).
     """
 
     def __init__(self, nodes: Sequence[Node], context: Any,
                  num_threads: int = DEFAULT_EXECUTOR_THREADS) -> None:
         self.context = context
         self.executor: Executor = (
-            MultiThreadedExecutor(num_threads=num_threads, context=context) if num_threads > 1
+            PoolExecutor(num_threads=num_threads, context=context) if num_threads > 1
             else SingleThreadedExecutor(context=context))
         for node in nodes:
             self.executor.add_node(node)
         self._stop = threading.Event()
+        self.waits_interrupted = 0
         self._thread = threading.Thread(target=self._spin, name="ltl-hm-executor", daemon=True)
         self._thread.start()
 
@@ -140,7 +145,8 @@ class SpinThread:
     def _spin(self) -> None:
         try:
             while not self._stop.is_set() and self.context.ok():
-                self.executor.spin_once(timeout_sec=0.05)
+                if not spin_once_tolerant(self.executor, 0.05):
+                    self.waits_interrupted += 1
         except ExternalShutdownException:
             pass
 

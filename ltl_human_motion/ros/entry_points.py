@@ -3,7 +3,7 @@ CLI's, :func:`ltl_human_motion.cli.bringup.ros_entry_point`: the ROS layer impor
 
 Each node entry point follows ros2/examples: ``rclpy.init(args=args)`` (so ``--ros-args
 -p name:=value --params-file f.yaml -r __ns:=/human_2`` work), spin in a
-MultiThreadedExecutor, shut down cleanly on Ctrl-C, and return the exit code (2 for
+PoolExecutor (ros/executors.py), shut down cleanly on Ctrl-C, and return the exit code (2 for
 invalid parameters, with the message on stderr).
 """
 

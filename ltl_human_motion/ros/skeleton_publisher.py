@@ -41,6 +41,7 @@ motion), ``loop`` (false), ``playback_rate`` (1.0), ``marker_lifetime`` (1.0 s),
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 import numpy as np
@@ -157,8 +158,10 @@ class SkeletonPublisher(Node):
         self._timer_group = MutuallyExclusiveCallbackGroup()
         self._timer = self.create_timer(1.0 / self.param("publish_rate"), self._tick,
                                         callback_group=self._timer_group)
-        self._scene_timer = self.create_timer(self.param("scene_period"), self._publish_scene,
-                                              callback_group=self._timer_group)
+        # The cell goes out from the tick (not a timer of its own in the same group, which a
+        # tick that is always due, on a loaded machine, would starve).
+        self._scene_period = float(self.param("scene_period"))
+        self._scene_due = 0.0
         self.body = BodyInterface(self, self.human_id, self.world_frame,
                                   self.param("rep155_link_frames")) \
             if self.param("rep155") else None
@@ -281,6 +284,8 @@ class SkeletonPublisher(Node):
             self._publish_markers(frame, stamp)
             self.frames_published += 1
         self._state_pub.publish(self._task_state(frame, stamp))
+        if time.monotonic() >= self._scene_due:
+            self._publish_scene()
 
     def _task_state(self, frame: Frame | None, stamp: Any) -> TaskState:
         msg = TaskState()
@@ -342,6 +347,7 @@ class SkeletonPublisher(Node):
             markers=cv.delete_markers(keys, self.world_frame, stamp)))
 
     def _publish_scene(self) -> None:
+        self._scene_due = time.monotonic() + self._scene_period
         if self.cell is None:
             return
         f = cv.MarkerFactory(self.world_frame, self.get_clock().now().to_msg())
