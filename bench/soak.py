@@ -14,7 +14,8 @@ process, a plain rclpy client over DDS, meanwhile:
 
 It reports answered/sent, RSS over time (and its change after the first minute), the
 slider during each fault (from ``/safety_status``: the highest slider after the fail-safe
-took hold) and the time from the first faulty message to the minimum slider. Prints a
+took hold) and the time to the minimum slider: from the first faulty message, and for a
+silent stream from the moment its data is stale (``stale_after`` of the config). Prints a
 summary and writes ``bench/results/soak.json``. Not a test: ``python bench/soak.py
 --minutes 3`` after ``. scripts/env.sh``. Takes the machine-wide lock of port 30004.
 """
@@ -135,8 +136,21 @@ class Soak:
         self.session.close()
 
 
-def _fault_report(soak: Soak, kind: str, t0: float, t1: float, min_slider: float
-                  ) -> dict[str, Any]:
+def _stale_after() -> float:
+    """The coexistence node's ``stale_after`` (s) in CONFIG."""
+    import yaml
+
+    params = yaml.safe_load(CONFIG.read_text())["coexistence_node"]["ros__parameters"]
+    return float(params["stale_after"])
+
+
+def _fault_report(soak: Soak, kind: str, t0: float, t1: float, min_slider: float,
+                  stale_after: float) -> dict[str, Any]:
+    """The slider during one fault. A silent stream is a fault from ``stale_after`` s after
+    its last sample (until then its data is fresh, and the arm may use it), so the time to
+    fail-safe of "stale" counts from then; ``time_from_first_fault_s`` counts from the
+    first faulty (or missing) message for every kind."""
+    onset = t0 + (stale_after if kind == "stale" else 0.0)
     seen = soak.statuses_since(t0 - 0.5, t1)
     before = [s for s in seen if s[0] < t0]
     during = [s for s in seen if s[0] >= t0]
@@ -147,10 +161,12 @@ def _fault_report(soak: Soak, kind: str, t0: float, t1: float, min_slider: float
         if s[1] > min_slider + 1e-9:
             break
         held = s[0]
-    reached = None if held is None else held - t0
+    reached = None if held is None else held - onset
     return {"fault": kind, "slider_before": before[-1][1] if before else None,
             "mode_before": before[-1][2] if before else None,
-            "time_to_fail_safe_s": reached, "statuses": len(during),
+            "time_to_fail_safe_s": reached,
+            "time_from_first_fault_s": None if held is None else held - t0,
+            "statuses": len(during),
             "slider_max_during": max((s[1] for s in during), default=None),
             "modes": sorted({s[2] for s in during}),
             "within_bound": reached is not None and reached <= FAIL_SAFE_BOUND}
@@ -169,6 +185,7 @@ def main(argv: list[str] | None = None) -> int:
     from ltl_human_motion.ros.coexistence_demo import rtde_port_lock, start_sim_when_free
 
     min_slider = SSMParameters().min_slider
+    stale_after = _stale_after()
     duration = 60.0 * args.minutes
     tmp = Path(tempfile.mkdtemp(prefix="lhm-soak-"))
     env = {**os.environ, "ROS_HOME": str(tmp)}
@@ -227,7 +244,7 @@ def main(argv: list[str] | None = None) -> int:
                 elif fault_end is not None and now >= fault_end:
                     soak.mode = "good"
                     faults.append(_fault_report(soak, fault_kind, fault_start, fault_end,
-                                                min_slider))
+                                                min_slider, stale_after))
                     fault_end = None
                     next_fault = now + args.fault_period
                 if now >= next_sim and fault_end is None:
@@ -274,7 +291,7 @@ def main(argv: list[str] | None = None) -> int:
         "lost_to_bringup_crashes": soak.lost, "bringup_crashes": crashes,
         "faults": faults, "sim_restarts": sim_restarts,
         "faults_within_bound": sum(f["within_bound"] for f in faults),
-        "fail_safe_bound_s": FAIL_SAFE_BOUND,
+        "fail_safe_bound_s": FAIL_SAFE_BOUND, "stale_after_s": stale_after,
         "sigint_exit_s": shutdown_s, "bringup_exit_code": bringup.returncode,
     }
     args.out.parent.mkdir(parents=True, exist_ok=True)

@@ -1,7 +1,7 @@
 """``ltl-human-motion bringup config/bringup.yaml``: the ROS 2 node set in one process.
 
 Starts the nodes a bringup file lists (the same set and parameters as
-``ros2 launch ltl_human_motion bringup.launch.py``) in one MultiThreadedExecutor, until
+``ros2 launch ltl_human_motion bringup.launch.py``) in one executor, until
 Ctrl-C or ``--duration`` seconds; ``--record out/run.mcap`` writes their topics to an
 MCAP file (rosbag2 layout) that is moved into place when the run ends.
 """
@@ -13,6 +13,7 @@ import json
 import signal
 import sys
 from pathlib import Path
+from typing import Any
 
 NAME = "bringup"
 HELP = "start the ROS 2 nodes of a bringup file in one process (optionally recording MCAP)"
@@ -30,12 +31,52 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="override the store_dir parameter (folder of motion npz files)")
 
 
+class _StopSignals:
+    """Ctrl-C and SIGTERM (e.g. from a process manager) while the node set starts and runs.
+
+    A signal sets :attr:`requested` and stops a running node set through its stop event,
+    not by raising KeyboardInterrupt: trimesh imports its optional parts under ``except
+    BaseException`` and so swallows a KeyboardInterrupt raised meanwhile (seen: Ctrl-C
+    during the bringup's start-up, and the process ran on). During start-up the signal
+    also raises KeyboardInterrupt to cut a long start short; if that one is swallowed,
+    :attr:`requested` still ends the run once start-up returns. A second Ctrl-C
+    interrupts at once.
+    """
+
+    def __init__(self) -> None:
+        self.requested = False
+        self.node_set: Any = None
+        self._previous = {s: signal.signal(s, self._on_signal)
+                          for s in (signal.SIGINT, signal.SIGTERM)}
+
+    def _on_signal(self, signum: int, frame: Any) -> None:
+        if self.requested and signum == signal.SIGINT:
+            signal.default_int_handler(signum, frame)
+        self.requested = True
+        if self.node_set is not None:
+            self.node_set.request_stop()
+        else:
+            raise KeyboardInterrupt
+
+    def restore(self) -> None:
+        for s, handler in self._previous.items():
+            signal.signal(s, handler)
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the node set; prints a JSON summary of what was recorded."""
     if args.duration is not None and not args.duration > 0:
         print(f"ltl-human-motion bringup: error: --duration must be positive, got "
               f"{args.duration}", file=sys.stderr)
         return 2
+    stop = _StopSignals()
+    try:
+        return _run(args, stop)
+    finally:
+        stop.restore()
+
+
+def _run(args: argparse.Namespace, stop: _StopSignals) -> int:
     try:
         from ltl_human_motion.ros.bringup import Bringup
     except ImportError as exc:
@@ -46,17 +87,17 @@ def run(args: argparse.Namespace) -> int:
             f"and source scripts/env.sh") from None
     overrides = {"store_dir": str(args.store_dir)} if args.store_dir is not None else None
     node_set = Bringup(args.config, record=args.record, overrides=overrides)
+    stop.node_set = node_set
+    if stop.requested:                       # a signal during start-up that was swallowed
+        node_set.shutdown()
+        raise KeyboardInterrupt
     names = ", ".join(n.get_fully_qualified_name() for n in node_set.nodes)
     print(f"bringup: {names}" + (f"; recording to {args.record}" if args.record else ""),
           file=sys.stderr)
-    # SIGTERM (e.g. from a process manager) ends the run like Ctrl-C: the recording is
-    # finished and moved into place.
-    previous = signal.signal(signal.SIGTERM, node_set.request_stop)
     try:
         node_set.spin(args.duration)
     finally:
-        signal.signal(signal.SIGTERM, previous)
-        path = node_set.shutdown()
+        path = node_set.shutdown()             # the recording is moved into place
     if path is not None:
         summary = {"mcap": str(path), "topics": node_set.recorder.summary()}
         print(json.dumps(summary, indent=2))
