@@ -85,6 +85,9 @@ def _run(args: argparse.Namespace, stop: _StopSignals) -> int:
         raise MissingDependencyError(
             f"bringup needs rclpy and the built interfaces ({exc}); run scripts/setup.sh "
             f"and source scripts/env.sh") from None
+    from ltl_human_motion.ros.entry_points import exit_without_final_collection
+
+    exit_without_final_collection()
     overrides = {"store_dir": str(args.store_dir)} if args.store_dir is not None else None
     node_set = Bringup(args.config, record=args.record, overrides=overrides)
     stop.node_set = node_set

@@ -36,6 +36,7 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
+from ltl_human_motion.deadline import checkpoint
 from ltl_human_motion.motion.types import MotionPrimitive
 
 __all__ = [
@@ -217,6 +218,7 @@ def build_transitions(end_windows: np.ndarray, start_windows: np.ndarray, delta:
     limit = (delta / scale) ** 2 * k          # d < delta  <=>  sse < limit
     B = _prepare(start_windows, dtype)
     for r0 in range(0, N, block):
+        checkpoint("library")               # a cancelled request stops a long build here
         A = _prepare(end_windows[r0:r0 + block], dtype)
         for c0 in range(0, M, col_block):
             sse = _sse_tile(A, tuple(v[c0:c0 + col_block] for v in B))

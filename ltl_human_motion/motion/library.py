@@ -38,6 +38,7 @@ import numpy as np
 from scipy.sparse import csr_matrix
 
 from ltl_human_motion.atomic import atomic_write_with
+from ltl_human_motion.deadline import checkpoint
 from ltl_human_motion.errors import MotionFormatError
 from ltl_human_motion.motion import gait as _gait
 from ltl_human_motion.motion.automaton import (
@@ -346,6 +347,7 @@ def build_library(stature: float = DEFAULT_STATURE, source=None,
     prims: list[MotionPrimitive] = []
     bar = _progress(len(files), "loading clips", progress)
     for f in files:
+        checkpoint("library")
         motion = load_motion(f, skeleton)
         looping = f in loop_names
         if not looping and f.suffix.lower() in (".txt", ".json"):
@@ -371,9 +373,11 @@ def build_library(stature: float = DEFAULT_STATURE, source=None,
     t_prims = time.perf_counter() - t0
     dropped: list[str] = []
     generated = len(prims)
+    checkpoint("library")
     if quality:
         from ltl_human_motion.motion.quality import check_primitives
         pre = check_primitives(prims, skeleton, kind="gait candidates")
+        checkpoint("library")
         bad = set(pre["failed"])
         dropped = sorted(bad)
         prims = [mp for mp in prims if mp.name not in bad]

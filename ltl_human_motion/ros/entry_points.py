@@ -9,6 +9,7 @@ invalid parameters, with the message on stderr).
 
 from __future__ import annotations
 
+import atexit
 import gc
 import sys
 from collections.abc import Callable
@@ -21,8 +22,26 @@ from ltl_human_motion.ros.common import DEFAULT_EXECUTOR_THREADS, spin_nodes
 from ltl_human_motion.ros.middleware import apply_middleware_defaults
 
 
+def exit_without_final_collection() -> None:
+    """At interpreter exit, skip the collector's final pass over every object.
+
+    That pass (``gc_collect_main`` during finalization) took 1-2 s for a synthesis node
+    with its motion library on a loaded machine: most of its 2 s budget after SIGINT
+    (issue 17). Everything that must outlive the process is written before (atomically);
+    the objects are still freed as the modules are torn down. Registered once.
+    """
+    global _FREEZE_REGISTERED
+    if not _FREEZE_REGISTERED:
+        atexit.register(gc.freeze)
+        _FREEZE_REGISTERED = True
+
+
+_FREEZE_REGISTERED = False
+
+
 def _run_node(factory: Callable[[], Node], args: list[str] | None,
               num_threads: int = DEFAULT_EXECUTOR_THREADS) -> int:
+    exit_without_final_collection()
     apply_middleware_defaults()
     rclpy.init(args=args)
     node: Node | None = None
