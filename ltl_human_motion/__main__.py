@@ -2,6 +2,10 @@
 
 import sys
 
-from ltl_human_motion.cli import main
+from ltl_human_motion.cli import interrupts
+
+interrupts.install()            # before the imports below: a Ctrl-C during them counts
+
+from ltl_human_motion.cli import main  # noqa: E402
 
 sys.exit(main())

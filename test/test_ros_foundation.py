@@ -113,7 +113,8 @@ def test_service_of_this_package_between_processes(session: ClientSession) -> No
     code = ("import sys; from ltl_human_motion.ros.entry_points import skeleton_publisher; "
             "sys.exit(skeleton_publisher())")
     proc = subprocess.Popen(
-        [sys.executable, "-c", code, "--ros-args", "-r", "__ns:=/foundation_human",
+        [sys.executable, "-X", "faulthandler", "-c", code, "--ros-args", "-r",
+         "__ns:=/foundation_human",
          "-p", "human_id:=9", "-p", "cell:=''"],
         env=_env(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
@@ -127,6 +128,11 @@ def test_service_of_this_package_between_processes(session: ClientSession) -> No
         assert proc.poll() is None
     finally:
         proc.send_signal(2)            # Ctrl-C: the entry point shuts down cleanly
-        out, _ = proc.communicate(timeout=15)
+        try:
+            out, _ = proc.communicate(timeout=15)
+        except subprocess.TimeoutExpired:
+            proc.send_signal(6)        # SIGABRT: faulthandler prints every thread's stack
+            out, _ = proc.communicate(timeout=15)
+            pytest.fail(f"the node ran on 15 s after Ctrl-C:\n{out[-6000:]}")
     assert proc.returncode == 0, out[-2000:]
     assert "Traceback" not in out

@@ -159,8 +159,10 @@ def test_cli_bringup_stops_on_ctrl_c_whenever_it_comes(tmp_path: Path) -> None:
             try:
                 _, err = proc.communicate(timeout=SIGINT_EXIT_BOUND)
             except subprocess.TimeoutExpired:
+                proc.kill()
+                _, err = proc.communicate()
                 pytest.fail(f"the bringup ran on {SIGINT_EXIT_BOUND:g} s after Ctrl-C at "
-                            f"{delay if delay is not None else 'run time'}")
+                            f"{delay if delay is not None else 'run time'}: {err[-3000:]}")
             outcomes.append((delay, proc.returncode, round(time.monotonic() - sent, 2)))
             assert proc.returncode in (0, 130, -signal.SIGINT), (delay, err[-2000:])
             if delay is None:

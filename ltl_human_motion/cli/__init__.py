@@ -15,6 +15,7 @@ import sys
 from collections.abc import Sequence
 
 from ltl_human_motion import __version__
+from ltl_human_motion.cli import interrupts
 from ltl_human_motion.errors import LtlHumanMotionError
 
 SUBCOMMAND_MODULES: tuple[str, ...] = (
@@ -48,13 +49,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``ltl-human-motion``; returns the process exit code."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if not hasattr(args, "_run"):
-        parser.print_help()
-        return 1
+    interrupts.install()
     try:
-        return int(args._run(args) or 0)
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        interrupts.check()                     # a Ctrl-C swallowed by an import
+        if not hasattr(args, "_run"):
+            parser.print_help()
+            return 1
+        code = int(args._run(args) or 0)
+        interrupts.check()
+        return code
     except LtlHumanMotionError as exc:
         print(f"ltl-human-motion {args.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -15,6 +15,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ltl_human_motion.cli import interrupts
+
 NAME = "bringup"
 HELP = "start the ROS 2 nodes of a bringup file in one process (optionally recording MCAP)"
 
@@ -44,7 +46,7 @@ class _StopSignals:
     """
 
     def __init__(self) -> None:
-        self.requested = False
+        self.requested = interrupts.interrupted()
         self.node_set: Any = None
         self._previous = {s: signal.signal(s, self._on_signal)
                           for s in (signal.SIGINT, signal.SIGTERM)}
