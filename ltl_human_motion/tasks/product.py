@@ -57,6 +57,9 @@ _FREEING = frozenset({"release", "move", "insert", "assemble"})
 #: Tasks that take a part somewhere in hand (fetching it first if needed).
 _CARRYING = frozenset({"move", "insert", "carry"})
 
+#: Of those, the tasks that set the part down there (the hand is free after them).
+_SETTING_DOWN = frozenset({"move", "insert"})
+
 
 class SearchBudgetError(RuntimeError):
     """The product search expanded more nodes than its budget allowed."""
@@ -212,8 +215,30 @@ class ProductSearch:
         self._rules: dict[Formula, tuple | None] = {}
         self._trees: dict[tuple[int, frozenset[int]], float] = {}
         self._tgt = [self._static_target(t) for t in self.tasks]
+        # the trip bound holds when every candidate step that frees a hand ends at a fixed
+        # place (move, insert into a fixed container, assemble) and none is a release
+        freeing = [self._tgt[i] for i, k in enumerate(self._kind) if k in _FREEING]
+        self._dests = sorted({v for _k, v in freeing}) if freeing and all(
+            k == 0 and v is not None for k, v in freeing) and "release" not in self._kind \
+            else []
+        n_pts = len(self._walk)
+        self._near_place = [min((self._walk[j][x] for j in range(n_pts) if j != x),
+                                default=0.0) for x in range(n_pts)]
+        self._dest_dist = [min((self._walk[d][x] for d in self._dests), default=0.0)
+                           for x in range(n_pts)]
         self._forget = hasattr(automaton, "mentioned")
         self._tails: dict[tuple[int, tuple[int, ...]], bool] = {}
+
+    def configure(self, weight: float, budget: int,
+                  cost_noise: Callable[[tuple, int], float] | None = None) -> ProductSearch:
+        """The same search (automaton, memoized steps, heuristic values and cycles, which
+        depend on neither) with another weight, budget and cost noise; ``expanded``
+        restarts at 0. A weight ladder reuses one search instead of translating again."""
+        self.weight = weight
+        self.budget = budget
+        self.noise = cost_noise
+        self.expanded = 0
+        return self
 
     def _duration(self, task: Atom) -> float:
         kind, args = self.model.kind(task)
@@ -246,6 +271,8 @@ class ProductSearch:
           is at least as long), or the walk to the farthest other one;
         * at least the distance each part still to be moved, inserted or carried travels
           in hand, over the number of hands (at most that many parts ride along at once);
+        * the walk of the trips that fetch the parts still to be moved or inserted and set
+          them down (:meth:`_trips`), when no step but those frees a hand;
         * the grasp that fetches such a part when it is not in hand;
         * the hand-freeing steps that two hands force: parts in hand plus parts still to
           be picked up (grasped, or fetched by a move that keeps them in hand), minus the
@@ -268,7 +295,8 @@ class ProductSearch:
         pickups: set[int] = set()
         parts = s.parts
         grasping = {item[3] for item in needs}
-        for opts, carry_part, carry_dest, grasp_part in needs:
+        delivered: list[int] = []
+        for opts, carry_part, carry_dest, grasp_part, sets_down in needs:
             if carry_part is not None:
                 where = parts[carry_part]
                 if where >= 0:
@@ -276,6 +304,8 @@ class ProductSearch:
                         total += self._grasp_dur
                     places.add(where)
                     carried.append(walk[where][carry_dest])
+                    if sets_down:
+                        delivered.append(carry_part)
                 elif where == HELD:
                     carried.append(walk[here][carry_dest])
             targets = {self._target(i, s) for i in opts}
@@ -291,7 +321,8 @@ class ProductSearch:
                 pickups.add(carry_part)       # fetched into a hand first
         hands = self.model.limits.hands
         carry = sum(carried) / hands
-        total += max(far, self._tree(here, places), carry)
+        trips = self._trips(s, delivered) if self._dests and delivered else 0.0
+        total += max(far, self._tree(here, places), carry, trips)
         to_grasp = sum(self.model._width[p] for p in pickups)
         if self._free_dur is not None:
             held = sum(self.model._width[p] for p in s.held)
@@ -299,6 +330,39 @@ class ProductSearch:
                 * self._free_dur
         self._h[key] = total
         return total
+
+    def _trips(self, s: CellState, delivered: list[int]) -> float:
+        """A lower bound (s) on the walk that picks up the parts ``delivered`` (each at its
+        place, not in hand) and sets them down by a ``move`` or ``insert``, with the
+        candidate steps' only hand-freeing steps ending at :attr:`_dests` (no release).
+
+        Between two hand-freeing steps at most ``hands`` parts are picked up, so the
+        pickups fall into at least ``T = ceil(m / hands)`` groups. Each pickup is reached
+        by its own stretch of walk: the first of a group from a freeing place (the first
+        group: from the worker's place or a freeing place), any other from the nearest
+        other place (0 when another part lies there); the last pickup of each group walks
+        on to a freeing place. The stretches are disjoint, so their least sum, with the
+        roles given to the parts that make it least, is a lower bound."""
+        parts = s.parts
+        here = s.location
+        walk = self._walk
+        near, to_dest = self._near_place, self._dest_dist
+        hands = self.model.limits.hands
+        base = 0.0
+        firsts: list[float] = []
+        lasts: list[float] = []
+        start = float("inf")
+        for p in delivered:
+            x = parts[p]
+            nb = 0.0 if parts.count(x) > 1 else near[x]
+            base += nb
+            firsts.append(to_dest[x] - nb)
+            lasts.append(to_dest[x])
+            start = min(start, min(walk[here][x], to_dest[x]) - nb)
+        groups = -(-len(delivered) // hands)
+        firsts.sort()
+        lasts.sort()
+        return max(0.0, base + start + sum(firsts[:groups - 1]) + sum(lasts[:groups]))
 
     def _target(self, i: int, s: CellState) -> int | None:
         """Where task ``i`` ends in ``s`` (fast path of :meth:`CellModel.target`)."""
@@ -390,8 +454,10 @@ class ProductSearch:
         heads = {self.tasks[i].args[0] for i in need} if kinds == {"grasp"} else ()
         if len(heads) == 1:
             grasp_part = self.model.part_index.get(next(iter(heads)))
+        sets_down = carry_part is not None and self._kind[need[0]] in _SETTING_DOWN
         hit = self._fneeds[f] = (need, min(self._min_dur[i] for i in need),
-                                 kinds <= _FREEING, (need, carry_part, carry_dest, grasp_part))
+                                 kinds <= _FREEING,
+                                 (need, carry_part, carry_dest, grasp_part, sets_down))
         return hit
 
     def _static_target(self, task: Atom) -> tuple[int, int | None]:
