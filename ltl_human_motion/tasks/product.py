@@ -213,6 +213,7 @@ class ProductSearch:
         self._qneeds: dict[int, tuple[float, int, list[tuple]]] = {}
         self._fneeds: dict[Formula, tuple] = {}
         self._rules: dict[Formula, tuple | None] = {}
+        self._need_sets: dict[Formula, frozenset[int]] = {}
         self._trees: dict[tuple[int, frozenset[int]], float] = {}
         self._tgt = [self._static_target(t) for t in self.tasks]
         # the trip bound holds when every candidate step that frees a hand ends at a fixed
@@ -342,27 +343,35 @@ class ProductSearch:
         group: from the worker's place or a freeing place), any other from the nearest
         other place (0 when another part lies there); the last pickup of each group walks
         on to a freeing place. The stretches are disjoint, so their least sum, with the
-        roles given to the parts that make it least, is a lower bound."""
+        roles given to the parts that make it least, is a lower bound. With two hands a
+        group is one part or two, so every part pays its way from or to a freeing place,
+        the second of a pair the nearest-place stretch too (a pair costs less than two
+        single trips); with more hands the roles may overlap in the bound."""
         parts = s.parts
-        here = s.location
-        walk = self._walk
+        row = self._walk[s.location]
         near, to_dest = self._near_place, self._dest_dist
         hands = self.model.limits.hands
-        base = 0.0
-        firsts: list[float] = []
-        lasts: list[float] = []
-        start = float("inf")
+        nears: list[float] = []       # the nearest-place stretch of each part
+        ends: list[float] = []        # its stretch from or to a freeing place
+        starts: list[float] = []      # its stretch from the worker's place, at most that
         for p in delivered:
             x = parts[p]
-            nb = 0.0 if parts.count(x) > 1 else near[x]
-            base += nb
-            firsts.append(to_dest[x] - nb)
-            lasts.append(to_dest[x])
-            start = min(start, min(walk[here][x], to_dest[x]) - nb)
-        groups = -(-len(delivered) // hands)
-        firsts.sort()
-        lasts.sort()
-        return max(0.0, base + start + sum(firsts[:groups - 1]) + sum(lasts[:groups]))
+            # at most its end stretch, so that a pair never costs more than two singles
+            nears.append(0.0 if parts.count(x) > 1 else min(near[x], to_dest[x]))
+            ends.append(to_dest[x])
+            starts.append(min(row[x], to_dest[x]))
+        m = len(delivered)
+        if hands == 2:
+            # every part: its end stretch; the second of each pair: its near stretch; a
+            # single trip: a second end stretch; less what starting from here saves
+            saved = max(t - w for t, w in zip(ends, starts))
+            return max(0.0, sum(ends) + sum(sorted(nears)[:m // 2])
+                       + (min(ends) if m % 2 else 0.0) - saved)
+        groups = -(-m // hands)
+        firsts = sorted(t - nb for t, nb in zip(ends, nears))
+        start = min(w - nb for w, nb in zip(starts, nears))
+        return max(0.0, sum(nears) + start + sum(firsts[:groups - 1])
+                   + sum(sorted(ends)[:groups]))
 
     def _target(self, i: int, s: CellState) -> int | None:
         """Where task ``i`` ends in ``s`` (fast path of :meth:`CellModel.target`)."""
@@ -387,8 +396,10 @@ class ProductSearch:
         base, freeing, needs = 0.0, 0, []
         used: set[int] = set()
         pending = list(self.aut.pending(q))
+        have = set(pending)                 # (list membership compares formulas deeply)
         for f in self._responses(q, pending):
-            if f not in pending:
+            if f not in have:
+                have.add(f)
                 pending.append(f)
         for f in pending:
             need, dur, frees, item = self._formula_need(f)
@@ -410,14 +421,21 @@ class ProductSearch:
         states = getattr(self.aut, "states", None)
         if states is None:
             return out
-        needs = [n for f in pending if (n := self._formula_need(f)[0])]
+        needs = [n for f in pending if (n := self._need_set(f))]
         for g in states[q]:
             rule = self._rules.get(g, ())
             if rule == ():
                 rule = self._rules[g] = self._response_rule(g)
-            if rule is not None and any(set(n) <= rule[0] for n in needs):
+            if rule is not None and any(n <= rule[0] for n in needs):
                 out.append(rule[1])
         return out
+
+    def _need_set(self, f: Formula) -> frozenset[int]:
+        """The letters satisfying the pending ``F phi`` as a set (memoized)."""
+        hit = self._need_sets.get(f)
+        if hit is None:
+            hit = self._need_sets[f] = frozenset(self._formula_need(f)[0])
+        return hit
 
     def _response_rule(self, g: Formula) -> tuple[frozenset[int], Formula] | None:
         """(trigger letters, ``F psi``) of ``g = G(a | b | ... | F psi)`` with a, b, ...
