@@ -238,3 +238,27 @@ def test_kitting_cell_synthesizes_a_verified_motion_end_to_end():
     moves = [t for t in motion.sequence if t.startswith("move(")]
     assert sorted(moves) == ["move(P0, R1)", "move(P1, R1)", "move(P5, R1)"]
     assert motion.stats["sequence_time"] > 0.0
+
+
+def test_recurrences_over_few_parts_give_a_cycle_with_each_grasp():
+    """G F over five parts: the cycle (longer than the default tails) grasps each part,
+    with the releases two hands force, and is physically consistent."""
+    n = 5
+    text = " & ".join(f"G F grasp(P{i})" for i in range(n))
+    seqs, _ = plan_sequences(text, _kitting(n), n=1)
+    cycle = seqs[0].cycle
+    assert sorted(t.args[0] for t in cycle if t.name == "grasp") == [f"P{i}" for i in range(n)]
+    _consistent(seqs[0].tasks)
+
+
+def test_recurrences_over_many_parts_are_refused_before_any_search(monkeypatch):
+    from ltl_human_motion.tasks.product import ProductSearch as Search
+    from ltl_human_motion.tasks.recurrence import MAX_RECURRENCES
+
+    def no_search(*_a, **_k):
+        raise AssertionError("searched")
+    monkeypatch.setattr(Search, "lassos", no_search)
+    n = MAX_RECURRENCES + 2
+    text = " & ".join(f"G F grasp(P{i})" for i in range(n))
+    with pytest.raises(SpecError, match=f"needs {n} different tasks again and again"):
+        plan_sequences(text, _kitting(n), n=1)

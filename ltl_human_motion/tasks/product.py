@@ -229,6 +229,9 @@ class ProductSearch:
                            for x in range(n_pts)]
         self._forget = hasattr(automaton, "mentioned")
         self._tails: dict[tuple[int, tuple[int, ...]], bool] = {}
+        #: Longest tail of a path tried as its cycle (a specification whose cycles must
+        #: be longer sets more, :func:`~ltl_human_motion.tasks.recurrence.cycle_steps`).
+        self.tail_steps = TAIL_STEPS
 
     def configure(self, weight: float, budget: int,
                   cost_noise: Callable[[tuple, int], float] | None = None) -> ProductSearch:
@@ -672,10 +675,10 @@ class ProductSearch:
 
     def _tail(self, labels: list, lab: int) -> tuple[tuple[int, ...], tuple[int, ...],
                                                      tuple[int, ...]]:
-        """The last (up to :data:`TAIL_STEPS`) steps of a label's path: their tasks, the
+        """The last (up to :attr:`tail_steps`) steps of a label's path: their tasks, the
         automaton state before each, and the marks of each."""
         tasks, states, marks = [], [], []
-        while lab > 0 and len(tasks) < TAIL_STEPS:
+        while lab > 0 and len(tasks) < self.tail_steps:
             _node, parent, task, _g, m = labels[lab]
             tasks.append(task)
             marks.append(m)

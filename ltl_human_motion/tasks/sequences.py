@@ -40,6 +40,7 @@ from ltl_human_motion.tasks.product import (
     SearchBudgetError,
     seeded_noise,
 )
+from ltl_human_motion.tasks.recurrence import cycle_steps, refuse_many_recurrences
 
 __all__ = ["MODES", "RANDOM_COST_FACTOR", "PlanStats", "has_geometry", "plan_sequences",
            "product_search", "task_steps"]
@@ -158,7 +159,9 @@ def product_search(spec: Specification, model: CellModel, backend: str = "builti
         view = ExplicitView(translate(spec.formula, backend="spot"), letters)
     else:
         view = LetterTableau(_search_formula(spec), letters)
-    return ProductSearch(view, model, tasks, repetitions=repetitions, **kwargs), tasks, letters
+    search = ProductSearch(view, model, tasks, repetitions=repetitions, **kwargs)
+    search.tail_steps = max(search.tail_steps, cycle_steps(spec, model, tasks, letters))
+    return search, tasks, letters
 
 
 def _ladder(spec: Specification, model: CellModel, backend: str, reps: int, k: int,
@@ -308,6 +311,7 @@ def plan_sequences(spec: str | Specification, cell: object, n: int | None = 5, s
         return seqs, stats
     want = n if n is not None else (5 if mode == "random" else 20)
     model = CellModel.from_cell(cell, limits)
+    refuse_many_recurrences(spec, task_steps(spec, model)[1])
     reps = cycles
     t0 = time.perf_counter()
     k = 3 * want if mode == "all" else 1     # equal words from other lassos are dropped
