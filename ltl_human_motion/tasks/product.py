@@ -51,6 +51,10 @@ __all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "seede
 #: Longest cycle made of a path's own last steps that the search tries as a goal.
 TAIL_STEPS = 6
 
+#: Children are pushed with a bound derived from their parent's heuristic and get
+#: their own only when popped (most never are); False evaluates every child at once.
+LAZY_HEURISTIC = True
+
 #: Tasks that leave a hand free (the part is put down, placed or used up).
 _FREEING = frozenset({"release", "move", "insert", "assemble"})
 
@@ -606,7 +610,7 @@ class ProductSearch:
         labels.append((root, -1, -1, g0, 0))
         heapq.heappush(heap, (g0 + self.weight * self.heuristic(*root), -g0, next(tie), 0, 0,
                               ()))
-        lazy = self.use_h and self.weight > 1.0
+        lazy = self.use_h and LAZY_HEURISTIC
         pops: dict[tuple[int, CellState], int] = {}
         closed_g: dict[tuple[int, CellState], float] = {}
         out: list[Lasso] = []
@@ -657,10 +661,10 @@ class ProductSearch:
                     if pops.get(node2, 0) >= k and (k > 1 or g2 >= closed_g[node2] - 1e-9):
                         continue
                     if lazy:
-                        # weighted: push with h(here) - step cost (a consistent heuristic's
-                        # bound); the real value only if the child is popped (most never
-                        # are). The optimal search needs the real value: the heuristic is
-                        # admissible but not always consistent.
+                        # push with h(here) - step cost, the real value only if the child
+                        # is popped (most never are). It stays a lower bound of the cost
+                        # through the child (h(here) <= c + h*(child) as h is admissible),
+                        # so the optimal search (weight 1) stays optimal.
                         h = max(0.0, h_here - c)
                     else:
                         h = self.heuristic(*node2) if self.use_h else 0.0
