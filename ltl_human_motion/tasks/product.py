@@ -43,7 +43,7 @@ from dataclasses import dataclass
 from ltl_human_motion.ltl.automaton import Automaton, accepting_components, lasso_accepted
 from ltl_human_motion.ltl.automaton import strongly_connected_components as _sccs
 from ltl_human_motion.ltl.formula import And, Atom, Const, Finally, Formula, Globally, Not, Or
-from ltl_human_motion.tasks.model import HELD, CellModel, CellState
+from ltl_human_motion.tasks.model import DONE, HELD, CellModel, CellState
 
 __all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "seeded_noise"]
 
@@ -232,6 +232,7 @@ class ProductSearch:
         self._dest_dist = [min((self._walk[d][x] for d in self._dests), default=0.0)
                            for x in range(n_pts)]
         self._forget = hasattr(automaton, "mentioned")
+        self._drop: dict[int, tuple[int, ...]] = {}
         self._tails: dict[tuple[int, tuple[int, ...]], bool] = {}
         #: Longest tail of a path tried as its cycle (a specification whose cycles must
         #: be longer sets more, :func:`~ltl_human_motion.tasks.recurrence.cycle_steps`).
@@ -263,8 +264,23 @@ class ProductSearch:
         return self._step[key]
 
     def forget(self, q: int, s: CellState) -> CellState:
-        """``s`` without the places of parts that state ``q`` no longer mentions."""
-        return self.model.forget(s, self.aut.mentioned(q)) if self._forget else s
+        """``s`` without the places of parts that state ``q`` no longer mentions (as
+        :meth:`CellModel.forget`, with the parts to drop memoized per state ``q``)."""
+        if not self._forget:
+            return s
+        drop = self._drop.get(q)
+        if drop is None:
+            keep = self.aut.mentioned(q)
+            drop = self._drop[q] = tuple(p for p, name in enumerate(self.model.part_names)
+                                         if name not in keep)
+        parts = s.parts
+        if all(parts[p] in (HELD, DONE) for p in drop):
+            return s
+        new = list(parts)
+        for p in drop:
+            if new[p] != HELD:
+                new[p] = DONE
+        return CellState(s.location, s.held, tuple(new), s.posture)
 
     def _cost(self, node: tuple, i: int, c: float) -> float:
         return c * self.noise(node, i) if self.noise is not None else c
@@ -316,13 +332,18 @@ class ProductSearch:
                         delivered.append(carry_part)
                 elif where == HELD:
                     carried.append(walk[here][carry_dest])
-            targets = {self._target(i, s) for i in opts}
-            if None in targets:
-                pass
-            elif len(targets) == 1:
-                places.update(targets)
+            if len(opts) == 1:
+                t = self._target(opts[0], s)
+                if t is not None:
+                    places.add(t)
             else:
-                far = max(far, min(walk[here][t] for t in targets))
+                targets = {self._target(i, s) for i in opts}
+                if None in targets:
+                    pass
+                elif len(targets) == 1:
+                    places.update(targets)
+                else:
+                    far = max(far, min(walk[here][t] for t in targets))
             if grasp_part is not None and grasp_part not in s.held:
                 pickups.add(grasp_part)
             if carry_part is not None and parts[carry_part] >= 0:
