@@ -450,11 +450,14 @@ class ProductSearch:
         if states is None:
             return out
         needs = [n for f in pending if (n := self._need_set(f))]
+        singles = {next(iter(n)) for n in needs if len(n) == 1}
+        multi = [n for n in needs if len(n) > 1]
         for g in states[q]:
             rule = self._rules.get(g, ())
             if rule == ():
                 rule = self._rules[g] = self._response_rule(g)
-            if rule is not None and any(n <= rule[0] for n in needs):
+            if rule is not None and (not rule[0].isdisjoint(singles)
+                                     or any(n <= rule[0] for n in multi)):
                 out.append(rule[1])
         return out
 
