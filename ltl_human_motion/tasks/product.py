@@ -55,6 +55,9 @@ TAIL_STEPS = 6
 #: their own only when popped (most never are); False evaluates every child at once.
 LAZY_HEURISTIC = True
 
+#: Decimals (of seconds) of the search's priorities (:func:`_key`).
+KEY_DIGITS = 9
+
 #: Tasks that leave a hand free (the part is put down, placed or used up).
 _FREEING = frozenset({"release", "move", "insert", "assemble"})
 
@@ -632,7 +635,7 @@ class ProductSearch:
             base, q, s, g0 = start
             root = (q, self.forget(q, s))
         labels.append((root, -1, -1, g0, 0))
-        heapq.heappush(heap, (g0 + self.weight * self.heuristic(*root), -g0, next(tie), 0, 0,
+        heapq.heappush(heap, (_key(g0 + self.weight * self.heuristic(*root)), -g0, next(tie), 0, 0,
                               ()))
         lazy = self.use_h and LAZY_HEURISTIC
         pops: dict[tuple[int, CellState], int] = {}
@@ -657,7 +660,7 @@ class ProductSearch:
                 if g + h > bound:
                     continue
                 if g + self.weight * h > f + 1e-9:
-                    heapq.heappush(heap, (g + self.weight * h, -g, next(tie), 0, lab, ()))
+                    heapq.heappush(heap, (_key(g + self.weight * h), -g, next(tie), 0, lab, ()))
                     continue
             pops[node] = count + 1
             closed_g[node] = min(g, closed_g.get(node, g))
@@ -669,11 +672,12 @@ class ProductSearch:
             if task >= 0:
                 c, again = self._tail_goal(q, s, *self._tail(labels, lab))
                 if c:
-                    heapq.heappush(heap, (g + again, -g, next(tie), 1, lab, c))
+                    heapq.heappush(heap, (_key(g + again), -g, next(tie), 1, lab, c))
             if long_cycles and self.aut.loopable(q):
                 cyc = self.cycle_from(q, s)
                 if cyc is not None:
-                    heapq.heappush(heap, (g + cyc[0], -g - cyc[0], next(tie), 1, lab, cyc[1]))
+                    heapq.heappush(heap, (_key(g + cyc[0]), -g - cyc[0], next(tie), 1, lab,
+                                          cyc[1]))
             for i in range(len(self.tasks)):
                 nxt = self.step(s, i)
                 if nxt is None:
@@ -695,7 +699,7 @@ class ProductSearch:
                     if g2 + h > bound:
                         continue
                     labels.append((node2, lab, i, g2, m2))
-                    heapq.heappush(heap, (g2 + self.weight * h, -g2, next(tie),
+                    heapq.heappush(heap, (_key(g2 + self.weight * h), -g2, next(tie),
                                           2 if lazy else 0, len(labels) - 1, ()))
         if not out and not long_cycles:
             return self.lassos(k, start, bound, long_cycles=True)
@@ -819,6 +823,13 @@ class ProductSearch:
             s, c = nxt
             total += c
         return total
+
+
+def _key(f: float) -> float:
+    """A priority rounded to :data:`KEY_DIGITS` decimals: costs summed in another order
+    differ in the last bits, and equal priorities must tie so that the deeper node wins
+    (many orders of the same trips cost the same)."""
+    return round(f, KEY_DIGITS)
 
 
 def seeded_noise(seed: int, factor: float) -> Callable[[tuple, int], float]:

@@ -22,9 +22,10 @@ __all__ = ["MAX_RECURRENCES", "cycle_steps", "recurrences", "refuse_many_recurre
 
 #: Most recurrences on disjoint tasks a specification may have. Measured with
 #: ``G F grasp(P0) & ... & G F grasp(Pn-1)`` in the kitting cell (2 shared cores,
-#: under load): n = 6 is answered in about 3 s of CPU (weighted A*, weight 3), n = 8
-#: exhausts the search budget after about 17 s; the cycle search is exponential in n.
-MAX_RECURRENCES = 6
+#: under load): n = 5 is answered optimally in 0.2 s of CPU, n = 6 takes 4 s (weighted
+#: A*, weight 3), n = 8 exhausts the search budget after about 17 s; the search for
+#: such cycles is exponential in n.
+MAX_RECURRENCES = 5
 
 
 def recurrences(spec: Specification, letters: Sequence[frozenset[str]]
