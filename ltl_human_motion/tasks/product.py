@@ -221,7 +221,7 @@ class ProductSearch:
         self._fneeds: dict[Formula, tuple] = {}
         self._rules: dict[Formula, tuple | None] = {}
         self._need_sets: dict[Formula, frozenset[int]] = {}
-        self._trees: dict[tuple[int, frozenset[int]], float] = {}
+        self._trees: dict[frozenset[int], float] = {}
         self._tgt = [self._static_target(t) for t in self.tasks]
         # the trip bound holds when every candidate step that frees a hand ends at a fixed
         # place (move, insert into a fixed container, assemble) and none is a release
@@ -293,9 +293,9 @@ class ProductSearch:
 
         * the durations of the tasks the pending ``F`` formulas of ``q`` need, counted
           once per disjoint set of letters;
-        * the walk through their places: the minimum spanning tree over the worker's
-          place and the places of the formulas with one place (a walk visiting them all
-          is at least as long), or the walk to the farthest other one;
+        * the walk through their places: to the nearest, then a minimum spanning tree
+          over the places of the formulas with one place (a walk visiting them all is at
+          least as long), or the walk to the farthest other one;
         * at least the distance each part still to be moved, inserted or carried travels
           in hand, over the number of hands (at most that many parts ride along at once);
         * the walk of the trips that fetch the parts still to be moved or inserted and set
@@ -532,17 +532,25 @@ class ProductSearch:
         return 2, None
 
     def _tree(self, here: int, places: set[int]) -> float:
-        """Length (s) of a minimum spanning tree over ``here`` and ``places`` (Prim)."""
+        """A lower bound (s) on a walk from ``here`` through all ``places``: the walk to
+        the nearest of them plus a minimum spanning tree over them (Prim, memoized per
+        set of places: the rest of the walk connects them all). At least the spanning
+        tree over ``here`` and ``places``."""
         places.discard(here)
         if not places:
             return 0.0
-        key = (here, frozenset(places))
+        row = self._walk[here]
+        return min(row[t] for t in places) + self._places_tree(frozenset(places))
+
+    def _places_tree(self, key: frozenset[int]) -> float:
+        """Length (s) of a minimum spanning tree over the places ``key`` (Prim)."""
         hit = self._trees.get(key)
         if hit is not None:
             return hit
         walk = self._walk
-        rest = list(places)
-        best = [walk[here][t] for t in rest]
+        rest = list(key)
+        first = rest.pop()
+        best = [walk[first][t] for t in rest]
         total = 0.0
         while rest:
             j = min(range(len(rest)), key=best.__getitem__)
