@@ -643,8 +643,9 @@ class ProductSearch:
             base, q, s, g0 = start
             root = (q, self.forget(q, s))
         labels.append((root, -1, -1, g0, 0))
-        heapq.heappush(heap, (_key(g0 + self.weight * self.heuristic(*root)), -g0, next(tie), 0, 0,
-                              ()))
+        depth = [0]        # steps of each label's path: fewer steps win a tie in cost
+        heapq.heappush(heap, (_key(g0 + self.weight * self.heuristic(*root)), -_key(g0),
+                              (0, next(tie)), 0, 0, ()))
         lazy = self.use_h and LAZY_HEURISTIC
         pops: dict[tuple[int, CellState], int] = {}
         closed_g: dict[tuple[int, CellState], float] = {}
@@ -668,7 +669,8 @@ class ProductSearch:
                 if g + h > bound:
                     continue
                 if g + self.weight * h > f + 1e-9:
-                    heapq.heappush(heap, (_key(g + self.weight * h), -g, next(tie), 0, lab, ()))
+                    heapq.heappush(heap, (_key(g + self.weight * h), -_key(g),
+                                          (depth[lab], next(tie)), 0, lab, ()))
                     continue
             pops[node] = count + 1
             closed_g[node] = min(g, closed_g.get(node, g))
@@ -680,11 +682,13 @@ class ProductSearch:
             if task >= 0:
                 c, again = self._tail_goal(q, s, *self._tail(labels, lab))
                 if c:
-                    heapq.heappush(heap, (_key(g + again), -g, next(tie), 1, lab, c))
+                    heapq.heappush(heap, (_key(g + again), -_key(g),
+                                          (depth[lab], next(tie)), 1, lab, c))
             if long_cycles and self.aut.loopable(q):
                 cyc = self.cycle_from(q, s)
                 if cyc is not None:
-                    heapq.heappush(heap, (_key(g + cyc[0]), -g - cyc[0], next(tie), 1, lab,
+                    heapq.heappush(heap, (_key(g + cyc[0]), -_key(g + cyc[0]),
+                                          (depth[lab] + len(cyc[1]), next(tie)), 1, lab,
                                           cyc[1]))
             for i in range(len(self.tasks)):
                 nxt = self.step(s, i)
@@ -707,7 +711,9 @@ class ProductSearch:
                     if g2 + h > bound:
                         continue
                     labels.append((node2, lab, i, g2, m2))
-                    heapq.heappush(heap, (_key(g2 + self.weight * h), -g2, next(tie),
+                    depth.append(depth[lab] + 1)
+                    heapq.heappush(heap, (_key(g2 + self.weight * h), -_key(g2),
+                                          (depth[lab] + 1, next(tie)),
                                           2 if lazy else 0, len(labels) - 1, ()))
         if not out and not long_cycles:
             return self.lassos(k, start, bound, long_cycles=True)
@@ -835,8 +841,8 @@ class ProductSearch:
 
 def _key(f: float) -> float:
     """A priority rounded to :data:`KEY_DIGITS` decimals: costs summed in another order
-    differ in the last bits, and equal priorities must tie so that the deeper node wins
-    (many orders of the same trips cost the same)."""
+    differ in the last bits, and equal costs must tie so that the deeper node wins (many
+    orders of the same trips cost the same), then the path with fewer steps."""
     return round(f, KEY_DIGITS)
 
 
