@@ -262,3 +262,23 @@ def test_recurrences_over_many_parts_are_refused_before_any_search(monkeypatch):
     text = " & ".join(f"G F grasp(P{i})" for i in range(n))
     with pytest.raises(SpecError, match=f"needs {n} different tasks again and again"):
         plan_sequences(text, _kitting(n), n=1)
+
+
+@pytest.mark.parametrize("family", ["grasp_each", "move_each", "response"])
+def test_twenty_part_kitting_is_answered_cost_optimally(family):
+    """With the trip bound and ties broken deepest-first, the optimal A* (weight 1)
+    answers 20-part kitting within its first budget; the sequence is consistent."""
+    seqs, stats = plan_sequences(kitting_spec(family, 20), _kitting(20), n=1)
+    assert stats.optimal, stats.weight
+    _consistent(seqs[0].tasks, fixed={"kit"})
+    done = {t.args[0] for t in seqs[0].tasks if t.name in ("grasp", "move", "insert")}
+    assert done == {f"P{i}" for i in range(20)}
+
+
+def test_equal_costs_prefer_fewer_steps():
+    """A move fetches its part itself: no separate grasp before it at the same cost
+    (summed in another order, the two costs differed in the last bits)."""
+    cell = load_cell(ROOT / "config" / "demo_cell.yaml")
+    seqs, stats = plan_sequences("F(move(O1, R0) & F grasp(O1))", cell, n=1)
+    assert [str(t) for t in seqs[0].prefix[:2]] == ["move(O1, R0)", "grasp(O1)"]
+    assert stats.optimal
