@@ -45,6 +45,10 @@ from ltl_human_motion.ltl.translate_builtin import _state_key
 __all__ = ["LetterTableau"]
 
 _Term = tuple[frozenset[Formula], frozenset[Formula]]
+
+#: States with at least this many formulas expand only those a letter touches (below, a
+#: plain product is cheaper: the paper's S1/S2 states hold 2-6 formulas, kitting's 20-60).
+SPLIT_MIN_FORMULAS = 12
 _EMPTY: frozenset = frozenset()
 _EVENTUALITIES = (Finally, Until, StrongRelease)
 _PERSISTENT = (Globally, Release, WeakUntil)
@@ -183,6 +187,36 @@ class LetterTableau:
         hit = self._succ.get(key)
         if hit is not None:
             return hit
+        if len(self.states[q]) < SPLIT_MIN_FORMULAS:
+            terms = self._plain_terms(q, i)
+        else:
+            terms = self._split_terms(q, i)
+        out = []
+        for nx, pr in terms:
+            promised = 0
+            for e in pr:
+                promised |= self.mark_of[e]
+            q2 = self._next_ids.get(nx)
+            if q2 is None:
+                q2 = self._next_ids[nx] = self._intern(_state_key(nx))
+            out.append((q2, self.full & ~promised))
+        result = tuple(sorted(set(out)))
+        self._succ[key] = result
+        return result
+
+    def _plain_terms(self, q: int, i: int) -> list[_Term]:
+        """The terms of state ``q`` on letter class ``i``: the product of the expansions
+        of all its formulas."""
+        terms: list[_Term] = [(_EMPTY, _EMPTY)]
+        for f in sorted(self.states[q], key=str):
+            terms = _product(terms, self.expand(f, i))
+            if not terms:
+                break
+        return terms
+
+    def _split_terms(self, q: int, i: int) -> list[_Term]:
+        """The terms of :meth:`_plain_terms`, expanding only the formulas whose atoms the
+        letter holds (:meth:`_split_state`)."""
         general, by_atom, nexts, promises, count_n, count_p, single = self._split_state(q)
         letter = self.letters[i]
         touched = set(general)
@@ -205,18 +239,7 @@ class LetterTableau:
             terms = _product(terms, self.expand(f, i))
             if not terms:
                 break
-        out = []
-        for nx, pr in terms:
-            promised = 0
-            for e in pr:
-                promised |= self.mark_of[e]
-            q2 = self._next_ids.get(nx)
-            if q2 is None:
-                q2 = self._next_ids[nx] = self._intern(_state_key(nx))
-            out.append((q2, self.full & ~promised))
-        result = tuple(sorted(set(out)))
-        self._succ[key] = result
-        return result
+        return terms
 
     def _split_state(self, q: int) -> tuple:
         """Per state (memoized): the formulas whose expansion on a letter none of their

@@ -229,11 +229,8 @@ class ProductSearch:
         self._dests = sorted({v for _k, v in freeing}) if freeing and all(
             k == 0 and v is not None for k, v in freeing) and "release" not in self._kind \
             else []
-        n_pts = len(self._walk)
-        self._near_place = [min((self._walk[j][x] for j in range(n_pts) if j != x),
-                                default=0.0) for x in range(n_pts)]
-        self._dest_dist = [min((self._walk[d][x] for d in self._dests), default=0.0)
-                           for x in range(n_pts)]
+        self._near_place: list[float] = []      # per place, made on the first trip bound
+        self._dest_dist: list[float] = []
         self._forget = hasattr(automaton, "mentioned")
         self._drop: dict[int, tuple[int, ...]] = {}
         self._tails: dict[tuple[int, tuple[int, ...]], bool] = {}
@@ -378,6 +375,12 @@ class ProductSearch:
         group is one part or two, so every part pays its way from or to a freeing place,
         the second of a pair the nearest-place stretch too (a pair costs less than two
         single trips); with more hands the roles may overlap in the bound."""
+        if not self._near_place:
+            walk = self._walk
+            n_pts = len(walk)
+            self._near_place = [min((walk[j][x] for j in range(n_pts) if j != x),
+                                    default=0.0) for x in range(n_pts)]
+            self._dest_dist = [min(walk[d][x] for d in self._dests) for x in range(n_pts)]
         parts = s.parts
         row = self._walk[s.location]
         near, to_dest = self._near_place, self._dest_dist
