@@ -13,6 +13,7 @@ from ltl_human_motion.ltl import Atom, build_specification, evaluate_lasso
 from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
 from ltl_human_motion.tasks import CellModel, Limits, plan_sequences
 from ltl_human_motion.tasks.kitting import kitting_cell_yaml, kitting_spec
+from ltl_human_motion.tasks.product import ProductSearch
 from ltl_human_motion.tasks.sequences import RANDOM_COST_FACTOR, product_search
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -103,11 +104,56 @@ def test_first_sequence_is_cost_optimal_against_uniform_cost_search():
         cell = _kitting(n)
         seqs, stats = plan_sequences(kitting_spec(family, n), cell, n=1)
         spec = build_specification(kitting_spec(family, n), cell)
+        # over every candidate release too: dropping the pointless ones loses nothing
         exhaustive, _, _ = product_search(spec, CellModel.from_cell(cell), weight=1.0,
-                                             budget=10**6, heuristic=False)
+                                             budget=10**6, heuristic=False, releases="all")
         best = exhaustive.lassos(1)[0].cost
         assert stats.costs[0] <= best * 1.01 + 1e-9, family
         _consistent(seqs[0].tasks, fixed={"kit"})
+
+
+@pytest.mark.parametrize("family,n", [("move_each", 5), ("response", 3),
+                                      ("precedence", 4), ("grasp_each", 4)])
+def test_heuristic_is_admissible_on_the_states_a_search_reaches(family, n):
+    """The A* heuristic (with the trip bound of moves and inserts) never exceeds the
+    optimal cost still to go, found by Dijkstra from the node, on sampled nodes."""
+    cell = _kitting(n)
+    spec = build_specification(kitting_spec(family, n), cell)
+    model = CellModel.from_cell(cell)
+    search, tasks, _ = product_search(spec, model)
+    exact = ProductSearch(search.aut, model, tasks, heuristic=False, budget=10**6)
+    q, s, path = search.aut.initial, model.initial_state(), []
+    checked = 0
+    for depth in range(3 * n):
+        s = search.forget(q, s)
+        h = search.heuristic(q, s)
+        found = exact.lassos(1, start=(tuple(path), q, s, 0.0))
+        assert found, (family, depth)
+        assert h <= found[0].cost + 1e-9, (family, depth, h, found[0].cost)
+        checked += 1
+        moves = [(i, nxt[0], q2) for i in range(len(tasks)) if (nxt := search.step(s, i))
+                 for q2, _m in search.aut.successors(q, i)]
+        start = (7 * depth + 3) % max(1, len(moves))           # a fixed pseudo-random walk
+        live = next(((i, s2, q2) for i, s2, q2 in moves[start:] + moves[:start]
+                     if exact.lassos(1, start=((*path, i), q2, s2, 0.0))), None)
+        if live is None:
+            break
+        i, s, q = live
+        path.append(i)
+    assert checked >= min(4, 2 * n)
+
+
+def test_pointless_releases_are_no_candidates_unless_needed():
+    """A release is a candidate step only for a part nothing else sets down."""
+    from ltl_human_motion.tasks.sequences import task_steps
+    cell = _kitting(4)
+    model = CellModel.from_cell(cell)
+    names = lambda text, **kw: {str(t) for t in task_steps(  # noqa: E731
+        build_specification(text, cell), model, **kw)[0]}
+    assert not any(t.startswith("release") for t in names(kitting_spec("move_each", 4)))
+    assert "release(P0)" in names(kitting_spec("move_each", 4), releases="all")
+    mixed = names("F grasp(P0) & F grasp(P1) & F grasp(P2) & F move(P2, R1)")
+    assert {"release(P0)", "release(P1)"} <= mixed and "release(P2)" not in mixed
 
 
 def test_move_each_part_to_the_tray_carries_two_at_a_time():
@@ -192,3 +238,47 @@ def test_kitting_cell_synthesizes_a_verified_motion_end_to_end():
     moves = [t for t in motion.sequence if t.startswith("move(")]
     assert sorted(moves) == ["move(P0, R1)", "move(P1, R1)", "move(P5, R1)"]
     assert motion.stats["sequence_time"] > 0.0
+
+
+def test_recurrences_over_few_parts_give_a_cycle_with_each_grasp():
+    """G F over five parts: the cycle (longer than the default tails) grasps each part,
+    with the releases two hands force, and is physically consistent."""
+    n = 5
+    text = " & ".join(f"G F grasp(P{i})" for i in range(n))
+    seqs, _ = plan_sequences(text, _kitting(n), n=1)
+    cycle = seqs[0].cycle
+    assert sorted(t.args[0] for t in cycle if t.name == "grasp") == [f"P{i}" for i in range(n)]
+    _consistent(seqs[0].tasks)
+
+
+def test_recurrences_over_many_parts_are_refused_before_any_search(monkeypatch):
+    from ltl_human_motion.tasks.product import ProductSearch as Search
+    from ltl_human_motion.tasks.recurrence import MAX_RECURRENCES
+
+    def no_search(*_a, **_k):
+        raise AssertionError("searched")
+    monkeypatch.setattr(Search, "lassos", no_search)
+    n = MAX_RECURRENCES + 2
+    text = " & ".join(f"G F grasp(P{i})" for i in range(n))
+    with pytest.raises(SpecError, match=f"needs {n} different tasks again and again"):
+        plan_sequences(text, _kitting(n), n=1)
+
+
+@pytest.mark.parametrize("family", ["grasp_each", "move_each", "response"])
+def test_twenty_part_kitting_is_answered_cost_optimally(family):
+    """With the trip bound and ties broken deepest-first, the optimal A* (weight 1)
+    answers 20-part kitting within its first budget; the sequence is consistent."""
+    seqs, stats = plan_sequences(kitting_spec(family, 20), _kitting(20), n=1)
+    assert stats.optimal, stats.weight
+    _consistent(seqs[0].tasks, fixed={"kit"})
+    done = {t.args[0] for t in seqs[0].tasks if t.name in ("grasp", "move", "insert")}
+    assert done == {f"P{i}" for i in range(20)}
+
+
+def test_equal_costs_prefer_fewer_steps():
+    """A move fetches its part itself: no separate grasp before it at the same cost
+    (summed in another order, the two costs differed in the last bits)."""
+    cell = load_cell(ROOT / "config" / "demo_cell.yaml")
+    seqs, stats = plan_sequences("F(move(O1, R0) & F grasp(O1))", cell, n=1)
+    assert [str(t) for t in seqs[0].prefix[:2]] == ["move(O1, R0)", "grasp(O1)"]
+    assert stats.optimal

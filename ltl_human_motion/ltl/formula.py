@@ -207,12 +207,14 @@ class StrongRelease(_Binary):
 def conj(*parts: Formula) -> Formula:
     """The conjunction of ``parts``, flattened, without duplicates or ``true``."""
     out: list[Formula] = []
+    seen: set[Formula] = set()      # membership in a list is quadratic in the parts
     for part in parts:
         items = part.args if isinstance(part, And) else (part,)
         for item in items:
             if item == FALSE:
                 return FALSE
-            if item != TRUE and item not in out:
+            if item != TRUE and item not in seen:
+                seen.add(item)
                 out.append(item)
     if not out:
         return TRUE
@@ -222,12 +224,14 @@ def conj(*parts: Formula) -> Formula:
 def disj(*parts: Formula) -> Formula:
     """The disjunction of ``parts``, flattened, without duplicates or ``false``."""
     out: list[Formula] = []
+    seen: set[Formula] = set()
     for part in parts:
         items = part.args if isinstance(part, Or) else (part,)
         for item in items:
             if item == TRUE:
                 return TRUE
-            if item != FALSE and item not in out:
+            if item != FALSE and item not in seen:
+                seen.add(item)
                 out.append(item)
     if not out:
         return FALSE

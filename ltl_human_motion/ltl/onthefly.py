@@ -45,6 +45,10 @@ from ltl_human_motion.ltl.translate_builtin import _state_key
 __all__ = ["LetterTableau"]
 
 _Term = tuple[frozenset[Formula], frozenset[Formula]]
+
+#: States with at least this many formulas expand only those a letter touches (below, a
+#: plain product is cheaper: the paper's S1/S2 states hold 2-6 formulas, kitting's 20-60).
+SPLIT_MIN_FORMULAS = 12
 _EMPTY: frozenset = frozenset()
 _EVENTUALITIES = (Finally, Until, StrongRelease)
 _PERSISTENT = (Globally, Release, WeakUntil)
@@ -107,6 +111,12 @@ class LetterTableau:
         classes: dict[frozenset[str], int] = {}
         self._class = [classes.setdefault(letter & keys, i)
                        for i, letter in enumerate(self.letters)]
+        # a letter holding none of the formula's atoms (index len(letters)): what every
+        # formula of a state does on a letter none of its atoms holds in
+        self._letter_sets = (*self.letters, _EMPTY)
+        self._class.append(classes.setdefault(_EMPTY, len(self.letters)))
+        self._split: dict[int, tuple] = {}
+        self._atoms: dict[Formula, frozenset[str]] = {}
         self.states: list[frozenset[Formula]] = []
         self._ids: dict[frozenset[Formula], int] = {}
         self._memo: dict[tuple[Formula, int], list[_Term]] = {}
@@ -115,7 +125,6 @@ class LetterTableau:
         self._proper: dict[Formula, frozenset[Formula]] = {}
         self._mentioned: dict[int, frozenset[str]] = {}
         self._next_ids: dict[frozenset[Formula], int] = {}
-        self._order: dict[int, tuple[Formula, ...]] = {}
         self._formula_names: dict[Formula, frozenset[str]] = {}
         self.initial = self._intern(_state_key(frozenset({self.formula})))
 
@@ -133,7 +142,7 @@ class LetterTableau:
         hit = self._memo.get(key)
         if hit is not None:
             return hit
-        letter = self.letters[i]
+        letter = self._letter_sets[i]
         if isinstance(f, Const):
             r = [(_EMPTY, _EMPTY)] if f.value else []
         elif isinstance(f, Atom):
@@ -178,14 +187,10 @@ class LetterTableau:
         hit = self._succ.get(key)
         if hit is not None:
             return hit
-        order = self._order.get(q)
-        if order is None:
-            order = self._order[q] = tuple(sorted(self.states[q], key=str))
-        terms: list[_Term] = [(_EMPTY, _EMPTY)]
-        for f in order:
-            terms = _product(terms, self.expand(f, i))
-            if not terms:
-                break
+        if len(self.states[q]) < SPLIT_MIN_FORMULAS:
+            terms = self._plain_terms(q, i)
+        else:
+            terms = self._split_terms(q, i)
         out = []
         for nx, pr in terms:
             promised = 0
@@ -198,6 +203,81 @@ class LetterTableau:
         result = tuple(sorted(set(out)))
         self._succ[key] = result
         return result
+
+    def _plain_terms(self, q: int, i: int) -> list[_Term]:
+        """The terms of state ``q`` on letter class ``i``: the product of the expansions
+        of all its formulas."""
+        terms: list[_Term] = [(_EMPTY, _EMPTY)]
+        for f in sorted(self.states[q], key=str):
+            terms = _product(terms, self.expand(f, i))
+            if not terms:
+                break
+        return terms
+
+    def _split_terms(self, q: int, i: int) -> list[_Term]:
+        """The terms of :meth:`_plain_terms`, expanding only the formulas whose atoms the
+        letter holds (:meth:`_split_state`)."""
+        general, by_atom, nexts, promises, count_n, count_p, single = self._split_state(q)
+        letter = self.letters[i]
+        touched = set(general)
+        for a in letter:
+            touched.update(by_atom.get(a, ()))
+        # the formulas none of whose atoms the letter holds: one term each, their union
+        gone_n: dict[Formula, int] = {}
+        gone_p: dict[Formula, int] = {}
+        for f in touched:
+            term = single.get(f)
+            if term is not None:
+                for x in term[0]:
+                    gone_n[x] = gone_n.get(x, 0) + 1
+                for x in term[1]:
+                    gone_p[x] = gone_p.get(x, 0) + 1
+        rest = (nexts - {x for x, k in gone_n.items() if k == count_n[x]},
+                promises - {x for x, k in gone_p.items() if k == count_p[x]})
+        terms: list[_Term] = [rest]
+        for f in sorted(touched, key=str):
+            terms = _product(terms, self.expand(f, i))
+            if not terms:
+                break
+        return terms
+
+    def _split_state(self, q: int) -> tuple:
+        """Per state (memoized): the formulas whose expansion on a letter none of their
+        atoms holds is not one term (always expanded), the others by atom, the union of
+        those single terms (next, promises) with how many formulas give each part, and
+        the single term of each. The product of single terms is their union, so a letter
+        only expands the formulas whose atoms it holds."""
+        hit = self._split.get(q)
+        if hit is not None:
+            return hit
+        null = len(self.letters)
+        general: list[Formula] = []
+        by_atom: dict[str, list[Formula]] = {}
+        count_n: dict[Formula, int] = {}
+        count_p: dict[Formula, int] = {}
+        single: dict[Formula, _Term] = {}
+        for f in self.states[q]:
+            terms = self.expand(f, null)
+            if len(terms) != 1:
+                general.append(f)
+                continue
+            single[f] = terms[0]
+            for x in terms[0][0]:
+                count_n[x] = count_n.get(x, 0) + 1
+            for x in terms[0][1]:
+                count_p[x] = count_p.get(x, 0) + 1
+            for a in self._atom_keys(f):
+                by_atom.setdefault(a, []).append(f)
+        hit = self._split[q] = (tuple(general), by_atom, frozenset(count_n),
+                                frozenset(count_p), count_n, count_p, single)
+        return hit
+
+    def _atom_keys(self, f: Formula) -> frozenset[str]:
+        hit = self._atoms.get(f)
+        if hit is None:
+            hit = self._atoms[f] = frozenset(g.key for g in _subformulas(f, set())
+                                             if isinstance(g, Atom))
+        return hit
 
     def loopable(self, q: int) -> bool:
         """False if no accepting cycle can pass through ``q`` (a syntactic test).

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 from ltl_human_motion.ltl.automaton import Automaton, accepting_components, lasso_accepted
 from ltl_human_motion.ltl.automaton import strongly_connected_components as _sccs
 from ltl_human_motion.ltl.formula import And, Atom, Const, Finally, Formula, Globally, Not, Or
-from ltl_human_motion.tasks.model import HELD, CellModel, CellState
+from ltl_human_motion.tasks.model import DONE, HELD, CellModel, CellState
 
 __all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "seeded_noise"]
 
@@ -51,11 +51,21 @@ __all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "seede
 #: Longest cycle made of a path's own last steps that the search tries as a goal.
 TAIL_STEPS = 6
 
+#: Children are pushed with a bound derived from their parent's heuristic and get
+#: their own only when popped (most never are); False evaluates every child at once.
+LAZY_HEURISTIC = True
+
+#: Decimals (of seconds) of the search's priorities (:func:`_key`).
+KEY_DIGITS = 9
+
 #: Tasks that leave a hand free (the part is put down, placed or used up).
 _FREEING = frozenset({"release", "move", "insert", "assemble"})
 
 #: Tasks that take a part somewhere in hand (fetching it first if needed).
 _CARRYING = frozenset({"move", "insert", "carry"})
+
+#: Of those, the tasks that set the part down there (the hand is free after them).
+_SETTING_DOWN = frozenset({"move", "insert"})
 
 
 class SearchBudgetError(RuntimeError):
@@ -210,10 +220,34 @@ class ProductSearch:
         self._qneeds: dict[int, tuple[float, int, list[tuple]]] = {}
         self._fneeds: dict[Formula, tuple] = {}
         self._rules: dict[Formula, tuple | None] = {}
-        self._trees: dict[tuple[int, frozenset[int]], float] = {}
+        self._need_sets: dict[Formula, frozenset[int]] = {}
+        self._trees: dict[frozenset[int], float] = {}
         self._tgt = [self._static_target(t) for t in self.tasks]
+        # the trip bound holds when every candidate step that frees a hand ends at a fixed
+        # place (move, insert into a fixed container, assemble) and none is a release
+        freeing = [self._tgt[i] for i, k in enumerate(self._kind) if k in _FREEING]
+        self._dests = sorted({v for _k, v in freeing}) if freeing and all(
+            k == 0 and v is not None for k, v in freeing) and "release" not in self._kind \
+            else []
+        self._near_place: list[float] = []      # per place, made on the first trip bound
+        self._dest_dist: list[float] = []
         self._forget = hasattr(automaton, "mentioned")
+        self._drop: dict[int, tuple[int, ...]] = {}
         self._tails: dict[tuple[int, tuple[int, ...]], bool] = {}
+        #: Longest tail of a path tried as its cycle (a specification whose cycles must
+        #: be longer sets more, :func:`~ltl_human_motion.tasks.recurrence.cycle_steps`).
+        self.tail_steps = TAIL_STEPS
+
+    def configure(self, weight: float, budget: int,
+                  cost_noise: Callable[[tuple, int], float] | None = None) -> ProductSearch:
+        """The same search (automaton, memoized steps, heuristic values and cycles, which
+        depend on neither) with another weight, budget and cost noise; ``expanded``
+        restarts at 0. A weight ladder reuses one search instead of translating again."""
+        self.weight = weight
+        self.budget = budget
+        self.noise = cost_noise
+        self.expanded = 0
+        return self
 
     def _duration(self, task: Atom) -> float:
         kind, args = self.model.kind(task)
@@ -230,8 +264,23 @@ class ProductSearch:
         return self._step[key]
 
     def forget(self, q: int, s: CellState) -> CellState:
-        """``s`` without the places of parts that state ``q`` no longer mentions."""
-        return self.model.forget(s, self.aut.mentioned(q)) if self._forget else s
+        """``s`` without the places of parts that state ``q`` no longer mentions (as
+        :meth:`CellModel.forget`, with the parts to drop memoized per state ``q``)."""
+        if not self._forget:
+            return s
+        drop = self._drop.get(q)
+        if drop is None:
+            keep = self.aut.mentioned(q)
+            drop = self._drop[q] = tuple(p for p, name in enumerate(self.model.part_names)
+                                         if name not in keep)
+        parts = s.parts
+        if all(parts[p] in (HELD, DONE) for p in drop):
+            return s
+        new = list(parts)
+        for p in drop:
+            if new[p] != HELD:
+                new[p] = DONE
+        return CellState(s.location, s.held, tuple(new), s.posture)
 
     def _cost(self, node: tuple, i: int, c: float) -> float:
         return c * self.noise(node, i) if self.noise is not None else c
@@ -241,11 +290,13 @@ class ProductSearch:
 
         * the durations of the tasks the pending ``F`` formulas of ``q`` need, counted
           once per disjoint set of letters;
-        * the walk through their places: the minimum spanning tree over the worker's
-          place and the places of the formulas with one place (a walk visiting them all
-          is at least as long), or the walk to the farthest other one;
+        * the walk through their places: to the nearest, then a minimum spanning tree
+          over the places of the formulas with one place (a walk visiting them all is at
+          least as long), or the walk to the farthest other one;
         * at least the distance each part still to be moved, inserted or carried travels
           in hand, over the number of hands (at most that many parts ride along at once);
+        * the walk of the trips that fetch the parts still to be moved or inserted and set
+          them down (:meth:`_trips`), when no step but those frees a hand;
         * the grasp that fetches such a part when it is not in hand;
         * the hand-freeing steps that two hands force: parts in hand plus parts still to
           be picked up (grasped, or fetched by a move that keeps them in hand), minus the
@@ -268,7 +319,8 @@ class ProductSearch:
         pickups: set[int] = set()
         parts = s.parts
         grasping = {item[3] for item in needs}
-        for opts, carry_part, carry_dest, grasp_part in needs:
+        delivered: list[int] = []
+        for opts, carry_part, carry_dest, grasp_part, sets_down in needs:
             if carry_part is not None:
                 where = parts[carry_part]
                 if where >= 0:
@@ -276,22 +328,30 @@ class ProductSearch:
                         total += self._grasp_dur
                     places.add(where)
                     carried.append(walk[where][carry_dest])
+                    if sets_down:
+                        delivered.append(carry_part)
                 elif where == HELD:
                     carried.append(walk[here][carry_dest])
-            targets = {self._target(i, s) for i in opts}
-            if None in targets:
-                pass
-            elif len(targets) == 1:
-                places.update(targets)
+            if len(opts) == 1:
+                t = self._target(opts[0], s)
+                if t is not None:
+                    places.add(t)
             else:
-                far = max(far, min(walk[here][t] for t in targets))
+                targets = {self._target(i, s) for i in opts}
+                if None in targets:
+                    pass
+                elif len(targets) == 1:
+                    places.update(targets)
+                else:
+                    far = max(far, min(walk[here][t] for t in targets))
             if grasp_part is not None and grasp_part not in s.held:
                 pickups.add(grasp_part)
             if carry_part is not None and parts[carry_part] >= 0:
                 pickups.add(carry_part)       # fetched into a hand first
         hands = self.model.limits.hands
         carry = sum(carried) / hands
-        total += max(far, self._tree(here, places), carry)
+        trips = self._trips(s, delivered) if self._dests and delivered else 0.0
+        total += max(far, self._tree(here, places), carry, trips)
         to_grasp = sum(self.model._width[p] for p in pickups)
         if self._free_dur is not None:
             held = sum(self.model._width[p] for p in s.held)
@@ -299,6 +359,53 @@ class ProductSearch:
                 * self._free_dur
         self._h[key] = total
         return total
+
+    def _trips(self, s: CellState, delivered: list[int]) -> float:
+        """A lower bound (s) on the walk that picks up the parts ``delivered`` (each at its
+        place, not in hand) and sets them down by a ``move`` or ``insert``, with the
+        candidate steps' only hand-freeing steps ending at :attr:`_dests` (no release).
+
+        Between two hand-freeing steps at most ``hands`` parts are picked up, so the
+        pickups fall into at least ``T = ceil(m / hands)`` groups. Each pickup is reached
+        by its own stretch of walk: the first of a group from a freeing place (the first
+        group: from the worker's place or a freeing place), any other from the nearest
+        other place (0 when another part lies there); the last pickup of each group walks
+        on to a freeing place. The stretches are disjoint, so their least sum, with the
+        roles given to the parts that make it least, is a lower bound. With two hands a
+        group is one part or two, so every part pays its way from or to a freeing place,
+        the second of a pair the nearest-place stretch too (a pair costs less than two
+        single trips); with more hands the roles may overlap in the bound."""
+        if not self._near_place:
+            walk = self._walk
+            n_pts = len(walk)
+            self._near_place = [min((walk[j][x] for j in range(n_pts) if j != x),
+                                    default=0.0) for x in range(n_pts)]
+            self._dest_dist = [min(walk[d][x] for d in self._dests) for x in range(n_pts)]
+        parts = s.parts
+        row = self._walk[s.location]
+        near, to_dest = self._near_place, self._dest_dist
+        hands = self.model.limits.hands
+        nears: list[float] = []       # the nearest-place stretch of each part
+        ends: list[float] = []        # its stretch from or to a freeing place
+        starts: list[float] = []      # its stretch from the worker's place, at most that
+        for p in delivered:
+            x = parts[p]
+            # at most its end stretch, so that a pair never costs more than two singles
+            nears.append(0.0 if parts.count(x) > 1 else min(near[x], to_dest[x]))
+            ends.append(to_dest[x])
+            starts.append(min(row[x], to_dest[x]))
+        m = len(delivered)
+        if hands == 2:
+            # every part: its end stretch; the second of each pair: its near stretch; a
+            # single trip: a second end stretch; less what starting from here saves
+            saved = max(t - w for t, w in zip(ends, starts))
+            return max(0.0, sum(ends) + sum(sorted(nears)[:m // 2])
+                       + (min(ends) if m % 2 else 0.0) - saved)
+        groups = -(-m // hands)
+        firsts = sorted(t - nb for t, nb in zip(ends, nears))
+        start = min(w - nb for w, nb in zip(starts, nears))
+        return max(0.0, sum(nears) + start + sum(firsts[:groups - 1])
+                   + sum(sorted(ends)[:groups]))
 
     def _target(self, i: int, s: CellState) -> int | None:
         """Where task ``i`` ends in ``s`` (fast path of :meth:`CellModel.target`)."""
@@ -323,8 +430,10 @@ class ProductSearch:
         base, freeing, needs = 0.0, 0, []
         used: set[int] = set()
         pending = list(self.aut.pending(q))
+        have = set(pending)                 # (list membership compares formulas deeply)
         for f in self._responses(q, pending):
-            if f not in pending:
+            if f not in have:
+                have.add(f)
                 pending.append(f)
         for f in pending:
             need, dur, frees, item = self._formula_need(f)
@@ -346,14 +455,24 @@ class ProductSearch:
         states = getattr(self.aut, "states", None)
         if states is None:
             return out
-        needs = [n for f in pending if (n := self._formula_need(f)[0])]
+        needs = [n for f in pending if (n := self._need_set(f))]
+        singles = {next(iter(n)) for n in needs if len(n) == 1}
+        multi = [n for n in needs if len(n) > 1]
         for g in states[q]:
             rule = self._rules.get(g, ())
             if rule == ():
                 rule = self._rules[g] = self._response_rule(g)
-            if rule is not None and any(set(n) <= rule[0] for n in needs):
+            if rule is not None and (not rule[0].isdisjoint(singles)
+                                     or any(n <= rule[0] for n in multi)):
                 out.append(rule[1])
         return out
+
+    def _need_set(self, f: Formula) -> frozenset[int]:
+        """The letters satisfying the pending ``F phi`` as a set (memoized)."""
+        hit = self._need_sets.get(f)
+        if hit is None:
+            hit = self._need_sets[f] = frozenset(self._formula_need(f)[0])
+        return hit
 
     def _response_rule(self, g: Formula) -> tuple[frozenset[int], Formula] | None:
         """(trigger letters, ``F psi``) of ``g = G(a | b | ... | F psi)`` with a, b, ...
@@ -390,8 +509,10 @@ class ProductSearch:
         heads = {self.tasks[i].args[0] for i in need} if kinds == {"grasp"} else ()
         if len(heads) == 1:
             grasp_part = self.model.part_index.get(next(iter(heads)))
+        sets_down = carry_part is not None and self._kind[need[0]] in _SETTING_DOWN
         hit = self._fneeds[f] = (need, min(self._min_dur[i] for i in need),
-                                 kinds <= _FREEING, (need, carry_part, carry_dest, grasp_part))
+                                 kinds <= _FREEING,
+                                 (need, carry_part, carry_dest, grasp_part, sets_down))
         return hit
 
     def _static_target(self, task: Atom) -> tuple[int, int | None]:
@@ -414,17 +535,25 @@ class ProductSearch:
         return 2, None
 
     def _tree(self, here: int, places: set[int]) -> float:
-        """Length (s) of a minimum spanning tree over ``here`` and ``places`` (Prim)."""
+        """A lower bound (s) on a walk from ``here`` through all ``places``: the walk to
+        the nearest of them plus a minimum spanning tree over them (Prim, memoized per
+        set of places: the rest of the walk connects them all). At least the spanning
+        tree over ``here`` and ``places``."""
         places.discard(here)
         if not places:
             return 0.0
-        key = (here, frozenset(places))
+        row = self._walk[here]
+        return min(row[t] for t in places) + self._places_tree(frozenset(places))
+
+    def _places_tree(self, key: frozenset[int]) -> float:
+        """Length (s) of a minimum spanning tree over the places ``key`` (Prim)."""
         hit = self._trees.get(key)
         if hit is not None:
             return hit
         walk = self._walk
-        rest = list(places)
-        best = [walk[here][t] for t in rest]
+        rest = list(key)
+        first = rest.pop()
+        best = [walk[first][t] for t in rest]
         total = 0.0
         while rest:
             j = min(range(len(rest)), key=best.__getitem__)
@@ -517,9 +646,10 @@ class ProductSearch:
             base, q, s, g0 = start
             root = (q, self.forget(q, s))
         labels.append((root, -1, -1, g0, 0))
-        heapq.heappush(heap, (g0 + self.weight * self.heuristic(*root), -g0, next(tie), 0, 0,
-                              ()))
-        lazy = self.use_h and self.weight > 1.0
+        depth = [0]        # steps of each label's path: fewer steps win a tie in cost
+        heapq.heappush(heap, (_key(g0 + self.weight * self.heuristic(*root)), -_key(g0),
+                              (0, next(tie)), 0, 0, ()))
+        lazy = self.use_h and LAZY_HEURISTIC
         pops: dict[tuple[int, CellState], int] = {}
         closed_g: dict[tuple[int, CellState], float] = {}
         out: list[Lasso] = []
@@ -542,7 +672,8 @@ class ProductSearch:
                 if g + h > bound:
                     continue
                 if g + self.weight * h > f + 1e-9:
-                    heapq.heappush(heap, (g + self.weight * h, -g, next(tie), 0, lab, ()))
+                    heapq.heappush(heap, (_key(g + self.weight * h), -_key(g),
+                                          (depth[lab], next(tie)), 0, lab, ()))
                     continue
             pops[node] = count + 1
             closed_g[node] = min(g, closed_g.get(node, g))
@@ -554,11 +685,14 @@ class ProductSearch:
             if task >= 0:
                 c, again = self._tail_goal(q, s, *self._tail(labels, lab))
                 if c:
-                    heapq.heappush(heap, (g + again, -g, next(tie), 1, lab, c))
+                    heapq.heappush(heap, (_key(g + again), -_key(g),
+                                          (depth[lab], next(tie)), 1, lab, c))
             if long_cycles and self.aut.loopable(q):
                 cyc = self.cycle_from(q, s)
                 if cyc is not None:
-                    heapq.heappush(heap, (g + cyc[0], -g - cyc[0], next(tie), 1, lab, cyc[1]))
+                    heapq.heappush(heap, (_key(g + cyc[0]), -_key(g + cyc[0]),
+                                          (depth[lab] + len(cyc[1]), next(tie)), 1, lab,
+                                          cyc[1]))
             for i in range(len(self.tasks)):
                 nxt = self.step(s, i)
                 if nxt is None:
@@ -570,17 +704,19 @@ class ProductSearch:
                     if pops.get(node2, 0) >= k and (k > 1 or g2 >= closed_g[node2] - 1e-9):
                         continue
                     if lazy:
-                        # weighted: push with h(here) - step cost (a consistent heuristic's
-                        # bound); the real value only if the child is popped (most never
-                        # are). The optimal search needs the real value: the heuristic is
-                        # admissible but not always consistent.
+                        # push with h(here) - step cost, the real value only if the child
+                        # is popped (most never are). It stays a lower bound of the cost
+                        # through the child (h(here) <= c + h*(child) as h is admissible),
+                        # so the optimal search (weight 1) stays optimal.
                         h = max(0.0, h_here - c)
                     else:
                         h = self.heuristic(*node2) if self.use_h else 0.0
                     if g2 + h > bound:
                         continue
                     labels.append((node2, lab, i, g2, m2))
-                    heapq.heappush(heap, (g2 + self.weight * h, -g2, next(tie),
+                    depth.append(depth[lab] + 1)
+                    heapq.heappush(heap, (_key(g2 + self.weight * h), -_key(g2),
+                                          (depth[lab] + 1, next(tie)),
                                           2 if lazy else 0, len(labels) - 1, ()))
         if not out and not long_cycles:
             return self.lassos(k, start, bound, long_cycles=True)
@@ -588,10 +724,10 @@ class ProductSearch:
 
     def _tail(self, labels: list, lab: int) -> tuple[tuple[int, ...], tuple[int, ...],
                                                      tuple[int, ...]]:
-        """The last (up to :data:`TAIL_STEPS`) steps of a label's path: their tasks, the
+        """The last (up to :attr:`tail_steps`) steps of a label's path: their tasks, the
         automaton state before each, and the marks of each."""
         tasks, states, marks = [], [], []
-        while lab > 0 and len(tasks) < TAIL_STEPS:
+        while lab > 0 and len(tasks) < self.tail_steps:
             _node, parent, task, _g, m = labels[lab]
             tasks.append(task)
             marks.append(m)
@@ -704,6 +840,13 @@ class ProductSearch:
             s, c = nxt
             total += c
         return total
+
+
+def _key(f: float) -> float:
+    """A priority rounded to :data:`KEY_DIGITS` decimals: costs summed in another order
+    differ in the last bits, and equal costs must tie so that the deeper node wins (many
+    orders of the same trips cost the same), then the path with fewer steps."""
+    return round(f, KEY_DIGITS)
 
 
 def seeded_noise(seed: int, factor: float) -> Callable[[tuple, int], float]:

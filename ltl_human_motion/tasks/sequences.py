@@ -40,6 +40,7 @@ from ltl_human_motion.tasks.product import (
     SearchBudgetError,
     seeded_noise,
 )
+from ltl_human_motion.tasks.recurrence import cycle_steps, refuse_many_recurrences
 
 __all__ = ["MODES", "RANDOM_COST_FACTOR", "PlanStats", "has_geometry", "plan_sequences",
            "product_search", "task_steps"]
@@ -53,8 +54,10 @@ RANDOM_COST_FACTOR = 1.25
 #: A* weights and work budgets tried in turn when a search exceeds its budget: the
 #: optimal A* first, then weighted A* (at most ``weight`` times the optimum), the last
 #: greedy. Work = nodes expanded times candidate steps (~20-50 us each on this machine),
-#: so a budget bounds the time whatever the number of steps.
-WEIGHT_LADDER = ((1.0, 8_000), (1.2, 12_000), (1.5, 100_000), (3.0, 200_000),
+#: so a budget bounds the time whatever the number of steps. The first budget lets the
+#: optimal search answer 20-part kitting ("grasp", "move each part", the response
+#: family: 205-247 nodes, bench/task_planning.py); the precedence family goes on to 1.2.
+WEIGHT_LADDER = ((1.0, 16_000), (1.2, 12_000), (1.5, 100_000), (3.0, 200_000),
                  (1e6, 1_000_000))
 
 #: Longest cycle made of a prefix's own last steps that is tried (each try is one
@@ -100,10 +103,20 @@ def has_geometry(cell: object) -> bool:
                 and all(hasattr(o, "position") for o in objects.values()))
 
 
-def task_steps(spec: Specification, model: CellModel) -> tuple[list[Atom], list[frozenset[str]]]:
+def task_steps(spec: Specification, model: CellModel, releases: str = "needed"
+               ) -> tuple[list[Atom], list[frozenset[str]]]:
     """Candidate steps: the specification's, plus ``grasp`` of every part a step handles,
     and ``release`` of it when the hands cannot hold them all (a worker picks parts up
-    and puts them down between the tasks the specification names), with their letters."""
+    and puts them down between the tasks the specification names), with their letters.
+
+    ``releases="needed"`` adds a ``release`` only for a part that no step of the
+    specification sets down or uses up (``move``, ``insert``, ``release``, a two-hand
+    shorthand): putting down a part that the specification will have carried elsewhere
+    is a detour a foreman would not accept. ``"all"`` adds one for every handled part
+    (the fallback when the first product has no lasso, and the yardstick of the
+    benchmark's exhaustive search)."""
+    if releases not in ("needed", "all"):
+        raise ValueError(f"releases must be 'needed' or 'all', got {releases!r}")
     tasks = list(spec.tasks)
     handled = [t.args[0] for t in spec.tasks if t.name in _PART_TASKS
                and len(t.args) > _PART_TASKS[t.name] and t.args[0] in model.part_index]
@@ -112,8 +125,17 @@ def task_steps(spec: Specification, model: CellModel) -> tuple[list[Atom], list[
     # hold every part it handles at once: otherwise a search may put a part down to have
     # it nearer next time (S2 over several cycles put O2 down beside O1, never assembling it).
     width = sum(2 if model.two_handed[model.part_index[p]] else 1 for p in handled)
-    helpers = ("grasp", "release") if width > model.limits.hands else ("grasp",)
+    freed: set[str] = set()
+    if releases == "needed":
+        for t in spec.tasks:
+            kind = model.kind(t)[0]
+            if kind == "assemble":
+                freed.update(handled)
+            elif kind in ("move", "insert", "release") and t.args:
+                freed.add(t.args[0])
     for part in handled:
+        helpers = ("grasp", "release") if width > model.limits.hands \
+            and part not in freed else ("grasp",)
         for helper in helpers:
             a = Atom(helper, (part,))
             if a not in tasks:
@@ -129,33 +151,46 @@ def _search_formula(spec: Specification):
 
 
 def product_search(spec: Specification, model: CellModel, backend: str = "builtin",
-                   repetitions: int = 1, **kwargs) -> tuple[ProductSearch, list[Atom],
-                                                            list[frozenset[str]]]:
+                   repetitions: int = 1, releases: str = "needed", **kwargs
+                   ) -> tuple[ProductSearch, list[Atom], list[frozenset[str]]]:
     """A :class:`ProductSearch` of ``spec`` in ``model`` (on-the-fly tableau, or the
-    explicit automaton of Spot for ``backend="spot"``)."""
-    tasks, letters = task_steps(spec, model)
+    explicit automaton of Spot for ``backend="spot"``) over the candidate steps of
+    :func:`task_steps` (``releases``)."""
+    tasks, letters = task_steps(spec, model, releases)
     if resolve_backend(backend) == "spot":
         view = ExplicitView(translate(spec.formula, backend="spot"), letters)
     else:
         view = LetterTableau(_search_formula(spec), letters)
-    return ProductSearch(view, model, tasks, repetitions=repetitions, **kwargs), tasks, letters
+    search = ProductSearch(view, model, tasks, repetitions=repetitions, **kwargs)
+    search.tail_steps = max(search.tail_steps, cycle_steps(spec, model, tasks, letters))
+    return search, tasks, letters
 
 
 def _ladder(spec: Specification, model: CellModel, backend: str, reps: int, k: int,
-            stats: PlanStats, noise=None) -> tuple[ProductSearch, list[Atom],
-                                                   list[frozenset[str]], list[Lasso]]:
+            stats: PlanStats, noise=None, reuse: ProductSearch | None = None,
+            releases: str = "needed"
+            ) -> tuple[ProductSearch, list[Atom], list[frozenset[str]], list[Lasso]]:
     """The cheapest ``k`` lassos by the first search of :data:`WEIGHT_LADDER` that ends
-    within its budget (weight 1: cost-optimal; ``stats.weight`` records it)."""
+    within its budget (weight 1: cost-optimal; ``stats.weight`` records it). The rungs
+    share one search (automaton and memos); ``reuse`` shares an earlier one's (same
+    ``spec``, ``model`` and ``reps``). When the product over the needed releases has no
+    lasso, the one over every release is searched (:func:`task_steps`)."""
+    if reuse is not None and reuse.repetitions == reps:
+        search, tasks, letters = reuse, list(reuse.tasks), list(reuse.aut.letters)
+    else:
+        search, tasks, letters = product_search(spec, model, backend, reps,
+                                                releases=releases)
     for weight, budget in WEIGHT_LADDER:
-        search, tasks, letters = product_search(spec, model, backend, reps, weight=weight,
-                                                budget=1, cost_noise=noise)
-        search.budget = max(50, budget // len(tasks))
+        search.configure(weight, max(50, budget // len(tasks)), noise)
         try:
             found = search.lassos(k)
         except SearchBudgetError:
             stats.expanded += search.expanded
             continue
         stats.expanded += search.expanded
+        if not found and releases == "needed" \
+                and len(task_steps(spec, model, "all")[0]) > len(tasks):
+            return _ladder(spec, model, backend, reps, k, stats, noise, releases="all")
         if noise is None:
             stats.weight = weight
         return search, tasks, letters, found
@@ -278,6 +313,7 @@ def plan_sequences(spec: str | Specification, cell: object, n: int | None = 5, s
         return seqs, stats
     want = n if n is not None else (5 if mode == "random" else 20)
     model = CellModel.from_cell(cell, limits)
+    refuse_many_recurrences(spec, task_steps(spec, model)[1])
     reps = cycles
     t0 = time.perf_counter()
     k = 3 * want if mode == "all" else 1     # equal words from other lassos are dropped
@@ -300,12 +336,14 @@ def plan_sequences(spec: str | Specification, cell: object, n: int | None = 5, s
             if len(emit.out) >= want:
                 break
             noise = seeded_noise(seed * 1_000_003 + r, RANDOM_COST_FACTOR)
-            _s, _t, _l, more = _ladder(spec, model, backend, reps, 1, stats, noise)
+            _s, _t, _l, more = _ladder(spec, model, backend, reps, 1, stats, noise,
+                                       reuse=search)
             for lasso in more:
                 emit.add(lasso)
         if len(emit.out) < want:     # few distinct optima under noise: the next cheapest
             limit = RANDOM_COST_FACTOR * emit.stats.costs[0]
-            _s, _t, _l, more = _ladder(spec, model, backend, reps, 3 * want, stats)
+            _s, _t, _l, more = _ladder(spec, model, backend, reps, 3 * want, stats,
+                                       reuse=search)
             for lasso in more:
                 if len(emit.out) < want and lasso.cost <= limit:
                     emit.add(lasso)
