@@ -29,10 +29,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ltl_human_motion.kernel.segments import min_signed_distance
+from ltl_human_motion.kernel.segments import batched_min_signed_distances
 from ltl_human_motion.robot.coexistence import ControlDecision, ssm_command
 from ltl_human_motion.robot.kinematics import URModel, robot_capsules, ur_model
-from ltl_human_motion.robot.metrics import commissioning_metrics
+from ltl_human_motion.robot.metrics import metrics_from_columns
 from ltl_human_motion.robot.sim.trajectory import JointTrajectory
 from ltl_human_motion.robot.ssm import SSMParameters, predictive_separation
 from ltl_human_motion.scene.occupancy import capsules_from_positions
@@ -95,8 +95,8 @@ def batched_separations(P: np.ndarray, p_radii: np.ndarray, Q: np.ndarray,
     """Minimum signed capsule separation per batch entry, shape (M,).
 
     ``min_signed_distance(P[i], p_radii, Q[i], q_radii)`` for every ``i``, with the one
-    exact kernel the live loop uses (:mod:`ltl_human_motion.kernel.segments`), so offline
-    and live decisions see the same numbers.
+    exact kernel the live loop uses (:mod:`ltl_human_motion.kernel.segments`, its batched
+    entry point), so offline and live decisions see the same numbers.
 
     Parameters
     ----------
@@ -105,8 +105,7 @@ def batched_separations(P: np.ndarray, p_radii: np.ndarray, Q: np.ndarray,
     Q : ndarray, shape (M, L, 2, 3)
     q_radii : ndarray, shape (L,)
     """
-    return np.array([min_signed_distance(P[i], p_radii, Q[i], q_radii)
-                     for i in range(len(P))], dtype=np.float64).reshape(len(P))
+    return batched_min_signed_distances(P, p_radii, Q, q_radii)
 
 
 def _violations(t: np.ndarray, dt: float, below: np.ndarray, sep: np.ndarray,
@@ -253,9 +252,11 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
     result = OfflineSSMResult(t, slider, sep, tau, modes)
     cycles = np.flatnonzero(np.diff(np.floor(tau / trajectory.cycle_time)) > 0)
     cycle_times = np.diff(np.concatenate([[0.0], (cycles + 1) * dt])).tolist()
-    metrics = commissioning_metrics(result.decisions(sp), cycle_times,
-                                    trajectory.cycle_time, params.max_slider,
-                                    params.min_slider)
+    columns = {"time": t, "slider": slider, "separation": sep,
+               "effective_separation": sep, "protective_distance": np.full(n, sp),
+               "mode": modes}
+    metrics = metrics_from_columns(columns, cycle_times, trajectory.cycle_time,
+                                   params.max_slider, params.min_slider)
     ratio = float((tau[-1] - tau[0]) / (n * dt))
     below = sep < sp
     metrics["violations"] = _violations(t, dt, below, sep, slider, params.min_slider)
