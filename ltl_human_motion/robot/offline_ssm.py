@@ -180,6 +180,7 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
     tau[0] = trajectory_start
     full = params.max_slider
     rrad = np.asarray(m.link_radii, dtype=np.float64)
+    rmax = float(rrad.max())
     sp = params.protective_distance
     band = sp + params.margin
     hlo = (hseg.min(axis=2) - hrad[:, None]).min(axis=1)            # (T, 3) body boxes
@@ -202,8 +203,9 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
         # the command is full speed whatever it is (their separations stay NaN).
         need = np.ones(M, dtype=bool)
         if guess >= full:
-            rlo = rseg.min(axis=(1, 2)) - rrad.max()
-            rhi = rseg.max(axis=(1, 2)) + rrad.max()
+            ends = rseg.reshape(M, -1, 3)       # all end points of a step's capsules
+            rlo = ends.min(axis=1) - rmax
+            rhi = ends.max(axis=1) + rmax
             lb[idx] = _box_gap(hlo[frame[idx]], hhi[frame[idx]], rlo, rhi)
             bound = lb[idx]
             for h in range(n_pred):
@@ -220,22 +222,32 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
             pred = np.full((M, n_pred), np.nan)
             pred[need] = batched_separations(hseg[pf], hrad, rrep, rrad).reshape(-1, n_pred)
         n_eval += int(need.sum())
-        accepted = 0
-        for i in range(len(idx)):
-            if not need[i]:
-                sl, mode = full, "full"
-            elif n_pred:
+        # Commands in step order up to the first that differs from ``guess``: steps that
+        # need no distance run at full speed (== guess, as they only occur at full speed).
+        M = len(idx)
+        accepted = M
+        for i in np.flatnonzero(need).tolist():
+            if n_pred:
                 sl, mode = ssm_command(predictive_separation(float(cur[i]), pred[i], horizons,
                                                              params), params)
             else:
                 sl, mode = ssm_command(float(cur[i]), params)
-            j = k + i
-            slider[j], modes[j], sep[j] = sl, mode, cur[i]
-            tau[j + 1] = tau[j] + dt * sl
-            accepted = i + 1
             if sl != guess:
-                guess = sl
+                slider[k + i], modes[k + i] = sl, mode
+                accepted = i + 1
                 break
+            modes[k + i] = mode
+        else:
+            sl = guess
+        head = slice(k, k + accepted)
+        slider[k:k + accepted - 1] = guess
+        slider[k + accepted - 1] = sl
+        modes[head][~need[:accepted]] = "full"
+        sep[head] = cur[:accepted]
+        # tau[j + 1] = tau[j] + dt * slider[j], added in step order as a loop would.
+        tau[k:k + accepted + 1] = np.cumsum(np.concatenate(([tau[k]],
+                                                           dt * slider[head])))
+        guess = sl
         if params.min_slider < guess < full:
             look = 1           # reduced speed follows the separation: it changes every step
         else:
