@@ -232,11 +232,10 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
                                                              params), params)
             else:
                 sl, mode = ssm_command(float(cur[i]), params)
+            modes[k + i] = mode
             if sl != guess:
-                slider[k + i], modes[k + i] = sl, mode
                 accepted = i + 1
                 break
-            modes[k + i] = mode
         else:
             sl = guess
         head = slice(k, k + accepted)
