@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from ltl_human_motion.kernel.segments import min_signed_distance
 from ltl_human_motion.robot.coexistence import CoexistenceController
 from ltl_human_motion.robot.kinematics import pose_from_xyz_rpy, robot_capsules, ur_model
 from ltl_human_motion.robot.offline_ssm import CONTROL_RATE, batched_separations, run_offline_ssm
@@ -56,6 +57,10 @@ def test_batched_kernel_equals_live_kernel(robot, s1):
     got = batched_separations(P, pr, Q, qr)
     want = [signed_distances(a, pr, b, qr).min() for a, b in zip(P, Q)]
     assert np.allclose(got, want, atol=1e-9, rtol=0)
+    # Bit for bit the live loop's one-query function (same pair kernel, same order).
+    assert got.tolist() == [min_signed_distance(a, pr, b, qr) for a, b in zip(P, Q)]
+    with pytest.raises(ValueError, match="batched capsules"):
+        batched_separations(P[0], pr, Q[0], qr)
 
 
 class _Clock:

@@ -244,7 +244,8 @@ def assess_motion(synth: SynthesizedMotion, masses: Mapping[str, float] | None =
         d = abs(ends[1]["V"] - ends[0]["V"])
         mass = float(masses.get(lf.obj, 1.0))
         res = [niosh_lift(mass, e["H"], e["V"], d, e["A"], freq, settings.duration,
-                          settings.niosh_coupling).to_dict() for e in ends]
+                          settings.niosh_coupling, v_origin_cm=ends[0]["V"]).to_dict()
+               for e in ends]
         lift_rows.append({"object": lf.obj, "start": lf.start / fps, "end": lf.end / fps,
                           "hand": "left" if lf.hand == 0 else "right", "origin": res[0],
                           "destination": res[1], "LI": max(res[0]["LI"], res[1]["LI"])})

@@ -99,6 +99,22 @@ def group_min_signed(P, pr, Q, qr, starts, out) -> None:
 
 
 @_jit
+def batched_min_signed(P, pr, Q, qr, out) -> None:
+    """out[m] = minimum separation of capsules P[m] (M, K, 2, 3) against Q[m] (M, L, 2, 3),
+    pair by pair as :func:`group_min_signed` with one group."""
+    for m in range(P.shape[0]):
+        Pm = P[m]
+        Qm = Q[m]
+        best = np.inf
+        for k in range(Pm.shape[0]):
+            for j in range(Qm.shape[0]):
+                d = _pair_of(Pm, k, Qm, j) - pr[k] - qr[j]
+                if d < best:
+                    best = d
+        out[m] = best
+
+
+@_jit
 def elementwise(A, B, out) -> None:
     """out[n] = distance of segments A[n] (N, 2, 3) and B[n] (N, 2, 3)."""
     for n in range(A.shape[0]):

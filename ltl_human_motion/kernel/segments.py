@@ -27,6 +27,7 @@ from ltl_human_motion.kernel.segment_constants import EPS, PARALLEL, TINY
 __all__ = [
     "MAX_COORDINATE",
     "MAX_RADIUS",
+    "batched_min_signed_distances",
     "check_capsules",
     "compiled",
     "group_min_signed_distances",
@@ -349,6 +350,37 @@ def min_signed_distance(P: ArrayLike, p_radii: ArrayLike, Q: ArrayLike,
 
 
 _ONE_GROUP = np.zeros(1, dtype=np.intp)
+
+
+def batched_min_signed_distances(P: ArrayLike, p_radii: ArrayLike, Q: ArrayLike,
+                                 q_radii: ArrayLike) -> NDArray[np.float64]:
+    """``min_signed_distance(P[m], p_radii, Q[m], q_radii)`` for every ``m``, in one call.
+
+    The same numbers as the one-query function (same pair kernel, same order), for many
+    independent queries, e.g. the control steps of an offline run.
+
+    Parameters
+    ----------
+    P : array-like, shape (M, K, 2, 3)
+    p_radii : array-like, shape (K,)
+    Q : array-like, shape (M, L, 2, 3)
+    q_radii : array-like, shape (L,)
+
+    Returns
+    -------
+    minima : ndarray, shape (M,)
+    """
+    P, pr, Q, qr = _contiguous(P, p_radii, Q, q_radii)
+    if P.ndim != 4 or Q.ndim != 4 or len(P) != len(Q):
+        raise ValueError(f"batched capsules: expected (M, K, 2, 3) and (M, L, 2, 3), got "
+                         f"{P.shape} and {Q.shape}")
+    nb = _compiled()
+    if nb is None:
+        return np.array([min_signed_distance(P[m], pr, Q[m], qr) for m in range(len(P))],
+                        dtype=np.float64).reshape(len(P))
+    out = np.empty(len(P))
+    nb.batched_min_signed(P, pr, Q, qr, out)
+    return out
 
 
 def group_min_signed_distances(P: ArrayLike, p_radii: ArrayLike, Q: ArrayLike,

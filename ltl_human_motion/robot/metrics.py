@@ -20,8 +20,8 @@ import numpy as np
 from ltl_human_motion.atomic import atomic_path, atomic_write_text
 from ltl_human_motion.robot.coexistence import ControlDecision
 
-__all__ = ["DecisionRecorder", "commissioning_metrics", "plot_commissioning",
-           "write_commissioning_report"]
+__all__ = ["DecisionRecorder", "commissioning_metrics", "metrics_from_columns",
+           "plot_commissioning", "write_commissioning_report"]
 
 
 class DecisionRecorder:
@@ -94,8 +94,19 @@ def commissioning_metrics(decisions: Sequence[ControlDecision],
     """
     if not decisions:
         raise ValueError("commissioning_metrics needs at least one decision")
-    c = _columns(decisions)
+    return metrics_from_columns(_columns(decisions), cycle_times, baseline_cycle_time,
+                                max_slider, min_slider)
+
+
+def metrics_from_columns(c: dict[str, np.ndarray], cycle_times: Sequence[float] = (),
+                         baseline_cycle_time: float | None = None, max_slider: float = 1.0,
+                         min_slider: float = 0.01) -> dict[str, Any]:
+    """:func:`commissioning_metrics` of a run given as columns (the arrays of
+    :meth:`DecisionRecorder.arrays`: ``time``, ``slider``, ``separation``,
+    ``protective_distance``, each (N,), and ``mode`` (N,) str), e.g. an offline run's."""
     t = c["time"]
+    if len(t) == 0:
+        raise ValueError("commissioning_metrics needs at least one decision")
     if np.any(np.diff(t) < 0):
         raise ValueError("decisions must be in time order")
     dt = _durations(t)
@@ -123,7 +134,7 @@ def commissioning_metrics(decisions: Sequence[ControlDecision],
     duration = float(t[-1] - t[0] + dt[-1])
     return {
         "duration": duration,
-        "steps": len(decisions),
+        "steps": len(t),
         "rate_hz": float((len(t) - 1) / (t[-1] - t[0])) if len(t) > 1 and t[-1] > t[0]
         else None,
         "min_separation": None if imin is None else float(sep[imin]),

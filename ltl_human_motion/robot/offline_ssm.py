@@ -29,10 +29,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ltl_human_motion.kernel.segments import min_signed_distance
+from ltl_human_motion.kernel.segments import batched_min_signed_distances
 from ltl_human_motion.robot.coexistence import ControlDecision, ssm_command
 from ltl_human_motion.robot.kinematics import URModel, robot_capsules, ur_model
-from ltl_human_motion.robot.metrics import commissioning_metrics
+from ltl_human_motion.robot.metrics import metrics_from_columns
 from ltl_human_motion.robot.sim.trajectory import JointTrajectory
 from ltl_human_motion.robot.ssm import SSMParameters, predictive_separation
 from ltl_human_motion.scene.occupancy import capsules_from_positions
@@ -95,8 +95,8 @@ def batched_separations(P: np.ndarray, p_radii: np.ndarray, Q: np.ndarray,
     """Minimum signed capsule separation per batch entry, shape (M,).
 
     ``min_signed_distance(P[i], p_radii, Q[i], q_radii)`` for every ``i``, with the one
-    exact kernel the live loop uses (:mod:`ltl_human_motion.kernel.segments`), so offline
-    and live decisions see the same numbers.
+    exact kernel the live loop uses (:mod:`ltl_human_motion.kernel.segments`, its batched
+    entry point), so offline and live decisions see the same numbers.
 
     Parameters
     ----------
@@ -105,8 +105,7 @@ def batched_separations(P: np.ndarray, p_radii: np.ndarray, Q: np.ndarray,
     Q : ndarray, shape (M, L, 2, 3)
     q_radii : ndarray, shape (L,)
     """
-    return np.array([min_signed_distance(P[i], p_radii, Q[i], q_radii)
-                     for i in range(len(P))], dtype=np.float64).reshape(len(P))
+    return batched_min_signed_distances(P, p_radii, Q, q_radii)
 
 
 def _violations(t: np.ndarray, dt: float, below: np.ndarray, sep: np.ndarray,
@@ -181,6 +180,7 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
     tau[0] = trajectory_start
     full = params.max_slider
     rrad = np.asarray(m.link_radii, dtype=np.float64)
+    rmax = float(rrad.max())
     sp = params.protective_distance
     band = sp + params.margin
     hlo = (hseg.min(axis=2) - hrad[:, None]).min(axis=1)            # (T, 3) body boxes
@@ -203,8 +203,9 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
         # the command is full speed whatever it is (their separations stay NaN).
         need = np.ones(M, dtype=bool)
         if guess >= full:
-            rlo = rseg.min(axis=(1, 2)) - rrad.max()
-            rhi = rseg.max(axis=(1, 2)) + rrad.max()
+            ends = rseg.reshape(M, -1, 3)       # all end points of a step's capsules
+            rlo = ends.min(axis=1) - rmax
+            rhi = ends.max(axis=1) + rmax
             lb[idx] = _box_gap(hlo[frame[idx]], hhi[frame[idx]], rlo, rhi)
             bound = lb[idx]
             for h in range(n_pred):
@@ -221,22 +222,31 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
             pred = np.full((M, n_pred), np.nan)
             pred[need] = batched_separations(hseg[pf], hrad, rrep, rrad).reshape(-1, n_pred)
         n_eval += int(need.sum())
-        accepted = 0
-        for i in range(len(idx)):
-            if not need[i]:
-                sl, mode = full, "full"
-            elif n_pred:
+        # Commands in step order up to the first that differs from ``guess``: steps that
+        # need no distance run at full speed (== guess, as they only occur at full speed).
+        M = len(idx)
+        accepted = M
+        for i in np.flatnonzero(need).tolist():
+            if n_pred:
                 sl, mode = ssm_command(predictive_separation(float(cur[i]), pred[i], horizons,
                                                              params), params)
             else:
                 sl, mode = ssm_command(float(cur[i]), params)
-            j = k + i
-            slider[j], modes[j], sep[j] = sl, mode, cur[i]
-            tau[j + 1] = tau[j] + dt * sl
-            accepted = i + 1
+            modes[k + i] = mode
             if sl != guess:
-                guess = sl
+                accepted = i + 1
                 break
+        else:
+            sl = guess
+        head = slice(k, k + accepted)
+        slider[k:k + accepted - 1] = guess
+        slider[k + accepted - 1] = sl
+        modes[head][~need[:accepted]] = "full"
+        sep[head] = cur[:accepted]
+        # tau[j + 1] = tau[j] + dt * slider[j], added in step order as a loop would.
+        tau[k:k + accepted + 1] = np.cumsum(np.concatenate(([tau[k]],
+                                                           dt * slider[head])))
+        guess = sl
         if params.min_slider < guess < full:
             look = 1           # reduced speed follows the separation: it changes every step
         else:
@@ -253,9 +263,11 @@ def run_offline_ssm(positions: ArrayLike, fps: float, trajectory: JointTrajector
     result = OfflineSSMResult(t, slider, sep, tau, modes)
     cycles = np.flatnonzero(np.diff(np.floor(tau / trajectory.cycle_time)) > 0)
     cycle_times = np.diff(np.concatenate([[0.0], (cycles + 1) * dt])).tolist()
-    metrics = commissioning_metrics(result.decisions(sp), cycle_times,
-                                    trajectory.cycle_time, params.max_slider,
-                                    params.min_slider)
+    columns = {"time": t, "slider": slider, "separation": sep,
+               "effective_separation": sep, "protective_distance": np.full(n, sp),
+               "mode": modes}
+    metrics = metrics_from_columns(columns, cycle_times, trajectory.cycle_time,
+                                   params.max_slider, params.min_slider)
     ratio = float((tau[-1] - tau[0]) / (n * dt))
     below = sep < sp
     metrics["violations"] = _violations(t, dt, below, sep, slider, params.min_slider)

@@ -132,7 +132,9 @@ def _floor_plan(ax, cell) -> None:
                                ls="--", ec="black", lw=0.8, zorder=4))
         ax.text(reg.lo[0], reg.lo[1] - 0.12, name, fontsize=8, zorder=5)
     for name, obj in cell.objects.items():
-        ax.plot(*obj.position[:2], "s", color=obj.color or "black", ms=6, zorder=5)
+        # A black edge keeps a part's square apart from the heat map's cells.
+        ax.plot(*obj.position[:2], "s", color=obj.color or "black", ms=7, mec="black",
+                mew=1.2, zorder=5)
         ax.text(obj.position[0] + 0.06, obj.position[1] + 0.06, name, fontsize=8, zorder=5)
 
 
@@ -150,9 +152,25 @@ def _extent(cell, paths: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     return lo[:2], hi[:2]
 
 
+Bounds = tuple[np.ndarray, np.ndarray]
+
+
+def _occupancy(paths: Sequence[np.ndarray], bounds: Bounds, cell_size: float, rate: float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Seconds per motion in each floor square: H (nx, ny) and the bin edges x, y."""
+    lo, hi = bounds
+    bx = np.arange(lo[0], hi[0] + cell_size, cell_size)
+    by = np.arange(lo[1], hi[1] + cell_size, cell_size)
+    pts = np.concatenate(paths) if paths else np.zeros((0, 2))
+    H, _, _ = np.histogram2d(pts[:, 0], pts[:, 1], bins=[bx, by])
+    return H / rate / max(len(paths), 1), bx, by
+
+
 def plot_spaghetti(cell, paths: Sequence[np.ndarray], path: Path, title: str,
-                   robot: dict[str, Any] | None = None) -> Path:
-    """Floor plan with every worker path (pelvis) of a layout."""
+                   robot: dict[str, Any] | None = None, bounds: Bounds | None = None
+                   ) -> Path:
+    """Floor plan with every worker path (pelvis) of a layout (``bounds``: the plotted
+    floor (lo (2,), hi (2,)), shared by the layouts of a comparison)."""
     fig = new_figure(6.0, 5.6, dpi=110)
     ax = fig.add_subplot(111)
     _floor_plan(ax, cell)
@@ -160,7 +178,7 @@ def plot_spaghetti(cell, paths: Sequence[np.ndarray], path: Path, title: str,
     alpha = float(np.clip(8.0 / max(len(paths), 1), 0.05, 0.6))
     for p in paths:
         ax.plot(p[:, 0], p[:, 1], color="tab:blue", lw=0.8, alpha=alpha, zorder=2)
-    lo, hi = _extent(cell, paths)
+    lo, hi = bounds if bounds is not None else _extent(cell, paths)
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_aspect("equal")
@@ -174,18 +192,17 @@ def plot_spaghetti(cell, paths: Sequence[np.ndarray], path: Path, title: str,
 
 def plot_heatmap(cell, paths: Sequence[np.ndarray], path: Path, title: str,
                  robot: dict[str, Any] | None = None, cell_size: float = 0.1,
-                 rate: float = 10.0) -> Path:
-    """Floor occupancy: seconds per motion spent in each ``cell_size`` square."""
+                 rate: float = 10.0, bounds: Bounds | None = None,
+                 vmax: float | None = None) -> Path:
+    """Floor occupancy: seconds per motion spent in each ``cell_size`` square (``bounds``
+    and ``vmax``, the top of the colour scale, shared by the layouts of a comparison)."""
     fig = new_figure(6.6, 5.6, dpi=110)
     ax = fig.add_subplot(111)
-    lo, hi = _extent(cell, paths)
-    bx = np.arange(lo[0], hi[0] + cell_size, cell_size)
-    by = np.arange(lo[1], hi[1] + cell_size, cell_size)
-    pts = np.concatenate(paths) if paths else np.zeros((0, 2))
-    H, _, _ = np.histogram2d(pts[:, 0], pts[:, 1], bins=[bx, by])
-    H = H / rate / max(len(paths), 1)
+    lo, hi = bounds if bounds is not None else _extent(cell, paths)
+    H, bx, by = _occupancy(paths, (lo, hi), cell_size, rate)
     im = ax.imshow(np.where(H > 0, H, np.nan).T, origin="lower", cmap="magma_r",
-                   extent=(bx[0], bx[-1], by[0], by[-1]), zorder=1, interpolation="nearest")
+                   extent=(bx[0], bx[-1], by[0], by[-1]), zorder=1, interpolation="nearest",
+                   vmin=0.0, vmax=vmax)
     fig.colorbar(im, ax=ax, label=f"s per motion in {cell_size * 100:.0f} cm squares",
                  shrink=0.85)
     _floor_plan(ax, cell)
@@ -219,10 +236,13 @@ def plot_distributions(layouts: Sequence[dict[str, Any]], path: Path,
         else:
             if key == "reba_max":
                 bins = np.arange(0.5, 16.0, 1.0)
-                for (a, b), color in zip(((0.5, 1.5), (1.5, 3.5), (3.5, 7.5), (7.5, 10.5),
-                                          (10.5, 15.5)), ("#e8f5e9", "#fffde7", "#fff3e0",
-                                                           "#ffebee", "#f8bbd0")):
+                for (a, b), color, name in zip(
+                        ((0.5, 1.5), (1.5, 3.5), (3.5, 7.5), (7.5, 10.5), (10.5, 15.5)),
+                        ("#e8f5e9", "#fffde7", "#fff3e0", "#ffebee", "#f8bbd0"),
+                        ("negl.", "low", "medium", "high", "very high")):
                     ax.axvspan(a, b, color=color, zorder=0)
+                    ax.text(0.5 * (a + b), 1.01, name, ha="center", va="bottom", fontsize=7,
+                            transform=ax.get_xaxis_transform())
                 ax.set_xticks(range(1, 16))
             else:
                 lo = min(allv.min(), ref) if ref is not None else allv.min()
@@ -231,8 +251,9 @@ def plot_distributions(layouts: Sequence[dict[str, Any]], path: Path,
                 bins = np.linspace(lo - 0.05 * span, hi + 0.05 * span, 31)
             for lay, x, color in zip(layouts, data, _COLORS):
                 if x.size:
-                    ax.hist(x, bins=bins, alpha=0.55, color=color,
+                    ax.hist(x, bins=bins, alpha=0.45, color=color,
                             label=f"{lay['label']} (mean {x.mean():.3g})")
+                    ax.hist(x, bins=bins, histtype="step", color=color, lw=1.4)
             if ref is not None:
                 ax.axvline(ref, color="red", ls=":", lw=1.5,
                            label="S_p" if key == "min_separation" else "LI = 1")
@@ -348,13 +369,18 @@ def write_report(layouts: Sequence[dict[str, Any]], out: Path, meta: dict[str, A
                 break
     pngs = {"distributions": plot_distributions(layouts, out / "distributions.png", sp),
             "breakdown": plot_breakdown(layouts, out / "cycle_breakdown.png")}
+    # One floor and one colour scale for all layouts, so their plots compare by eye.
+    ext = [_extent(cells[lay["label"]], lay["paths"]) for lay in layouts]
+    bounds = (np.min([e[0] for e in ext], axis=0), np.max([e[1] for e in ext], axis=0))
+    vmax = max((float(_occupancy(lay["paths"], bounds, 0.1, 10.0)[0].max(initial=0.0))
+                for lay in layouts), default=0.0) or None
     for lay in layouts:
         lb = lay["label"]
         pngs[f"spaghetti_{lb}"] = plot_spaghetti(cells[lb], lay["paths"],
                                                  out / f"spaghetti_{lb}.png",
-                                                 f"layout {lb}", robot)
+                                                 f"layout {lb}", robot, bounds)
         pngs[f"heatmap_{lb}"] = plot_heatmap(cells[lb], lay["paths"], out / f"heatmap_{lb}.png",
-                                             f"layout {lb}", robot)
+                                             f"layout {lb}", robot, bounds=bounds, vmax=vmax)
     summaries = {lay["label"]: summarize(lay["items"]) for lay in layouts}
     comparison = compare(layouts[0]["items"], layouts[1]["items"]) if len(layouts) == 2 \
         else None
