@@ -3,6 +3,7 @@ consistent and cost-optimal first sequences, variations, explanations, the CLI."
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import pytest
@@ -226,6 +227,42 @@ def test_explicit_automaton_view_gives_the_same_optimum(paper_cell):
         assert explicit.cost == pytest.approx(onthefly.lassos(1)[0].cost)
         assert evaluate_lasso(spec.formula, [letters[i] for i in explicit.prefix],
                               [letters[i] for i in explicit.cycle])
+
+
+SPOT_REFERENCE = Path(__file__).resolve().parents[2] / "shared" / "data" / "spot-reference"
+if not SPOT_REFERENCE.is_dir():
+    SPOT_REFERENCE = Path("/work/shared/data/spot-reference")
+
+
+@pytest.mark.skipif(not (SPOT_REFERENCE / "S1_formula3.hoa").is_file(),
+                    reason="shared/data/spot-reference not present")
+def test_spots_own_automaton_gives_the_same_sequences(paper_cell):
+    """Issue 16, must-have 5: with Spot's automaton (Spot 2.12.1's output for the paper's
+    formula (3), stored as HOA; its propositions g, a renamed to the tasks) the product
+    search finds a lasso of the same cost as with ours, and physically consistent: no
+    grasp of the part in hand (the Spot backend used to give grasp(O1), grasp(O1), ...)."""
+    from ltl_human_motion.ltl import automaton_from_hoa, parse, translate
+    from ltl_human_motion.tasks import ExplicitView
+    from ltl_human_motion.tasks.sequences import task_steps
+    hoa = (SPOT_REFERENCE / "S1_formula3.hoa").read_text()
+    hoa = hoa.replace('"g"', '"grasp(O1)"').replace('"a"', '"assemble(R1)"')
+    spot = automaton_from_hoa(hoa)
+    formula = parse("grasp(O1) & G((assemble(R1) -> F grasp(O1)) & "
+                    "(grasp(O1) -> F assemble(R1)))", free_atoms=True)
+    spec = build_specification("S1", paper_cell)
+    model = CellModel.from_cell(paper_cell)
+    tasks, _ = task_steps(spec, model)
+    letters = [frozenset({str(t)}) for t in tasks]        # one task per step, as Spot's
+    ours = ProductSearch(ExplicitView(translate(formula, backend="builtin"), letters),
+                         model, tasks).lassos(1)[0]
+    lasso = ProductSearch(ExplicitView(spot, letters), model, tasks).lassos(1)[0]
+    assert lasso.cost == pytest.approx(ours.cost)
+    words = [[letters[i] for i in part] for part in (lasso.prefix, lasso.cycle)]
+    assert evaluate_lasso(formula, *words)
+    steps = [tasks[i] for i in (*lasso.prefix, *lasso.cycle)]
+    names = [str(t) for t in steps]
+    assert "grasp(O1)" in names and "assemble(R1)" in names
+    assert all(a != b for a, b in itertools.pairwise(names)), names
 
 
 def test_kitting_cell_synthesizes_a_verified_motion_end_to_end():
