@@ -217,7 +217,9 @@ SUBSET: dict[str, str | None] = {
     "under_shelf/job/low_shelf_assemble": "planning:grasp:blocked (part under a low board)",
     "bins/job/bin_to_bin": None,
     "aisle/single/walk(R2)": "planning:walk:unreachable (an aisle 0.8 m wide)",
-    "shelf_heights/single/grasp(O_shoulder)": "planning:grasp:blocked (shoulder-high shelf)",
+    "shelf_heights/single/grasp(O_shoulder)": None,
+    "shelf_heights/single/grasp(O_over)": None,
+    "kitting/single/grasp(gear)": None,
     # refused before any search, one per reason
     "shelf_heights/infeasible/F grasp(O_top)": None,
     "seats/infeasible/F sit(locker)": None,

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.motion.goals import HAND_PATHS, LEVEL_PATH_TASKS
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import (
@@ -134,6 +135,14 @@ RELEASE_SURFACE_MAX = 1.2 / 1.75
 #: Gap between a part set down and the surface under it when it is let go, metres (the
 #: cells' parts rest 1 cm above their tables).
 RELEASE_GAP = 0.01
+
+#: Raising a grasp's palm target off the part's support (:meth:`SequencePlanner.
+#: _palm_clear_of_support`): step and the gap kept to the support (the planner's goal
+#: checks need PLACED_MARGIN; blends move the palm a few mm), and how deep the palm
+#: sphere stays in the part (grasp holds when it enters), metres.
+PALM_RISE_STEP = 0.005
+PALM_SUPPORT_GAP = 0.01
+PALM_IN_PART = 0.01
 
 #: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
@@ -363,8 +372,9 @@ class SequencePlanner:
             return np.asarray(cell.region(args[-1]).center, dtype=np.float64)
         if kind in ("grasp",):
             obj = cell.object(args[0])
-            return np.asarray(obj.grasp_points_at(self.object_position(args[0]))[0],
-                              dtype=np.float64)
+            point = np.asarray(obj.grasp_points_at(self.object_position(args[0]))[0],
+                               dtype=np.float64)
+            return self._palm_clear_of_support(point, args[0])
         if kind in ("move",):
             return np.asarray(cell.region(args[1]).center, dtype=np.float64)
         if kind in ("insert", "extract"):
@@ -375,6 +385,25 @@ class SequencePlanner:
             obj = cell.object(args[0])
             return np.asarray(obj.sitting_surface_at(obj.position).center, dtype=np.float64)
         return None
+
+    def _palm_clear_of_support(self, point: np.ndarray, obj: str) -> np.ndarray:
+        """The palm target (3,) for a grasp at ``point`` (3,): the grasp point, raised by
+        up to the palm's radius where the palm sphere there would touch the support (a
+        flat part on a board): grasp holds while the palm still enters the part."""
+        cell = self.cell
+        if not cell.obstacles:
+            return point
+        from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_radii
+        radius = float(capsule_radii(self.library.skeleton.stature)[BODY_PARTS.index("r_palm")])
+        part = cell.object(obj).occupancy_at(self.object_position(obj))
+        for rise in np.arange(0.0, radius, PALM_RISE_STEP):
+            palm = point + np.array([0.0, 0.0, rise])
+            clear = float(cell.part_set.capsule_clearance(np.stack([palm, palm])[None],
+                                                          radius)[0])
+            if clear > PALM_SUPPORT_GAP:
+                inside = float(part.signed_distance(palm[None])[0])
+                return palm if inside <= radius - PALM_IN_PART else point
+        return point
 
     def object_position(self, name: str) -> np.ndarray:
         """Where object ``name`` rests now (3,): where the last step put it down, else its
@@ -735,14 +764,13 @@ class SequencePlanner:
         leave the spot otherwise."""
         from ltl_human_motion.planning.turns import make_step_primitive
         x, y, yaw = self.pose
-        need = self.options.body_radius + STEP_OUT_MARGIN
-        if float(self._clearance(np.array([[x, y]]))[0]) > need:
+        if self._walkable(x, y):
             return
         carrying = bool(self.held)
         lib = self.library
         c, s = math.cos(yaw), math.sin(yaw)
         for back in STEP_OUT_DISTANCES:
-            if float(self._clearance(np.array([[x - back * c, y - back * s]]))[0]) <= need:
+            if not self._walkable(x - back * c, y - back * s):
                 continue
             mp = make_step_primitive(self._stance(carrying), lib.standing_height, -back, 0.0,
                                      0.0, lib.skeleton, lib.fps,
@@ -751,6 +779,20 @@ class SequencePlanner:
                 self._add(mp, self.pose, -1, self.overlap)
                 self.pose = self._hand_over_pose(mp, self.pose)
                 return
+
+    def _walkable(self, x: float, y: float) -> bool:
+        """Whether a walk may start at (x, y): ``STEP_OUT_MARGIN`` more floor clearance
+        than ``options.body_radius``, and the navigation grid's cell there is free (the
+        searches start from that cell)."""
+        if float(self._clearance(np.array([[x, y]]))[0]) <= (self.options.body_radius
+                                                               + STEP_OUT_MARGIN):
+            return False
+        grid = floor_grid(self.clearance, self.cell.workspace_lo[:2],
+                          self.cell.workspace_hi[:2], self.options.body_radius,
+                          self.options.grid_resolution)
+        i = int(np.clip(np.rint((x - grid.lo[0]) / grid.res), 0, grid.shape[0] - 1))
+        j = int(np.clip(np.rint((y - grid.lo[1]) / grid.res), 0, grid.shape[1] - 1))
+        return bool(grid.free[i, j])
 
     def _first_collision(self, primitives: list[int], poses: list[Pose]) -> int | None:
         """Index of the first gait primitive of a path that comes within the planner's
@@ -1168,6 +1210,9 @@ class SequencePlanner:
         mp = None
         attempts = self.options.goal_attempts if attempts is None else attempts
         for attempt in range(attempts):
+            if kind in LEVEL_PATH_TASKS:
+                # Every other try comes in level (over a shelf board, under the one above).
+                kwargs["path"] = HAND_PATHS[attempt % len(HAND_PATHS)]
             try:
                 candidate = self._sit_still(kwargs.get("duration", 2.0)) \
                     if seated and kind == "wait" else self.library.goal(kind, local, **kwargs)
