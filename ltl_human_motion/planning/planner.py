@@ -996,6 +996,7 @@ class SequencePlanner:
         tries = self._alternatives(kind, args, target, placement, text, raised)
         failure = None
         for k, (target, prepare) in enumerate(tries):
+            mark = (len(self.segments), self.pose, self.gait_state)
             try:
                 if prepare is not None:
                     walked += prepare()
@@ -1006,14 +1007,20 @@ class SequencePlanner:
                     attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
                 break
             except PlanningError as exc:
-                if k == 0 and exc.reason != "blocked":
+                # Blocked, or out of reach from where the walk ended (it came from the
+                # side of a machine): the other placements may do; an alternative may
+                # fail in any way.
+                if k == 0 and exc.reason not in ("blocked", "unreachable"):
                     raise
-                failure = failure or exc       # an alternative may fail in any way
+                failure = failure or exc
+                # What a failed try placed (a walk, an arm transition) is taken back.
+                del self.segments[mark[0]:]
+                self.pose, self.gait_state = mark[1], mark[2]
         else:
             if len(tries) == 1:
                 raise failure
             raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements "
-                                "tried", task=text, reason="blocked")
+                                "tried", task=text, reason=failure.reason)
         hand = mp.meta.get("hand")
         joints = dict(self.held)
         effect = self._apply_effects(kind, args, hand, keep_hold)
