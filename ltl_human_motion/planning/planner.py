@@ -144,6 +144,9 @@ PALM_RISE_STEP = 0.005
 PALM_SUPPORT_GAP = 0.01
 PALM_IN_PART = 0.01
 
+#: The other hand of each hand joint.
+OTHER_HAND = {"l_hand": "r_hand", "r_hand": "l_hand"}
+
 #: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
 
@@ -1004,6 +1007,7 @@ class SequencePlanner:
                     kind, target, i, text, carry_stance=carrying_before,
                     seconds=float(args[0]) if kind == "wait" and args else None,
                     grasped=args[0] if kind == "grasp" else None,
+                    part=args[0] if kind in ("move", "insert", "release") and args else None,
                     attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
                 break
             except PlanningError as exc:
@@ -1190,13 +1194,15 @@ class SequencePlanner:
 
     def _goal_segment(self, kind: str, target: np.ndarray | None, label: int,
                       text: str, *, carry_stance: bool = False, seconds: float | None = None,
-                      grasped: str | None = None, attempts: int | None = None
-                      ) -> tuple[int, MotionPrimitive]:
+                      grasped: str | None = None, attempts: int | None = None,
+                      part: str | None = None) -> tuple[int, MotionPrimitive]:
         """Make, check and place the goal primitive of ``kind`` for ``target``.
 
         ``carry_stance``: the arms are already in the carry stance; ``seconds``: how long
         a wait lasts; ``grasped``: the part a grasp picks up (checked from contact on);
-        ``attempts``: seeded primitives tried (default ``options.goal_attempts``).
+        ``attempts``: seeded primitives tried (default ``options.goal_attempts``);
+        ``part``: the part a move, insert or release puts down (done by the hand holding
+        it). A grasp or extract while one hand holds a part is done by the other hand.
         """
         x, y, yaw = self.pose
         local = None
@@ -1204,13 +1210,16 @@ class SequencePlanner:
             c, s = math.cos(-yaw), math.sin(-yaw)
             dx, dy = target[0] - x, target[1] - y
             local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
-        hold_hand = next(iter(self.held.values()), None)
+        busy = set(self.held.values())
         seated = self.seat is not None and kind != "standUp"
         kwargs = {"rng": self.rng,
                   "start_pose": self._seated_pose() if seated
                   else self._stance(bool(self.held) or carry_stance)}
-        if kind in ("move", "insert", "extract", "release") and hold_hand:
-            kwargs["hand"] = hold_hand
+        if part is not None and part in self.held:
+            kwargs["hand"] = self.held[part]
+        elif kind in ("grasp", "extract") and len(busy) == 1:
+            kwargs["hand"] = OTHER_HAND[next(iter(busy))]
+        hand_fixed = "hand" in kwargs
         if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
             kwargs["duration"] = seconds + (2 * self.overlap + 6) / self.library.fps
@@ -1229,10 +1238,9 @@ class SequencePlanner:
             if self._goal_clear(candidate, grasped):
                 mp = candidate
                 break
-            if attempt == 1 and kind in ("grasp", "leftHand", "rightHand", "release"):
-                other = {"l_hand": "r_hand", "r_hand": "l_hand"}.get(
-                    candidate.meta.get("hand"), None)
-                if other and kind not in ("leftHand", "rightHand"):
+            if attempt == 1 and kind in ("grasp", "release") and not hand_fixed:
+                other = OTHER_HAND.get(candidate.meta.get("hand"))
+                if other:
                     kwargs["hand"] = other
         if mp is None:
             raise PlanningError(f"task {text}: every {kind} motion tried "
