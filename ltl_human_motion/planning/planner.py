@@ -144,6 +144,11 @@ PALM_RISE_STEP = 0.005
 PALM_SUPPORT_GAP = 0.01
 PALM_IN_PART = 0.01
 
+#: Floor clearance below which the navigation field counts the floor longer, metres:
+#: about half the hip and shoulder width of a 1.75 m worker (0.2 m) plus the gait's
+#: sway, more than ``PlannerOptions.body_radius`` (the least a walk needs).
+PASSAGE_RADIUS = 0.25
+
 #: The other hand of each hand joint.
 OTHER_HAND = {"l_hand": "r_hand", "r_hand": "l_hand"}
 
@@ -431,10 +436,23 @@ class SequencePlanner:
     def _field(self, goal_cells, key: tuple | None = None) -> NavigationField:
         """The navigation field of ``goal_cells`` on the floor grid. ``key``: numbers that
         determine the goal cells on this floor; fields with a key are kept (a target that
-        does not move between items, e.g. an assembly region, reuses its field)."""
+        does not move between items, e.g. an assembly region, reuses its field).
+
+        The field keeps to lanes with ``PASSAGE_RADIUS`` of clearance where they lead from
+        the worker to a goal; else it uses all floor the walk may take, counting floor
+        with less clearance longer. Either way the search does not squeeze the gait
+        through a gap the body barely fits (and exhaust its budget there) where a roomier
+        way exists."""
+        roomy = self._field_with(PASSAGE_RADIUS, goal_cells, key)
+        if roomy.has_goal and roomy.reachable_from(self.pose[0], self.pose[1]):
+            return roomy
+        return self._field_with(self.options.body_radius, goal_cells, key)
+
+    def _field_with(self, radius: float, goal_cells, key: tuple | None) -> NavigationField:
+        """:meth:`_field` on the floor grid whose free cells keep ``radius``."""
         grid = floor_grid(self.clearance, self.cell.workspace_lo[:2],
-                          self.cell.workspace_hi[:2], self.options.body_radius,
-                          self.options.grid_resolution)
+                          self.cell.workspace_hi[:2], radius, self.options.grid_resolution,
+                          passage=PASSAGE_RADIUS if radius < PASSAGE_RADIUS else None)
         if key is None:
             return NavigationField.on_grid(grid, goal_cells)
         full = (id(grid), *key)
@@ -792,7 +810,7 @@ class SequencePlanner:
             return False
         grid = floor_grid(self.clearance, self.cell.workspace_lo[:2],
                           self.cell.workspace_hi[:2], self.options.body_radius,
-                          self.options.grid_resolution)
+                          self.options.grid_resolution, passage=PASSAGE_RADIUS)
         i = int(np.clip(np.rint((x - grid.lo[0]) / grid.res), 0, grid.shape[0] - 1))
         j = int(np.clip(np.rint((y - grid.lo[1]) / grid.res), 0, grid.shape[1] - 1))
         return bool(grid.free[i, j])
