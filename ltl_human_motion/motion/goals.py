@@ -67,6 +67,7 @@ _SIDES = ("l", "r")
 _REACH_FRACTION = 0.93          # hand never further than this fraction of the arm length
 _ASSEMBLE_HALF_GAP = 0.035      # m, hands either side of an assembly target
 _INSERT_TRAVEL = 0.08           # m, straight push of insert / pull of extract
+_MAX_TRAVEL = 0.3               # m, longest push or pull asked for (a forearm's length)
 _APPROACH_LIFT = 0.08           # m, grasp/release/move come down onto low targets
 #: Peak palm speed of a goal reach, m/s at 1.75 m: under the 2.5 m/s limit of
 #: planning.biomechanics with room for the seeded bow and the body's own motion.
@@ -515,8 +516,9 @@ def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> float:
 
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
-               fps: float, path: str = "arc") -> MotionPrimitive:
+               fps: float, path: str = "arc", travel: float | None = None) -> MotionPrimitive:
     H = skeleton.stature
+    travel = _INSERT_TRAVEL if travel is None else float(travel)
     level = path == "level" and task in LEVEL_PATH_TASKS
     if target is None:
         raise ValueError(f"{task} needs a target position (3,) in the start frame")
@@ -578,7 +580,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     rel_pre = rel_home.copy()
     for k in active:
         rel_goal[k] = targets[k] - sh1[k]
-        rel_pre[k] = targets[k] - _INSERT_TRAVEL * approach - sh1[k]
+        rel_pre[k] = targets[k] - travel * approach - sh1[k]
     if task == "insert":
         push = min(0.5, 0.6 * hold)
         keys = [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
@@ -863,7 +865,7 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
                         start_pose: np.ndarray | None = None,
                         rng: np.random.Generator | None = None, duration: float | None = None,
                         hand: str = "auto", fps: float = LIBRARY_FPS,
-                        path: str = "arc") -> MotionPrimitive:
+                        path: str = "arc", travel: float | None = None) -> MotionPrimitive:
     """A goal primitive for one Table I task, made for the exact target.
 
     Parameters
@@ -896,6 +898,9 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     fps : float
     path : {"arc", "level"}
         Hand path of grasp, release and move (:data:`HAND_PATHS`); other tasks ignore it.
+    travel : float, optional
+        Length of the straight push of insert and pull of extract, metres (default
+        8 cm; a part deep in a fixture needs a longer pull to come out).
 
     Returns
     -------
@@ -921,7 +926,9 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     rng = np.random.default_rng(0) if rng is None else rng
     st = _Start(skeleton, start_pose)
     if task in HAND_TASKS:
-        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path)
+        if travel is not None and not 0.0 < float(travel) <= _MAX_TRAVEL:
+            raise ValueError(f"travel must be in (0, {_MAX_TRAVEL}] m, got {travel!r}")
+        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel)
     if task in ("bend", "stoop", "kneel"):
         return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
     if task == "wait":

@@ -149,6 +149,12 @@ PALM_IN_PART = 0.01
 #: sway, more than ``PlannerOptions.body_radius`` (the least a walk needs).
 PASSAGE_RADIUS = 0.25
 
+#: How far beyond its container an extract pulls the part, metres.
+PULL_MARGIN = 0.03
+
+#: Stride of the frames on which the planner checks that an extract takes its part out.
+EXTRACT_CHECK_STRIDE = 4
+
 #: The other hand of each hand joint.
 OTHER_HAND = {"l_hand": "r_hand", "r_hand": "l_hand"}
 
@@ -317,6 +323,16 @@ def lift_frame(mp: MotionPrimitive, hand: np.ndarray) -> int:
     hold_end = max(int(mp.meta.get("hold_frames", [contact, contact])[1]), contact)
     rose = np.flatnonzero(hand[hold_end:, 2] >= hand[contact, 2] + LIFT_RISE)
     return hold_end + int(rose[0]) if rose.size else contact
+
+
+def grip_frame(mp: MotionPrimitive) -> int:
+    """The frame of a goal primitive from which the hand holds the part it acts on: the
+    contact frame, except for extract, where the hand takes the part when it reaches it
+    (the start of the hold) and then pulls it out (its contact frame, where the part is
+    out, is the end of the pull)."""
+    if mp.task == "extract" and "hold_frames" in mp.meta:
+        return int(mp.meta["hold_frames"][0])
+    return int(mp.meta.get("contact_frame", mp.n_frames - 1))
 
 
 def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, tuple[str, ...]]:
@@ -1015,34 +1031,9 @@ class SequencePlanner:
             self._arm_transition(False, -1)
             carrying_before = True
         tries = self._alternatives(kind, args, target, placement, text, raised)
-        failure = None
-        for k, (target, prepare) in enumerate(tries):
-            mark = (len(self.segments), self.pose, self.gait_state)
-            try:
-                if prepare is not None:
-                    walked += prepare()
-                seg, mp = self._goal_segment(
-                    kind, target, i, text, carry_stance=carrying_before,
-                    seconds=float(args[0]) if kind == "wait" and args else None,
-                    grasped=args[0] if kind == "grasp" else None,
-                    part=args[0] if kind in ("move", "insert", "release") and args else None,
-                    attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
-                break
-            except PlanningError as exc:
-                # Blocked, or out of reach from where the walk ended (it came from the
-                # side of a machine): the other placements may do; an alternative may
-                # fail in any way.
-                if k == 0 and exc.reason not in ("blocked", "unreachable"):
-                    raise
-                failure = failure or exc
-                # What a failed try placed (a walk, an arm transition) is taken back.
-                del self.segments[mark[0]:]
-                self.pose, self.gait_state = mark[1], mark[2]
-        else:
-            if len(tries) == 1:
-                raise failure
-            raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements "
-                                "tried", task=text, reason=failure.reason)
+        seg, mp, target, prepared = self._first_clear_try(i, text, kind, args, tries,
+                                                          carrying_before)
+        walked += prepared
         hand = mp.meta.get("hand")
         joints = dict(self.held)
         effect = self._apply_effects(kind, args, hand, keep_hold)
@@ -1058,17 +1049,52 @@ class SequencePlanner:
             joint = next(iter(effect["attach"].values()))
             lift = lift_frame(mp, self.segments[seg].positions[:, JOINT_INDEX[joint]])
         return StepPlan(text, kind, target, walk_segments=walked, goal_segment=seg,
-                        contact_frame=int(mp.meta.get("contact_frame", mp.n_frames - 1)),
+                        contact_frame=grip_frame(mp),
                         lift_frame=lift, hand=hand, expanded=self.expanded - expanded0,
                         primitive=mp.name,
                         objects_effect=effect, sub_steps=subs)
+
+    def _first_clear_try(self, i: int, text: str, kind: str, args: tuple[str, ...],
+                         tries: list, carrying_before: bool
+                         ) -> tuple[int, MotionPrimitive, np.ndarray | None, int]:
+        """Make the goal primitive of step ``i`` from the first of ``tries`` (see
+        :meth:`_alternatives`) that works; returns (segment, primitive, the target it
+        reached, gait primitives its preparation walked). Raises the first failure, with
+        how many other placements were tried."""
+        failure = None
+        for k, (target, prepare) in enumerate(tries):
+            mark = (len(self.segments), self.pose, self.gait_state)
+            try:
+                walked = prepare() if prepare is not None else 0
+                seg, mp = self._goal_segment(
+                    kind, target, i, text, carry_stance=carrying_before,
+                    seconds=float(args[0]) if kind == "wait" and args else None,
+                    grasped=args[0] if kind == "grasp" else None,
+                    part=args[0] if kind in ("move", "insert", "release", "extract") and args
+                    else None, container=args[1] if kind == "extract" else None,
+                    attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
+                return seg, mp, target, walked
+            except PlanningError as exc:
+                # Blocked, or out of reach from where the walk ended (it came from the
+                # side of a machine): the other placements may do; an alternative may
+                # fail in any way.
+                if k == 0 and exc.reason not in ("blocked", "unreachable"):
+                    raise
+                failure = failure or exc
+                # What a failed try placed (a walk, an arm transition) is taken back.
+                del self.segments[mark[0]:]
+                self.pose, self.gait_state = mark[1], mark[2]
+        if len(tries) == 1:
+            raise failure
+        raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements tried",
+                            task=text, reason=failure.reason)
 
     def _track_objects(self, effect: dict, joints: dict[str, str], seg: int,
                        mp: MotionPrimitive) -> None:
         """Follow a step's effect on the parts as the object tracks will: a part keeps
         its world offset from the hand from the contact frame on, and rests where the
         hand let it go (``joints``: the hands holding parts before the step)."""
-        contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
+        contact = min(grip_frame(mp), mp.n_frames - 1)
         positions = self.segments[seg].positions
         for name, joint in effect.get("attach", {}).items():
             joints[name] = joint
@@ -1159,6 +1185,7 @@ class SequencePlanner:
             lowered = raised and not self.held
             if lowered:
                 self._arm_transition(True, -1)
+            self._step_out()            # the first try may have left the worker at a rack
             walked = self._approach(target, (placement[0] + back, placement[1]), text,
                                     sector=(first + turn, APPROACH_HALF_WIDTH),
                                     budget=SearchBudget(ALTERNATIVE_NODES))
@@ -1213,14 +1240,16 @@ class SequencePlanner:
     def _goal_segment(self, kind: str, target: np.ndarray | None, label: int,
                       text: str, *, carry_stance: bool = False, seconds: float | None = None,
                       grasped: str | None = None, attempts: int | None = None,
-                      part: str | None = None) -> tuple[int, MotionPrimitive]:
+                      part: str | None = None, container: str | None = None
+                      ) -> tuple[int, MotionPrimitive]:
         """Make, check and place the goal primitive of ``kind`` for ``target``.
 
         ``carry_stance``: the arms are already in the carry stance; ``seconds``: how long
         a wait lasts; ``grasped``: the part a grasp picks up (checked from contact on);
         ``attempts``: seeded primitives tried (default ``options.goal_attempts``);
         ``part``: the part a move, insert or release puts down (done by the hand holding
-        it). A grasp or extract while one hand holds a part is done by the other hand.
+        it; for extract, the part taken out of ``container``). A grasp or extract while
+        one hand holds a part is done by the other hand.
         """
         x, y, yaw = self.pose
         local = None
@@ -1233,8 +1262,10 @@ class SequencePlanner:
         kwargs = {"rng": self.rng,
                   "start_pose": self._seated_pose() if seated
                   else self._stance(bool(self.held) or carry_stance)}
-        if part is not None and part in self.held:
+        if part is not None and part in self.held and kind != "extract":
             kwargs["hand"] = self.held[part]
+        if kind == "extract" and part is not None and container is not None:
+            kwargs["travel"] = self._pull_length(part, container)
         elif kind in ("grasp", "extract") and len(busy) == 1:
             kwargs["hand"] = OTHER_HAND[next(iter(busy))]
         hand_fixed = "hand" in kwargs
@@ -1242,6 +1273,7 @@ class SequencePlanner:
             # Longer than asked by the blends at both ends, so the stillness lasts.
             kwargs["duration"] = seconds + (2 * self.overlap + 6) / self.library.fps
         mp = None
+        kept_in = 0
         attempts = self.options.goal_attempts if attempts is None else attempts
         for attempt in range(attempts):
             if kind in LEVEL_PATH_TASKS:
@@ -1253,13 +1285,23 @@ class SequencePlanner:
             except ValueError as exc:
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
-            if self._goal_clear(candidate, grasped):
+            clear = self._goal_clear(candidate, grasped)
+            if clear and kind == "extract" and part is not None and container is not None \
+                    and not self._pulls_out(candidate, part, container):
+                kept_in += 1
+                clear = False
+            if clear:
                 mp = candidate
                 break
             if attempt == 1 and kind in ("grasp", "release") and not hand_fixed:
                 other = OTHER_HAND.get(candidate.meta.get("hand"))
                 if other:
                     kwargs["hand"] = other
+        if mp is None and kept_in:
+            raise PlanningError(f"task {text}: {kept_in} of the {attempts} {kind} motions "
+                                f"tried keep {part} in {container} (the hand does not take "
+                                "it out far enough from where the worker stands), the others "
+                                "run into an obstacle", task=text, reason="blocked")
         if mp is None:
             raise PlanningError(f"task {text}: every {kind} motion tried "
                                 f"({attempts}) runs into an obstacle; "
@@ -1268,6 +1310,33 @@ class SequencePlanner:
         self.pose = self._hand_over_pose(mp, self.pose)
         self.gait_state = None
         return seg, mp
+
+    def _pull_length(self, part: str, container: str) -> float:
+        """How far an extract pulls ``part`` (m): out of ``container`` horizontally from
+        where it lies (the container's half extent beyond the part's centre plus the
+        part's half size and ``PULL_MARGIN``), at least the model's 8 cm, at most 0.3 m."""
+        lo, hi = self.cell.object(container).occupancy_at(
+            self.object_position(container)).aabb()
+        plo, phi = self.cell.object(part).occupancy_at(self.object_position(part)).aabb()
+        centre = 0.5 * (plo + phi)
+        out = min(float(np.min(np.r_[hi[:2] - centre[:2], centre[:2] - lo[:2]])),
+                  0.5 * float(np.max(hi[:2] - lo[:2])))
+        need = out + 0.5 * float(np.max(phi[:2] - plo[:2])) + PULL_MARGIN
+        return float(np.clip(need, 0.08, 0.3))
+
+    def _pulls_out(self, mp: MotionPrimitive, part: str, container: str) -> bool:
+        """Whether the hand of an extract primitive brings ``part`` (carried from the
+        contact frame on) out of ``container`` on some frame: Table I's condition, which
+        the verifier checks (a worker standing close keeps the part in a deep fixture)."""
+        from ltl_human_motion.scene.predicates import enter_object
+        joint = {"l_hand": "l_hand"}.get(mp.meta.get("hand"), "r_hand")
+        hand = world_positions(mp, *self.pose)[:, JOINT_INDEX[joint]]
+        contact = min(grip_frame(mp), len(hand) - 1)
+        obj, box = self.cell.object(part), self.cell.object(container)
+        around = box.occupancy_at(self.object_position(container))
+        offset = self.object_position(part) - hand[contact]
+        return any(not enter_object(obj.occupancy_at(p + offset), around)
+                   for p in hand[contact::EXTRACT_CHECK_STRIDE])
 
     def _goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
         """Whether the body, the objects already in the hands and the part being grasped
