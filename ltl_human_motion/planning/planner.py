@@ -436,11 +436,25 @@ class SequencePlanner:
         return np.asarray(self.cell.object(name).position if at is None else at,
                           dtype=np.float64)
 
-    def _placement(self, kind: str, target: np.ndarray, task: str) -> tuple[float, float]:
-        """Where the target should be in the standing root's frame: (ahead, left), metres."""
+    def _acting_hand(self, kind: str, part: str | None) -> str | None:
+        """The hand a goal task must use, or None (either): a move, insert or release of
+        a held ``part`` uses the hand holding it; a grasp or extract while one hand holds
+        a part uses the other hand."""
+        if part is not None and part in self.held and kind in ("move", "insert", "release"):
+            return self.held[part]
+        busy = set(self.held.values())
+        if kind in ("grasp", "extract") and len(busy) == 1:
+            return OTHER_HAND[next(iter(busy))]
+        return None
+
+    def _placement(self, kind: str, target: np.ndarray, task: str,
+                   hand: str | None = None) -> tuple[float, float]:
+        """Where the target should be in the standing root's frame: (ahead, left), metres
+        (for ``hand``, if given: the left hand reaches a target on the left)."""
         from ltl_human_motion.motion import goals
         try:
-            d, lat = goals.reach_placement(kind, float(target[2]), self.library.skeleton)
+            d, lat = goals.reach_placement(kind, float(target[2]), self.library.skeleton,
+                                           hand=hand or "auto")
             return float(d), float(lat)
         except ValueError as exc:
             raise PlanningError(f"task {task}: the target at height {target[2]:.2f} m is "
@@ -1020,7 +1034,8 @@ class SequencePlanner:
         placement = None
         if target is not None and kind not in ("release", "standUp") and self.seat is None:
             # (Seated, the hands work from the seat.)
-            placement = self._placement(kind, target, text)
+            placement = self._placement(kind, target, text,
+                                        self._acting_hand(kind, args[0] if args else None))
             walked = self._approach_facing(target, placement, text, facing)
         carrying_before = bool(self.held)
         raised = kind in HAND_TASKS and not carrying_before and self.seat is None
@@ -1257,17 +1272,15 @@ class SequencePlanner:
             c, s = math.cos(-yaw), math.sin(-yaw)
             dx, dy = target[0] - x, target[1] - y
             local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
-        busy = set(self.held.values())
         seated = self.seat is not None and kind != "standUp"
         kwargs = {"rng": self.rng,
                   "start_pose": self._seated_pose() if seated
                   else self._stance(bool(self.held) or carry_stance)}
-        if part is not None and part in self.held and kind != "extract":
-            kwargs["hand"] = self.held[part]
+        hand = self._acting_hand(kind, part if kind != "grasp" else grasped)
+        if hand is not None:
+            kwargs["hand"] = hand
         if kind == "extract" and part is not None and container is not None:
             kwargs["travel"] = self._pull_length(part, container)
-        elif kind in ("grasp", "extract") and len(busy) == 1:
-            kwargs["hand"] = OTHER_HAND[next(iter(busy))]
         hand_fixed = "hand" in kwargs
         if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
