@@ -14,6 +14,7 @@ from ltl_human_motion.ltl import Atom, build_specification, evaluate_lasso
 from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
 from ltl_human_motion.tasks import CellModel, Limits, plan_sequences
 from ltl_human_motion.tasks.kitting import kitting_cell_yaml, kitting_spec
+from ltl_human_motion.tasks.model import HELD
 from ltl_human_motion.tasks.product import ProductSearch
 from ltl_human_motion.tasks.sequences import RANDOM_COST_FACTOR, product_search
 
@@ -76,7 +77,9 @@ def test_model_preconditions_and_effects():
     assert m.step(s3, _t("grasp(kit)")) is None           # a fixed object
     assert s3.parts[0] == m.region_location("R1")
     s4, _ = m.step(s3, _t("insert(P1, kit)"))
-    assert s4.held == () and m.step(s4, _t("grasp(P1)")) is None     # inside the kit
+    assert s4.held == ()
+    picked, _ = m.step(s4, _t("grasp(P1)"))       # picked out of the open kit, as planned
+    assert picked.held == (1,) and picked.parts[1] == HELD
     s5, _ = m.step(s4, _t("extract(P1, kit)"))
     assert s5.held == (1,)
     seat = m.step(s, _t("sit(P0)"))[0]

@@ -67,6 +67,7 @@ _SIDES = ("l", "r")
 _REACH_FRACTION = 0.93          # hand never further than this fraction of the arm length
 _ASSEMBLE_HALF_GAP = 0.035      # m, hands either side of an assembly target
 _INSERT_TRAVEL = 0.08           # m, straight push of insert / pull of extract
+_MAX_TRAVEL = 0.3               # m, longest push or pull asked for (a forearm's length)
 _APPROACH_LIFT = 0.08           # m, grasp/release/move come down onto low targets
 #: Peak palm speed of a goal reach, m/s at 1.75 m: under the 2.5 m/s limit of
 #: planning.biomechanics with room for the seeded bow and the body's own motion.
@@ -77,6 +78,22 @@ _ARC_PATH_FACTOR = 1.35
 #: Extra outward bow of the palm path for a target below the hips, fraction of stature
 #: (full up to 0.45 H, none from 0.6 H): the hand passes outside the thigh.
 _LOW_REACH_WIDE = 0.05
+#: Hand paths of ``make_goal_primitive``: ``"arc"`` swings the palm about the shoulder
+#: straight to the target; ``"level"`` first brings it, near the body, to the height it
+#: comes in at, then moves it in horizontally (over a shelf board's edge, under the
+#: board above), and out the same way before the body straightens.
+HAND_PATHS: tuple[str, ...] = ("arc", "level")
+#: Tasks whose hand may take the level path (the palm comes in over a support).
+LEVEL_PATH_TASKS: tuple[str, ...] = ("grasp", "release", "move")
+#: Horizontal distance from the shoulder of the level path's turn point, fraction of
+#: stature (0.12 m at 1.75 m: in front of the chest, behind the front edge of a shelf the
+#: worker stands at, also one overhead).
+_LEVEL_NEAR = 0.07
+#: Shortest shoulder-to-palm distance on the level path, fraction of the arm's length
+#: (a palm nearer the shoulder folds the elbow fully and its two-bone solution flips).
+_LEVEL_MIN_EXTENSION = 0.5
+#: Reach time of the level path over the arc's (its path is about this much longer).
+_LEVEL_TIME = 1.3
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -467,10 +484,42 @@ def _frames(skeleton: Skeleton, st: _Start, t: np.ndarray, pelvis: np.ndarray,
                  trunk)
 
 
+def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: np.ndarray,
+                rel_goal: np.ndarray, lift: float, t1: float, t2: float, total: float,
+                H: float, arm: float) -> list[tuple[float, np.ndarray]]:
+    """Shoulder-to-palm keys of the level path (see :data:`HAND_PATHS`): home, the turn
+    point near the body at the approach height, above the target, the target (held), and
+    back the same way. Arrays (2, 3); ``sh1`` (2, 3): the shoulders in the reach posture;
+    ``arm``: the arm's length (the turn point keeps the elbow clearly bent, not folded)."""
+    rel_above, rel_near = rel_goal.copy(), rel_goal.copy()
+    for k in active:
+        above = targets[k] + np.array([0.0, 0.0, lift])
+        rel_above[k] = above - sh1[k]
+        flat = rel_above[k, :2]
+        dh = float(np.linalg.norm(flat))
+        unfolded = np.sqrt(max((_LEVEL_MIN_EXTENSION * arm) ** 2 - rel_above[k, 2] ** 2, 0.0))
+        near = min(dh, max(_LEVEL_NEAR * H, unfolded))
+        rel_near[k, :2] = flat * (near / dh) if dh > 1e-9 else flat
+        rel_near[k, 2] = rel_above[k, 2]
+    r = total - t2
+    return [(0.0, rel_home), (0.5 * t1, rel_near), (0.8 * t1, rel_above), (t1, rel_goal),
+            (t2, rel_goal), (t2 + 0.2 * r, rel_above), (t2 + 0.5 * r, rel_near),
+            (total, rel_home)]
+
+
+def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """Distance of the origin from the segment a-b (points (3,))."""
+    d = b - a
+    s = float(np.clip(-np.dot(a, d) / max(float(np.dot(d, d)), 1e-12), 0.0, 1.0))
+    return float(np.linalg.norm(a + s * d))
+
+
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
-               fps: float) -> MotionPrimitive:
+               fps: float, path: str = "arc", travel: float | None = None) -> MotionPrimitive:
     H = skeleton.stature
+    travel = _INSERT_TRAVEL if travel is None else float(travel)
+    level = path == "level" and task in LEVEL_PATH_TASKS
     if target is None:
         raise ValueError(f"{task} needs a target position (3,) in the start frame")
     target = np.asarray(target, dtype=np.float64)
@@ -497,7 +546,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     # HAND_GOAL_PEAK_SPEED along the arced path (motion.timing)
     t_reach = max(t_reach, fitts_time(dist), min_move_time(
         _ARC_PATH_FACTOR * dist, HAND_GOAL_PEAK_SPEED * H / DEFAULT_STATURE) / 0.9)
-    t_reach *= jitter
+    t_reach *= jitter * (_LEVEL_TIME if level else 1.0)
     t_ret = t_reach * rng.uniform(0.95, 1.05)
     holds = {"grasp": 0.3, "release": 0.3, "move": 0.3, "leftHand": 1.0, "rightHand": 1.0,
              "assemble": 3.0, "insert": 0.9, "extract": 0.9}
@@ -511,8 +560,10 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     T = _n_frames(total, fps)
     t = np.arange(T) / fps
     t1, t2 = t_reach, t_reach + hold
-    # body posture leads the hand: it is reached at 85 % of the reach time
-    body_keys = [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)]
+    # body posture leads the hand: it is reached at 85 % of the reach time (level path:
+    # before the hand comes in, and kept until it is out again)
+    body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + 0.5 * t_ret, 1.0), (total, 0.0)] if level
+                 else [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)])
     sb = _profile(t, body_keys)
     pelvis = np.tile(st.pelvis, (T, 1))
     pelvis[:, 2] -= drop1 * sb
@@ -529,7 +580,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     rel_pre = rel_home.copy()
     for k in active:
         rel_goal[k] = targets[k] - sh1[k]
-        rel_pre[k] = targets[k] - _INSERT_TRAVEL * approach - sh1[k]
+        rel_pre[k] = targets[k] - travel * approach - sh1[k]
     if task == "insert":
         push = min(0.5, 0.6 * hold)
         keys = [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
@@ -550,15 +601,30 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
             for k in active:
                 if targets[k][2] < sh1[k][2] - 0.1:
                     lift[k, 2] = _APPROACH_LIFT
-            if np.any(lift):
+            if level:
+                keys = _level_keys(targets, active, sh1, rel_home, rel_goal, _APPROACH_LIFT,
+                                   t1, t2, total, H, _arm_length(skeleton))
+            elif np.any(lift):
                 rel_above = rel_goal + lift
                 keys = [(0.0, rel_home), (0.7 * t1, rel_above), (t1, rel_goal), (t2, rel_goal),
                         (t2 + 0.3 * (total - t2), rel_above), (total, rel_home)]
     rel = _arc_keys(t, keys)
-    # a small seeded bow of the hand path (outward and up), zero at every key pose
-    s_out = _profile(t, [(0.0, 0.0), (t1, 1.0)])
-    s_back = _profile(t, [(t2, 0.0), (total, 1.0)])
-    bow = np.sin(np.pi * s_out) * (t <= t1) + np.sin(np.pi * s_back) * (t >= t2)
+    if level:
+        # Straight legs (an arc about the shoulder bulges forward, into the shelf), except
+        # a leg to or from home passing the shoulder nearer than a folded elbow allows.
+        straight = _interp_keys(t, keys)
+        least = _LEVEL_MIN_EXTENSION * _arm_length(skeleton)
+        for (t0, v0), (t1_, v1) in itertools.pairwise(keys):
+            leg = (t >= t0) & (t <= t1_)
+            for k in active:
+                if _segment_origin_distance(v0[k], v1[k]) >= least:
+                    rel[leg, k] = straight[leg, k]
+    # a small seeded bow of the hand path (outward and up), zero at every key pose (level
+    # path: only between home and the turn point)
+    out_end, back_start = (keys[1][0], keys[-2][0]) if level else (t1, t2)
+    s_out = _profile(t, [(0.0, 0.0), (out_end, 1.0)])
+    s_back = _profile(t, [(back_start, 0.0), (total, 1.0)])
+    bow = np.sin(np.pi * s_out) * (t <= out_end) + np.sin(np.pi * s_back) * (t >= back_start)
     for k in active:
         out_dir = np.array([0.0, 1.0 if k == 0 else -1.0, 0.6])
         out_dir /= np.linalg.norm(out_dir)
@@ -798,7 +864,8 @@ def _sit(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: flo
 def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton, *,
                         start_pose: np.ndarray | None = None,
                         rng: np.random.Generator | None = None, duration: float | None = None,
-                        hand: str = "auto", fps: float = LIBRARY_FPS) -> MotionPrimitive:
+                        hand: str = "auto", fps: float = LIBRARY_FPS,
+                        path: str = "arc", travel: float | None = None) -> MotionPrimitive:
     """A goal primitive for one Table I task, made for the exact target.
 
     Parameters
@@ -829,6 +896,11 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         Acting hand; auto = left for targets with y > 0, else right. For kneel,
         "l_hand" kneels on the left knee.
     fps : float
+    path : {"arc", "level"}
+        Hand path of grasp, release and move (:data:`HAND_PATHS`); other tasks ignore it.
+    travel : float, optional
+        Length of the straight push of insert and pull of extract, metres (default
+        8 cm; a part deep in a fixture needs a longer pull to come out).
 
     Returns
     -------
@@ -849,10 +921,14 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         raise ValueError(f"fps must be positive, got {fps!r}")
     if duration is not None and not duration > 0:
         raise ValueError(f"duration must be positive, got {duration!r}")
+    if path not in HAND_PATHS:
+        raise ValueError(f"path must be one of {', '.join(HAND_PATHS)}, got {path!r}")
     rng = np.random.default_rng(0) if rng is None else rng
     st = _Start(skeleton, start_pose)
     if task in HAND_TASKS:
-        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps)
+        if travel is not None and not 0.0 < float(travel) <= _MAX_TRAVEL:
+            raise ValueError(f"travel must be in (0, {_MAX_TRAVEL}] m, got {travel!r}")
+        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel)
     if task in ("bend", "stoop", "kneel"):
         return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
     if task == "wait":

@@ -34,6 +34,9 @@ class FloorGrid:
         ``free(xy (N, 2)) -> bool (N,)``: where the walking root may be.
     resolution : float
         Cell size in metres.
+    cell_cost : callable, optional
+        ``cell_cost(xy (N, 2)) -> (N,)``, at least 1: how much a metre through each cell
+        counts (an edge counts the mean of its two cells); default 1 everywhere.
 
     Attributes
     ----------
@@ -47,7 +50,8 @@ class FloorGrid:
     """
 
     def __init__(self, lo: np.ndarray, hi: np.ndarray,
-                 free: Callable[[np.ndarray], np.ndarray], resolution: float = 0.1) -> None:
+                 free: Callable[[np.ndarray], np.ndarray], resolution: float = 0.1,
+                 cell_cost: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
         lo = np.asarray(lo, dtype=np.float64)
         hi = np.asarray(hi, dtype=np.float64)
         if lo.shape != (2,) or hi.shape != (2,) or np.any(hi <= lo):
@@ -61,6 +65,8 @@ class FloorGrid:
         self.free = np.asarray(free(self.centres), dtype=bool).reshape(self.shape)
         self.free.flags.writeable = False              # grids are shared (floor_grid)
         ids = np.arange(nx * ny).reshape(self.shape)
+        cost = (np.ones(nx * ny) if cell_cost is None
+                else np.asarray(cell_cost(self.centres), dtype=np.float64))
         rows, cols, weights = [], [], []
         for dx, dy in _NEIGHBOURS:
             a = ids[0:nx - dx, max(0, -dy):ny - max(0, dy)]
@@ -68,7 +74,8 @@ class FloorGrid:
             ok = self.free.ravel()[a.ravel()] & self.free.ravel()[b.ravel()]
             rows.append(a.ravel()[ok])
             cols.append(b.ravel()[ok])
-            weights.append(np.full(int(ok.sum()), self.res * np.hypot(dx, dy)))
+            weights.append(self.res * np.hypot(dx, dy)
+                           * 0.5 * (cost[a.ravel()[ok]] + cost[b.ravel()[ok]]))
         r, c, w = np.concatenate(rows), np.concatenate(cols), np.concatenate(weights)
         # Both directions stored, so the search needs no symmetrized copy per goal.
         self.graph = coo_matrix((np.concatenate([w, w]), (np.concatenate([r, c]),
@@ -142,6 +149,13 @@ class NavigationField:
         return bool(np.isfinite(self.distance(np.array([x]), np.array([y]))[0]))
 
 
+#: How much closer than its footprint a tall part counts for walking (the swinging arms
+#: pass it at shoulder width), metres.
+TALL_EXTRA = 0.25
+#: Tall parts reach down below this height (about the shoulder of a 1.95 m worker), m.
+TALL_TOP = 1.6
+
+
 class ClearanceMap:
     """Floor clearance from obstacle footprints, sampled once on a grid.
 
@@ -159,10 +173,13 @@ class ClearanceMap:
         Grid step in metres.
     tall_extra, tall_height : float
         Metres.
+    tall_top : float
+        Parts wholly above this height (an overhead board, a machine's roof) are no
+        tall parts: the arms swing below it. Metres.
     """
 
-    def __init__(self, cell, resolution: float = 0.04, tall_extra: float = 0.25,
-                 tall_height: float = 1.2) -> None:
+    def __init__(self, cell, resolution: float = 0.04, tall_extra: float = TALL_EXTRA,
+                 tall_height: float = 1.2, tall_top: float = TALL_TOP) -> None:
         lo = np.asarray(cell.workspace_lo[:2], dtype=np.float64)
         hi = np.asarray(cell.workspace_hi[:2], dtype=np.float64)
         xs = np.arange(lo[0], hi[0] + resolution, resolution)
@@ -172,7 +189,8 @@ class ClearanceMap:
         values = np.full(len(pts), 1e3)
         for ob in cell.obstacles:
             for part in ob.parts:
-                extra = tall_extra if part.aabb()[1][2] > tall_height else 0.0
+                plo, phi = part.aabb()
+                extra = tall_extra if phi[2] > tall_height and plo[2] < tall_top else 0.0
                 values = np.minimum(values, part.footprint().signed_distance(pts) - extra)
         self.lo, self.hi = lo, hi
         self._xs, self._ys = xs, ys
@@ -359,13 +377,20 @@ class ObstacleField:
 
 
 _CLEARANCE_CACHE: BoundedCache[tuple[ClearanceMap, ObstacleField]] = BoundedCache(64)
-_FIELDS_FORMAT = 3
+_FIELDS_FORMAT = 4
 _GRID_CACHE: BoundedCache[FloorGrid] = BoundedCache(16)
+#: Extra cost of a metre through the narrowest walkable floor (see :func:`floor_grid`):
+#: a gap the body barely fits counts twice its length (a choice: 3 served the cell with
+#: crates better, 1 the wall with a doorway, over both together 1 did a little better).
+NARROW_COST = 1.0
 
 
 def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: float,
-               resolution: float) -> FloorGrid:
-    """The :class:`FloorGrid` whose free cells keep ``radius`` of floor clearance.
+               resolution: float, passage: float | None = None) -> FloorGrid:
+    """The :class:`FloorGrid` whose free cells keep ``radius`` of floor clearance; with
+    ``passage``, a metre through a cell with less clearance than that counts up to
+    ``1 + NARROW_COST`` metres (linear from ``passage`` down to ``radius``), so the
+    fields lead through gaps the body barely fits only when there is no roomier way.
 
     Built once per clearance map (one per obstacle layout, :func:`clearance_maps`),
     area, radius and resolution, and shared by every navigation field on that floor.
@@ -378,9 +403,16 @@ def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: 
         Metres.
     """
     key = (np.asarray(lo, dtype=np.float64).tobytes(),
-           np.asarray(hi, dtype=np.float64).tobytes(), float(radius), float(resolution))
+           np.asarray(hi, dtype=np.float64).tobytes(), float(radius), float(resolution),
+           None if passage is None else float(passage))
+
+    def cell_cost(xy: np.ndarray) -> np.ndarray:
+        narrow = (passage - clearance(xy)) / max(passage - radius, 1e-9)
+        return 1.0 + NARROW_COST * np.clip(narrow, 0.0, 1.0)
+
     return _GRID_CACHE.get_or_build(
-        key, lambda: FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution),
+        key, lambda: FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution,
+                               None if passage is None else cell_cost),
         owner=clearance)
 
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.motion.goals import HAND_PATHS, LEVEL_PATH_TASKS
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import (
@@ -134,6 +135,28 @@ RELEASE_SURFACE_MAX = 1.2 / 1.75
 #: Gap between a part set down and the surface under it when it is let go, metres (the
 #: cells' parts rest 1 cm above their tables).
 RELEASE_GAP = 0.01
+
+#: Raising a grasp's palm target off the part's support (:meth:`SequencePlanner.
+#: _palm_clear_of_support`): step and the gap kept to the support (the planner's goal
+#: checks need PLACED_MARGIN; blends move the palm a few mm), and how deep the palm
+#: sphere stays in the part (grasp holds when it enters), metres.
+PALM_RISE_STEP = 0.005
+PALM_SUPPORT_GAP = 0.01
+PALM_IN_PART = 0.01
+
+#: Floor clearance below which the navigation field counts the floor longer, metres:
+#: about half the hip and shoulder width of a 1.75 m worker (0.2 m) plus the gait's
+#: sway, more than ``PlannerOptions.body_radius`` (the least a walk needs).
+PASSAGE_RADIUS = 0.25
+
+#: How far beyond its container an extract pulls the part, metres.
+PULL_MARGIN = 0.03
+
+#: Stride of the frames on which the planner checks that an extract takes its part out.
+EXTRACT_CHECK_STRIDE = 4
+
+#: The other hand of each hand joint.
+OTHER_HAND = {"l_hand": "r_hand", "r_hand": "l_hand"}
 
 #: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
@@ -302,6 +325,16 @@ def lift_frame(mp: MotionPrimitive, hand: np.ndarray) -> int:
     return hold_end + int(rose[0]) if rose.size else contact
 
 
+def grip_frame(mp: MotionPrimitive) -> int:
+    """The frame of a goal primitive from which the hand holds the part it acts on: the
+    contact frame, except for extract, where the hand takes the part when it reaches it
+    (the start of the hold) and then pulls it out (its contact frame, where the part is
+    out, is the end of the pull)."""
+    if mp.task == "extract" and "hold_frames" in mp.meta:
+        return int(mp.meta["hold_frames"][0])
+    return int(mp.meta.get("contact_frame", mp.n_frames - 1))
+
+
 def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, tuple[str, ...]]:
     """The goal-primitive task realising a step and its arguments.
 
@@ -363,8 +396,9 @@ class SequencePlanner:
             return np.asarray(cell.region(args[-1]).center, dtype=np.float64)
         if kind in ("grasp",):
             obj = cell.object(args[0])
-            return np.asarray(obj.grasp_points_at(self.object_position(args[0]))[0],
-                              dtype=np.float64)
+            point = np.asarray(obj.grasp_points_at(self.object_position(args[0]))[0],
+                               dtype=np.float64)
+            return self._palm_clear_of_support(point, args[0])
         if kind in ("move",):
             return np.asarray(cell.region(args[1]).center, dtype=np.float64)
         if kind in ("insert", "extract"):
@@ -376,6 +410,25 @@ class SequencePlanner:
             return np.asarray(obj.sitting_surface_at(obj.position).center, dtype=np.float64)
         return None
 
+    def _palm_clear_of_support(self, point: np.ndarray, obj: str) -> np.ndarray:
+        """The palm target (3,) for a grasp at ``point`` (3,): the grasp point, raised by
+        up to the palm's radius where the palm sphere there would touch the support (a
+        flat part on a board): grasp holds while the palm still enters the part."""
+        cell = self.cell
+        if not cell.obstacles:
+            return point
+        from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_radii
+        radius = float(capsule_radii(self.library.skeleton.stature)[BODY_PARTS.index("r_palm")])
+        part = cell.object(obj).occupancy_at(self.object_position(obj))
+        for rise in np.arange(0.0, radius, PALM_RISE_STEP):
+            palm = point + np.array([0.0, 0.0, rise])
+            clear = float(cell.part_set.capsule_clearance(np.stack([palm, palm])[None],
+                                                          radius)[0])
+            if clear > PALM_SUPPORT_GAP:
+                inside = float(part.signed_distance(palm[None])[0])
+                return palm if inside <= radius - PALM_IN_PART else point
+        return point
+
     def object_position(self, name: str) -> np.ndarray:
         """Where object ``name`` rests now (3,): where the last step put it down, else its
         supply position in the cell."""
@@ -383,11 +436,25 @@ class SequencePlanner:
         return np.asarray(self.cell.object(name).position if at is None else at,
                           dtype=np.float64)
 
-    def _placement(self, kind: str, target: np.ndarray, task: str) -> tuple[float, float]:
-        """Where the target should be in the standing root's frame: (ahead, left), metres."""
+    def _acting_hand(self, kind: str, part: str | None) -> str | None:
+        """The hand a goal task must use, or None (either): a move, insert or release of
+        a held ``part`` uses the hand holding it; a grasp or extract while one hand holds
+        a part uses the other hand."""
+        if part is not None and part in self.held and kind in ("move", "insert", "release"):
+            return self.held[part]
+        busy = set(self.held.values())
+        if kind in ("grasp", "extract") and len(busy) == 1:
+            return OTHER_HAND[next(iter(busy))]
+        return None
+
+    def _placement(self, kind: str, target: np.ndarray, task: str,
+                   hand: str | None = None) -> tuple[float, float]:
+        """Where the target should be in the standing root's frame: (ahead, left), metres
+        (for ``hand``, if given: the left hand reaches a target on the left)."""
         from ltl_human_motion.motion import goals
         try:
-            d, lat = goals.reach_placement(kind, float(target[2]), self.library.skeleton)
+            d, lat = goals.reach_placement(kind, float(target[2]), self.library.skeleton,
+                                           hand=hand or "auto")
             return float(d), float(lat)
         except ValueError as exc:
             raise PlanningError(f"task {task}: the target at height {target[2]:.2f} m is "
@@ -399,10 +466,23 @@ class SequencePlanner:
     def _field(self, goal_cells, key: tuple | None = None) -> NavigationField:
         """The navigation field of ``goal_cells`` on the floor grid. ``key``: numbers that
         determine the goal cells on this floor; fields with a key are kept (a target that
-        does not move between items, e.g. an assembly region, reuses its field)."""
+        does not move between items, e.g. an assembly region, reuses its field).
+
+        The field keeps to lanes with ``PASSAGE_RADIUS`` of clearance where they lead from
+        the worker to a goal; else it uses all floor the walk may take, counting floor
+        with less clearance longer. Either way the search does not squeeze the gait
+        through a gap the body barely fits (and exhaust its budget there) where a roomier
+        way exists."""
+        roomy = self._field_with(PASSAGE_RADIUS, goal_cells, key)
+        if roomy.has_goal and roomy.reachable_from(self.pose[0], self.pose[1]):
+            return roomy
+        return self._field_with(self.options.body_radius, goal_cells, key)
+
+    def _field_with(self, radius: float, goal_cells, key: tuple | None) -> NavigationField:
+        """:meth:`_field` on the floor grid whose free cells keep ``radius``."""
         grid = floor_grid(self.clearance, self.cell.workspace_lo[:2],
-                          self.cell.workspace_hi[:2], self.options.body_radius,
-                          self.options.grid_resolution)
+                          self.cell.workspace_hi[:2], radius, self.options.grid_resolution,
+                          passage=PASSAGE_RADIUS if radius < PASSAGE_RADIUS else None)
         if key is None:
             return NavigationField.on_grid(grid, goal_cells)
         full = (id(grid), *key)
@@ -735,14 +815,13 @@ class SequencePlanner:
         leave the spot otherwise."""
         from ltl_human_motion.planning.turns import make_step_primitive
         x, y, yaw = self.pose
-        need = self.options.body_radius + STEP_OUT_MARGIN
-        if float(self._clearance(np.array([[x, y]]))[0]) > need:
+        if self._walkable(x, y):
             return
         carrying = bool(self.held)
         lib = self.library
         c, s = math.cos(yaw), math.sin(yaw)
         for back in STEP_OUT_DISTANCES:
-            if float(self._clearance(np.array([[x - back * c, y - back * s]]))[0]) <= need:
+            if not self._walkable(x - back * c, y - back * s):
                 continue
             mp = make_step_primitive(self._stance(carrying), lib.standing_height, -back, 0.0,
                                      0.0, lib.skeleton, lib.fps,
@@ -751,6 +830,20 @@ class SequencePlanner:
                 self._add(mp, self.pose, -1, self.overlap)
                 self.pose = self._hand_over_pose(mp, self.pose)
                 return
+
+    def _walkable(self, x: float, y: float) -> bool:
+        """Whether a walk may start at (x, y): ``STEP_OUT_MARGIN`` more floor clearance
+        than ``options.body_radius``, and the navigation grid's cell there is free (the
+        searches start from that cell)."""
+        if float(self._clearance(np.array([[x, y]]))[0]) <= (self.options.body_radius
+                                                               + STEP_OUT_MARGIN):
+            return False
+        grid = floor_grid(self.clearance, self.cell.workspace_lo[:2],
+                          self.cell.workspace_hi[:2], self.options.body_radius,
+                          self.options.grid_resolution, passage=PASSAGE_RADIUS)
+        i = int(np.clip(np.rint((x - grid.lo[0]) / grid.res), 0, grid.shape[0] - 1))
+        j = int(np.clip(np.rint((y - grid.lo[1]) / grid.res), 0, grid.shape[1] - 1))
+        return bool(grid.free[i, j])
 
     def _first_collision(self, primitives: list[int], poses: list[Pose]) -> int | None:
         """Index of the first gait primitive of a path that comes within the planner's
@@ -941,7 +1034,8 @@ class SequencePlanner:
         placement = None
         if target is not None and kind not in ("release", "standUp") and self.seat is None:
             # (Seated, the hands work from the seat.)
-            placement = self._placement(kind, target, text)
+            placement = self._placement(kind, target, text,
+                                        self._acting_hand(kind, args[0] if args else None))
             walked = self._approach_facing(target, placement, text, facing)
         carrying_before = bool(self.held)
         raised = kind in HAND_TASKS and not carrying_before and self.seat is None
@@ -952,26 +1046,9 @@ class SequencePlanner:
             self._arm_transition(False, -1)
             carrying_before = True
         tries = self._alternatives(kind, args, target, placement, text, raised)
-        failure = None
-        for k, (target, prepare) in enumerate(tries):
-            try:
-                if prepare is not None:
-                    walked += prepare()
-                seg, mp = self._goal_segment(
-                    kind, target, i, text, carry_stance=carrying_before,
-                    seconds=float(args[0]) if kind == "wait" and args else None,
-                    grasped=args[0] if kind == "grasp" else None,
-                    attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
-                break
-            except PlanningError as exc:
-                if k == 0 and exc.reason != "blocked":
-                    raise
-                failure = failure or exc       # an alternative may fail in any way
-        else:
-            if len(tries) == 1:
-                raise failure
-            raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements "
-                                "tried", task=text, reason="blocked")
+        seg, mp, target, prepared = self._first_clear_try(i, text, kind, args, tries,
+                                                          carrying_before)
+        walked += prepared
         hand = mp.meta.get("hand")
         joints = dict(self.held)
         effect = self._apply_effects(kind, args, hand, keep_hold)
@@ -987,17 +1064,52 @@ class SequencePlanner:
             joint = next(iter(effect["attach"].values()))
             lift = lift_frame(mp, self.segments[seg].positions[:, JOINT_INDEX[joint]])
         return StepPlan(text, kind, target, walk_segments=walked, goal_segment=seg,
-                        contact_frame=int(mp.meta.get("contact_frame", mp.n_frames - 1)),
+                        contact_frame=grip_frame(mp),
                         lift_frame=lift, hand=hand, expanded=self.expanded - expanded0,
                         primitive=mp.name,
                         objects_effect=effect, sub_steps=subs)
+
+    def _first_clear_try(self, i: int, text: str, kind: str, args: tuple[str, ...],
+                         tries: list, carrying_before: bool
+                         ) -> tuple[int, MotionPrimitive, np.ndarray | None, int]:
+        """Make the goal primitive of step ``i`` from the first of ``tries`` (see
+        :meth:`_alternatives`) that works; returns (segment, primitive, the target it
+        reached, gait primitives its preparation walked). Raises the first failure, with
+        how many other placements were tried."""
+        failure = None
+        for k, (target, prepare) in enumerate(tries):
+            mark = (len(self.segments), self.pose, self.gait_state)
+            try:
+                walked = prepare() if prepare is not None else 0
+                seg, mp = self._goal_segment(
+                    kind, target, i, text, carry_stance=carrying_before,
+                    seconds=float(args[0]) if kind == "wait" and args else None,
+                    grasped=args[0] if kind == "grasp" else None,
+                    part=args[0] if kind in ("move", "insert", "release", "extract") and args
+                    else None, container=args[1] if kind == "extract" else None,
+                    attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
+                return seg, mp, target, walked
+            except PlanningError as exc:
+                # Blocked, or out of reach from where the walk ended (it came from the
+                # side of a machine): the other placements may do; an alternative may
+                # fail in any way.
+                if k == 0 and exc.reason not in ("blocked", "unreachable"):
+                    raise
+                failure = failure or exc
+                # What a failed try placed (a walk, an arm transition) is taken back.
+                del self.segments[mark[0]:]
+                self.pose, self.gait_state = mark[1], mark[2]
+        if len(tries) == 1:
+            raise failure
+        raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements tried",
+                            task=text, reason=failure.reason)
 
     def _track_objects(self, effect: dict, joints: dict[str, str], seg: int,
                        mp: MotionPrimitive) -> None:
         """Follow a step's effect on the parts as the object tracks will: a part keeps
         its world offset from the hand from the contact frame on, and rests where the
         hand let it go (``joints``: the hands holding parts before the step)."""
-        contact = min(int(mp.meta.get("contact_frame", mp.n_frames - 1)), mp.n_frames - 1)
+        contact = min(grip_frame(mp), mp.n_frames - 1)
         positions = self.segments[seg].positions
         for name, joint in effect.get("attach", {}).items():
             joints[name] = joint
@@ -1088,6 +1200,7 @@ class SequencePlanner:
             lowered = raised and not self.held
             if lowered:
                 self._arm_transition(True, -1)
+            self._step_out()            # the first try may have left the worker at a rack
             walked = self._approach(target, (placement[0] + back, placement[1]), text,
                                     sector=(first + turn, APPROACH_HALF_WIDTH),
                                     budget=SearchBudget(ALTERNATIVE_NODES))
@@ -1141,13 +1254,17 @@ class SequencePlanner:
 
     def _goal_segment(self, kind: str, target: np.ndarray | None, label: int,
                       text: str, *, carry_stance: bool = False, seconds: float | None = None,
-                      grasped: str | None = None, attempts: int | None = None
+                      grasped: str | None = None, attempts: int | None = None,
+                      part: str | None = None, container: str | None = None
                       ) -> tuple[int, MotionPrimitive]:
         """Make, check and place the goal primitive of ``kind`` for ``target``.
 
         ``carry_stance``: the arms are already in the carry stance; ``seconds``: how long
         a wait lasts; ``grasped``: the part a grasp picks up (checked from contact on);
-        ``attempts``: seeded primitives tried (default ``options.goal_attempts``).
+        ``attempts``: seeded primitives tried (default ``options.goal_attempts``);
+        ``part``: the part a move, insert or release puts down (done by the hand holding
+        it; for extract, the part taken out of ``container``). A grasp or extract while
+        one hand holds a part is done by the other hand.
         """
         x, y, yaw = self.pose
         local = None
@@ -1155,33 +1272,49 @@ class SequencePlanner:
             c, s = math.cos(-yaw), math.sin(-yaw)
             dx, dy = target[0] - x, target[1] - y
             local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
-        hold_hand = next(iter(self.held.values()), None)
         seated = self.seat is not None and kind != "standUp"
         kwargs = {"rng": self.rng,
                   "start_pose": self._seated_pose() if seated
                   else self._stance(bool(self.held) or carry_stance)}
-        if kind in ("move", "insert", "extract", "release") and hold_hand:
-            kwargs["hand"] = hold_hand
+        hand = self._acting_hand(kind, part if kind != "grasp" else grasped)
+        if hand is not None:
+            kwargs["hand"] = hand
+        if kind == "extract" and part is not None and container is not None:
+            kwargs["travel"] = self._pull_length(part, container)
+        hand_fixed = "hand" in kwargs
         if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
             kwargs["duration"] = seconds + (2 * self.overlap + 6) / self.library.fps
         mp = None
+        kept_in = 0
         attempts = self.options.goal_attempts if attempts is None else attempts
         for attempt in range(attempts):
+            if kind in LEVEL_PATH_TASKS:
+                # Every other try comes in level (over a shelf board, under the one above).
+                kwargs["path"] = HAND_PATHS[attempt % len(HAND_PATHS)]
             try:
                 candidate = self._sit_still(kwargs.get("duration", 2.0)) \
                     if seated and kind == "wait" else self.library.goal(kind, local, **kwargs)
             except ValueError as exc:
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
-            if self._goal_clear(candidate, grasped):
+            clear = self._goal_clear(candidate, grasped)
+            if clear and kind == "extract" and part is not None and container is not None \
+                    and not self._pulls_out(candidate, part, container):
+                kept_in += 1
+                clear = False
+            if clear:
                 mp = candidate
                 break
-            if attempt == 1 and kind in ("grasp", "leftHand", "rightHand", "release"):
-                other = {"l_hand": "r_hand", "r_hand": "l_hand"}.get(
-                    candidate.meta.get("hand"), None)
-                if other and kind not in ("leftHand", "rightHand"):
+            if attempt == 1 and kind in ("grasp", "release") and not hand_fixed:
+                other = OTHER_HAND.get(candidate.meta.get("hand"))
+                if other:
                     kwargs["hand"] = other
+        if mp is None and kept_in:
+            raise PlanningError(f"task {text}: {kept_in} of the {attempts} {kind} motions "
+                                f"tried keep {part} in {container} (the hand does not take "
+                                "it out far enough from where the worker stands), the others "
+                                "run into an obstacle", task=text, reason="blocked")
         if mp is None:
             raise PlanningError(f"task {text}: every {kind} motion tried "
                                 f"({attempts}) runs into an obstacle; "
@@ -1190,6 +1323,33 @@ class SequencePlanner:
         self.pose = self._hand_over_pose(mp, self.pose)
         self.gait_state = None
         return seg, mp
+
+    def _pull_length(self, part: str, container: str) -> float:
+        """How far an extract pulls ``part`` (m): out of ``container`` horizontally from
+        where it lies (the container's half extent beyond the part's centre plus the
+        part's half size and ``PULL_MARGIN``), at least the model's 8 cm, at most 0.3 m."""
+        lo, hi = self.cell.object(container).occupancy_at(
+            self.object_position(container)).aabb()
+        plo, phi = self.cell.object(part).occupancy_at(self.object_position(part)).aabb()
+        centre = 0.5 * (plo + phi)
+        out = min(float(np.min(np.r_[hi[:2] - centre[:2], centre[:2] - lo[:2]])),
+                  0.5 * float(np.max(hi[:2] - lo[:2])))
+        need = out + 0.5 * float(np.max(phi[:2] - plo[:2])) + PULL_MARGIN
+        return float(np.clip(need, 0.08, 0.3))
+
+    def _pulls_out(self, mp: MotionPrimitive, part: str, container: str) -> bool:
+        """Whether the hand of an extract primitive brings ``part`` (carried from the
+        contact frame on) out of ``container`` on some frame: Table I's condition, which
+        the verifier checks (a worker standing close keeps the part in a deep fixture)."""
+        from ltl_human_motion.scene.predicates import enter_object
+        joint = {"l_hand": "l_hand"}.get(mp.meta.get("hand"), "r_hand")
+        hand = world_positions(mp, *self.pose)[:, JOINT_INDEX[joint]]
+        contact = min(grip_frame(mp), len(hand) - 1)
+        obj, box = self.cell.object(part), self.cell.object(container)
+        around = box.occupancy_at(self.object_position(container))
+        offset = self.object_position(part) - hand[contact]
+        return any(not enter_object(obj.occupancy_at(p + offset), around)
+                   for p in hand[contact::EXTRACT_CHECK_STRIDE])
 
     def _goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
         """Whether the body, the objects already in the hands and the part being grasped

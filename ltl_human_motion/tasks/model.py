@@ -4,8 +4,8 @@ The state (:class:`CellState`) holds where the worker is (the start, or the targ
 the last task), what each hand holds, where every movable part is and the posture.
 Preconditions and effects follow Table I of the paper and what the planner does:
 
-* ``grasp(O)`` needs a free hand (both for a ``two_handed`` part) and O not held and
-  not inside a container; O is picked up where it lies.
+* ``grasp(O)`` needs a free hand (both for a ``two_handed`` part) and O not held; O is
+  picked up where it lies (out of the open container it lies in, as the planner does).
 * ``release(O)`` needs O in hand, or fetches it first (as the planner does); O is put
   down where the worker stands. A part that starts inside a fixed object (a bin) is
   inside it.
@@ -306,11 +306,14 @@ class CellModel:
                 parts[p] = INSIDE - c
         elif kind == "grasp":
             p = self.part_index.get(args[0])
-            if p is None or parts[p] == HELD or parts[p] < -1 \
-                    or self._free_hands(held) < self._width[p]:
+            if p is None or parts[p] == HELD:
                 return None
-            cost += self._walk[loc][parts[p]]
-            loc = parts[p]
+            # A part in an open container (a bin) is picked out of it where it lies.
+            at = self._fetch_place(p, state, held)
+            if at is None:
+                return None
+            cost += self._walk[loc][at]
+            loc = at
             parts[p] = HELD
             held.append(p)
         elif kind == "release":

@@ -1,0 +1,71 @@
+"""Walking lanes: overhead parts are no tall parts, and the navigation field prefers
+roomy floor to a gap the body barely fits (scenario families timeout:grasp and
+planning:*:budget in the cells with clutter and the 0.8 m aisle)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ltl_human_motion.planning.navigation import (
+    NARROW_COST,
+    ClearanceMap,
+    NavigationField,
+    floor_grid,
+)
+from ltl_human_motion.scene.cell import cell_from_yaml
+
+CELL = """
+name: lanes
+frame: zup
+workspace: {lo: [-2.0, -2.0, 0.0], hi: [2.0, 2.0, 2.5]}
+start_region: R0
+regions:
+  R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}
+obstacles:
+  board:                               # an overhead board, 1.8 m up
+    shape: box
+    position: [-1.5, 1.5, 1.8]
+    size: [0.5, 0.5, 0.02]
+  column:                              # a column from the floor to 2 m
+    shape: box
+    position: [-1.5, -1.5, 1.0]
+    size: [0.5, 0.5, 2.0]
+"""
+
+
+def test_overhead_parts_are_no_tall_parts() -> None:
+    cell = cell_from_yaml(CELL)
+    walk = ClearanceMap(cell)
+    plain = ClearanceMap(cell, tall_extra=0.0)
+    beside_board = np.array([[-1.5, 1.0]])          # 0.25 m from the board's footprint
+    beside_column = np.array([[-1.5, -1.0]])        # 0.25 m from the column's
+    assert walk(beside_board)[0] == plain(beside_board)[0]
+    assert walk(beside_column)[0] < plain(beside_column)[0] - 0.2
+
+
+def test_narrow_floor_counts_longer() -> None:
+    """A wall with two 0.6 m gaps between the worker and the goal: with lanes, the
+    field's distance counts the floor the body barely fits up to ``1 + NARROW_COST``
+    times its length (longer than plain, never more than that bound)."""
+    cell = cell_from_yaml(CELL.replace("obstacles:", """obstacles:
+  wall_a:
+    shape: box
+    position: [0.0, 1.2, 1.0]
+    size: [0.1, 1.6, 2.0]
+  wall_b:
+    shape: box
+    position: [0.0, -0.8, 1.0]
+    size: [0.1, 1.2, 2.0]"""))
+    clearance = ClearanceMap(cell, tall_extra=0.0)
+    lo, hi = np.asarray(cell.workspace_lo[:2]), np.asarray(cell.workspace_hi[:2])
+
+    def goal(xy: np.ndarray) -> np.ndarray:
+        return np.hypot(xy[:, 0] - 1.5, xy[:, 1] - 0.2) < 0.1
+
+    plain = NavigationField.on_grid(floor_grid(clearance, lo, hi, 0.15, 0.05), goal)
+    lanes = NavigationField.on_grid(floor_grid(clearance, lo, hi, 0.15, 0.05,
+                                               passage=0.25), goal)
+    start = (np.array([-1.0]), np.array([0.2]))      # in front of the 0.4 m gap
+    assert np.isfinite(plain.distance(*start)[0]) and np.isfinite(lanes.distance(*start)[0])
+    assert lanes.distance(*start)[0] > plain.distance(*start)[0]
+    assert lanes.distance(*start)[0] <= (1.0 + NARROW_COST) * plain.distance(*start)[0] + 1e-9
