@@ -7,12 +7,13 @@ foot is detected on the final motion and its contact point is pinned; the leg is
 re-solved by two-bone IK from the unchanged hip, so bone lengths stay exact.
 
 Per foot and frame the contact point is the foot joint nearer its rest height (heel =
-ankle, ball = toe). A stance is a run of frames where that joint is within
-``contact_height`` of its rest height above the floor and moves horizontally slower than
-``stance_speed``. Within a stance the foot is translated (horizontally) so that the
-contact point keeps the position it had when it became the contact point; when the
-contact passes from heel to ball the new anchor continues the old offset, so nothing
-jumps. After a stance the offset returns to zero over ``release`` seconds with the
+ankle, ball = toe), with a hysteresis of ``CONTACT_SWITCH``. A stance is a run of frames
+where that joint is within ``CONTACT_HEIGHT`` of its rest height above the floor and moves
+horizontally slower than ``STANCE_SPEED``. Within a stance a flat foot keeps its heading
+(it pivots about the contact joint, which does not move), and the foot is translated
+(horizontally) so that the contact point stays where it was; when the contact passes from
+heel to ball the new contact joint is held where it was the frame before, so nothing
+jumps. After a stance the correction returns to zero over ``RELEASE`` seconds with the
 minimum-jerk profile, while the foot is in the air.
 """
 
@@ -48,6 +49,10 @@ RELEASE = 0.15
 SWING_CLEARANCE = 1.2 * CONTACT_HEIGHT
 #: Half-width (s) of the smoothing of that lift (it starts and ends this gradually).
 LIFT_RAMP = 0.1
+#: How much lower (m) the other foot joint must be for the contact to pass to it.
+CONTACT_SWITCH = 0.003
+#: Time (s) over which the heading lock of a flat planted foot fades fully in or out.
+YAW_RAMP = 0.1
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -56,26 +61,102 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
 
 
-def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float],
-                  fps: float, floor_z: float
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Offsets (T, 3) of one foot: horizontal ones pin its contact point during its
-    stances, vertical ones lift a foot that moves fast while low (a swing foot that would
-    slide over the floor) to ``SWING_CLEARANCE`` above its rest height.
+def _contact_joint(h: np.ndarray) -> np.ndarray:
+    """Contact joint of every frame (T,) (0 = ankle, 1 = toe) from their heights over their
+    rest heights (T, 2): the lower one, kept until the other is ``CONTACT_SWITCH`` lower
+    (a flat foot's pin and pivot do not flicker between heel and ball)."""
+    contact = np.empty(len(h), dtype=np.int64)
+    c = int(np.argmin(h[0])) if len(h) else 0
+    for t in range(len(h)):
+        if h[t, 1 - c] < h[t, c] - CONTACT_SWITCH:
+            c = 1 - c
+        contact[t] = c
+    return contact
+
+
+def _stance(hc: np.ndarray, vc: np.ndarray) -> np.ndarray:
+    """Stance frames (T,) of bool from the contact point's height over its rest height and
+    horizontal speed (T,): low and slower than ``STANCE_SPEED`` to enter, slower than twice
+    that to stay (no flicker)."""
+    low = hc <= CONTACT_HEIGHT
+    stance = low & (vc <= STANCE_SPEED)
+    keep = low & (vc <= 2.0 * STANCE_SPEED)
+    for t in range(1, len(hc)):
+        stance[t] |= stance[t - 1] & keep[t]
+    for t in range(len(hc) - 2, -1, -1):
+        stance[t] |= stance[t + 1] & keep[t]
+    return stance
+
+
+def _keep_heading(joints: np.ndarray, h: np.ndarray, contact: np.ndarray,
+                  stance: np.ndarray, fps: float) -> np.ndarray:
+    """The foot's joints (T, 2, 3) with a flat planted foot keeping the heading it landed
+    with, pivoting about its contact joint (which therefore does not move).
+
+    The lock fades out where the motion turns the foot further than ``MAX_TWIST`` (to
+    nothing at twice that: a turn in place turns the feet), and its weight changes by at
+    most 1 over ``YAW_RAMP`` (no swing of the free end).
+    """
+    T = len(joints)
+    w = np.zeros(T)
+    ref = np.zeros((T, 2))
+    for a, b in _runs(stance):
+        flat = np.flatnonzero(np.all(h[a:b] <= CONTACT_HEIGHT, axis=1)) + a
+        if not flat.size:
+            continue
+        kf = flat[0]
+        r = joints[kf, 1, :2] - joints[kf, 0, :2]
+        ref[a:b] = r
+        cur = joints[flat, 1, :2] - joints[flat, 0, :2]
+        twist = np.abs(np.arctan2(cur[:, 0] * r[1] - cur[:, 1] * r[0], cur @ r))
+        w[flat] = np.clip(2.0 - twist / MAX_TWIST, 0.0, 1.0)
+    w = np.minimum(w, stance.astype(float))
+    w = _rate_limited(w[:, None], 1.0 / max(1.0, YAW_RAMP * fps))[:, 0]
+    out = joints.copy()
+    idx = np.flatnonzero((w > 0) & stance)
+    if not idx.size:
+        return out
+    fv = joints[idx, 1, :2] - joints[idx, 0, :2]
+    hl = np.linalg.norm(fv, axis=-1, keepdims=True)
+    cur = fv / np.maximum(hl, 1e-9)
+    want = ref[idx] / np.maximum(np.linalg.norm(ref[idx], axis=-1, keepdims=True), 1e-9)
+    d = (1.0 - w[idx, None]) * cur + w[idx, None] * want
+    d /= np.maximum(np.linalg.norm(d, axis=-1, keepdims=True), 1e-9)
+    on_toe = contact[idx] == 1
+    out[idx, 1, :2] = np.where(on_toe[:, None], joints[idx, 1, :2], joints[idx, 0, :2] + d * hl)
+    out[idx, 0, :2] = np.where(on_toe[:, None], joints[idx, 1, :2] - d * hl, joints[idx, 0, :2])
+    return out
+
+
+def _pin_offsets(joints: np.ndarray, contact: np.ndarray, a: int, b: int, k: int
+                 ) -> np.ndarray:
+    """Horizontal offsets (b - a, 2) that hold the contact point of frames ``a..b-1`` where
+    it is at frame ``k``; when the contact passes to the other joint, that joint is held
+    where it was (corrected) the frame before, so nothing jumps."""
+    off = np.zeros((b - a, 2))
+    for order in (range(k + 1, b), range(k - 1, a - 1, -1)):
+        step = 1 if order.step == 1 else -1
+        c = int(contact[k])
+        anchor = joints[k, c, :2].copy()
+        for t in order:
+            if contact[t] != c:
+                c = int(contact[t])
+                anchor = joints[t - step, c, :2] + off[t - step - a]
+            off[t - a] = anchor - joints[t, c, :2]
+    return off
+
+
+def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float],
+                  fps: float, floor_z: float) -> tuple[np.ndarray, np.ndarray]:
+    """Ankle and toe targets (T, 3) each of one foot: its contact point (the joint nearer
+    its rest height, as the skate measure of :mod:`~ltl_human_motion.planning.
+    biomechanics` takes it) pinned during its stances, a flat planted foot keeping its
+    heading, and a foot that moves fast while low (a swing foot that would slide over the
+    floor) lifted to ``SWING_CLEARANCE`` above its rest height.
 
     Each stance is anchored where its contact point is nearest its median position (the
     mid-stance of a step, the standing part of a stop or a start); the correction ramps
     in before the stance and out after it over ``RELEASE`` while the foot is in the air.
-
-    Returns
-    -------
-    offset : ndarray, shape (T, 3)
-    heading : ndarray, shape (T, 2)
-        Horizontal ankle-to-toe direction a flat planted foot keeps (not normalized).
-    heading_weight : ndarray, shape (T,)
-        How much of it to apply (0 where the foot is free to turn).
-    contact : ndarray of int, shape (T,)
-        The contact joint of every frame (0 = ankle, 1 = toe).
     """
     T = len(ankle)
     joints = np.stack([ankle, toe], 1)                                   # (T, 2, 3)
@@ -84,34 +165,21 @@ def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     if T > 1:
         v[1:] = np.linalg.norm(np.diff(joints[:, :, :2], axis=0), axis=-1) * fps
         v[0] = v[1]
-    contact = np.argmin(h, axis=1)                                       # (T,)
-    # a flat foot (both joints low) is held by the ball, so the pin never flickers and the
-    # heel can rise about it (toe-off)
-    contact[np.all(h <= CONTACT_HEIGHT, axis=1)] = 1
+    contact = _contact_joint(h)
     hc = h[np.arange(T), contact]
-    vc = v[np.arange(T), contact]
-    low = hc <= CONTACT_HEIGHT
-    # enter a stance under STANCE_SPEED, stay in it under twice that (no flicker)
-    stance = low & (vc <= STANCE_SPEED)
-    keep = low & (vc <= 2.0 * STANCE_SPEED)
-    for t in range(1, T):
-        stance[t] |= stance[t - 1] & keep[t]
-    for t in range(T - 2, -1, -1):
-        stance[t] |= stance[t + 1] & keep[t]
-    offset = np.zeros((T, 2))
+    stance = _stance(hc, v[np.arange(T), contact])
+    held = _keep_heading(joints, h, contact, stance, fps)
+    # displacement of each joint (T, 2, 2): heading kept, contact point pinned
+    disp = np.zeros((T, 2, 2))
     weight = np.zeros(T)
-    heading = np.zeros((T, 2))
-    yaw_w = np.zeros(T)
     n_rel = max(1, round(RELEASE * fps))
     ramp = min_jerk(np.arange(1, n_rel + 1) / (n_rel + 1))
     for a, b in _runs(stance):
         # the anchor frame: where the contact point is nearest its median position over
         # the stance (a slide within the stance is split, not all undone one way)
-        cp = joints[np.arange(a, b), contact[a:b], :2]
+        cp = held[np.arange(a, b), contact[a:b], :2]
         k = a + int(np.argmin(np.linalg.norm(cp - np.median(cp, axis=0), axis=-1)))
-        # per frame the lower joint is held at its position at the anchor frame
-        off = joints[k, :, :2][None] - joints[a:b, :, :2]                # (n, 2, 2)
-        run_off = off[np.arange(b - a), contact[a:b]]
+        run_off = _pin_offsets(held, contact, a, b, k)
         big = np.linalg.norm(run_off, axis=-1) > MAX_LOCK
         if np.any(big):                     # keep the frames around the anchor only
             ok = ~big
@@ -125,25 +193,17 @@ def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
             stance[a + hi + 1:b] = False
             run_off = run_off[lo:hi + 1]
             a, b = a + lo, a + hi + 1
-        offset[a:b] = uniform_filter1d(run_off, size=9, axis=0, mode="nearest")
+        # the pinned joint's displacement is continuous where the contact passes from
+        # heel to ball (the pivot of the heading changes): smooth the total, per joint
+        run = held[a:b, :, :2] - joints[a:b, :, :2] + run_off[:, None]
+        disp[a:b] = uniform_filter1d(run, size=9, axis=0, mode="nearest")
         weight[a:b] = 1.0
-        # a flat planted foot keeps its heading (it pivots only with the heel up)
-        flat = np.flatnonzero(np.all(h[a:b] <= CONTACT_HEIGHT, axis=1)) + a
-        if flat.size:
-            kf = flat[0]                 # the heading it landed with: no snap
-            ref = joints[kf, 1, :2] - joints[kf, 0, :2]
-            heading[a:b] = ref
-            cur = joints[flat, 1, :2] - joints[flat, 0, :2]
-            twist = np.abs(np.arctan2(cur[:, 0] * ref[1] - cur[:, 1] * ref[0],
-                                      cur @ ref))
-            # a foot turned further than MAX_TWIST by the motion pivots (turns in place)
-            yaw_w[flat] = np.clip(2.0 - twist / MAX_TWIST, 0.0, 1.0)
         for i, w in enumerate(ramp[::-1]):          # ramp in before, out after
             if a - 1 - i >= 0 and weight[a - 1 - i] < w:
-                offset[a - 1 - i] = offset[a] * w
+                disp[a - 1 - i] = disp[a] * w
                 weight[a - 1 - i] = w
             if b + i < T and weight[b + i] < w:
-                offset[b + i] = offset[b - 1] * w
+                disp[b + i] = disp[b - 1] * w
                 weight[b + i] = w
     h_min = h.min(axis=1)
     sliding = (h_min < SWING_CLEARANCE) & ~stance
@@ -152,8 +212,10 @@ def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
         width = max(1, round(LIFT_RAMP * fps))
         smooth = uniform_filter1d(maximum_filter1d(lift, 2 * width + 1), 2 * width + 1)
         lift = np.maximum(smooth, lift)
-    yaw_w = np.maximum(yaw_w, uniform_filter1d(yaw_w, size=9, mode="nearest"))
-    return np.concatenate([offset, lift[:, None]], axis=1), heading, yaw_w, contact
+    out = joints.copy()
+    out[:, :, :2] += disp
+    out[:, :, 2] += lift[:, None]
+    return out[:, 0], out[:, 1]
 
 
 def _unit3(v: np.ndarray) -> np.ndarray:
@@ -198,36 +260,17 @@ def lock_feet(positions: np.ndarray, fps: float, skeleton: Skeleton,
     bones = skeleton.bone_lengths()
     for s in "lr":
         hip, knee, ank, toe = (_J[f"{s}_{n}"] for n in ("hip", "knee", "ankle", "toe"))
-        off, heading, yaw_w, contact = _foot_offsets(
-            p[:, ank], p[:, toe], (rest[ank, 2], rest[toe, 2]), fps, floor_z)
-        moved = np.any(np.abs(off) > 1e-9, axis=1) | (yaw_w > 0)
+        ank_all, toe_all = _foot_targets(p[:, ank], p[:, toe], (rest[ank, 2], rest[toe, 2]),
+                                         fps, floor_z)
+        moved = (np.any(np.abs(ank_all - p[:, ank]) > 1e-9, axis=1)
+                 | np.any(np.abs(toe_all - p[:, toe]) > 1e-9, axis=1))
         if not np.any(moved):
             continue
         foot = p[moved, toe] - p[moved, ank]
-        d = off[moved]
-        d = d.copy()
         hip_p = p[moved, hip]
         leg = 0.995 * (bones[knee] + bones[ank])
-        ank_t = p[moved, ank] + d
-        toe_t = p[moved, toe] + d
-        w = yaw_w[moved]
-        turn = w > 0
-        if np.any(turn):
-            fv = toe_t[turn] - ank_t[turn]
-            hl = np.linalg.norm(fv[:, :2], axis=-1, keepdims=True)
-            cur = fv[:, :2] / np.maximum(hl, 1e-9)
-            want = heading[moved][turn]
-            want = want / np.maximum(np.linalg.norm(want, axis=-1, keepdims=True), 1e-9)
-            dirn = (1 - w[turn, None]) * cur + w[turn, None] * want
-            dirn /= np.maximum(np.linalg.norm(dirn, axis=-1, keepdims=True), 1e-9)
-            on_toe = contact[moved][turn] == 1
-            new_ank = ank_t[turn].copy()
-            new_toe = toe_t[turn].copy()
-            new_toe[:, :2] = np.where(on_toe[:, None], new_toe[:, :2],
-                                      new_ank[:, :2] + dirn * hl)
-            new_ank[:, :2] = np.where(on_toe[:, None], new_toe[:, :2] - dirn * hl,
-                                      new_ank[:, :2])
-            ank_t[turn], toe_t[turn] = new_ank, new_toe
+        ank_t = ank_all[moved]
+        toe_t = toe_all[moved]
         # Where the leg cannot reach the moved ankle (a straight stance leg late in the
         # stance), the heel rises: the ankle goes to the point nearest its target that is
         # within reach and a foot's length from the pinned toe (toe-off).
