@@ -54,6 +54,48 @@ def _progress(t: np.ndarray, a: float, b: float) -> np.ndarray:
     return min_jerk(np.clip((t - a) / (b - a), 0.0, 1.0))
 
 
+#: Clearance (m) the hanging arms keep from the thighs of the stepping legs, over the
+#: self-penetration check of planning.biomechanics.
+ARM_CLEARANCE = 0.01
+#: Time (s) over which the arms swing out of the legs' way and back (half-width).
+ARM_RAMP = 0.15
+
+
+def _arms_clear_of_thighs(poses: np.ndarray, skeleton: Skeleton, fps: float) -> np.ndarray:
+    """Poses (T, J, 3) (root-relative, facing +x) with each arm abducted about its shoulder
+    just enough that no arm segment enters the thigh of its side (a thigh stepping back or
+    turning swings through the hanging hand), the angle smoothed over ``ARM_RAMP``."""
+    from scipy.ndimage import maximum_filter1d, uniform_filter1d
+
+    from ltl_human_motion.planning.biomechanics import self_penetration
+    out = np.array(poses, dtype=np.float64, copy=True)
+    width = 2 * max(1, round(ARM_RAMP * fps)) + 1
+    for _ in range(2):
+        depth, pairs = self_penetration(out, skeleton.stature)
+        done = True
+        for side, sign in (("l", 1.0), ("r", -1.0)):
+            cols = [i for i, (a, b) in enumerate(pairs) if b == f"{side}_thigh"
+                    and a in (f"{side}_upper_arm", f"{side}_lower_arm", f"{side}_hand")]
+            need = np.maximum(depth[:, cols].max(axis=1) + ARM_CLEARANCE, 0.0)
+            if not np.any(depth[:, cols] > -ARM_CLEARANCE):
+                continue
+            done = False
+            sh = JOINT_INDEX[f"{side}_shoulder"]
+            arm = [JOINT_INDEX[f"{side}_{x}"] for x in ("elbow", "wrist", "hand")]
+            reach = np.linalg.norm(out[:, arm[-1]] - out[:, sh], axis=-1)
+            ang = need / np.maximum(reach, 1e-6)
+            ang = uniform_filter1d(maximum_filter1d(ang, width), width)
+            c, s = np.cos(sign * ang)[:, None], np.sin(sign * ang)[:, None]
+            rel = out[:, arm] - out[:, sh][:, None]
+            y, z = rel[..., 1].copy(), rel[..., 2].copy()
+            rel[..., 1] = c * y - s * z
+            rel[..., 2] = s * y + c * z
+            out[:, arm] = out[:, sh][:, None] + rel
+        if done:
+            break
+    return out
+
+
 def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, angle: float,
                         skeleton: Skeleton, fps: float, task: str = "walk",
                         lift: float = 0.06) -> MotionPrimitive:
@@ -135,7 +177,7 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
                                                      pole, max_stretch=1.0)
     body[:, :, :2] -= root_xy[:, None, :]
     body[:, :, 2] += dip[:, None]
-    poses = _turned(heading, body, inverse=True)                       # back to heading frame
+    poses = _arms_clear_of_thighs(_turned(heading, body, inverse=True), skeleton, fps)
     root = np.zeros((n, 4))
     root[:, :2] = root_xy
     root[:, 2] = height - dip
