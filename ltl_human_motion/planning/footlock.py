@@ -49,6 +49,9 @@ RELEASE = 0.15
 SWING_CLEARANCE = 1.2 * CONTACT_HEIGHT
 #: Half-width (s) of the smoothing of that lift (it starts and ends this gradually).
 LIFT_RAMP = 0.1
+#: Horizontal miss (m) of a grounded contact point from its pin over which the leg is
+#: taken as unable to hold it (the foot is then lifted clear there instead).
+LOCK_MISS = 0.003
 #: How much lower (m) the other foot joint must be for the contact to pass to it.
 CONTACT_SWITCH = 0.003
 #: Time (s) over which the heading lock of a flat planted foot fades fully in or out.
@@ -147,7 +150,8 @@ def _pin_offsets(joints: np.ndarray, contact: np.ndarray, a: int, b: int, k: int
 
 
 def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float],
-                  fps: float, floor_z: float) -> tuple[np.ndarray, np.ndarray]:
+                  fps: float, floor_z: float, free: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Ankle and toe targets (T, 3) each of one foot: its contact point (the joint nearer
     its rest height, as the skate measure of :mod:`~ltl_human_motion.planning.
     biomechanics` takes it) pinned during its stances, a flat planted foot keeping its
@@ -157,6 +161,15 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     Each stance is anchored where its contact point is nearest its median position (the
     mid-stance of a step, the standing part of a stop or a start); the correction ramps
     in before the stance and out after it over ``RELEASE`` while the foot is in the air.
+    Frames in ``free`` (T,) of bool are never stance frames (the leg cannot hold the pin
+    there): a low foot is lifted clear instead.
+
+    Returns
+    -------
+    ankle_target, toe_target : ndarray, shape (T, 3)
+    contact : ndarray of int, shape (T,)
+        The contact joint (0 = ankle, 1 = toe).
+    stance : ndarray of bool, shape (T,)
     """
     T = len(ankle)
     joints = np.stack([ankle, toe], 1)                                   # (T, 2, 3)
@@ -168,6 +181,8 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     contact = _contact_joint(h)
     hc = h[np.arange(T), contact]
     stance = _stance(hc, v[np.arange(T), contact])
+    if free is not None:
+        stance &= ~free
     held = _keep_heading(joints, h, contact, stance, fps)
     # displacement of each joint (T, 2, 2): heading kept, contact point pinned
     disp = np.zeros((T, 2, 2))
@@ -194,9 +209,13 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
             run_off = run_off[lo:hi + 1]
             a, b = a + lo, a + hi + 1
         # the pinned joint's displacement is continuous where the contact passes from
-        # heel to ball (the pivot of the heading changes): smooth the total, per joint
+        # heel to ball, the other joint's jumps (the pivot of the heading changes): that
+        # one is smoothed, the pinned one cancels the motion's slide exactly
         run = held[a:b, :, :2] - joints[a:b, :, :2] + run_off[:, None]
-        disp[a:b] = uniform_filter1d(run, size=9, axis=0, mode="nearest")
+        smooth = uniform_filter1d(run, size=9, axis=0, mode="nearest")
+        i = np.arange(b - a)
+        smooth[i, contact[a:b]] = run[i, contact[a:b]]
+        disp[a:b] = smooth
         weight[a:b] = 1.0
         for i, w in enumerate(ramp[::-1]):          # ramp in before, out after
             if a - 1 - i >= 0 and weight[a - 1 - i] < w:
@@ -215,7 +234,7 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     out = joints.copy()
     out[:, :, :2] += disp
     out[:, :, 2] += lift[:, None]
-    return out[:, 0], out[:, 1]
+    return out[:, 0], out[:, 1], contact, stance
 
 
 def _unit3(v: np.ndarray) -> np.ndarray:
@@ -259,58 +278,81 @@ def lock_feet(positions: np.ndarray, fps: float, skeleton: Skeleton,
     rest = skeleton.rest_positions()
     bones = skeleton.bone_lengths()
     for s in "lr":
-        hip, knee, ank, toe = (_J[f"{s}_{n}"] for n in ("hip", "knee", "ankle", "toe"))
-        ank_all, toe_all = _foot_targets(p[:, ank], p[:, toe], (rest[ank, 2], rest[toe, 2]),
-                                         fps, floor_z)
-        moved = (np.any(np.abs(ank_all - p[:, ank]) > 1e-9, axis=1)
-                 | np.any(np.abs(toe_all - p[:, toe]) > 1e-9, axis=1))
-        if not np.any(moved):
-            continue
-        foot = p[moved, toe] - p[moved, ank]
-        hip_p = p[moved, hip]
-        leg = 0.995 * (bones[knee] + bones[ank])
-        ank_t = ank_all[moved]
-        toe_t = toe_all[moved]
-        # Where the leg cannot reach the moved ankle (a straight stance leg late in the
-        # stance), the heel rises: the ankle goes to the point nearest its target that is
-        # within reach and a foot's length from the pinned toe (toe-off).
-        reach = np.maximum(leg, np.linalg.norm(p[moved, ank] - hip_p, axis=-1))
-        far = np.linalg.norm(ank_t - hip_p, axis=-1) > reach
-        if np.any(far):
-            leg = reach[far][:, None]
-            f_len = float(bones[toe])
-            ht = toe_t[far] - hip_p[far]
-            D = np.linalg.norm(ht, axis=-1, keepdims=True)
-            u = ht / np.maximum(D, 1e-9)
-            x = np.clip((D * D + leg * leg - f_len * f_len) / (2.0 * np.maximum(D, 1e-9)),
-                        -leg, leg)
-            rho = np.sqrt(np.maximum(leg * leg - x * x, 0.0))
-            c = hip_p[far] + u * x
-            q = ank_t[far] - c
-            q = q - np.sum(q * u, -1, keepdims=True) * u
-            q /= np.maximum(np.linalg.norm(q, axis=-1, keepdims=True), 1e-9)
-            new_ank = c + rho * q
-            ok = (D[:, 0] <= leg[:, 0] + f_len) & (new_ank[:, 2] >= ank_t[far, 2])
-            idx = np.flatnonzero(far)[ok]
-            ank_t[idx] = new_ank[ok]
-            toe_t[idx] = ank_t[idx] + f_len * _unit3(toe_t[idx] - ank_t[idx])
-        # no correction changes faster than MAX_CORRECTION_RATE
-        da = np.zeros((len(p), 3))
-        dt = np.zeros((len(p), 3))
-        da[moved] = ank_t - p[moved, ank]
-        dt[moved] = toe_t - p[moved, toe]
-        step = MAX_CORRECTION_RATE / fps
-        target = p[moved, ank] + _rate_limited(da, step)[moved]
-        toe_target = p[moved, toe] + _rate_limited(dt, step)[moved]
-        # the knee bends towards where it was, and forward over the foot when the leg is
-        # straight (then the old offset from the hip-ankle line is only noise)
-        fwd = np.zeros_like(foot)
-        fwd[:, :2] = foot[:, :2] / np.maximum(np.linalg.norm(foot[:, :2], axis=-1,
-                                                             keepdims=True), 1e-9)
-        pole = p[moved, knee] - 0.5 * (p[moved, hip] + p[moved, ank]) + 0.01 * fwd
-        kn, an = two_bone_ik(p[moved, hip], target, bones[knee], bones[ank], pole,
-                             max_stretch=1.0)
-        p[moved, knee] = kn
-        p[moved, ank] = an
-        p[moved, toe] = an + float(bones[toe]) * _unit3(toe_target - an)
+        ank, toe = _J[f"{s}_ankle"], _J[f"{s}_toe"]
+        rest_h = (rest[ank, 2], rest[toe, 2])
+        ank_all, toe_all, contact, stance = _foot_targets(p[:, ank], p[:, toe], rest_h, fps,
+                                                          floor_z)
+        leg = _solve_leg(p, s, bones, ank_all, toe_all, fps)
+        # where the leg could not hold a grounded contact point on its pin (the hip is too
+        # far: a push-off the motion slides), the foot leaves the floor a little earlier
+        got = np.stack([leg[1], leg[2]], 1)[np.arange(len(p)), contact]     # (T, 3)
+        want = np.stack([ank_all, toe_all], 1)[np.arange(len(p)), contact]
+        low = got[:, 2] - floor_z - np.asarray(rest_h)[contact] <= 0.5 * CONTACT_HEIGHT
+        miss = stance & low & (np.linalg.norm(got[:, :2] - want[:, :2], axis=-1) > LOCK_MISS)
+        if np.any(miss):
+            free = maximum_filter1d(miss, 2 * max(1, round(0.025 * fps)) + 1)
+            ank_all, toe_all, _, _ = _foot_targets(p[:, ank], p[:, toe], rest_h, fps,
+                                                   floor_z, free)
+            leg = _solve_leg(p, s, bones, ank_all, toe_all, fps)
+        p[:, _J[f"{s}_knee"]], p[:, ank], p[:, toe] = leg
     return p
+
+
+def _solve_leg(p: np.ndarray, s: str, bones: np.ndarray, ank_all: np.ndarray,
+               toe_all: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Knee, ankle and toe (T, 3) each of leg ``s`` ("l"/"r") of ``p`` (T, J, 3) moved
+    towards the ankle and toe targets (T, 3) by two-bone IK from the unchanged hip."""
+    hip, knee, ank, toe = (_J[f"{s}_{n}"] for n in ("hip", "knee", "ankle", "toe"))
+    kn_out, an_out, to_out = p[:, knee].copy(), p[:, ank].copy(), p[:, toe].copy()
+    moved = (np.any(np.abs(ank_all - p[:, ank]) > 1e-9, axis=1)
+             | np.any(np.abs(toe_all - p[:, toe]) > 1e-9, axis=1))
+    if not np.any(moved):
+        return kn_out, an_out, to_out
+    foot = p[moved, toe] - p[moved, ank]
+    hip_p = p[moved, hip]
+    leg = 0.995 * (bones[knee] + bones[ank])
+    ank_t = ank_all[moved]
+    toe_t = toe_all[moved]
+    # Where the leg cannot reach the moved ankle (a straight stance leg late in the
+    # stance), the heel rises: the ankle goes to the point nearest its target that is
+    # within reach and a foot's length from the pinned toe (toe-off).
+    reach = np.maximum(leg, np.linalg.norm(p[moved, ank] - hip_p, axis=-1))
+    far = np.linalg.norm(ank_t - hip_p, axis=-1) > reach
+    if np.any(far):
+        leg = reach[far][:, None]
+        f_len = float(bones[toe])
+        ht = toe_t[far] - hip_p[far]
+        D = np.linalg.norm(ht, axis=-1, keepdims=True)
+        u = ht / np.maximum(D, 1e-9)
+        x = np.clip((D * D + leg * leg - f_len * f_len) / (2.0 * np.maximum(D, 1e-9)),
+                    -leg, leg)
+        rho = np.sqrt(np.maximum(leg * leg - x * x, 0.0))
+        c = hip_p[far] + u * x
+        q = ank_t[far] - c
+        q = q - np.sum(q * u, -1, keepdims=True) * u
+        q /= np.maximum(np.linalg.norm(q, axis=-1, keepdims=True), 1e-9)
+        new_ank = c + rho * q
+        ok = (D[:, 0] <= leg[:, 0] + f_len) & (new_ank[:, 2] >= ank_t[far, 2])
+        idx = np.flatnonzero(far)[ok]
+        ank_t[idx] = new_ank[ok]
+        toe_t[idx] = ank_t[idx] + f_len * _unit3(toe_t[idx] - ank_t[idx])
+    # no correction changes faster than MAX_CORRECTION_RATE
+    da = np.zeros((len(p), 3))
+    dt = np.zeros((len(p), 3))
+    da[moved] = ank_t - p[moved, ank]
+    dt[moved] = toe_t - p[moved, toe]
+    step = MAX_CORRECTION_RATE / fps
+    target = p[moved, ank] + _rate_limited(da, step)[moved]
+    toe_target = p[moved, toe] + _rate_limited(dt, step)[moved]
+    # the knee bends towards where it was, and forward over the foot when the leg is
+    # straight (then the old offset from the hip-ankle line is only noise)
+    fwd = np.zeros_like(foot)
+    fwd[:, :2] = foot[:, :2] / np.maximum(np.linalg.norm(foot[:, :2], axis=-1,
+                                                         keepdims=True), 1e-9)
+    pole = p[moved, knee] - 0.5 * (p[moved, hip] + p[moved, ank]) + 0.01 * fwd
+    kn, an = two_bone_ik(p[moved, hip], target, bones[knee], bones[ank], pole,
+                         max_stretch=1.0)
+    kn_out[moved] = kn
+    an_out[moved] = an
+    to_out[moved] = an + float(bones[toe]) * _unit3(toe_target - an)
+    return kn_out, an_out, to_out
