@@ -91,10 +91,11 @@ def _stance(hc: np.ndarray, vc: np.ndarray) -> np.ndarray:
     return stance
 
 
-def _keep_heading(joints: np.ndarray, h: np.ndarray, contact: np.ndarray,
-                  stance: np.ndarray, fps: float) -> np.ndarray:
+def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: float
+                  ) -> np.ndarray:
     """The foot's joints (T, 2, 3) with a flat planted foot keeping the heading it landed
-    with, pivoting about its contact joint (which therefore does not move).
+    with, pivoting about its lower joint (a blend of heel and ball while they are within
+    ``CONTACT_SWITCH`` of each other).
 
     The lock fades out where the motion turns the foot further than ``MAX_TWIST`` (to
     nothing at twice that: a turn in place turns the feet), and its weight changes by at
@@ -124,10 +125,16 @@ def _keep_heading(joints: np.ndarray, h: np.ndarray, contact: np.ndarray,
     cur = fv / np.maximum(hl, 1e-9)
     want = ref[idx] / np.maximum(np.linalg.norm(ref[idx], axis=-1, keepdims=True), 1e-9)
     d = (1.0 - w[idx, None]) * cur + w[idx, None] * want
-    d /= np.maximum(np.linalg.norm(d, axis=-1, keepdims=True), 1e-9)
-    on_toe = contact[idx] == 1
-    out[idx, 1, :2] = np.where(on_toe[:, None], joints[idx, 1, :2], joints[idx, 0, :2] + d * hl)
-    out[idx, 0, :2] = np.where(on_toe[:, None], joints[idx, 1, :2] - d * hl, joints[idx, 0, :2])
+    phi = np.arctan2(cur[:, 0] * d[:, 1] - cur[:, 1] * d[:, 0], np.sum(cur * d, -1))
+    # the pivot slides from heel to ball as the ball becomes the lower joint, so the turned
+    # foot never jumps (the pin then holds the contact joint where it is)
+    beta = np.clip(0.5 + (h[idx, 0] - h[idx, 1]) / (2.0 * CONTACT_SWITCH), 0.0, 1.0)
+    pivot = (1.0 - beta[:, None]) * joints[idx, 0, :2] + beta[:, None] * joints[idx, 1, :2]
+    c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
+    for j in range(2):
+        r = joints[idx, j, :2] - pivot
+        out[idx, j, 0] = pivot[:, 0] + c[:, 0] * r[:, 0] - s[:, 0] * r[:, 1]
+        out[idx, j, 1] = pivot[:, 1] + s[:, 0] * r[:, 0] + c[:, 0] * r[:, 1]
     return out
 
 
@@ -183,7 +190,7 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     stance = _stance(hc, v[np.arange(T), contact])
     if free is not None:
         stance &= ~free
-    held = _keep_heading(joints, h, contact, stance, fps)
+    held = _keep_heading(joints, h, stance, fps)
     # displacement of each joint (T, 2, 2): heading kept, contact point pinned
     disp = np.zeros((T, 2, 2))
     weight = np.zeros(T)
@@ -208,14 +215,9 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
             stance[a + hi + 1:b] = False
             run_off = run_off[lo:hi + 1]
             a, b = a + lo, a + hi + 1
-        # the pinned joint's displacement is continuous where the contact passes from
-        # heel to ball, the other joint's jumps (the pivot of the heading changes): that
-        # one is smoothed, the pinned one cancels the motion's slide exactly
-        run = held[a:b, :, :2] - joints[a:b, :, :2] + run_off[:, None]
-        smooth = uniform_filter1d(run, size=9, axis=0, mode="nearest")
-        i = np.arange(b - a)
-        smooth[i, contact[a:b]] = run[i, contact[a:b]]
-        disp[a:b] = smooth
+        # continuous where the contact passes from heel to ball (the pin continues, the
+        # heading's pivot slides), and not smoothed: it cancels the motion's slide exactly
+        disp[a:b] = held[a:b, :, :2] - joints[a:b, :, :2] + run_off[:, None]
         weight[a:b] = 1.0
         for i, w in enumerate(ramp[::-1]):          # ramp in before, out after
             if a - 1 - i >= 0 and weight[a - 1 - i] < w:
