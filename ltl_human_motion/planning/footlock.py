@@ -10,11 +10,12 @@ Per foot and frame the contact point is the foot joint nearer its rest height (h
 ankle, ball = toe), with a hysteresis of ``CONTACT_SWITCH``. A stance is a run of frames
 where that joint is within ``CONTACT_HEIGHT`` of its rest height above the floor and moves
 horizontally slower than ``STANCE_SPEED``. Within a stance a flat foot keeps its heading
-(it pivots about the contact joint, which does not move), and the foot is translated
-(horizontally) so that the contact point stays where it was; when the contact passes from
-heel to ball the new contact joint is held where it was the frame before, so nothing
-jumps. After a stance the correction returns to zero over ``RELEASE`` seconds with the
-minimum-jerk profile, while the foot is in the air.
+(it pivots about its lower joint), and the foot is translated (horizontally) so that its
+pinned point does not move: the lower joint, or while heel and ball are within
+``CONTACT_SWITCH`` of each other (the foot rolls) a blend of the two, so the pin passes
+from heel to ball without a jump. After a stance the correction returns to zero over
+``RELEASE`` seconds with the minimum-jerk profile, while the foot is in the air. Where the
+leg cannot hold a grounded pin, the foot is lifted clear of the floor instead.
 """
 
 from __future__ import annotations
@@ -99,7 +100,8 @@ def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: fl
 
     The lock fades out where the motion turns the foot further than ``MAX_TWIST`` (to
     nothing at twice that: a turn in place turns the feet), and its weight changes by at
-    most 1 over ``YAW_RAMP`` (no swing of the free end).
+    most 1 over ``YAW_RAMP``, reaching full weight when the foot becomes flat (the ball
+    does not swing round as it comes down).
     """
     T = len(joints)
     w = np.zeros(T)
@@ -114,8 +116,14 @@ def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: fl
         cur = joints[flat, 1, :2] - joints[flat, 0, :2]
         twist = np.abs(np.arctan2(cur[:, 0] * r[1] - cur[:, 1] * r[0], cur @ r))
         w[flat] = np.clip(2.0 - twist / MAX_TWIST, 0.0, 1.0)
+    # the lock is in full by the time the foot is flat: it fades in over YAW_RAMP before
+    # (while the heel is down and the ball comes down) and out over YAW_RAMP after
+    step = 1.0 / max(1.0, YAW_RAMP * fps)
+    for t in range(T - 2, -1, -1):
+        w[t] = max(w[t], w[t + 1] - step)
+    for t in range(1, T):
+        w[t] = max(w[t], w[t - 1] - step)
     w = np.minimum(w, stance.astype(float))
-    w = _rate_limited(w[:, None], 1.0 / max(1.0, YAW_RAMP * fps))[:, 0]
     out = joints.copy()
     idx = np.flatnonzero((w > 0) & stance)
     if not idx.size:
@@ -128,7 +136,7 @@ def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: fl
     phi = np.arctan2(cur[:, 0] * d[:, 1] - cur[:, 1] * d[:, 0], np.sum(cur * d, -1))
     # the pivot slides from heel to ball as the ball becomes the lower joint, so the turned
     # foot never jumps (the pin then holds the contact joint where it is)
-    beta = np.clip(0.5 + (h[idx, 0] - h[idx, 1]) / (2.0 * CONTACT_SWITCH), 0.0, 1.0)
+    beta = _roll_weight(h[idx])
     pivot = (1.0 - beta[:, None]) * joints[idx, 0, :2] + beta[:, None] * joints[idx, 1, :2]
     c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
     for j in range(2):
@@ -138,21 +146,27 @@ def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: fl
     return out
 
 
-def _pin_offsets(joints: np.ndarray, contact: np.ndarray, a: int, b: int, k: int
-                 ) -> np.ndarray:
-    """Horizontal offsets (b - a, 2) that hold the contact point of frames ``a..b-1`` where
-    it is at frame ``k``; when the contact passes to the other joint, that joint is held
-    where it was (corrected) the frame before, so nothing jumps."""
+def _roll_weight(h: np.ndarray) -> np.ndarray:
+    """Share (T,) of the ball in the pinned point of a foot, from the heights of heel and
+    ball over their rest heights (T, 2): 0 with the heel the lower joint by
+    ``CONTACT_SWITCH`` or more, 1 with the ball, in between while the foot rolls."""
+    return np.clip(0.5 + (h[:, 0] - h[:, 1]) / (2.0 * CONTACT_SWITCH), 0.0, 1.0)
+
+
+def _pin_offsets(joints: np.ndarray, h: np.ndarray, a: int, b: int, k: int) -> np.ndarray:
+    """Horizontal offsets (b - a, 2) that hold the foot's pinned point still over frames
+    ``a..b-1``, zero at frame ``k``: the lower of heel and ball, a blend of the two while
+    their heights are within ``CONTACT_SWITCH`` (:func:`_roll_weight`). Each frame's
+    offset cancels the pinned point's step from the frame before, so the pin passes from
+    heel to ball without a jump."""
+    beta = _roll_weight(h[a:b])[:, None]
+    step = np.diff(joints[a:b, :, :2], axis=0)                         # (n-1, 2, 2)
     off = np.zeros((b - a, 2))
-    for order in (range(k + 1, b), range(k - 1, a - 1, -1)):
-        step = 1 if order.step == 1 else -1
-        c = int(contact[k])
-        anchor = joints[k, c, :2].copy()
-        for t in order:
-            if contact[t] != c:
-                c = int(contact[t])
-                anchor = joints[t - step, c, :2] + off[t - step - a]
-            off[t - a] = anchor - joints[t, c, :2]
+    i = k - a
+    for t in range(i + 1, b - a):
+        off[t] = off[t - 1] - ((1.0 - beta[t]) * step[t - 1, 0] + beta[t] * step[t - 1, 1])
+    for t in range(i - 1, -1, -1):
+        off[t] = off[t + 1] + ((1.0 - beta[t + 1]) * step[t, 0] + beta[t + 1] * step[t, 1])
     return off
 
 
@@ -201,7 +215,7 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
         # the stance (a slide within the stance is split, not all undone one way)
         cp = held[np.arange(a, b), contact[a:b], :2]
         k = a + int(np.argmin(np.linalg.norm(cp - np.median(cp, axis=0), axis=-1)))
-        run_off = _pin_offsets(held, contact, a, b, k)
+        run_off = _pin_offsets(held, h, a, b, k)
         big = np.linalg.norm(run_off, axis=-1) > MAX_LOCK
         if np.any(big):                     # keep the frames around the anchor only
             ok = ~big
