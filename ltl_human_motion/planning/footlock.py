@@ -20,6 +20,8 @@ leg cannot hold a grounded pin, the foot is lifted clear of the floor instead.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from scipy.ndimage import maximum_filter1d, uniform_filter1d
 
@@ -240,6 +242,13 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
             if b + i < T and weight[b + i] < w:
                 disp[b + i] = disp[b - 1] * w
                 weight[b + i] = w
+    # between two stances closer than two release times the correction passes from the
+    # one to the other along the minimum-jerk profile (their ramps would meet in a step)
+    held_runs = _runs(weight >= 1.0)
+    for (_, b0), (a1, _) in itertools.pairwise(held_runs):
+        if a1 - b0 < 2 * n_rel:
+            u = min_jerk(np.arange(1, a1 - b0 + 1) / (a1 - b0 + 1))[:, None, None]
+            disp[b0:a1] = disp[b0 - 1] + u * (disp[a1] - disp[b0 - 1])
     h_min = h.min(axis=1)
     sliding = (h_min < SWING_CLEARANCE) & ~stance
     lift = np.where(sliding, SWING_CLEARANCE - h_min, 0.0)
