@@ -69,7 +69,8 @@ def main(argv: list[str] | None = None) -> int:
               "median_time_s": statistics.median(times), "failures": failures}
     atomic_write_text(out, json.dumps(result, indent=1) + "\n")
     print(f"verified {result['verified']} of {runs} (S1, S2 x statures {args.statures} x "
-          f"{args.seeds} seeds{', biomechanical checks on' if args.biomechanics else ''}), median {1000 * result['median_time_s']:.0f} ms per motion")
+          f"{args.seeds} seeds{', biomechanical checks on' if args.biomechanics else ''}), "
+          f"median {1000 * result['median_time_s']:.0f} ms per motion")
     for f in failures:
         print(f"  {f['spec']} stature {f['stature']} seed {f['seed']}: {f['error']}")
     print(f"written to {out}")
