@@ -66,3 +66,21 @@ def test_a_flat_turning_foot_does_not_jump_between_heel_and_ball() -> None:
     step = np.linalg.norm(np.diff(out[:, [J["l_ankle"], J["l_toe"]]], axis=0), axis=-1)
     assert step.max() * FPS < 0.3
     assert _bone_error(out) < 1e-6
+
+
+def test_synthesis_with_foot_locking_pins_the_feet_or_falls_back_when_it_collides() -> None:
+    from ltl_human_motion.ltl.spec import PAPER_SPECS
+    from ltl_human_motion.planning.pipeline import SynthesisOptions, resolve_cell, synthesize
+
+    on = SynthesisOptions(foot_locking=True)
+    s1 = synthesize(PAPER_SPECS["S1"], resolve_cell("paper_cell"), seed=0, options=on)[0]
+    assert s1.verification["passed"] and s1.stats["foot_locking"] is True
+    assert foot_skate(s1.motion.positions, s1.motion.fps, 1.75)[0].max() < 0.03
+    off = synthesize(PAPER_SPECS["S1"], resolve_cell("paper_cell"), seed=0)[0]
+    assert off.stats["foot_locking"] is False
+    # next to the demo cell's table foot locking moves a pose into it: the motion is
+    # blended again without it, and verified
+    m = synthesize("F(grasp(O1) & X release(O1))", resolve_cell("demo_cell"), seed=0,
+                   options=on)[0]
+    assert m.verification["passed"] and m.verification["collision"]["passed"]
+    assert m.stats["foot_locking"] is False

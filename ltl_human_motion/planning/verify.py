@@ -256,8 +256,13 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
 
     report["passed"] = all(c["passed"] for c in report.values() if isinstance(c, dict))
     if raise_on_failure and not report["passed"]:
-        failed = [k for k, c in report.items() if isinstance(c, dict) and not c["passed"]]
-        details = "; ".join(f"{k}: {report[k]['detail']}" for k in failed)
-        raise VerificationError(f"verification failed ({', '.join(failed)}): {details}",
-                                failed[0])
+        raise failure_error(report)
     return report
+
+
+def failure_error(report: dict) -> VerificationError:
+    """The error of a failed report of :func:`verify_motion`, naming every failed check."""
+    failed = [k for k, c in report.items() if isinstance(c, dict) and not c["passed"]]
+    details = "; ".join(f"{k}: {report[k]['detail']}" for k in failed)
+    return VerificationError(f"verification failed ({', '.join(failed)}): {details}",
+                             failed[0])
