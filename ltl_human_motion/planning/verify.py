@@ -15,7 +15,7 @@ Checks (each a key of the report):
                  limits by body part and activity, anatomical range of motion, no body
                  part through another, static balance, foot skate): see
                  :mod:`~ltl_human_motion.planning.biomechanics` for the limits and their
-                 sources. On by default (``VerificationOptions.biomechanics``).
+                 sources. Opt-in for now (``VerificationOptions.biomechanics``).
 """
 
 from __future__ import annotations
@@ -55,7 +55,8 @@ class VerificationOptions:
         Longest time both feet may be more than ``flight_height`` above the floor, s.
     flight_height : float
     biomechanics : bool
-        Run the biomechanical checks (default on).
+        Run the biomechanical checks (default off for now: README, "Human
+        plausibility").
     limits : BiomechanicsLimits
         Their limits (:mod:`~ltl_human_motion.planning.biomechanics`).
     """
