@@ -21,7 +21,13 @@ sys.path.insert(0, str(ROOT))
 from ltl_human_motion.atomic import atomic_write_text  # noqa: E402
 from ltl_human_motion.errors import LtlHumanMotionError  # noqa: E402
 from ltl_human_motion.ltl.spec import PAPER_SPECS  # noqa: E402
-from ltl_human_motion.planning.pipeline import get_library, resolve_cell, synthesize  # noqa: E402
+from ltl_human_motion.planning.pipeline import (  # noqa: E402
+    SynthesisOptions,
+    get_library,
+    resolve_cell,
+    synthesize,
+)
+from ltl_human_motion.planning.verify import VerificationOptions  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from paper_specs import machine  # noqa: E402
@@ -32,8 +38,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--statures", type=float, nargs="+",
                         default=[1.55, 1.65, 1.75, 1.85, 1.95])
     parser.add_argument("--seeds", type=int, default=5)
-    parser.add_argument("--out", default=str(ROOT / "bench" / "results" / "statures.json"))
+    parser.add_argument("--biomechanics", action="store_true",
+                        help="verify with the biomechanical checks (and their motion work)")
+    parser.add_argument("--out", default=None,
+                        help="default bench/results/statures.json, with --biomechanics "
+                             "bench/results/statures_biomechanics.json")
     args = parser.parse_args(argv)
+    out = args.out or str(ROOT / "bench" / "results" / (
+        "statures_biomechanics.json" if args.biomechanics else "statures.json"))
+    options = SynthesisOptions(verification=VerificationOptions(biomechanics=True)) \
+        if args.biomechanics else None
     cell = resolve_cell("paper_cell")
     runs, failures, times = 0, [], []
     for name in ("S1", "S2"):
@@ -43,20 +57,23 @@ def main(argv: list[str] | None = None) -> int:
                 runs += 1
                 t0 = time.perf_counter()
                 try:
-                    synthesize(PAPER_SPECS[name], cell, stature=stature, seed=seed)
+                    synthesize(PAPER_SPECS[name], cell, stature=stature, seed=seed,
+                               options=options)
                 except LtlHumanMotionError as exc:
                     failures.append({"spec": name, "stature": stature, "seed": seed,
                                      "error": str(exc)})
                 times.append(time.perf_counter() - t0)
     result = {"benchmark": "statures", "machine": machine(), "statures": args.statures,
+              "biomechanics": bool(args.biomechanics),
               "seeds": args.seeds, "runs": runs, "verified": runs - len(failures),
               "median_time_s": statistics.median(times), "failures": failures}
-    atomic_write_text(args.out, json.dumps(result, indent=1) + "\n")
+    atomic_write_text(out, json.dumps(result, indent=1) + "\n")
     print(f"verified {result['verified']} of {runs} (S1, S2 x statures {args.statures} x "
-          f"{args.seeds} seeds), median {1000 * result['median_time_s']:.0f} ms per motion")
+          f"{args.seeds} seeds{', biomechanical checks on' if args.biomechanics else ''}), "
+          f"median {1000 * result['median_time_s']:.0f} ms per motion")
     for f in failures:
         print(f"  {f['spec']} stature {f['stature']} seed {f['seed']}: {f['error']}")
-    print(f"written to {args.out}")
+    print(f"written to {out}")
     return 0
 
 

@@ -9,13 +9,7 @@ import pytest
 
 from ltl_human_motion.cli import build_parser, main
 
-LOW_GRASP_DEFECT = (
-    "known defect, found by the self-penetration check of the realism work: a grasp at a "
-    "low target (0.3-0.45 m) puts the hand 6-16 mm into the thigh just before contact "
-    "(where reach placement puts the target); fix the placement, then drop this")
 
-
-@pytest.mark.xfail(strict=True, reason=LOW_GRASP_DEFECT)
 def test_library_command_writes_report_and_plot(tmp_path: Path, capsys) -> None:
     report, plot = tmp_path / "report.json", tmp_path / "graph.png"
     rc = main(["library", "--cache-dir", str(tmp_path / "cache"), "--report", str(report),

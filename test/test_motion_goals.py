@@ -20,6 +20,7 @@ from ltl_human_motion.motion.quality import primitive_metrics
 from ltl_human_motion.motion.skeleton import JOINT_INDEX as J
 from ltl_human_motion.motion.skeleton import Skeleton
 from ltl_human_motion.motion.types import world_positions
+from ltl_human_motion.planning.biomechanics import self_penetration
 
 SK = Skeleton(1.75)
 STAND, STAND_Z = standing_pose(SK)
@@ -57,15 +58,8 @@ def test_every_task_passes_quality_and_returns_to_standing(task: str) -> None:
         np.testing.assert_allclose(end, STAND_WORLD, atol=1e-6)
 
 
-LOW_GRASP_DEFECT = pytest.mark.xfail(strict=True, reason=(
-    "known defect, found by the self-penetration check of the realism work: a grasp at "
-    "0.3 m puts a 1.55 m worker's hand 16 mm into the thigh just before contact (where "
-    "reach placement puts the target); fix the placement, then drop this"))
-
-
 @pytest.mark.parametrize(("stature", "height"), [
-    pytest.param(s, h, marks=LOW_GRASP_DEFECT) if (s, h) == (1.55, 0.3) else (s, h)
-    for s in (1.55, 1.95) for h in (0.02, 0.3, 0.75, 1.1, 1.5, 1.9)])
+    (s, h) for s in (1.55, 1.95) for h in (0.02, 0.3, 0.75, 1.1, 1.5, 1.9)])
 def test_grasp_reaches_any_height(height: float, stature: float) -> None:
     sk = Skeleton(stature)
     if height > max_reach("grasp", sk):
@@ -83,6 +77,21 @@ def test_grasp_reaches_any_height(height: float, stature: float) -> None:
     heel = w[0, [J["l_ankle"], J["r_ankle"]], 0].min() - 0.035 * stature
     toe = w[0, [J["l_toe"], J["r_toe"]], 0].max() + 0.01 * stature
     assert np.all((com[:, 0] > heel) & (com[:, 0] < toe))
+
+
+@pytest.mark.parametrize("stature", [1.55, 1.75, 1.95])
+@pytest.mark.parametrize("task", ["grasp", "move"])
+def test_low_reaches_keep_the_hand_out_of_the_thigh(task: str, stature: float) -> None:
+    # targets at thigh height, where reach placement used to put the hand into the thigh
+    sk = Skeleton(stature)
+    for height in (0.3, 0.4, 0.5, 0.6):
+        for hand in ("l_hand", "r_hand"):
+            x, y = reach_placement(task, height, sk, hand=hand)
+            mp = make_goal_primitive(task, np.array([x, y, height]), sk, hand=hand,
+                                     rng=np.random.default_rng(1))
+            depth, pairs = self_penetration(world_positions(mp), stature)
+            f, k = np.unravel_index(int(np.argmax(depth)), depth.shape)
+            assert depth[f, k] <= 0.0, (height, hand, pairs[k], f, depth[f, k])
 
 
 def test_hand_selection_and_two_hands() -> None:

@@ -22,11 +22,6 @@ from ltl_human_motion.motion.library import (
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import world_positions
 
-LOW_GRASP_DEFECT = (
-    "known defect, found by the self-penetration check of the realism work: a grasp at a "
-    "low target (0.3-0.45 m) puts the hand 6-16 mm into the thigh just before contact "
-    "(where reach placement puts the target); fix the placement, then drop this")
-
 
 @pytest.fixture(scope="module")
 def cache(tmp_path_factory) -> Path:
@@ -152,7 +147,6 @@ def test_carry_holds_the_hands_in_front_of_the_chest(lib: MotionLibrary) -> None
             assert np.all(np.abs(rel[:, 2]) < 0.3)                # at chest height
 
 
-@pytest.mark.xfail(strict=True, reason=LOW_GRASP_DEFECT)
 def test_quality_report_passes(lib: MotionLibrary) -> None:
     q = lib.quality
     assert q["ok"] and q["gait"]["failed"] == [] and q["goal"]["failed"] == []

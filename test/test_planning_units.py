@@ -149,3 +149,30 @@ def test_step_back_moves_the_root_back() -> None:
     speeds = np.linalg.norm(np.diff(mp.poses + mp.root[:, None, :3] * [1, 1, 0], axis=0),
                             axis=-1) * 120
     assert speeds.max() < 3.0
+
+
+@pytest.mark.parametrize("stature", [1.55, 1.95])
+def test_steps_and_turns_keep_every_body_part_out_of_the_others(stature: float) -> None:
+    from ltl_human_motion.motion.gait import standing_pose
+    from ltl_human_motion.planning.biomechanics import self_penetration
+    from ltl_human_motion.planning.turns import STEPS, TURN_ANGLES_DEG
+
+    sk = Skeleton(stature)
+    bones = sk.bone_lengths()
+    parents = np.asarray(sk.parents)
+    # the planner's own steps also turn against their direction (a step left turning right)
+    against = [(0.0, 0.25, -75.0), (0.15, 0.15, -90.0), (0.25, 0.0, -105.0),
+               (0.19, -0.15, 163.0), (-0.2, 0.2, -135.0)]
+    for (dx, dy, deg), carry in [*((c, False) for c in STEPS),
+                                 *(((0.0, 0.0, d), False) for d in TURN_ANGLES_DEG),
+                                 *((c, k) for c in against for k in (False, True))]:
+        stand, height = standing_pose(sk, carry=carry)
+        mp = make_step_primitive(stand, height, dx, dy, np.radians(deg), sk, 120.0,
+                                 "carry" if carry else "walk")
+        depth, pairs = self_penetration(mp.poses, stature)
+        f, k = np.unravel_index(int(np.argmax(depth)), depth.shape)
+        assert depth[f, k] <= 0.0, (dx, dy, deg, pairs[k], f, depth[f, k])
+        # the arms turn about the shoulders: their bones keep their lengths
+        arm = [JOINT_INDEX[f"{s}_{j}"] for s in "lr" for j in ("elbow", "wrist", "hand")]
+        d = np.linalg.norm(mp.poses[:, arm] - mp.poses[:, parents[arm]], axis=-1)
+        assert np.abs(d - bones[arm]).max() < 1e-9

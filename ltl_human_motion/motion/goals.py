@@ -94,6 +94,10 @@ _LEVEL_NEAR = 0.07
 _LEVEL_MIN_EXTENSION = 0.5
 #: Reach time of the level path over the arc's (its path is about this much longer).
 _LEVEL_TIME = 1.3
+#: Clearance (m) a reaching posture keeps between body parts at contact, over the
+#: self-penetration check of planning.biomechanics (capsule axis outside the other
+#: capsule): the seeded timing and the blend of the start pose move the arm by a few mm.
+_SELF_CLEARANCE = 0.005
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -334,9 +338,13 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
     return out
 
 
-def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...]
-          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
+          task: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Costs of trunk flexion / pelvis drop candidates for hand targets.
+
+    A candidate is infeasible when a hand cannot reach its target, or when its posture
+    with the hands on the targets (:func:`_contact_poses`) puts a body part through
+    another (a low reach with the hand in the thigh).
 
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
@@ -346,8 +354,59 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         d = np.linalg.norm(targets[k] - shoulders[:, k], axis=-1)
         feasible = feasible & (d <= _REACH_FRACTION * arm)
         cost = cost + 0.5 * (d / arm - 0.8) ** 2
+    idx = np.flatnonzero(feasible)
+    if idx.size:
+        from ltl_human_motion.planning.biomechanics import self_penetration
+        poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
+                               task)
+        depth = self_penetration(poses, skeleton.stature)[0].max(axis=1)
+        feasible = feasible.copy()
+        feasible[idx[depth > -_SELF_CLEARANCE]] = False
     cost = np.where(feasible, cost, np.inf)
     return P, D, shift, cost
+
+
+def _goal_hand_dir(task: str | None, k: int, rel_goal: np.ndarray) -> np.ndarray:
+    """Palm direction(s) (..., 3) of hand ``k`` on its target, ``rel_goal`` (..., 3) the
+    shoulder-to-target vector(s)."""
+    if task == "assemble":
+        reach_dir = np.broadcast_to(np.array([0.75, -0.35 if k == 0 else 0.35, -0.55]),
+                                    rel_goal.shape)
+    else:
+        reach_dir = rel_goal / np.maximum(np.linalg.norm(rel_goal, axis=-1, keepdims=True),
+                                          1e-9)
+    goal_dir = reach_dir + np.array([0.0, 0.0, -0.3])
+    return goal_dir / np.linalg.norm(goal_dir, axis=-1, keepdims=True)
+
+
+def _goal_elbow_pole(k: int) -> np.ndarray:
+    """Elbow pole (3,) of hand ``k`` while it is on its target."""
+    return np.array([-0.35, 1.0 if k == 0 else -1.0, -0.45])
+
+
+def _contact_poses(skeleton: Skeleton, st: _Start, pitch: np.ndarray, drop: np.ndarray,
+                   shift: np.ndarray, targets: np.ndarray, active: tuple[int, ...],
+                   task: str | None) -> np.ndarray:
+    """Poses (C, J, 3) of posture candidates (C,) with the active hands on ``targets``
+    (2, 3) and a free hand by the hip, as :func:`_hand_task` holds them at contact."""
+    C = pitch.size
+    pelvis = np.tile(st.pelvis, (C, 1))
+    pelvis[:, 2] -= drop
+    pelvis[:, 0] += shift
+    tr = _trunk(skeleton, pelvis, pitch)
+    hands = np.empty((C, 2, 3))
+    hand_dir = np.broadcast_to(st.hand_dir, (C, 2, 3)).copy()
+    elbow_pole = np.broadcast_to(st.elbow_pole, (C, 2, 3)).copy()
+    for k, s in enumerate(_SIDES):
+        if k in active:
+            hands[:, k] = targets[k]
+            hand_dir[:, k] = _goal_hand_dir(task, k, targets[k] - tr[:, _J[f"{s}_shoulder"]])
+            elbow_pole[:, k] = _goal_elbow_pole(k)
+        else:
+            hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04])
+    return _body(skeleton, pelvis, pitch, np.broadcast_to(st.ankles, (C, 2, 3)),
+                 np.broadcast_to(st.toes, (C, 2, 3)), np.broadcast_to(st.knee_pole, (C, 2, 3)),
+                 hands, hand_dir, elbow_pole, tr)
 
 
 def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray, tuple, str]:
@@ -375,7 +434,7 @@ def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray,
 
 def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
                  task: str, target: np.ndarray) -> tuple[float, float, float]:
-    P, D, S, cost = _grid(skeleton, st, targets, active)
+    P, D, S, cost = _grid(skeleton, st, targets, active, task)
     i = int(np.argmin(cost))
     if not np.isfinite(cost[i]):
         raise ValueError(
@@ -655,16 +714,11 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     hand_dir = np.broadcast_to(st.hand_dir, (T, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy()
     for k in active:
-        reach_dir = rel_goal[k] / max(np.linalg.norm(rel_goal[k]), 1e-9)
-        if task == "assemble":
-            reach_dir = np.array([0.75, -0.35 if k == 0 else 0.35, -0.55])
-        goal_dir = reach_dir + np.array([0.0, 0.0, -0.3])
-        goal_dir /= np.linalg.norm(goal_dir)
+        goal_dir = _goal_hand_dir(task, k, rel_goal[k])
         hd = (1 - s_hand)[:, None] * st.hand_dir[k] + s_hand[:, None] * goal_dir
         hand_dir[:, k] = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
-        side = 1.0 if k == 0 else -1.0
-        goal_pole = np.array([-0.35, 1.0 * side, -0.45])
-        elbow_pole[:, k] = (1 - s_hand)[:, None] * st.elbow_pole[k] + s_hand[:, None] * goal_pole
+        elbow_pole[:, k] = ((1 - s_hand)[:, None] * st.elbow_pole[k]
+                            + s_hand[:, None] * _goal_elbow_pole(k))
     world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
     contact = min(round(contact_t * fps), T - 1)
     meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
@@ -1003,7 +1057,7 @@ def _placement(task: str, height: float, stature: float, hand: str) -> tuple[flo
         target = np.array([x, lateral, height])
         targets, active, _ = _hand_targets(task, target, "both" if both else (
             "l_hand" if lateral > 0 else "r_hand"))
-        _, _, _, cost = _grid(skeleton, st, targets, active)
+        _, _, _, cost = _grid(skeleton, st, targets, active, task)
         c = float(np.min(cost))
         if c < best[0]:
             best = (c, float(x))

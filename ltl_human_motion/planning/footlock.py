@@ -7,16 +7,20 @@ foot is detected on the final motion and its contact point is pinned; the leg is
 re-solved by two-bone IK from the unchanged hip, so bone lengths stay exact.
 
 Per foot and frame the contact point is the foot joint nearer its rest height (heel =
-ankle, ball = toe). A stance is a run of frames where that joint is within
-``contact_height`` of its rest height above the floor and moves horizontally slower than
-``stance_speed``. Within a stance the foot is translated (horizontally) so that the
-contact point keeps the position it had when it became the contact point; when the
-contact passes from heel to ball the new anchor continues the old offset, so nothing
-jumps. After a stance the offset returns to zero over ``release`` seconds with the
-minimum-jerk profile, while the foot is in the air.
+ankle, ball = toe), with a hysteresis of ``CONTACT_SWITCH``. A stance is a run of frames
+where that joint is within ``CONTACT_HEIGHT`` of its rest height above the floor and moves
+horizontally slower than ``STANCE_SPEED``. Within a stance a flat foot keeps its heading
+(it pivots about its lower joint), and the foot is translated (horizontally) so that its
+pinned point does not move: the lower joint, or while heel and ball are within
+``CONTACT_SWITCH`` of each other (the foot rolls) a blend of the two, so the pin passes
+from heel to ball without a jump. After a stance the correction returns to zero over
+``RELEASE`` seconds with the minimum-jerk profile, while the foot is in the air. Where the
+leg cannot hold a grounded pin, the foot is lifted clear of the floor instead.
 """
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 from scipy.ndimage import maximum_filter1d, uniform_filter1d
@@ -48,6 +52,13 @@ RELEASE = 0.15
 SWING_CLEARANCE = 1.2 * CONTACT_HEIGHT
 #: Half-width (s) of the smoothing of that lift (it starts and ends this gradually).
 LIFT_RAMP = 0.1
+#: Horizontal miss (m) of a grounded contact point from its pin over which the leg is
+#: taken as unable to hold it (the foot is then lifted clear there instead).
+LOCK_MISS = 0.003
+#: How much lower (m) the other foot joint must be for the contact to pass to it.
+CONTACT_SWITCH = 0.003
+#: Time (s) over which the heading lock of a flat planted foot fades fully in or out.
+YAW_RAMP = 0.1
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -56,26 +67,132 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
 
 
-def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float],
-                  fps: float, floor_z: float
+def _contact_joint(h: np.ndarray) -> np.ndarray:
+    """Contact joint of every frame (T,) (0 = ankle, 1 = toe) from their heights over their
+    rest heights (T, 2): the lower one, kept until the other is ``CONTACT_SWITCH`` lower
+    (a flat foot's pin and pivot do not flicker between heel and ball)."""
+    contact = np.empty(len(h), dtype=np.int64)
+    c = int(np.argmin(h[0])) if len(h) else 0
+    for t in range(len(h)):
+        if h[t, 1 - c] < h[t, c] - CONTACT_SWITCH:
+            c = 1 - c
+        contact[t] = c
+    return contact
+
+
+def _stance(hc: np.ndarray, vc: np.ndarray) -> np.ndarray:
+    """Stance frames (T,) of bool from the contact point's height over its rest height and
+    horizontal speed (T,): low and slower than ``STANCE_SPEED`` to enter, slower than twice
+    that to stay (no flicker)."""
+    low = hc <= CONTACT_HEIGHT
+    stance = low & (vc <= STANCE_SPEED)
+    keep = low & (vc <= 2.0 * STANCE_SPEED)
+    for t in range(1, len(hc)):
+        stance[t] |= stance[t - 1] & keep[t]
+    for t in range(len(hc) - 2, -1, -1):
+        stance[t] |= stance[t + 1] & keep[t]
+    return stance
+
+
+def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: float
+                  ) -> np.ndarray:
+    """The foot's joints (T, 2, 3) with a flat planted foot keeping the heading it landed
+    with, pivoting about its lower joint (a blend of heel and ball while they are within
+    ``CONTACT_SWITCH`` of each other).
+
+    The lock fades out where the motion turns the foot further than ``MAX_TWIST`` (to
+    nothing at twice that: a turn in place turns the feet), and its weight changes by at
+    most 1 over ``YAW_RAMP``, reaching full weight when the foot becomes flat (the ball
+    does not swing round as it comes down).
+    """
+    T = len(joints)
+    w = np.zeros(T)
+    ref = np.zeros((T, 2))
+    for a, b in _runs(stance):
+        flat = np.flatnonzero(np.all(h[a:b] <= CONTACT_HEIGHT, axis=1)) + a
+        if not flat.size:
+            continue
+        kf = flat[0]
+        r = joints[kf, 1, :2] - joints[kf, 0, :2]
+        ref[a:b] = r
+        cur = joints[flat, 1, :2] - joints[flat, 0, :2]
+        twist = np.abs(np.arctan2(cur[:, 0] * r[1] - cur[:, 1] * r[0], cur @ r))
+        w[flat] = np.clip(2.0 - twist / MAX_TWIST, 0.0, 1.0)
+    # the lock is in full by the time the foot is flat: it fades in over YAW_RAMP before
+    # (while the heel is down and the ball comes down) and out over YAW_RAMP after
+    step = 1.0 / max(1.0, YAW_RAMP * fps)
+    for t in range(T - 2, -1, -1):
+        w[t] = max(w[t], w[t + 1] - step)
+    for t in range(1, T):
+        w[t] = max(w[t], w[t - 1] - step)
+    w = np.minimum(w, stance.astype(float))
+    out = joints.copy()
+    idx = np.flatnonzero((w > 0) & stance)
+    if not idx.size:
+        return out
+    fv = joints[idx, 1, :2] - joints[idx, 0, :2]
+    hl = np.linalg.norm(fv, axis=-1, keepdims=True)
+    cur = fv / np.maximum(hl, 1e-9)
+    want = ref[idx] / np.maximum(np.linalg.norm(ref[idx], axis=-1, keepdims=True), 1e-9)
+    d = (1.0 - w[idx, None]) * cur + w[idx, None] * want
+    phi = np.arctan2(cur[:, 0] * d[:, 1] - cur[:, 1] * d[:, 0], np.sum(cur * d, -1))
+    # the pivot slides from heel to ball as the ball becomes the lower joint, so the turned
+    # foot never jumps (the pin then holds the contact joint where it is)
+    beta = _roll_weight(h[idx])
+    pivot = (1.0 - beta[:, None]) * joints[idx, 0, :2] + beta[:, None] * joints[idx, 1, :2]
+    c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
+    for j in range(2):
+        r = joints[idx, j, :2] - pivot
+        out[idx, j, 0] = pivot[:, 0] + c[:, 0] * r[:, 0] - s[:, 0] * r[:, 1]
+        out[idx, j, 1] = pivot[:, 1] + s[:, 0] * r[:, 0] + c[:, 0] * r[:, 1]
+    return out
+
+
+def _roll_weight(h: np.ndarray) -> np.ndarray:
+    """Share (T,) of the ball in the pinned point of a foot, from the heights of heel and
+    ball over their rest heights (T, 2): 0 with the heel the lower joint by
+    ``CONTACT_SWITCH`` or more, 1 with the ball, in between while the foot rolls."""
+    return np.clip(0.5 + (h[:, 0] - h[:, 1]) / (2.0 * CONTACT_SWITCH), 0.0, 1.0)
+
+
+def _pin_offsets(joints: np.ndarray, h: np.ndarray, a: int, b: int, k: int) -> np.ndarray:
+    """Horizontal offsets (b - a, 2) that hold the foot's pinned point still over frames
+    ``a..b-1``, zero at frame ``k``: the lower of heel and ball, a blend of the two while
+    their heights are within ``CONTACT_SWITCH`` (:func:`_roll_weight`). Each frame's
+    offset cancels the pinned point's step from the frame before, so the pin passes from
+    heel to ball without a jump."""
+    beta = _roll_weight(h[a:b])[:, None]
+    step = np.diff(joints[a:b, :, :2], axis=0)                         # (n-1, 2, 2)
+    off = np.zeros((b - a, 2))
+    i = k - a
+    for t in range(i + 1, b - a):
+        off[t] = off[t - 1] - ((1.0 - beta[t]) * step[t - 1, 0] + beta[t] * step[t - 1, 1])
+    for t in range(i - 1, -1, -1):
+        off[t] = off[t + 1] + ((1.0 - beta[t + 1]) * step[t, 0] + beta[t + 1] * step[t, 1])
+    return off
+
+
+def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float],
+                  fps: float, floor_z: float, free: np.ndarray | None = None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Offsets (T, 3) of one foot: horizontal ones pin its contact point during its
-    stances, vertical ones lift a foot that moves fast while low (a swing foot that would
-    slide over the floor) to ``SWING_CLEARANCE`` above its rest height.
+    """Ankle and toe targets (T, 3) each of one foot: its contact point (the joint nearer
+    its rest height, as the skate measure of :mod:`~ltl_human_motion.planning.
+    biomechanics` takes it) pinned during its stances, a flat planted foot keeping its
+    heading, and a foot that moves fast while low (a swing foot that would slide over the
+    floor) lifted to ``SWING_CLEARANCE`` above its rest height.
 
     Each stance is anchored where its contact point is nearest its median position (the
     mid-stance of a step, the standing part of a stop or a start); the correction ramps
     in before the stance and out after it over ``RELEASE`` while the foot is in the air.
+    Frames in ``free`` (T,) of bool are never stance frames (the leg cannot hold the pin
+    there): a low foot is lifted clear instead.
 
     Returns
     -------
-    offset : ndarray, shape (T, 3)
-    heading : ndarray, shape (T, 2)
-        Horizontal ankle-to-toe direction a flat planted foot keeps (not normalized).
-    heading_weight : ndarray, shape (T,)
-        How much of it to apply (0 where the foot is free to turn).
+    ankle_target, toe_target : ndarray, shape (T, 3)
     contact : ndarray of int, shape (T,)
-        The contact joint of every frame (0 = ankle, 1 = toe).
+        The contact joint (0 = ankle, 1 = toe).
+    stance : ndarray of bool, shape (T,)
     """
     T = len(ankle)
     joints = np.stack([ankle, toe], 1)                                   # (T, 2, 3)
@@ -84,34 +201,23 @@ def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     if T > 1:
         v[1:] = np.linalg.norm(np.diff(joints[:, :, :2], axis=0), axis=-1) * fps
         v[0] = v[1]
-    contact = np.argmin(h, axis=1)                                       # (T,)
-    # a flat foot (both joints low) is held by the ball, so the pin never flickers and the
-    # heel can rise about it (toe-off)
-    contact[np.all(h <= CONTACT_HEIGHT, axis=1)] = 1
+    contact = _contact_joint(h)
     hc = h[np.arange(T), contact]
-    vc = v[np.arange(T), contact]
-    low = hc <= CONTACT_HEIGHT
-    # enter a stance under STANCE_SPEED, stay in it under twice that (no flicker)
-    stance = low & (vc <= STANCE_SPEED)
-    keep = low & (vc <= 2.0 * STANCE_SPEED)
-    for t in range(1, T):
-        stance[t] |= stance[t - 1] & keep[t]
-    for t in range(T - 2, -1, -1):
-        stance[t] |= stance[t + 1] & keep[t]
-    offset = np.zeros((T, 2))
+    stance = _stance(hc, v[np.arange(T), contact])
+    if free is not None:
+        stance &= ~free
+    held = _keep_heading(joints, h, stance, fps)
+    # displacement of each joint (T, 2, 2): heading kept, contact point pinned
+    disp = np.zeros((T, 2, 2))
     weight = np.zeros(T)
-    heading = np.zeros((T, 2))
-    yaw_w = np.zeros(T)
     n_rel = max(1, round(RELEASE * fps))
     ramp = min_jerk(np.arange(1, n_rel + 1) / (n_rel + 1))
     for a, b in _runs(stance):
         # the anchor frame: where the contact point is nearest its median position over
         # the stance (a slide within the stance is split, not all undone one way)
-        cp = joints[np.arange(a, b), contact[a:b], :2]
+        cp = held[np.arange(a, b), contact[a:b], :2]
         k = a + int(np.argmin(np.linalg.norm(cp - np.median(cp, axis=0), axis=-1)))
-        # per frame the lower joint is held at its position at the anchor frame
-        off = joints[k, :, :2][None] - joints[a:b, :, :2]                # (n, 2, 2)
-        run_off = off[np.arange(b - a), contact[a:b]]
+        run_off = _pin_offsets(held, h, a, b, k)
         big = np.linalg.norm(run_off, axis=-1) > MAX_LOCK
         if np.any(big):                     # keep the frames around the anchor only
             ok = ~big
@@ -125,26 +231,24 @@ def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
             stance[a + hi + 1:b] = False
             run_off = run_off[lo:hi + 1]
             a, b = a + lo, a + hi + 1
-        offset[a:b] = uniform_filter1d(run_off, size=9, axis=0, mode="nearest")
+        # continuous where the contact passes from heel to ball (the pin continues, the
+        # heading's pivot slides), and not smoothed: it cancels the motion's slide exactly
+        disp[a:b] = held[a:b, :, :2] - joints[a:b, :, :2] + run_off[:, None]
         weight[a:b] = 1.0
-        # a flat planted foot keeps its heading (it pivots only with the heel up)
-        flat = np.flatnonzero(np.all(h[a:b] <= CONTACT_HEIGHT, axis=1)) + a
-        if flat.size:
-            kf = flat[0]                 # the heading it landed with: no snap
-            ref = joints[kf, 1, :2] - joints[kf, 0, :2]
-            heading[a:b] = ref
-            cur = joints[flat, 1, :2] - joints[flat, 0, :2]
-            twist = np.abs(np.arctan2(cur[:, 0] * ref[1] - cur[:, 1] * ref[0],
-                                      cur @ ref))
-            # a foot turned further than MAX_TWIST by the motion pivots (turns in place)
-            yaw_w[flat] = np.clip(2.0 - twist / MAX_TWIST, 0.0, 1.0)
         for i, w in enumerate(ramp[::-1]):          # ramp in before, out after
             if a - 1 - i >= 0 and weight[a - 1 - i] < w:
-                offset[a - 1 - i] = offset[a] * w
+                disp[a - 1 - i] = disp[a] * w
                 weight[a - 1 - i] = w
             if b + i < T and weight[b + i] < w:
-                offset[b + i] = offset[b - 1] * w
+                disp[b + i] = disp[b - 1] * w
                 weight[b + i] = w
+    # between two stances closer than two release times the correction passes from the
+    # one to the other along the minimum-jerk profile (their ramps would meet in a step)
+    held_runs = _runs(weight >= 1.0)
+    for (_, b0), (a1, _) in itertools.pairwise(held_runs):
+        if a1 - b0 < 2 * n_rel:
+            u = min_jerk(np.arange(1, a1 - b0 + 1) / (a1 - b0 + 1))[:, None, None]
+            disp[b0:a1] = disp[b0 - 1] + u * (disp[a1] - disp[b0 - 1])
     h_min = h.min(axis=1)
     sliding = (h_min < SWING_CLEARANCE) & ~stance
     lift = np.where(sliding, SWING_CLEARANCE - h_min, 0.0)
@@ -152,8 +256,10 @@ def _foot_offsets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
         width = max(1, round(LIFT_RAMP * fps))
         smooth = uniform_filter1d(maximum_filter1d(lift, 2 * width + 1), 2 * width + 1)
         lift = np.maximum(smooth, lift)
-    yaw_w = np.maximum(yaw_w, uniform_filter1d(yaw_w, size=9, mode="nearest"))
-    return np.concatenate([offset, lift[:, None]], axis=1), heading, yaw_w, contact
+    out = joints.copy()
+    out[:, :, :2] += disp
+    out[:, :, 2] += lift[:, None]
+    return out[:, 0], out[:, 1], contact, stance
 
 
 def _unit3(v: np.ndarray) -> np.ndarray:
@@ -197,77 +303,81 @@ def lock_feet(positions: np.ndarray, fps: float, skeleton: Skeleton,
     rest = skeleton.rest_positions()
     bones = skeleton.bone_lengths()
     for s in "lr":
-        hip, knee, ank, toe = (_J[f"{s}_{n}"] for n in ("hip", "knee", "ankle", "toe"))
-        off, heading, yaw_w, contact = _foot_offsets(
-            p[:, ank], p[:, toe], (rest[ank, 2], rest[toe, 2]), fps, floor_z)
-        moved = np.any(np.abs(off) > 1e-9, axis=1) | (yaw_w > 0)
-        if not np.any(moved):
-            continue
-        foot = p[moved, toe] - p[moved, ank]
-        d = off[moved]
-        d = d.copy()
-        hip_p = p[moved, hip]
-        leg = 0.995 * (bones[knee] + bones[ank])
-        ank_t = p[moved, ank] + d
-        toe_t = p[moved, toe] + d
-        w = yaw_w[moved]
-        turn = w > 0
-        if np.any(turn):
-            fv = toe_t[turn] - ank_t[turn]
-            hl = np.linalg.norm(fv[:, :2], axis=-1, keepdims=True)
-            cur = fv[:, :2] / np.maximum(hl, 1e-9)
-            want = heading[moved][turn]
-            want = want / np.maximum(np.linalg.norm(want, axis=-1, keepdims=True), 1e-9)
-            dirn = (1 - w[turn, None]) * cur + w[turn, None] * want
-            dirn /= np.maximum(np.linalg.norm(dirn, axis=-1, keepdims=True), 1e-9)
-            on_toe = contact[moved][turn] == 1
-            new_ank = ank_t[turn].copy()
-            new_toe = toe_t[turn].copy()
-            new_toe[:, :2] = np.where(on_toe[:, None], new_toe[:, :2],
-                                      new_ank[:, :2] + dirn * hl)
-            new_ank[:, :2] = np.where(on_toe[:, None], new_toe[:, :2] - dirn * hl,
-                                      new_ank[:, :2])
-            ank_t[turn], toe_t[turn] = new_ank, new_toe
-        # Where the leg cannot reach the moved ankle (a straight stance leg late in the
-        # stance), the heel rises: the ankle goes to the point nearest its target that is
-        # within reach and a foot's length from the pinned toe (toe-off).
-        reach = np.maximum(leg, np.linalg.norm(p[moved, ank] - hip_p, axis=-1))
-        far = np.linalg.norm(ank_t - hip_p, axis=-1) > reach
-        if np.any(far):
-            leg = reach[far][:, None]
-            f_len = float(bones[toe])
-            ht = toe_t[far] - hip_p[far]
-            D = np.linalg.norm(ht, axis=-1, keepdims=True)
-            u = ht / np.maximum(D, 1e-9)
-            x = np.clip((D * D + leg * leg - f_len * f_len) / (2.0 * np.maximum(D, 1e-9)),
-                        -leg, leg)
-            rho = np.sqrt(np.maximum(leg * leg - x * x, 0.0))
-            c = hip_p[far] + u * x
-            q = ank_t[far] - c
-            q = q - np.sum(q * u, -1, keepdims=True) * u
-            q /= np.maximum(np.linalg.norm(q, axis=-1, keepdims=True), 1e-9)
-            new_ank = c + rho * q
-            ok = (D[:, 0] <= leg[:, 0] + f_len) & (new_ank[:, 2] >= ank_t[far, 2])
-            idx = np.flatnonzero(far)[ok]
-            ank_t[idx] = new_ank[ok]
-            toe_t[idx] = ank_t[idx] + f_len * _unit3(toe_t[idx] - ank_t[idx])
-        # no correction changes faster than MAX_CORRECTION_RATE
-        da = np.zeros((len(p), 3))
-        dt = np.zeros((len(p), 3))
-        da[moved] = ank_t - p[moved, ank]
-        dt[moved] = toe_t - p[moved, toe]
-        step = MAX_CORRECTION_RATE / fps
-        target = p[moved, ank] + _rate_limited(da, step)[moved]
-        toe_target = p[moved, toe] + _rate_limited(dt, step)[moved]
-        # the knee bends towards where it was, and forward over the foot when the leg is
-        # straight (then the old offset from the hip-ankle line is only noise)
-        fwd = np.zeros_like(foot)
-        fwd[:, :2] = foot[:, :2] / np.maximum(np.linalg.norm(foot[:, :2], axis=-1,
-                                                             keepdims=True), 1e-9)
-        pole = p[moved, knee] - 0.5 * (p[moved, hip] + p[moved, ank]) + 0.01 * fwd
-        kn, an = two_bone_ik(p[moved, hip], target, bones[knee], bones[ank], pole,
-                             max_stretch=1.0)
-        p[moved, knee] = kn
-        p[moved, ank] = an
-        p[moved, toe] = an + float(bones[toe]) * _unit3(toe_target - an)
+        ank, toe = _J[f"{s}_ankle"], _J[f"{s}_toe"]
+        rest_h = (rest[ank, 2], rest[toe, 2])
+        ank_all, toe_all, contact, stance = _foot_targets(p[:, ank], p[:, toe], rest_h, fps,
+                                                          floor_z)
+        leg = _solve_leg(p, s, bones, ank_all, toe_all, fps)
+        # where the leg could not hold a grounded contact point on its pin (the hip is too
+        # far: a push-off the motion slides), the foot leaves the floor a little earlier
+        got = np.stack([leg[1], leg[2]], 1)[np.arange(len(p)), contact]     # (T, 3)
+        want = np.stack([ank_all, toe_all], 1)[np.arange(len(p)), contact]
+        low = got[:, 2] - floor_z - np.asarray(rest_h)[contact] <= 0.5 * CONTACT_HEIGHT
+        miss = stance & low & (np.linalg.norm(got[:, :2] - want[:, :2], axis=-1) > LOCK_MISS)
+        if np.any(miss):
+            free = maximum_filter1d(miss, 2 * max(1, round(0.025 * fps)) + 1)
+            ank_all, toe_all, _, _ = _foot_targets(p[:, ank], p[:, toe], rest_h, fps,
+                                                   floor_z, free)
+            leg = _solve_leg(p, s, bones, ank_all, toe_all, fps)
+        p[:, _J[f"{s}_knee"]], p[:, ank], p[:, toe] = leg
     return p
+
+
+def _solve_leg(p: np.ndarray, s: str, bones: np.ndarray, ank_all: np.ndarray,
+               toe_all: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Knee, ankle and toe (T, 3) each of leg ``s`` ("l"/"r") of ``p`` (T, J, 3) moved
+    towards the ankle and toe targets (T, 3) by two-bone IK from the unchanged hip."""
+    hip, knee, ank, toe = (_J[f"{s}_{n}"] for n in ("hip", "knee", "ankle", "toe"))
+    kn_out, an_out, to_out = p[:, knee].copy(), p[:, ank].copy(), p[:, toe].copy()
+    moved = (np.any(np.abs(ank_all - p[:, ank]) > 1e-9, axis=1)
+             | np.any(np.abs(toe_all - p[:, toe]) > 1e-9, axis=1))
+    if not np.any(moved):
+        return kn_out, an_out, to_out
+    foot = p[moved, toe] - p[moved, ank]
+    hip_p = p[moved, hip]
+    leg = 0.995 * (bones[knee] + bones[ank])
+    ank_t = ank_all[moved]
+    toe_t = toe_all[moved]
+    # Where the leg cannot reach the moved ankle (a straight stance leg late in the
+    # stance), the heel rises: the ankle goes to the point nearest its target that is
+    # within reach and a foot's length from the pinned toe (toe-off).
+    reach = np.maximum(leg, np.linalg.norm(p[moved, ank] - hip_p, axis=-1))
+    far = np.linalg.norm(ank_t - hip_p, axis=-1) > reach
+    if np.any(far):
+        leg = reach[far][:, None]
+        f_len = float(bones[toe])
+        ht = toe_t[far] - hip_p[far]
+        D = np.linalg.norm(ht, axis=-1, keepdims=True)
+        u = ht / np.maximum(D, 1e-9)
+        x = np.clip((D * D + leg * leg - f_len * f_len) / (2.0 * np.maximum(D, 1e-9)),
+                    -leg, leg)
+        rho = np.sqrt(np.maximum(leg * leg - x * x, 0.0))
+        c = hip_p[far] + u * x
+        q = ank_t[far] - c
+        q = q - np.sum(q * u, -1, keepdims=True) * u
+        q /= np.maximum(np.linalg.norm(q, axis=-1, keepdims=True), 1e-9)
+        new_ank = c + rho * q
+        ok = (D[:, 0] <= leg[:, 0] + f_len) & (new_ank[:, 2] >= ank_t[far, 2])
+        idx = np.flatnonzero(far)[ok]
+        ank_t[idx] = new_ank[ok]
+        toe_t[idx] = ank_t[idx] + f_len * _unit3(toe_t[idx] - ank_t[idx])
+    # no correction changes faster than MAX_CORRECTION_RATE
+    da = np.zeros((len(p), 3))
+    dt = np.zeros((len(p), 3))
+    da[moved] = ank_t - p[moved, ank]
+    dt[moved] = toe_t - p[moved, toe]
+    step = MAX_CORRECTION_RATE / fps
+    target = p[moved, ank] + _rate_limited(da, step)[moved]
+    toe_target = p[moved, toe] + _rate_limited(dt, step)[moved]
+    # the knee bends towards where it was, and forward over the foot when the leg is
+    # straight (then the old offset from the hip-ankle line is only noise)
+    fwd = np.zeros_like(foot)
+    fwd[:, :2] = foot[:, :2] / np.maximum(np.linalg.norm(foot[:, :2], axis=-1,
+                                                         keepdims=True), 1e-9)
+    pole = p[moved, knee] - 0.5 * (p[moved, hip] + p[moved, ank]) + 0.01 * fwd
+    kn, an = two_bone_ik(p[moved, hip], target, bones[knee], bones[ank], pole,
+                         max_stretch=1.0)
+    kn_out[moved] = kn
+    an_out[moved] = an
+    to_out[moved] = an + float(bones[toe]) * _unit3(toe_target - an)
+    return kn_out, an_out, to_out

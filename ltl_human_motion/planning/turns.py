@@ -13,6 +13,7 @@ import numpy as np
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import MotionPrimitive
+from ltl_human_motion.planning.biomechanics import self_penetration
 
 TURN_ANGLES_DEG = (-180.0, -135.0, -90.0, -45.0, -20.0, 20.0, 45.0, 90.0, 135.0)
 #: Steps on the spot: (forward, left, turn in degrees). The short ones let a walk end
@@ -54,6 +55,47 @@ def _progress(t: np.ndarray, a: float, b: float) -> np.ndarray:
     return min_jerk(np.clip((t - a) / (b - a), 0.0, 1.0))
 
 
+#: Clearance (m) the hanging arms keep from the thighs of the stepping legs, over the
+#: self-penetration check of planning.biomechanics.
+ARM_CLEARANCE = 0.01
+#: Time (s) over which the arms swing out of the legs' way and back (half-width).
+ARM_RAMP = 0.15
+
+
+def _arms_clear_of_thighs(poses: np.ndarray, skeleton: Skeleton, fps: float) -> np.ndarray:
+    """Poses (T, J, 3) (root-relative, facing +x) with each arm abducted about its shoulder
+    just enough that no arm segment enters the thigh of its side (a thigh stepping back or
+    turning swings through the hanging hand), the angle smoothed over ``ARM_RAMP``."""
+    from scipy.ndimage import maximum_filter1d, uniform_filter1d
+
+    out = np.array(poses, dtype=np.float64, copy=True)
+    width = 2 * max(1, round(ARM_RAMP * fps)) + 1
+    for _ in range(2):
+        depth, pairs = self_penetration(out, skeleton.stature)
+        done = True
+        for side, sign in (("l", 1.0), ("r", -1.0)):
+            cols = [i for i, (a, b) in enumerate(pairs) if b == f"{side}_thigh"
+                    and a in (f"{side}_upper_arm", f"{side}_lower_arm", f"{side}_hand")]
+            need = np.maximum(depth[:, cols].max(axis=1) + ARM_CLEARANCE, 0.0)
+            if not np.any(depth[:, cols] > -ARM_CLEARANCE):
+                continue
+            done = False
+            sh = JOINT_INDEX[f"{side}_shoulder"]
+            arm = [JOINT_INDEX[f"{side}_{x}"] for x in ("elbow", "wrist", "hand")]
+            reach = np.linalg.norm(out[:, arm[-1]] - out[:, sh], axis=-1)
+            ang = need / np.maximum(reach, 1e-6)
+            ang = uniform_filter1d(maximum_filter1d(ang, width), width)
+            c, s = np.cos(sign * ang)[:, None], np.sin(sign * ang)[:, None]
+            rel = out[:, arm] - out[:, sh][:, None]
+            y, z = rel[..., 1].copy(), rel[..., 2].copy()
+            rel[..., 1] = c * y - s * z
+            rel[..., 2] = s * y + c * z
+            out[:, arm] = out[:, sh][:, None] + rel
+        if done:
+            break
+    return out
+
+
 def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, angle: float,
                         skeleton: Skeleton, fps: float, task: str = "walk",
                         lift: float = 0.06) -> MotionPrimitive:
@@ -87,12 +129,34 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
     """
     stand = np.asarray(stand, dtype=np.float64)
     # Turns over 90 deg take two steps per foot (one step turning a foot further crosses
-    # the legs), and correspondingly longer.
-    n_steps = 4 if abs(angle) > np.radians(95.0) else 2
+    # the legs), and correspondingly longer. The foot on the side of the turn (or of the
+    # step) leads, unless the other lead, or a further step per foot, keeps the legs from
+    # passing through each other (a step against the direction of the turn).
+    n_min = 4 if abs(angle) > np.radians(95.0) else 2
+    lead = "l" if (angle > 0 or (angle == 0 and dy > 0)) else "r"
+    other = "r" if lead == "l" else "l"
+    best = None
+    for n_steps in (n_min, n_min + 2):
+        for side in (lead, other):
+            mp = _step_primitive(stand, height, dx, dy, angle, skeleton, fps, task, lift,
+                                 side, n_steps)
+            depth = float(self_penetration(mp.poses, skeleton.stature)[0].max())
+            if depth <= 0.0:
+                return mp
+            if best is None or depth < best[0]:
+                best = (depth, mp)
+    return best[1]
+
+
+def _step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, angle: float,
+                    skeleton: Skeleton, fps: float, task: str, lift: float, lead: str,
+                    n_steps: int) -> MotionPrimitive:
+    """:func:`make_step_primitive` with ``lead`` ("l"/"r") stepping first and ``n_steps``
+    steps (even)."""
     # (each foot moves only in the middle 60 % of its window, so the windows are longer
     # than a plain sine step's: knees stay under 2.5 m/s)
     duration = (0.6 + 0.45 * abs(angle) / (np.pi / 2) + 1.5 * np.hypot(dx, dy)) * (
-        1.4 if n_steps == 4 else 1.0)
+        1.0 + 0.2 * (n_steps - 2))
     n = round(duration * fps) + 1
     t = np.linspace(0.0, 1.0, n)
     s_root = _progress(t, 0.05, 0.95)
@@ -103,7 +167,6 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
     body = _turned(heading, stand[None])                                 # (T, J, 3)
     body[:, :, :2] += root_xy[:, None, :]
     body[:, :, 2] -= dip[:, None]
-    lead = "l" if (angle > 0 or (angle == 0 and dy > 0)) else "r"
     first, second = (lead, "r" if lead == "l" else "l")
     # One foot after the other, never both in the air; each lifts before it moves and
     # lands before the other lifts, so no foot slides over the floor.
@@ -135,7 +198,7 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
                                                      pole, max_stretch=1.0)
     body[:, :, :2] -= root_xy[:, None, :]
     body[:, :, 2] += dip[:, None]
-    poses = _turned(heading, body, inverse=True)                       # back to heading frame
+    poses = _arms_clear_of_thighs(_turned(heading, body, inverse=True), skeleton, fps)
     root = np.zeros((n, 4))
     root[:, :2] = root_xy
     root[:, 2] = height - dip

@@ -15,7 +15,7 @@ Checks (each a key of the report):
                  limits by body part and activity, anatomical range of motion, no body
                  part through another, static balance, foot skate): see
                  :mod:`~ltl_human_motion.planning.biomechanics` for the limits and their
-                 sources. On by default (``VerificationOptions.biomechanics``).
+                 sources. Opt-in for now (``VerificationOptions.biomechanics``).
 """
 
 from __future__ import annotations
@@ -55,7 +55,8 @@ class VerificationOptions:
         Longest time both feet may be more than ``flight_height`` above the floor, s.
     flight_height : float
     biomechanics : bool
-        Run the biomechanical checks (default on).
+        Run the biomechanical checks (default off for now: README, "Human
+        plausibility").
     limits : BiomechanicsLimits
         Their limits (:mod:`~ltl_human_motion.planning.biomechanics`).
     """
@@ -256,8 +257,13 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
 
     report["passed"] = all(c["passed"] for c in report.values() if isinstance(c, dict))
     if raise_on_failure and not report["passed"]:
-        failed = [k for k, c in report.items() if isinstance(c, dict) and not c["passed"]]
-        details = "; ".join(f"{k}: {report[k]['detail']}" for k in failed)
-        raise VerificationError(f"verification failed ({', '.join(failed)}): {details}",
-                                failed[0])
+        raise failure_error(report)
     return report
+
+
+def failure_error(report: dict) -> VerificationError:
+    """The error of a failed report of :func:`verify_motion`, naming every failed check."""
+    failed = [k for k, c in report.items() if isinstance(c, dict) and not c["passed"]]
+    details = "; ".join(f"{k}: {report[k]['detail']}" for k in failed)
+    return VerificationError(f"verification failed ({', '.join(failed)}): {details}",
+                             failed[0])
