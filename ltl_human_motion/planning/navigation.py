@@ -10,6 +10,8 @@ unreachable goal is known before any primitive is expanded.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -423,9 +425,18 @@ def _layout_key(cell) -> str:
     """A hash of the cell's workspace and obstacles (what the maps depend on)."""
     import hashlib
     import pickle
-    return hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, np.asarray(cell.workspace_lo),
+    return hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, _code_fingerprint(),
+                                      np.asarray(cell.workspace_lo),
                                       np.asarray(cell.workspace_hi), cell.obstacles))
                         ).hexdigest()
+
+
+@lru_cache(maxsize=1)
+def _code_fingerprint() -> str:
+    """A hash of this module's source: maps pickled by other code are never loaded (the
+    lane-keeping fields of the scenario work read stale maps until this was keyed)."""
+    import hashlib
+    return hashlib.sha1(Path(__file__).read_bytes()).hexdigest()
 
 
 def stand_clearance_map(cell) -> ClearanceMap:
