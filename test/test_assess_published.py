@@ -122,15 +122,17 @@ _RULA_B = [
 
 def test_rula_tables_match_the_worksheet_where_its_text_is_unambiguous():
     """Table B rows neck 1-4, and Table A rows (upper arm 1, lower arm 1-3), (upper arm 5,
-    lower arm 1-3), (upper arm 6, lower arm 1 and 3) of the RULA worksheet (scribd
+    lower arm 1-3), (upper arm 6, lower arm 1-3) of the RULA worksheet (scribd
     36693774). The stored copy interleaves the other Table A rows with the figure labels,
-    so they are not checked here."""
+    so they are not checked here. (Row (6, 2) read 8 8 8 8 8 9 9 9 here until the
+    worksheet's 7 8 8 8 8 9 9 9 was checked.)"""
     assert rula.TABLE_B[:4].tolist() == _RULA_B
     assert rula.TABLE_A[0].tolist() == [[1, 2, 2, 2, 2, 3, 3, 3], [2, 2, 2, 2, 3, 3, 3, 3],
                                         [2, 3, 3, 3, 3, 3, 4, 4]]
     assert rula.TABLE_A[4].tolist() == [[5, 5, 5, 5, 5, 6, 6, 7], [5, 6, 6, 6, 6, 7, 7, 7],
                                         [6, 6, 6, 7, 7, 7, 7, 8]]
     assert rula.TABLE_A[5, 0].tolist() == [7, 7, 7, 7, 7, 8, 8, 9]
+    assert rula.TABLE_A[5, 1].tolist() == [7, 8, 8, 8, 8, 9, 9, 9]
     assert rula.TABLE_A[5, 2].tolist() == [9] * 8
 
 
