@@ -162,10 +162,6 @@ class Bringup:
         """Make :meth:`spin` return (usable as a signal handler)."""
         self._stop.set()
 
-    @property
-    def stop_requested(self) -> bool:
-        return self._stop.is_set()
-
     def shutdown(self) -> Path | None:
         """Stop spinning, close the recording, destroy the nodes; returns the MCAP path.
 

@@ -135,7 +135,6 @@ class SpinThread:
         for node in nodes:
             self.executor.add_node(node)
         self._stop = threading.Event()
-        self.waits_interrupted = 0
         self._thread = threading.Thread(target=self._spin, name="ltl-hm-executor", daemon=True)
         self._thread.start()
 
@@ -145,8 +144,7 @@ class SpinThread:
     def _spin(self) -> None:
         try:
             while not self._stop.is_set() and self.context.ok():
-                if not spin_once_tolerant(self.executor, 0.05):
-                    self.waits_interrupted += 1
+                spin_once_tolerant(self.executor, 0.05)
         except ExternalShutdownException:
             pass
 

@@ -10,6 +10,7 @@ invalid parameters, with the message on stderr).
 from __future__ import annotations
 
 import atexit
+import functools
 import gc
 import sys
 from collections.abc import Callable
@@ -22,6 +23,7 @@ from ltl_human_motion.ros.common import DEFAULT_EXECUTOR_THREADS, spin_nodes
 from ltl_human_motion.ros.middleware import apply_middleware_defaults
 
 
+@functools.cache
 def exit_without_final_collection() -> None:
     """At interpreter exit, skip the collector's final pass over every object.
 
@@ -30,13 +32,7 @@ def exit_without_final_collection() -> None:
     (issue 17). Everything that must outlive the process is written before (atomically);
     the objects are still freed as the modules are torn down. Registered once.
     """
-    global _FREEZE_REGISTERED
-    if not _FREEZE_REGISTERED:
-        atexit.register(gc.freeze)
-        _FREEZE_REGISTERED = True
-
-
-_FREEZE_REGISTERED = False
+    atexit.register(gc.freeze)
 
 
 def _run_node(factory: Callable[[], Node], args: list[str] | None,
