@@ -231,10 +231,9 @@ def test_stale_occupancy_commands_the_minimum_and_recovers(
         stack: Stack, motion: tuple[str, float]) -> None:
     worker_away(stack, motion[0])
     stack.play(motion[0], "stop")                # the occupancy stream stops
-    t0 = time.monotonic()
+    assert _silence_to_minimum(stack, "1") < FAIL_SAFE_WITHIN
     wait_for(lambda: stack.slider() == pytest.approx(MIN), 2.0,
              "the slider minimum over RTDE after the occupancy stream stopped")
-    assert time.monotonic() - t0 < 1.0           # stale_after is 0.25 s
     wait_for(lambda: stack.status.last.mode == "stale", 1.0, "safety_status mode 'stale'")
     worker_away(stack, motion[0])                # the stream returns: full speed again
     assert stack.node.control_alive
@@ -317,13 +316,18 @@ def _second_human(stack: Stack, topic: str = "/human_2/occupancy") -> Callable[.
 
 def _fault_to_minimum(stack: Stack, send: Callable[[], None], what: str,
                       rejected: bool = True) -> float:
-    """Seconds from the first faulty message until the node commands the minimum (the
-    faulty stream keeps coming at 50 Hz meanwhile). The minimum counts only once the node
-    has seen the fault (rejected a message, or received a few of the old-stamped ones), so
-    a coincidental pause of worker 1's stream on a loaded machine is not taken for it."""
+    """The node's own latency (s) from receiving the first faulty sample to the first
+    control step at the minimum slider (the faulty stream keeps coming at 50 Hz meanwhile).
+
+    The node stamps both ends on its controller clock (``fault_receipts``,
+    ``minimum_since``), so neither DDS delivery nor this thread's polling on a loaded
+    machine counts; the end-to-end time is bounded by ``wait_for``'s timeout, and measured
+    under load by ``bench/soak.py``. The minimum counts only once the node has seen the
+    fault (rejected a message, or received a few old-stamped ones), so a coincidental pause
+    of worker 1's stream is not taken for it."""
     node = stack.node
     rejected_before, received_before = node.messages_rejected, node.messages_received
-    t0 = time.monotonic()
+    t0 = node.controller.clock()
 
     def seen() -> bool:
         if rejected:
@@ -332,15 +336,33 @@ def _fault_to_minimum(stack: Stack, send: Callable[[], None], what: str,
         return node.messages_received > received_before and human is not None \
             and human.fresh_at < node.controller.clock() - node.config.stale_after
 
-    def minimum() -> bool:
+    def minimum() -> float | None:
         send()
-        d = node.latest
-        return seen() and d is not None and d.slider == pytest.approx(MIN) \
-            and d.mode == "stale" and d.time > t0
+        d, since = node.latest, node.minimum_since
+        ok = seen() and d is not None and d.slider == pytest.approx(MIN) \
+            and d.mode == "stale" and d.time > t0 and since is not None
+        return since if ok else None
 
-    wait_for(minimum, 3.0, f"the slider minimum after {what}",
-             detail=lambda: f"{stack.node.latest}, humans {stack.node.humans}")
-    return time.monotonic() - t0
+    since = wait_for(minimum, 3.0,
+                     f"the slider minimum after {what}",
+                     detail=lambda: f"{stack.node.latest}, humans {stack.node.humans}")
+    first_fault = min(t for t in list(node.fault_receipts) if t >= t0)
+    return max(0.0, since - first_fault)
+
+
+def _silence_to_minimum(stack: Stack, human: str) -> float:
+    """The node's own latency (s) from the moment ``human``'s last data went stale (its
+    receipt plus ``stale_after``, on the controller clock) to the first step at the minimum
+    slider; call it right after the stream stops."""
+    node = stack.node
+
+    def minimum() -> tuple[float, float] | None:
+        since, held = node.minimum_since, node._humans.get(human)
+        return (since, held.fresh_at) if since is not None and held is not None else None
+
+    since, fresh_at = wait_for(minimum, 2.0, f"the minimum once worker {human} fell silent",
+                               detail=lambda: f"{node.latest}, humans {node.humans}")
+    return max(0.0, since - (fresh_at + node.config.stale_after))
 
 
 def _hold_minimum(stack: Stack, send: Callable[[], None], seconds: float) -> None:
@@ -380,10 +402,7 @@ def test_future_stamps_of_a_second_human_hold_the_minimum(
         # Correct stamps, then silence: stale (judged on the node's receive time). The
         # fault begins stale_after s after the last sample; the minimum follows within
         # FAIL_SAFE_WITHIN of it.
-        t0 = time.monotonic()
-        wait_for(lambda: stack.node.latest.slider == pytest.approx(MIN), 2.0,
-                 "the minimum once worker 2 fell silent")
-        assert time.monotonic() - t0 < stack.node.config.stale_after + FAIL_SAFE_WITHIN
+        assert _silence_to_minimum(stack, "2") < FAIL_SAFE_WITHIN
         assert stack.node.latest.mode == "stale"
     finally:
         stack.session.node.destroy_publisher(send.publisher)  # type: ignore[attr-defined]

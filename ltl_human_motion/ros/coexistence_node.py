@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import math
 import threading
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -305,6 +306,11 @@ class CoexistenceNode(Node):
         self.steps = 0
         self.messages_received = 0
         self.messages_rejected = 0
+        # Controller-clock receipt times of faulty samples and of samples already stale on
+        # arrival, and the time of the first step of the current run at the minimum slider:
+        # together they give the node's own fault-to-minimum latency.
+        self.fault_receipts: deque[float] = deque(maxlen=256)
+        self.minimum_since: float | None = None
 
         self._joint_pub = self.create_publisher(JointState, "/joint_states", STREAM_QOS)
         self._tf_pub = self.create_publisher(TFMessage, "/tf", TF_QOS)
@@ -375,6 +381,8 @@ class CoexistenceNode(Node):
                 raise ValueError(f"stamp lies {-age:.3f} s in the future (tolerance "
                                  f"{self.future_tolerance:g} s)")
             fresh_at = ctl_now - max(age, 0.0)
+            if ctl_now - fresh_at > self.config.stale_after:
+                self.fault_receipts.append(ctl_now)
             self.controller.check_occupancy(sample.segments, sample.radii, fresh_at,
                                             sample.predicted or None)
         except ValueError as exc:
@@ -397,6 +405,7 @@ class CoexistenceNode(Node):
     def _fault(self, topic: str, key: str, ctl_now: float, exc: Exception) -> None:
         """A faulty sample of human ``key``: hold them as faulty, drop the occupancy."""
         self.messages_rejected += 1
+        self.fault_receipts.append(ctl_now)
         with self._humans_lock:
             human = self._humans.get(key)
             if human is None:
@@ -419,6 +428,10 @@ class CoexistenceNode(Node):
 
     # ------------------------------------------------------------------ control
     def _on_decision(self, decision: ControlDecision) -> None:
+        if decision.slider > self.params.min_slider:
+            self.minimum_since = None
+        elif self.minimum_since is None:
+            self.minimum_since = decision.time
         self._latest = decision
         self.steps += 1
         if self.recorder is not None:
