@@ -30,7 +30,7 @@ from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 def _stats_dict(stats: Any) -> dict[str, float]:
     names = ("automaton_time", "sequence_time", "planning_time", "blending_time",
              "verification_time", "total_time", "nodes_expanded", "real_time_factor")
-    return {n: float(getattr(stats, n)) for n in names}
+    return {n: float(getattr(stats, n)) for n in names}   # PlanningStats message fields
 
 
 def run_ros_demo(spec: str, cell: str, out_dir: str | Path, duration: float | None = None,

@@ -22,6 +22,7 @@ Parameters: ``human_id`` ("1"), ``world_frame`` ("world"), ``rate`` (10.0 Hz), `
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -47,6 +48,7 @@ from ltl_human_motion.ros.params import (
     topic_name,
 )
 from ltl_human_motion.ros.playback import Playback
+from ltl_human_motion.scene.cell import Cell
 
 __all__ = ["LEVEL_COLORS", "ErgonomicsNode", "cell_masses", "response_figures"]
 
@@ -57,14 +59,14 @@ LEVEL_COLORS = ((0.1, 0.75, 0.2, 0.9), (0.85, 0.85, 0.1, 0.9), (1.0, 0.55, 0.0, 
 MARKER_HEIGHT = 0.35
 
 
-def cell_masses(cell: Any) -> dict[str, float]:
+def cell_masses(cell: Cell | str | Path) -> dict[str, float]:
     """Part masses (kg) of a cell (a Cell, a name or a YAML path); {} if unresolvable."""
     from ltl_human_motion.planning.pipeline import resolve_cell
     try:
-        c = resolve_cell(cell) if not hasattr(cell, "objects") else cell
+        c = cell if isinstance(cell, Cell) else resolve_cell(cell)
     except (ValueError, OSError, KeyError):
         return {}
-    return {name: float(getattr(obj, "mass", 1.0)) for name, obj in c.objects.items()}
+    return {name: float(obj.mass) for name, obj in c.objects.items()}
 
 
 def response_figures(motion: Any, masses: dict[str, float] | None = None, cycles: int = 1

@@ -187,7 +187,7 @@ class BodyInterface:
         skeleton publisher calls this before it starts the playback clock)."""
         if motion_id not in self._tables:
             body = motion.motion
-            stature = float(getattr(getattr(body, "skeleton", None), "stature", 1.75))
+            stature = float(body.skeleton.stature)
             positions = np.asarray(body.positions, dtype=np.float64)
             quats = link_quaternions(positions, stature)
             velocity = body_velocity(positions, quats[:, 0], float(body.fps))

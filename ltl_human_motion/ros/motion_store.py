@@ -21,9 +21,14 @@ import uuid
 from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from ltl_human_motion.ros.playback import task_sequence_text
+
+if TYPE_CHECKING:
+    from ltl_human_motion.planning.result import SynthesizedMotion
 
 #: Ids of evicted motions remembered for a clear KeyError (bounded, 100 bytes each).
 _MAX_EVICTED_IDS = 10_000
@@ -55,14 +60,11 @@ def default_store_dir() -> Path:
     return Path(ros_home) / "ltl_human_motion" / "motions"
 
 
-def motion_nbytes(motion: Any) -> int:
-    """Bytes of the arrays of a SynthesizedMotion (positions, yaw, labels, object tracks)."""
-    total = 0
-    for value in (getattr(getattr(motion, "motion", None), "positions", None),
-                  getattr(motion, "root_yaw", None), getattr(motion, "task_index", None),
-                  *dict(getattr(motion, "objects", None) or {}).values()):
-        total += int(getattr(value, "nbytes", 0))
-    return total
+def motion_nbytes(motion: SynthesizedMotion) -> int:
+    """Bytes of the arrays of a motion (positions, yaw, labels, object tracks)."""
+    arrays = [motion.motion.positions, motion.root_yaw, motion.task_index,
+              *motion.objects.values()]
+    return sum(int(np.asarray(a).nbytes) for a in arrays)
 
 
 def new_motion_id() -> str:

@@ -360,11 +360,8 @@ class SkeletonPublisher(Node):
             return
         stamp = self.get_clock().now().to_msg()
         transforms = []
-        for name, region in sorted((getattr(self.cell, "regions", None) or {}).items()):
-            lo, hi = getattr(region, "lo", None), getattr(region, "hi", None)
-            if lo is None or hi is None:
-                continue
-            centre = (np.asarray(lo, dtype=np.float64) + np.asarray(hi, dtype=np.float64)) / 2
+        for name, region in sorted(self.cell.regions.items()):
+            centre = (region.lo + region.hi) / 2
             tf = TransformStamped()
             tf.header.stamp, tf.header.frame_id = stamp, self.world_frame
             tf.child_frame_id = f"cell/{name}"

@@ -46,13 +46,17 @@ import queue
 import threading
 import time
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+if TYPE_CHECKING:
+    from ltl_human_motion.planning.pipeline import SynthesisOptions
+    from ltl_human_motion.planning.result import SynthesizedMotion
 
 from ltl_human_motion.deadline import DEFAULT_MAX_SECONDS, Deadline
 from ltl_human_motion.errors import LtlHumanMotionError, SpecError
@@ -83,23 +87,15 @@ _STATS_FIELDS = ("automaton_time", "sequence_time", "planning_time", "blending_t
                  "verification_time", "total_time", "real_time_factor")
 
 
-def _planning(name: str) -> Any:
-    """``ltl_human_motion.planning.<name>`` (re-exported from ``planning.pipeline``)."""
-    from ltl_human_motion import planning
+def planning_synthesize(spec: str, cell: Any, **kwargs: Any) -> list[SynthesizedMotion]:
+    """:func:`ltl_human_motion.planning.pipeline.synthesize`, imported on the first request
+    (the planning stack loads trimesh and the compiled kernels)."""
+    from ltl_human_motion.planning.pipeline import synthesize
 
-    if hasattr(planning, name):
-        return getattr(planning, name)
-    from ltl_human_motion.planning import pipeline
-
-    return getattr(pipeline, name)
+    return list(synthesize(spec, cell, **kwargs))
 
 
-def planning_synthesize(*args: Any, **kwargs: Any) -> list:
-    """``ltl_human_motion.planning.synthesize``, looked up at call time."""
-    return _planning("synthesize")(*args, **kwargs)
-
-
-def synthesis_options(options_json: str) -> Any:
+def synthesis_options(options_json: str) -> SynthesisOptions | None:
     """``planning.SynthesisOptions`` from the request's JSON object ("" for defaults)."""
     text = options_json.strip()
     if not text:
@@ -116,21 +112,15 @@ def synthesis_options(options_json: str) -> Any:
             from None
     if not isinstance(values, dict):
         raise ValueError(f"options_json must be a JSON object, got {type(values).__name__}")
-    options_class = _planning("SynthesisOptions")
-    if hasattr(options_class, "from_dict"):
-        return options_class.from_dict(values)
-    try:
-        return options_class(**values)
-    except TypeError as exc:
-        raise ValueError(f"options_json: {exc}") from None
+    from ltl_human_motion.planning.pipeline import SynthesisOptions
+
+    return SynthesisOptions.from_dict(values)
 
 
-def stats_message(stats: Any, duration: float) -> PlanningStats:
-    """PlanningStats from a motion's ``stats`` (an object or a dict; missing fields are 0)."""
-    def get(name: str) -> Any:
-        if isinstance(stats, dict):
-            return stats.get(name)
-        return getattr(stats, name, None)
+def stats_message(stats: Mapping[str, Any], duration: float) -> PlanningStats:
+    """PlanningStats from a motion's ``stats`` (:attr:`SynthesizedMotion.stats`; missing or
+    non-numeric fields are 0)."""
+    get = stats.get
 
     msg = PlanningStats()
     for name in _STATS_FIELDS:
@@ -326,21 +316,24 @@ class SynthesisNode(Node):
             "cycles": int(request.cycles) or 1,
             "stature": float(request.stature) or 1.75,
         }
-        options = synthesis_options(request.options_json) or _planning("SynthesisOptions")()
+        options = synthesis_options(request.options_json)
+        if options is None:
+            from ltl_human_motion.planning.pipeline import SynthesisOptions
+            options = SynthesisOptions()
         kwargs["options"] = replace(options, deadline=deadline)
         motions = list(self._synthesize(spec, cell, **kwargs))
         if not motions:
             raise ValueError("synthesis returned no motion")
         return motions, cell
 
-    def _fill(self, response: SynthesizeMotion.Response, motions: list) -> None:
+    def _fill(self, response: SynthesizeMotion.Response, motions: list[SynthesizedMotion]) -> None:
         for motion in motions:
             motion_id = self.store.add(motion)
             duration = float(motion.motion.duration)
             response.motion_ids.append(motion_id)
             response.task_sequences.append(task_sequence_text(motion))
             response.durations.append(duration)
-            response.stats.append(stats_message(getattr(motion, "stats", None), duration))
+            response.stats.append(stats_message(motion.stats, duration))
         response.success = True
         self._publish_catalog()
 
@@ -359,8 +352,8 @@ class SynthesisNode(Node):
         super().destroy_node()
 
     @staticmethod
-    def _fill_ergonomics(response: SynthesizeMotion.Response, motions: list, cell: Any,
-                         cycles: int) -> None:
+    def _fill_ergonomics(response: SynthesizeMotion.Response,
+                         motions: list[SynthesizedMotion], cell: Any, cycles: int) -> None:
         """Cycle time and worst REBA/RULA per motion (:mod:`ltl_human_motion.ros.ergonomics`)."""
         from ltl_human_motion.ros.ergonomics import cell_masses, response_figures
         masses = cell_masses(cell)
@@ -374,10 +367,9 @@ class SynthesisNode(Node):
     def _fail(response: SynthesizeMotion.Response, exc: Exception) -> None:
         response.success = False
         response.error_message = str(exc) or type(exc).__name__
-        line = getattr(exc, "line", None)
-        column = getattr(exc, "column", None)
-        response.error_line = int(line) if isinstance(line, int) else 0
-        response.error_column = int(column) if isinstance(column, int) else 0
+        if isinstance(exc, SpecError):
+            response.error_line = exc.line or 0
+            response.error_column = exc.column or 0
 
     def _publish_catalog(self) -> None:
         with self._catalog_lock:
