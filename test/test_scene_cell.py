@@ -305,3 +305,28 @@ def test_yaml_exponent_numbers_are_numbers():
     with pytest.raises(CellError, match=r"floor_z: expected a number, got 'abc'"):
         cell_from_yaml("start_region: R0\nfloor_z: abc\nregions:\n"
                        "  R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}\n")
+
+
+def test_resolve_cell_takes_a_cell_a_name_a_path_or_yaml_text(tmp_path: Path) -> None:
+    """One resolver for the library, the CLI and the ROS nodes: the same text resolves to
+    the same cell whichever layer reads it."""
+    from ltl_human_motion.ros.common import resolve_cell as ros_resolve
+    from ltl_human_motion.scene.cell_yaml import looks_like_yaml, resolve_cell
+
+    paper = resolve_cell("paper_cell")
+    assert resolve_cell(paper) is paper
+    path = Path(__file__).resolve().parents[1] / "config" / "paper_cell.yaml"
+    text = path.read_text()
+    for given in (str(path), path, text, "  paper_cell  "):
+        assert sorted(resolve_cell(given).objects) == sorted(paper.objects)
+    flow = ("{name: tiny, start_region: R0, "
+            "regions: {R0: {lo: [-0.3, -0.3, 0], hi: [0.3, 0.3, 2]}}}")
+    assert looks_like_yaml(flow) and looks_like_yaml("name: tiny") and looks_like_yaml(text)
+    assert not looks_like_yaml("paper_cell") and not looks_like_yaml(str(path))
+    assert resolve_cell(flow).name == ros_resolve(flow).name == "tiny"
+    assert sorted(ros_resolve("paper_cell").objects) == sorted(paper.objects)
+    for bad in ("", "   ", 3):
+        with pytest.raises(CellError, match="cell must be"):
+            resolve_cell(bad)  # type: ignore[arg-type]
+    with pytest.raises(CellError, match="no_such_cell"):
+        resolve_cell("no_such_cell")

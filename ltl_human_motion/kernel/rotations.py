@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "MOCAP_FROM_ZUP",
+    "ZUP_FROM_MOCAP",
     "ZUP_FROM_YUP",
     "matrix_from_axis_angle",
     "matrix_from_compact_axis_angle",
@@ -33,6 +34,8 @@ ZUP_FROM_YUP = np.array([[1.0, 0.0, 0.0],
 #: Rotation taking our z-up, x-forward vectors to the motion-capture convention of BVH
 #: files (y up, facing +z): (x, y, z) -> (y, z, x). Shape (3, 3).
 MOCAP_FROM_ZUP = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+#: Its inverse, from BVH/ASF motion capture (y up, facing +z) to z up: (x, y, z) -> (z, x, y).
+ZUP_FROM_MOCAP = MOCAP_FROM_ZUP.T.copy()
 
 
 def matrix_from_quaternion(q: ArrayLike) -> NDArray[np.float64]:

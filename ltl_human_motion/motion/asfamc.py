@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ltl_human_motion.errors import MotionFormatError
+from ltl_human_motion.kernel.rotations import ZUP_FROM_MOCAP
 from ltl_human_motion.motion.retarget import retarget_points
 from ltl_human_motion.motion.rotations import matrix_from_euler
 from ltl_human_motion.motion.skeleton import Skeleton
@@ -47,7 +48,6 @@ NAME_CANDIDATES: dict[str, tuple[str, ...]] = {
     "l_ankle": ("ltibia",), "r_ankle": ("rtibia",),
     "l_toe": ("lfoot",), "r_toe": ("rfoot",),
 }
-_ZUP_FROM_YUP = np.array([[0.0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0]])
 
 
 @dataclass(frozen=True)
@@ -312,7 +312,7 @@ def load_raw(asf_path: str | os.PathLike[str], amc_path: str | os.PathLike[str]
         r = rot[par] @ c @ m @ c.T
         rot[name] = r
         pos[name] = pos[par] + bone.length * np.einsum("tij,j->ti", r, bone.direction)
-    return skel, {k: v @ _ZUP_FROM_YUP.T for k, v in pos.items()}
+    return skel, {k: v @ ZUP_FROM_MOCAP.T for k, v in pos.items()}
 
 
 def load(asf_path: str | os.PathLike[str], amc_path: str | os.PathLike[str],

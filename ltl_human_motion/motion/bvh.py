@@ -23,6 +23,7 @@ import numpy as np
 
 from ltl_human_motion.atomic import atomic_write_text
 from ltl_human_motion.errors import MotionFormatError
+from ltl_human_motion.kernel.rotations import ZUP_FROM_MOCAP
 from ltl_human_motion.motion.retarget import retarget_points
 from ltl_human_motion.motion.rotations import matrix_from_euler
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton
@@ -58,7 +59,6 @@ NAME_CANDIDATES: dict[str, tuple[str, ...]] = {
     "r_toe": ("RightToeBase", "RightToe", "RightToes", "RightFoot_End", "RightAnkle_End",
               "r_toe"),
 }
-_ZUP_FROM_YUP = np.array([[0.0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0]])
 
 
 @dataclass(frozen=True)
@@ -314,7 +314,7 @@ def load_raw(path: str | os.PathLike[str]) -> tuple[BvhSkeleton, np.ndarray, flo
     except OSError as exc:
         raise _err(path, None, f"cannot read: {exc.strerror or exc}") from None
     skel, data, fps = _parse(path, text)
-    pos = _fk(skel, data) @ _ZUP_FROM_YUP.T
+    pos = _fk(skel, data) @ ZUP_FROM_MOCAP.T
     return skel, pos, fps
 
 
@@ -403,8 +403,8 @@ def save(motion: Motion, path: str | os.PathLike[str], precision: int = 6) -> No
     """
     if not isinstance(motion, Motion):
         raise ValueError(f"motion must be a Motion, got {type(motion).__name__}")
-    pos = motion.positions @ _ZUP_FROM_YUP          # z-up -> y-up (inverse rotation)
-    rest = motion.skeleton.rest_positions() @ _ZUP_FROM_YUP
+    pos = motion.positions @ ZUP_FROM_MOCAP          # z-up -> y-up (inverse rotation)
+    rest = motion.skeleton.rest_positions() @ ZUP_FROM_MOCAP
     children: dict[int, list[int]] = {j: [] for j in range(len(JOINT_NAMES))}
     for j, p in enumerate(PARENTS):
         if p >= 0:

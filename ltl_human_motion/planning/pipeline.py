@@ -16,14 +16,12 @@ import inspect
 import math
 import time
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ltl_human_motion.deadline import Deadline, checkpoint
 from ltl_human_motion.deadline import active as active_deadline
-from ltl_human_motion.errors import CellError
 from ltl_human_motion.motion.realism import realism_summary
 from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
@@ -34,6 +32,7 @@ from ltl_human_motion.planning.footlock import lock_feet
 from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner, task_kind
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, failure_error, verify_motion
+from ltl_human_motion.scene.cell_yaml import resolve_cell
 
 __all__ = ["SynthesisOptions", "get_library", "resolve_cell", "synthesize"]
 
@@ -119,24 +118,6 @@ class SynthesisOptions:
                    planner=planner, verification=ver, verify=bool(data.get("verify", True)),
                    library_source=data.get("library_source"),
                    max_seconds=None if max_seconds is None else float(max_seconds))
-
-
-def resolve_cell(cell):
-    """A :class:`~ltl_human_motion.scene.cell.Cell` from a Cell, a name, a path or YAML text."""
-    from ltl_human_motion.scene.cell import Cell, cell_by_name, cell_from_yaml, load_cell
-    if isinstance(cell, Cell):
-        return cell
-    if isinstance(cell, Path):
-        return load_cell(cell)
-    if not isinstance(cell, str) or not cell.strip():
-        raise CellError(f"cell must be a Cell, a cell name, a YAML path or YAML text, got "
-                        f"{cell!r}")
-    text = cell.strip()
-    if "\n" in text or text.startswith("{"):
-        return cell_from_yaml(text, source="<inline>")
-    if text.endswith((".yaml", ".yml")) or "/" in text:
-        return load_cell(text)
-    return cell_by_name(text)
 
 
 @functools.lru_cache(maxsize=8)

@@ -6,7 +6,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import rclpy
 from rclpy.executors import (
@@ -18,6 +18,9 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from ltl_human_motion.ros.executors import PoolExecutor, spin_once_tolerant
+
+if TYPE_CHECKING:
+    from ltl_human_motion.scene.cell import Cell
 
 #: /tf as tf2_ros.TransformBroadcaster publishes it.
 TF_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST,
@@ -46,32 +49,20 @@ def stamp_seconds(stamp: Any) -> float:
     return stamp.sec + stamp.nanosec * 1e-9
 
 
-def looks_like_yaml(cell: str) -> bool:
-    """True if ``cell`` is inline YAML rather than a cell name or path."""
-    return "\n" in cell or ":" in cell
+def resolve_cell(cell: str) -> Cell:
+    """:func:`ltl_human_motion.scene.cell_yaml.resolve_cell`, with shipped cells and YAML
+    files loaded once per process (inline YAML is parsed on every call)."""
+    from ltl_human_motion.scene.cell_yaml import looks_like_yaml
+    from ltl_human_motion.scene.cell_yaml import resolve_cell as load
 
-
-def resolve_cell(cell: str) -> Any:
-    """A Cell from a name (``config/<name>.yaml``), a path to a YAML file or inline YAML."""
-    cell = cell.strip()
-    if not cell:
-        raise ValueError("cell is empty: give a cell name such as 'paper_cell' or inline YAML")
-    if looks_like_yaml(cell):
-        from ltl_human_motion.scene.cell import cell_from_yaml
-
-        return cell_from_yaml(cell)
-    return _named_cell(cell)
+    return load(cell) if looks_like_yaml(cell) else _named_cell(cell.strip())
 
 
 @lru_cache(maxsize=32)
-def _named_cell(name: str) -> Any:
-    if name.endswith((".yaml", ".yml")):
-        from ltl_human_motion.scene.cell import load_cell
+def _named_cell(name: str) -> Cell:
+    from ltl_human_motion.scene.cell_yaml import resolve_cell as load
 
-        return load_cell(name)
-    from ltl_human_motion.scene.cell import cell_by_name
-
-    return cell_by_name(name)
+    return load(name)
 
 
 def spin_nodes(nodes: Sequence[Node], num_threads: int = DEFAULT_EXECUTOR_THREADS,

@@ -28,8 +28,17 @@ from ltl_human_motion.scene.tasks import TASK_ARGUMENTS
 from ltl_human_motion.scene.yaml_limits import YamlLimitError, load_yaml_limited
 from ltl_human_motion.scene.yaml_limits import short_repr as _r
 
-__all__ = ["MAX_CELL_COORDINATE", "MAX_CELL_ENTRIES", "MAX_WORKSPACE_EXTENT", "cell_by_name",
-           "cell_from_yaml", "cell_search_paths", "load_cell"]
+__all__ = [
+    "MAX_CELL_COORDINATE",
+    "MAX_CELL_ENTRIES",
+    "MAX_WORKSPACE_EXTENT",
+    "cell_by_name",
+    "cell_from_yaml",
+    "cell_search_paths",
+    "load_cell",
+    "looks_like_yaml",
+    "resolve_cell",
+]
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _SHORTHAND_KEY = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\(([^()]*)\))?\s*$")
@@ -466,3 +475,35 @@ def cell_by_name(name: str) -> Cell:
             found.update(p.stem for p in folder.glob("*.yaml")
                          if "start_region:" in p.read_text(encoding="utf-8", errors="replace"))
     raise CellError(f"no cell named {stem!r}; known cells: {', '.join(sorted(found)) or '(none)'}")
+
+
+def looks_like_yaml(text: str) -> bool:
+    """True if ``text`` is inline YAML rather than a cell name or a path: it spans lines,
+    is a flow mapping (``{...}``) or holds a ``key: value`` pair."""
+    text = text.strip()
+    return "\n" in text or text.startswith("{") or (
+        ":" in text and not text.endswith((".yaml", ".yml")))
+
+
+def resolve_cell(cell: Cell | str | os.PathLike[str]) -> Cell:
+    """A :class:`Cell` from a Cell, a shipped cell's name, a path to a YAML file or YAML text.
+
+    Raises
+    ------
+    CellError
+        Empty or unknown input, or a malformed cell (the message names the file and key).
+    """
+    if isinstance(cell, Cell):
+        return cell
+    if isinstance(cell, os.PathLike):
+        return load_cell(cell)
+    if not isinstance(cell, str) or not cell.strip():
+        raise CellError(f"cell must be a Cell, a cell name such as 'paper_cell', a YAML path "
+                        f"or YAML text, got {_r(cell)}")
+    text = cell.strip()
+    if looks_like_yaml(text):
+        return cell_from_yaml(text, source="<inline>")
+    if text.endswith((".yaml", ".yml")) or "/" in text:
+        return load_cell(text)
+    return cell_by_name(text)
+
