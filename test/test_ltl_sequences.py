@@ -183,6 +183,22 @@ def test_cli_prints_sequences_json_and_automata(capsys, paper_cell):
     assert "doublecircle" in capsys.readouterr().out
 
 
+def test_cli_summarises_a_long_exclusivity_conjunct(capsys):
+    """Six tasks in the kitting cell give 15 exclusivity clauses: one summary line (the
+    JSON keeps the whole formula); S1's two clauses stay printed in full."""
+    cell = str(Path(__file__).resolve().parents[1] / "scenarios" / "cells" / "kitting.yaml")
+    spec = ("F grasp(gear) & F grasp(bolt) & F insert(gear, kit_c) & F insert(bolt, kit_c)"
+            " & F move(gear, R_cart)")
+    assert main(["tasks", spec, "--cell", cell, "-n", "1"]) == 0
+    header = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("# always")]
+    assert header[0].startswith("# always on: exclusivity (one task per step): G !(p & q) "
+                                "for 15 pairs of tasks, e.g. !(grasp(bolt) & grasp(gear))")
+    assert header[1] == "# always on: final region R_line: F enter(R_line)"
+    assert all(len(ln) < 200 for ln in header)
+    assert main(["tasks", spec, "--cell", cell, "-n", "1", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["formula"].count("!(") == 15
+
+
 @pytest.mark.parametrize(("spec", "fragment"), [
     ("grasp(O9)", "unknown object 'O9'"),
     ("G(grasp(O1)", "expected ')'"),

@@ -20,6 +20,8 @@ from ltl_human_motion.ltl import (
     task_automaton,
 )
 from ltl_human_motion.ltl.automaton import degeneralize
+from ltl_human_motion.ltl.formula import And, Globally
+from ltl_human_motion.ltl.spec import Specification
 from ltl_human_motion.tasks import has_geometry, plan_sequences
 
 NAME = "tasks"
@@ -71,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
     cell = args.cell
     if cell is not None:
         try:
-            from ltl_human_motion.planning.pipeline import resolve_cell
+            from ltl_human_motion.scene.cell import Cell  # noqa: F401 (the scene layer)
+            from ltl_human_motion.scene.cell_yaml import resolve_cell
             cell = resolve_cell(cell)
         except ImportError:   # without the scene module a YAML file still names things
             pass
@@ -105,7 +108,8 @@ def run(args: argparse.Namespace) -> int:
             for i, s in enumerate(seqs)]}, indent=2))
         return 0
     print(f"# specification: {spec.text}")
-    print(f"# with always-on conjuncts: {spec.formula}")
+    for line in always_on_lines(spec):
+        print(f"# always on: {line}")
     for i, seq in enumerate(seqs, 1):
         print(f"{i}: {' -> '.join(map(str, seq.tasks))}")
         if i - 1 < len(costs):
@@ -113,6 +117,27 @@ def run(args: argparse.Namespace) -> int:
         print(f"   prefix [{', '.join(map(str, seq.prefix))}] cycle "
               f"[{', '.join(map(str, seq.cycle))}] x{seq.repetitions}")
     return 0
+
+
+#: Up to this many exclusivity clauses are printed in full; more are summarised.
+MAX_PRINTED_CLAUSES = 6
+
+
+def always_on_lines(spec: Specification) -> list[str]:
+    """One line per always-on conjunct the specification adds to the user's formula; a long
+    exclusivity conjunct (``G(!(p & q) & ...)``, one clause per pair of tasks that no
+    single task makes true together) is summarised by its number of pairs (``--json`` and
+    ``--automaton`` keep the whole formula)."""
+    lines = []
+    for label, formula in spec.always_on:
+        clauses = formula.arg.args if isinstance(formula, Globally) and \
+            isinstance(formula.arg, And) else ()
+        if label.startswith("exclusivity") and len(clauses) > MAX_PRINTED_CLAUSES:
+            lines.append(f"{label}: G !(p & q) for {len(clauses)} pairs of tasks, e.g. "
+                         f"{' & '.join(map(str, clauses[:2]))}")
+        else:
+            lines.append(f"{label}: {formula}")
+    return lines
 
 
 def _read_hoa(path: str) -> Automaton:
