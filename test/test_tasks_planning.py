@@ -280,6 +280,33 @@ def test_kitting_cell_synthesizes_a_verified_motion_end_to_end():
     assert motion.stats["sequence_time"] > 0.0
 
 
+def test_inserts_into_the_kit_tray_verify_and_a_flush_tray_is_refused_early(monkeypatch):
+    """Four parts into the kit (the response family): the parts come to rest inside the
+    tray and Table I's enclose holds. A tray exactly as deep as the parts leaves no room
+    (a placed part would hold enclose only to rounding, as the 10-part run showed): it is
+    refused before any search, naming the axis and the clearance."""
+    from ltl_human_motion.errors import PlanningError
+    from ltl_human_motion.planning import planner as planner_mod
+    from ltl_human_motion.planning.pipeline import synthesize
+    spec = kitting_spec("response", 4)
+    motion = synthesize(spec, kitting_cell_yaml(4), variants=1)[0]
+    assert motion.verification["passed"]
+    assert sum(t.startswith("insert(") for t in motion.sequence) == 4
+    flush = kitting_cell_yaml(4).replace("position: [0.0, -1.85, 0.94], shape: box, "
+                                         "size: [0.35, 0.25, 0.08]",
+                                         "position: [0.0, -1.85, 0.93], shape: box, "
+                                         "size: [0.35, 0.25, 0.06]")
+    assert flush != kitting_cell_yaml(4)
+
+    def no_search(*_a, **_k):
+        raise AssertionError("searched")
+    monkeypatch.setattr(planner_mod, "astar", no_search)      # the planner's A*
+    with pytest.raises(PlanningError, match=r"container kit leaves P\d 0.000 m of room "
+                       r"along z \(at least 0.002 m, FIT_CLEARANCE") as info:
+        synthesize(spec, flush, variants=1)
+    assert info.value.reason == "size"
+
+
 def test_recurrences_over_few_parts_give_a_cycle_with_each_grasp():
     """G F over five parts: the cycle (longer than the default tails) grasps each part,
     with the releases two hands force, and is physically consistent."""

@@ -61,6 +61,10 @@ SEAT_MAX_FRACTION = 0.53
 GRASP_EPS = 0.05
 #: Cell size of the floor map, metres.
 FLOOR_RESOLUTION = 0.05
+#: Least room (m) a box part needs inside a box container or region along each axis: a
+#: part exactly as large as its container along an axis has no clearance to be put in
+#: (and a placed part then holds Table I's enclose only up to rounding: 3e-8 m was seen).
+FIT_CLEARANCE = 0.002
 
 
 @dataclass(frozen=True)
@@ -367,6 +371,13 @@ class _Checker:
             return PlanningError(
                 f"task {task}: {kind} {container} ({cv * 1e3:.2f} l) is smaller than {part} "
                 f"({pv * 1e3:.2f} l): {task} can never hold", task=task, reason="size")
+        room = _box_room(obj.shape, cshape)
+        if room is not None and room.min() < FIT_CLEARANCE:
+            axis = "xyz"[int(np.argmin(room))]
+            return PlanningError(
+                f"task {task}: {kind} {container} leaves {part} {max(room.min(), 0.0):.3f} m "
+                f"of room along {axis} (at least {FIT_CLEARANCE:.3f} m, FIT_CLEARANCE; "
+                f"parts only translate): {part} cannot be put in", task=task, reason="size")
         return None
 
     def seat(self, task: str, name: str) -> PlanningError | None:
@@ -451,3 +462,20 @@ def check_steps(cell, steps: Sequence[tuple[str, Sequence[str]]], stature: float
     if problems:
         first = problems[0]
         raise PlanningError(str(first), task=first.task, reason=first.reason)
+
+
+def _box_room(part: object, container: object) -> np.ndarray | None:
+    """Spare length (3,) of box ``container`` over box ``part`` along the container's axes,
+    for parts that only translate (their yaws equal, or a quarter turn apart); None for
+    other shapes or yaws."""
+    from ltl_human_motion.scene.shapes import Box
+    if not (isinstance(part, Box) and isinstance(container, Box)):
+        return None
+    turn = (part.yaw - container.yaw) / (math.pi / 2)
+    if abs(turn - round(turn)) > 1e-6:
+        return None
+    extents = np.asarray(part.extents, dtype=np.float64)
+    if round(turn) % 2:
+        extents = extents[[1, 0, 2]]
+    return np.asarray(container.extents, dtype=np.float64) - extents
+

@@ -3,8 +3,9 @@
 Used by ``bench/task_planning.py``, the tests and ``config/kitting_cell.yaml`` (made
 with :func:`kitting_cell_yaml`). Parts lie along the near edges of two tables left and
 right of the start R0; the kit tray ``kit`` (a fixed object, the container of
-``insert``) fills region R1 behind the start, on a cart that is not modelled (nothing
-below it: the planner releases a part in front of the worker at 0.75 m).
+``insert``, 2 cm deeper than the parts) fills region R1 behind the start, on a cart
+that is not modelled (nothing below it: the planner releases a part in front of the
+worker at 0.75 m).
 """
 
 from __future__ import annotations
@@ -56,7 +57,7 @@ def kitting_cell_yaml(n: int, name: str | None = None) -> str:
                      "size: [0.06, 0.06, 0.06], grasp_points: [[0.0, 0.0, 0.03]], "
                      "mass: 0.2}")
     lines += [
-        "  kit: {position: [0.0, -1.85, 0.93], shape: box, size: [0.35, 0.25, 0.06], "
+        "  kit: {position: [0.0, -1.85, 0.94], shape: box, size: [0.35, 0.25, 0.08], "
         "movable: false}",
         "regions:",
         "  R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}",
