@@ -223,3 +223,29 @@ def test_the_motion_store_is_bounded_and_evicts_to_its_folder(tmp_path: Path) ->
         by_bytes.get(kept[0])
     assert by_bytes.get(kept[-1]) is motion
     assert default_store_dir() == Path(os.environ["ROS_HOME"]) / "ltl_human_motion" / "motions"
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.1, 0.3])
+def test_sigint_while_the_node_loads_exits_quietly(tmp_path: Path, delay: float) -> None:
+    """Ctrl-C while rclpy and the node's modules load (before rclpy's own handler is in
+    place) ends the standalone node with exit code 0 and no traceback, as it does while
+    spinning."""
+    code = ("import sys; from ltl_human_motion.ros.entry_points import synthesis_node; "
+            "print('loaded', flush=True); "
+            "sys.exit(synthesis_node(['--ros-args', '-r', '__ns:=/sigint_load', "
+            "'-p', 'store_dir:=' + sys.argv[1]]))")
+    proc = subprocess.Popen([sys.executable, "-c", code, str(tmp_path / "motions")],
+                            env={**os.environ, "ROS_HOME": str(tmp_path)},
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().strip() == "loaded"
+        time.sleep(delay)
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=30.0)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, out
+    assert "Traceback" not in out and "KeyboardInterrupt" not in out, out
+

@@ -4,7 +4,9 @@ CLI's, :func:`ltl_human_motion.cli.bringup.ros_entry_point`: the ROS layer impor
 Each node entry point follows ros2/examples: ``rclpy.init(args=args)`` (so ``--ros-args
 -p name:=value --params-file f.yaml -r __ns:=/human_2`` work), spin in a
 PoolExecutor (ros/executors.py), shut down cleanly on Ctrl-C, and return the exit code (2 for
-invalid parameters, with the message on stderr).
+invalid parameters, with the message on stderr). This module imports rclpy and the nodes only
+inside the entry points, so a Ctrl-C while they load (about a second) also ends the process
+quietly with exit code 0, as one while spinning does.
 """
 
 from __future__ import annotations
@@ -14,13 +16,10 @@ import functools
 import gc
 import sys
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
-import rclpy
-from rclpy.executors import ExternalShutdownException
-from rclpy.node import Node
-
-from ltl_human_motion.ros.common import DEFAULT_EXECUTOR_THREADS, spin_nodes
-from ltl_human_motion.ros.middleware import apply_middleware_defaults
+if TYPE_CHECKING:
+    from rclpy.node import Node
 
 
 @functools.cache
@@ -35,15 +34,33 @@ def exit_without_final_collection() -> None:
     atexit.register(gc.freeze)
 
 
+def quiet_on_interrupt(entry: Callable[..., int]) -> Callable[..., int]:
+    """An entry point that returns 0 on Ctrl-C, wherever it comes (while the node's
+    modules load, or before rclpy installs its own signal handler), with no traceback."""
+    @functools.wraps(entry)
+    def run(*args: object, **kwargs: object) -> int:
+        try:
+            return entry(*args, **kwargs)
+        except KeyboardInterrupt:
+            return 0
+    return run
+
+
 def _run_node(factory: Callable[[], Node], args: list[str] | None,
-              num_threads: int = DEFAULT_EXECUTOR_THREADS) -> int:
+              num_threads: int | None = None) -> int:
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+
+    from ltl_human_motion.ros.common import DEFAULT_EXECUTOR_THREADS, spin_nodes
+    from ltl_human_motion.ros.middleware import apply_middleware_defaults
+
     exit_without_final_collection()
     apply_middleware_defaults()
     rclpy.init(args=args)
     node: Node | None = None
     try:
         node = factory()
-        spin_nodes([node], num_threads=num_threads)
+        spin_nodes([node], num_threads=num_threads or DEFAULT_EXECUTOR_THREADS)
         return 0
     except (KeyboardInterrupt, ExternalShutdownException):
         return 0
@@ -61,6 +78,7 @@ def _run_node(factory: Callable[[], Node], args: list[str] | None,
 OCCUPANCY_EXECUTOR_THREADS = 2
 
 
+@quiet_on_interrupt
 def synthesis_node(args: list[str] | None = None) -> int:
     """Serve ``synthesize_motion``."""
     from ltl_human_motion.ros.synthesis_node import SynthesisNode
@@ -68,6 +86,7 @@ def synthesis_node(args: list[str] | None = None) -> int:
     return _run_node(SynthesisNode, args)
 
 
+@quiet_on_interrupt
 def skeleton_publisher(args: list[str] | None = None) -> int:
     """Play motions on TF, markers and ``task_state``."""
     from ltl_human_motion.ros.skeleton_publisher import SkeletonPublisher
@@ -75,6 +94,7 @@ def skeleton_publisher(args: list[str] | None = None) -> int:
     return _run_node(SkeletonPublisher, args)
 
 
+@quiet_on_interrupt
 def occupancy_node(args: list[str] | None = None) -> int:
     """Stream ``occupancy``, following the skeleton publisher's ``task_state``."""
     from ltl_human_motion.ros.occupancy_node import STREAM_SWITCH_INTERVAL, OccupancyNode
@@ -100,6 +120,7 @@ def occupancy_node(args: list[str] | None = None) -> int:
     return _run_node(make, args, num_threads=OCCUPANCY_EXECUTOR_THREADS)
 
 
+@quiet_on_interrupt
 def ergonomics_node(args: list[str] | None = None) -> int:
     """Publish ``ergonomics`` (REBA/RULA now) during playback, following ``task_state``."""
     from ltl_human_motion.ros.ergonomics import ErgonomicsNode
@@ -107,6 +128,7 @@ def ergonomics_node(args: list[str] | None = None) -> int:
     return _run_node(ErgonomicsNode, args)
 
 
+@quiet_on_interrupt
 def coexistence_node(args: list[str] | None = None) -> int:
     """Speed and separation monitoring of a UR arm (``robot_host``) against every human's
     ``occupancy``: reads the arm over RTDE, writes its speed slider."""
