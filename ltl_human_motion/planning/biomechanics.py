@@ -445,6 +445,18 @@ def check_biomechanics(positions: np.ndarray, fps: float, *, stature: float = DE
     scale = float(stature) / limits.reference_stature
     out: dict = {}
 
+    out["joint_speed"] = _speed_entry(p, fps, labels, limits, scale)
+    out["range_of_motion"] = _rom_entry(p, fps, labels, limits)
+    out["self_penetration"] = _penetration_entry(p, fps, labels, stature)
+    out["balance"] = _balance_entry(p, fps, labels, stature, floor_z, seated, limits)
+    out["foot_skate"] = _skate_entry(p, fps, labels, stature, floor_z, limits)
+    return out
+
+
+def _speed_entry(p: np.ndarray, fps: float, labels: list[str], limits: BiomechanicsLimits,
+                 scale: float) -> dict:
+    """The ``joint_speed`` entry of :func:`check_biomechanics`; ``p`` is (T, J, 3)."""
+    T = len(p)
     speed = joint_speeds(p, fps)
     if speed.size:
         w = T - len(speed)
@@ -457,16 +469,19 @@ def check_biomechanics(positions: np.ndarray, fps: float, *, stature: float = DE
         ok = bool(ratio[f0, j] <= 1.0)
         jf = int(np.argmax(speed.max(axis=0)))
         f = int(f0) + w // 2
-        out["joint_speed"] = _entry(
+        return _entry(
             ok, (f"{JOINT_NAMES[j]} at frame {f} ({f / fps:.2f} s, {labels[f]}) moves "
                  f"at {speed[f0, j]:.2f} m/s, over its limit {lim:.2f} m/s") if not ok else
             f"fastest joint {JOINT_NAMES[jf]} at {speed[:, jf].max():.2f} m/s; every joint "
             f"within its limit (closest: {JOINT_NAMES[j]} at {100 * ratio[f0, j]:.0f} %)",
             max_speed=float(speed.max()), joint=JOINT_NAMES[j], frame=f,
             value=float(speed[f0, j]), limit=float(lim))
-    else:
-        out["joint_speed"] = _entry(True, "a single frame has no speed", max_speed=0.0)
+    return _entry(True, "a single frame has no speed", max_speed=0.0)
 
+
+def _rom_entry(p: np.ndarray, fps: float, labels: list[str],
+               limits: BiomechanicsLimits) -> dict:
+    """The ``range_of_motion`` entry of :func:`check_biomechanics`; ``p`` is (T, J, 3)."""
     angles = joint_angles(p)
     worst = (0.0, "", 0, 0.0, (0.0, 0.0))
     for name, a in angles.items():
@@ -476,30 +491,38 @@ def check_biomechanics(positions: np.ndarray, fps: float, *, stature: float = DE
         if excess[f] > worst[0]:
             worst = (float(excess[f]), name, f, float(a[f]), (lo, hi))
     ok = worst[0] <= 0.0
-    out["range_of_motion"] = _entry(
+    return _entry(
         ok, "every joint angle within its range of motion" if ok else
         f"{worst[1]} at frame {worst[2]} ({worst[2] / fps:.2f} s, {labels[worst[2]]}) is "
         f"{worst[3]:.1f} deg, outside [{worst[4][0]:.0f}, {worst[4][1]:.0f}] deg",
         joint=worst[1], frame=worst[2], value=worst[3],
         extremes={k: [float(v.min()), float(v.max())] for k, v in angles.items()})
 
+
+def _penetration_entry(p: np.ndarray, fps: float, labels: list[str], stature: float) -> dict:
+    """The ``self_penetration`` entry of :func:`check_biomechanics`; ``p`` is (T, J, 3)."""
     depth, names = self_penetration(p, stature)
     f, k = np.unravel_index(int(np.argmax(depth)), depth.shape) if depth.size else (0, 0)
     dmax = float(depth[f, k]) if depth.size else -1.0
     ok = dmax <= 0.0
     a, b = names[k] if names else ("", "")
-    out["self_penetration"] = _entry(
+    return _entry(
         ok, f"no body part passes through another (closest: {a} and {b}, "
             f"{-dmax * 100:.1f} cm apart)" if ok else
         f"{a} passes through {b} at frame {f} ({f / fps:.2f} s, {labels[f]}) by "
         f"{dmax * 100:.1f} cm", joint=a, other=b, frame=int(f), value=dmax)
 
+
+def _balance_entry(p: np.ndarray, fps: float, labels: list[str], stature: float,
+                   floor_z: float, seated: np.ndarray | None,
+                   limits: BiomechanicsLimits) -> dict:
+    """The ``balance`` entry of :func:`check_biomechanics`; ``p`` is (T, J, 3)."""
     frames, outside = balance_margins(p, fps, stature, floor_z, seated, limits)
     i = int(np.argmax(outside)) if outside.size else 0
     worst_out = float(outside[i]) if outside.size else -np.inf
     ok = worst_out <= limits.balance_margin
     fr = int(frames[i]) if frames.size else 0
-    out["balance"] = _entry(
+    return _entry(
         ok, (f"{frames.size} static frames, the centre of mass at most "
              f"{100 * worst_out:+.1f} cm outside the support polygon (limit "
              f"{100 * limits.balance_margin:.0f} cm)") if frames.size and ok else
@@ -509,6 +532,10 @@ def check_biomechanics(positions: np.ndarray, fps: float, *, stature: float = DE
         f"{100 * limits.balance_margin:.0f} cm)", joint="center_of_mass", frame=fr,
         value=worst_out if frames.size else None, static_frames=int(frames.size))
 
+
+def _skate_entry(p: np.ndarray, fps: float, labels: list[str], stature: float,
+                 floor_z: float, limits: BiomechanicsLimits) -> dict:
+    """The ``foot_skate`` entry of :func:`check_biomechanics`; ``p`` is (T, J, 3)."""
     mean, v, grounded = foot_skate(p, fps, stature, floor_z, limits.contact_height)
     vg = np.where(grounded, v, 0.0)
     f, k = np.unravel_index(int(np.argmax(vg)), vg.shape) if vg.size else (0, 0)
@@ -526,6 +553,5 @@ def check_biomechanics(positions: np.ndarray, fps: float, *, stature: float = DE
     else:
         detail = (f"mean foot skate {mean.max():.3f} m/s, fastest planted slide "
                   f"{peak:.2f} m/s")
-    out["foot_skate"] = _entry(ok_mean and ok_peak, detail, joint=foot[k], frame=int(f),
-                               value=peak, mean=float(mean.max()))
-    return out
+    return _entry(ok_mean and ok_peak, detail, joint=foot[k], frame=int(f),
+                  value=peak, mean=float(mean.max()))

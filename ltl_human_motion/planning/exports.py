@@ -382,6 +382,71 @@ def _fmt(v: float) -> str:
     return "0.000000" if s == "-0.000000" else s
 
 
+def _bvh_hierarchy(rest: np.ndarray, C: np.ndarray, scale: float, translations: bool,
+                   stature: float) -> tuple[list[str], list[int]]:
+    """The HIERARCHY lines of :func:`save_bvh` and the joints in their file order.
+
+    ``rest`` is the (J, 3) rest pose, ``C`` the (3, 3) rotation from our frame to the file's.
+    """
+    lines = ["HIERARCHY"]
+    order: list[int] = []
+
+    def emit(j: int, depth: int) -> None:
+        order.append(j)
+        ind = "  " * depth
+        p = PARENTS[j]
+        offset = (np.zeros(3) if p < 0 else (rest[j] - rest[p]) @ C.T * scale)
+        lines.append(f"{ind}{'ROOT' if p < 0 else 'JOINT'} {JOINT_NAMES[j]}")
+        lines.append(f"{ind}{{")
+        lines.append(f"{ind}  OFFSET {' '.join(_fmt(v) for v in offset)}")
+        if p < 0 or translations:
+            lines.append(f"{ind}  CHANNELS 6 Xposition Yposition Zposition "
+                         "Zrotation Yrotation Xrotation")
+        else:
+            lines.append(f"{ind}  CHANNELS 3 Zrotation Yrotation Xrotation")
+        if _CHILDREN[j]:
+            for c in _CHILDREN[j]:
+                emit(c, depth + 1)
+        else:
+            tip, _ = _normalize(rest[j] - rest[p])
+            end = tip @ C.T * 0.05 * stature * scale
+            lines.append(f"{ind}  End Site")
+            lines.append(f"{ind}  {{")
+            lines.append(f"{ind}    OFFSET {' '.join(_fmt(v) for v in end)}")
+            lines.append(f"{ind}  }}")
+        lines.append(f"{ind}}}")
+
+    emit(0, 0)
+    return lines, order
+
+
+def _bvh_reconstruction_error(pos: np.ndarray, rest: np.ndarray, euler: np.ndarray,
+                              root: np.ndarray, delta_file: np.ndarray, order: list[int],
+                              C: np.ndarray, scale: float) -> float:
+    """Largest distance (m) between ``pos`` (T, J, 3) and the joints the BVH values give.
+
+    ``euler`` (T, J, 3) degrees ZYX, ``root`` (T, 3) and ``delta_file`` (T, J, 3) as
+    written by :func:`save_bvh`, in the file's frame and unit.
+    """
+    from scipy.spatial.transform import Rotation
+
+    T, J = euler.shape[:2]
+    R = Rotation.from_euler("ZYX", euler.reshape(-1, 3), degrees=True).as_matrix()
+    R = C.T @ R.reshape(T, J, 3, 3) @ C
+    world = np.empty_like(R)
+    recon = np.empty((T, J, 3))
+    for j in order:
+        p = PARENTS[j]
+        if p < 0:
+            world[:, j] = R[:, j]
+            recon[:, j] = root @ C / scale
+        else:
+            world[:, j] = world[:, p] @ R[:, j]
+            off = rest[j] - rest[p] + delta_file[:, j] @ C / scale
+            recon[:, j] = recon[:, p] + np.einsum("tij,tj->ti", world[:, p], off)
+    return float(np.max(np.linalg.norm(recon - pos, axis=-1))) if T else 0.0
+
+
 def save_bvh(motion: SynthesizedMotion | Motion, path: PathLike, up: str = "y",
              scale: float = 1.0, translations: bool = False) -> float:
     """Write a BVH file (Blender-compatible) of a motion.
@@ -442,35 +507,7 @@ def save_bvh(motion: SynthesizedMotion | Motion, path: PathLike, up: str = "y",
     root = np.round((pos[:, 0] @ C.T) * scale, 6)
     delta_file = np.round((delta @ C.T) * scale, 6)
 
-    lines = ["HIERARCHY"]
-    order: list[int] = []
-
-    def emit(j: int, depth: int) -> None:
-        order.append(j)
-        ind = "  " * depth
-        p = PARENTS[j]
-        offset = (np.zeros(3) if p < 0 else (rest[j] - rest[p]) @ C.T * scale)
-        lines.append(f"{ind}{'ROOT' if p < 0 else 'JOINT'} {JOINT_NAMES[j]}")
-        lines.append(f"{ind}{{")
-        lines.append(f"{ind}  OFFSET {' '.join(_fmt(v) for v in offset)}")
-        if p < 0 or translations:
-            lines.append(f"{ind}  CHANNELS 6 Xposition Yposition Zposition "
-                         "Zrotation Yrotation Xrotation")
-        else:
-            lines.append(f"{ind}  CHANNELS 3 Zrotation Yrotation Xrotation")
-        if _CHILDREN[j]:
-            for c in _CHILDREN[j]:
-                emit(c, depth + 1)
-        else:
-            tip, _ = _normalize(rest[j] - rest[p])
-            end = tip @ C.T * 0.05 * skel.stature * scale
-            lines.append(f"{ind}  End Site")
-            lines.append(f"{ind}  {{")
-            lines.append(f"{ind}    OFFSET {' '.join(_fmt(v) for v in end)}")
-            lines.append(f"{ind}  }}")
-        lines.append(f"{ind}}}")
-
-    emit(0, 0)
+    lines, order = _bvh_hierarchy(rest, C, scale, translations, skel.stature)
     lines.append("MOTION")
     lines.append(f"Frames: {T}")
     lines.append(f"Frame Time: {1.0 / m.fps:.8f}")
@@ -486,20 +523,7 @@ def save_bvh(motion: SynthesizedMotion | Motion, path: PathLike, up: str = "y",
     atomic_write_text(path, "\n".join(lines) + "\n")
 
     # Reconstruction error of what was written (rounded values included).
-    R = Rotation.from_euler("ZYX", euler.reshape(-1, 3), degrees=True).as_matrix()
-    R = C.T @ R.reshape(T, J, 3, 3) @ C
-    world = np.empty_like(R)
-    recon = np.empty((T, J, 3))
-    for j in order:
-        p = PARENTS[j]
-        if p < 0:
-            world[:, j] = R[:, j]
-            recon[:, j] = root @ C / scale
-        else:
-            world[:, j] = world[:, p] @ R[:, j]
-            off = rest[j] - rest[p] + delta_file[:, j] @ C / scale
-            recon[:, j] = recon[:, p] + np.einsum("tij,tj->ti", world[:, p], off)
-    return float(np.max(np.linalg.norm(recon - pos, axis=-1))) if T else 0.0
+    return _bvh_reconstruction_error(pos, rest, euler, root, delta_file, order, C, scale)
 
 
 # --------------------------------------------------------------------------- dispatch

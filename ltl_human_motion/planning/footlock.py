@@ -172,6 +172,52 @@ def _pin_offsets(joints: np.ndarray, h: np.ndarray, a: int, b: int, k: int) -> n
     return off
 
 
+def _trim_to_anchor(run_off: np.ndarray, stance: np.ndarray, a: int, b: int, k: int
+                    ) -> tuple[np.ndarray, int, int]:
+    """Keep only the frames around the anchor ``k`` of the stance [a, b) whose pin
+    offsets ``run_off`` (b - a, 2) stay within ``MAX_LOCK``; the others leave ``stance``
+    (T,) of bool, which is changed in place. Returns the kept offsets and their [a, b)."""
+    big = np.linalg.norm(run_off, axis=-1) > MAX_LOCK
+    if np.any(big):                     # keep the frames around the anchor only
+        ok = ~big
+        lo = k - a
+        while lo > 0 and ok[lo - 1]:
+            lo -= 1
+        hi = k - a
+        while hi < b - a - 1 and ok[hi + 1]:
+            hi += 1
+        stance[a:a + lo] = False
+        stance[a + hi + 1:b] = False
+        run_off = run_off[lo:hi + 1]
+        a, b = a + lo, a + hi + 1
+    return run_off, a, b
+
+
+def _bridge_stances(disp: np.ndarray, weight: np.ndarray, n_rel: int) -> None:
+    """Between two held stances closer than two release times (``n_rel`` frames each),
+    pass the displacement ``disp`` (T, 2, 2) from the one to the other along the
+    minimum-jerk profile, in place; ``weight`` (T,) is 1 on held frames."""
+    held_runs = _runs(weight >= 1.0)
+    for (_, b0), (a1, _) in itertools.pairwise(held_runs):
+        if a1 - b0 < 2 * n_rel:
+            u = min_jerk(np.arange(1, a1 - b0 + 1) / (a1 - b0 + 1))[:, None, None]
+            disp[b0:a1] = disp[b0 - 1] + u * (disp[a1] - disp[b0 - 1])
+
+
+def _swing_lift(h: np.ndarray, stance: np.ndarray, fps: float) -> np.ndarray:
+    """Lift (T,) in metres of a foot that is low but not in stance, up to
+    ``SWING_CLEARANCE`` above its rest height, ramped over ``LIFT_RAMP``; ``h`` is the
+    (T, 2) height of ankle and toe above their rest heights."""
+    h_min = h.min(axis=1)
+    sliding = (h_min < SWING_CLEARANCE) & ~stance
+    lift = np.where(sliding, SWING_CLEARANCE - h_min, 0.0)
+    if np.any(lift > 0):
+        width = max(1, round(LIFT_RAMP * fps))
+        smooth = uniform_filter1d(maximum_filter1d(lift, 2 * width + 1), 2 * width + 1)
+        lift = np.maximum(smooth, lift)
+    return lift
+
+
 def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float],
                   fps: float, floor_z: float, free: np.ndarray | None = None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -218,19 +264,7 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
         cp = held[np.arange(a, b), contact[a:b], :2]
         k = a + int(np.argmin(np.linalg.norm(cp - np.median(cp, axis=0), axis=-1)))
         run_off = _pin_offsets(held, h, a, b, k)
-        big = np.linalg.norm(run_off, axis=-1) > MAX_LOCK
-        if np.any(big):                     # keep the frames around the anchor only
-            ok = ~big
-            lo = k - a
-            while lo > 0 and ok[lo - 1]:
-                lo -= 1
-            hi = k - a
-            while hi < b - a - 1 and ok[hi + 1]:
-                hi += 1
-            stance[a:a + lo] = False
-            stance[a + hi + 1:b] = False
-            run_off = run_off[lo:hi + 1]
-            a, b = a + lo, a + hi + 1
+        run_off, a, b = _trim_to_anchor(run_off, stance, a, b, k)
         # continuous where the contact passes from heel to ball (the pin continues, the
         # heading's pivot slides), and not smoothed: it cancels the motion's slide exactly
         disp[a:b] = held[a:b, :, :2] - joints[a:b, :, :2] + run_off[:, None]
@@ -244,18 +278,8 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
                 weight[b + i] = w
     # between two stances closer than two release times the correction passes from the
     # one to the other along the minimum-jerk profile (their ramps would meet in a step)
-    held_runs = _runs(weight >= 1.0)
-    for (_, b0), (a1, _) in itertools.pairwise(held_runs):
-        if a1 - b0 < 2 * n_rel:
-            u = min_jerk(np.arange(1, a1 - b0 + 1) / (a1 - b0 + 1))[:, None, None]
-            disp[b0:a1] = disp[b0 - 1] + u * (disp[a1] - disp[b0 - 1])
-    h_min = h.min(axis=1)
-    sliding = (h_min < SWING_CLEARANCE) & ~stance
-    lift = np.where(sliding, SWING_CLEARANCE - h_min, 0.0)
-    if np.any(lift > 0):
-        width = max(1, round(LIFT_RAMP * fps))
-        smooth = uniform_filter1d(maximum_filter1d(lift, 2 * width + 1), 2 * width + 1)
-        lift = np.maximum(smooth, lift)
+    _bridge_stances(disp, weight, n_rel)
+    lift = _swing_lift(h, stance, fps)
     out = joints.copy()
     out[:, :, :2] += disp
     out[:, :, 2] += lift[:, None]

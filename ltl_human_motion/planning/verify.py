@@ -181,9 +181,7 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
     VerificationError
         Naming the first failed check, when ``raise_on_failure``.
     """
-    from ltl_human_motion.ltl.evaluator import evaluate_lasso
-    from ltl_human_motion.scene.predicates import collision, enter
-    from ltl_human_motion.scene.termination import termination_series
+    from ltl_human_motion.scene.predicates import enter
 
     pos = synth.motion.positions
     fps = synth.motion.fps
@@ -192,62 +190,12 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
     start_ok = bool(enter(pos[0], cell.start_region, stature=stature))
     report["start"] = _check(start_ok, f"frame 0 {'enters' if start_ok else 'is outside'} "
                              f"the start region {cell.start_region.name}")
-
-    carried = {name: np.where(np.asarray(mask)[:, None], synth.objects[name], np.nan)
-               for name, mask in (held or {}).items() if np.any(mask)}
-    hits = np.zeros(len(pos), dtype=bool)
-    if cell.obstacles:
-        # Exact on every frame: the capsule test itself skips (frame, part) pairs whose
-        # bounding boxes are apart.
-        hits = collision(pos, cell, stature=stature, carried=carried)
-    n_hit = int(np.sum(hits))
-    report["collision"] = _check(n_hit == 0, "no frame collides" if n_hit == 0 else
-                                 f"{n_hit} frames collide, first at t = "
-                                 f"{int(np.argmax(hits)) / fps:.2f} s", frames=n_hit)
-
-    windows = step_windows(synth, len(steps))
-    term_ok: list[bool] = []
-    failed_tasks = []
-    for (name, args), (a, b), seg in zip(steps, windows, synth.timeline):
-        if name == "wait":
-            a = seg.start_frame + blend_frames      # t*: the wait starts once blended in
-        objects_state = {k: v[a:b] for k, v in synth.objects.items()}
-        holds = termination_series(name, args, pos[a:b], cell, objects_state,
-                                   eps=options.eps, stature=stature, fps=fps)
-        ok = bool(np.any(holds))
-        term_ok.append(ok)
-        if not ok:
-            failed_tasks.append(f"{seg.task} (frames {a}-{b})")
-    report["termination"] = _check(not failed_tasks, "every task's termination condition holds"
-                                   if not failed_tasks else
-                                   "termination condition not met: " + ", ".join(failed_tasks))
-
-    letters = observed_letters(synth, cell, spec, steps, term_ok, stature)
-    n_pre = len(sequence.prefix) + (sequence.repetitions - 1) * len(sequence.cycle)
-    u, v = letters[:n_pre], letters[n_pre:]
-    ltl_ok = bool(v) and evaluate_lasso(spec.formula, u, v)
-    report["ltl"] = _check(ltl_ok, "the observed trace satisfies the specification" if ltl_ok
-                           else "the observed trace violates the specification",
-                           trace=[sorted(x) for x in letters])
-
-    step = np.diff(pos, axis=0)                                         # (T-1, J, 3)
-    speed = np.sqrt(step[..., 0] * step[..., 0] + step[..., 1] * step[..., 1]
-                    + step[..., 2] * step[..., 2]) * fps                  # (T-1, J)
-    vmax = float(speed.max()) if speed.size else 0.0
-    worst = synth.motion.skeleton.names[int(np.argmax(speed.max(axis=0)))] if speed.size else ""
-    report["smoothness"] = _check(vmax <= options.max_joint_speed,
-                                  f"fastest joint {worst} at {vmax:.2f} m/s (limit "
-                                  f"{options.max_joint_speed} m/s)", max_speed=vmax)
-
-    feet = pos[:, [JOINT_INDEX[j] for j in FOOT_JOINTS], 2] - cell.floor_z
-    lowest = float(feet.min())
-    flying = feet.min(axis=1) > options.flight_height
-    # Longest run of flying frames: the gaps between the edges of the runs.
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], flying.astype(np.int8), [0]])))
-    longest = int(np.max(edges[1::2] - edges[::2])) if edges.size else 0
-    feet_ok = lowest >= -options.floor_tolerance and longest / fps <= options.max_flight
-    report["feet"] = _check(feet_ok, f"lowest foot joint {lowest:+.3f} m, longest flight "
-                            f"{longest / fps:.2f} s", lowest=lowest, flight=longest / fps)
+    report["collision"] = _collision_check(synth, cell, held, stature)
+    report["termination"], term_ok = _termination_check(synth, cell, steps, options,
+                                                        stature, blend_frames)
+    report["ltl"] = _ltl_check(synth, cell, spec, sequence, steps, term_ok, stature)
+    report["smoothness"] = _smoothness_check(synth, options)
+    report["feet"] = _feet_check(pos, fps, cell.floor_z, options)
 
     if options.biomechanics:
         report.update(check_biomechanics(
@@ -259,6 +207,94 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
     if raise_on_failure and not report["passed"]:
         raise failure_error(report)
     return report
+
+
+def _collision_check(synth, cell, held: dict[str, np.ndarray] | None,
+                     stature: float) -> dict:
+    """The ``collision`` entry of :func:`verify_motion`: exact on every frame."""
+    from ltl_human_motion.scene.predicates import collision
+
+    pos = synth.motion.positions
+    carried = {name: np.where(np.asarray(mask)[:, None], synth.objects[name], np.nan)
+               for name, mask in (held or {}).items() if np.any(mask)}
+    hits = np.zeros(len(pos), dtype=bool)
+    if cell.obstacles:
+        # Exact on every frame: the capsule test itself skips (frame, part) pairs whose
+        # bounding boxes are apart.
+        hits = collision(pos, cell, stature=stature, carried=carried)
+    n_hit = int(np.sum(hits))
+    return _check(n_hit == 0, "no frame collides" if n_hit == 0 else
+                  f"{n_hit} frames collide, first at t = "
+                  f"{int(np.argmax(hits)) / synth.motion.fps:.2f} s", frames=n_hit)
+
+
+def _termination_check(synth, cell, steps: list[tuple[str, tuple[str, ...]]],
+                       options: VerificationOptions, stature: float,
+                       blend_frames: int) -> tuple[dict, list[bool]]:
+    """The ``termination`` entry of :func:`verify_motion` and, per step, whether it held."""
+    from ltl_human_motion.scene.termination import termination_series
+
+    pos = synth.motion.positions
+    windows = step_windows(synth, len(steps))
+    term_ok: list[bool] = []
+    failed_tasks = []
+    for (name, args), (a, b), seg in zip(steps, windows, synth.timeline):
+        if name == "wait":
+            a = seg.start_frame + blend_frames      # t*: the wait starts once blended in
+        objects_state = {k: v[a:b] for k, v in synth.objects.items()}
+        holds = termination_series(name, args, pos[a:b], cell, objects_state,
+                                   eps=options.eps, stature=stature, fps=synth.motion.fps)
+        ok = bool(np.any(holds))
+        term_ok.append(ok)
+        if not ok:
+            failed_tasks.append(f"{seg.task} (frames {a}-{b})")
+    return _check(not failed_tasks, "every task's termination condition holds"
+                  if not failed_tasks else
+                  "termination condition not met: " + ", ".join(failed_tasks)), term_ok
+
+
+def _ltl_check(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str, ...]]],
+               term_ok: list[bool], stature: float) -> dict:
+    """The ``ltl`` entry of :func:`verify_motion`: the observed lasso against the formula."""
+    from ltl_human_motion.ltl.evaluator import evaluate_lasso
+
+    letters = observed_letters(synth, cell, spec, steps, term_ok, stature)
+    n_pre = len(sequence.prefix) + (sequence.repetitions - 1) * len(sequence.cycle)
+    u, v = letters[:n_pre], letters[n_pre:]
+    ltl_ok = bool(v) and evaluate_lasso(spec.formula, u, v)
+    return _check(ltl_ok, "the observed trace satisfies the specification" if ltl_ok
+                  else "the observed trace violates the specification",
+                  trace=[sorted(x) for x in letters])
+
+
+def _smoothness_check(synth, options: VerificationOptions) -> dict:
+    """The ``smoothness`` entry of :func:`verify_motion`: the fastest joint between frames."""
+    pos = synth.motion.positions
+    step = np.diff(pos, axis=0)                                         # (T-1, J, 3)
+    speed = np.sqrt(step[..., 0] * step[..., 0] + step[..., 1] * step[..., 1]
+                    + step[..., 2] * step[..., 2]) * synth.motion.fps     # (T-1, J)
+    vmax = float(speed.max()) if speed.size else 0.0
+    worst = synth.motion.skeleton.names[int(np.argmax(speed.max(axis=0)))] if speed.size else ""
+    return _check(vmax <= options.max_joint_speed,
+                  f"fastest joint {worst} at {vmax:.2f} m/s (limit "
+                  f"{options.max_joint_speed} m/s)", max_speed=vmax)
+
+
+def _feet_check(pos: np.ndarray, fps: float, floor_z: float,
+                options: VerificationOptions) -> dict:
+    """The ``feet`` entry of :func:`verify_motion`: no foot below the floor, no long flight.
+
+    ``pos`` is (T, J, 3).
+    """
+    feet = pos[:, [JOINT_INDEX[j] for j in FOOT_JOINTS], 2] - floor_z
+    lowest = float(feet.min())
+    flying = feet.min(axis=1) > options.flight_height
+    # Longest run of flying frames: the gaps between the edges of the runs.
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], flying.astype(np.int8), [0]])))
+    longest = int(np.max(edges[1::2] - edges[::2])) if edges.size else 0
+    feet_ok = lowest >= -options.floor_tolerance and longest / fps <= options.max_flight
+    return _check(feet_ok, f"lowest foot joint {lowest:+.3f} m, longest flight "
+                  f"{longest / fps:.2f} s", lowest=lowest, flight=longest / fps)
 
 
 def failure_error(report: dict) -> VerificationError:
