@@ -274,3 +274,33 @@ def test_generator_frame_and_floor_variants_keep_the_layout() -> None:
     for ob in base.obstacles:
         np.testing.assert_allclose(paper.obstacle(ob.name).aabb()[0], ob.aabb()[0], atol=1e-9)
         np.testing.assert_allclose(paper.obstacle(ob.name).aabb()[1], ob.aabb()[1], atol=1e-9)
+
+
+# ----------------------------------------------------------------------- task order
+@pytest.mark.parametrize("pair", [p for p in PAIRS if "/dwyer/" in p.id and not p.feasible],
+                         ids=lambda p: p.id)
+def test_a_pattern_that_orders_one_part_backwards_is_refused_before_motion(pair) -> None:
+    """A Dwyer pair labelled unsatisfiable (S must precede P, but S needs what only P
+    gives) is refused by the task layer in well under a second, naming the parts'
+    states as the limit; its label says why in words."""
+    assert pair.reason == "unsatisfiable" and len(pair.why) > 40
+    outcome = run_pair(pair.spec, pair.cell_file, 1.75, 0, timeout=8.0)
+    ok, family = judge(pair.expect, pair.reason, outcome)
+    assert ok, f"{pair.id}: {family}: {outcome.message[:300]}"
+    assert "the parts' states" in outcome.message
+    assert outcome.seconds < 2.0
+
+
+def test_generated_dwyer_tuples_act_on_different_parts() -> None:
+    import re
+    seen = 0
+    for index in range(12):
+        scen = generate_scenario(0, index)
+        for pair in scen.pairs:
+            if pair.family.startswith("gen:dwyer:"):
+                atoms = set(re.findall(r"\b\w+\([^()]*\)", pair.spec))
+                parts = [a.split("(")[1].split(",")[0].rstrip(")").strip() for a in atoms
+                         if a.split("(")[0] in ("grasp", "carry", "move", "insert")]
+                assert len(parts) == len(set(parts)), (scen.name, pair.spec)
+                seen += 1
+    assert seen >= 12

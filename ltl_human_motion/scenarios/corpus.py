@@ -118,6 +118,43 @@ def _strings(value: Any, source: str, key: str) -> list[str]:
     return [v.strip() for v in value]
 
 
+def _pattern_pairs(name: str, path: str, entry: Any, source: str, key: str,
+                   index: int) -> list[Pair]:
+    """The 20 Dwyer pairs of one tuple ``[P, S, Q, R]``, or of ``{tasks: [P, S, Q, R],
+    infeasible: {pattern: why}}``, whose listed patterns are labelled ``unsatisfiable``:
+    with only the tuple's tasks no physical order of task steps satisfies them (for
+    example ``precedence_global`` with S = ``carry(O1, R1)`` and P = ``grasp(O1)``: the
+    carry leaves O1 in hand and no task of the specification frees the hand for the
+    grasp it demands afterwards)."""
+    overrides: Mapping[str, Any] = {}
+    if isinstance(entry, Mapping):
+        unknown = sorted(set(entry) - {"tasks", "infeasible"})
+        if unknown or "tasks" not in entry:
+            raise _error(source, key, f"expected {{tasks, infeasible}}, got keys {sorted(entry)}")
+        overrides = entry.get("infeasible") or {}
+        bad = sorted(set(overrides) - set(DWYER_PATTERNS)) if isinstance(overrides, Mapping) \
+            else ["(not a mapping)"]
+        if bad or not all(isinstance(w, str) and w.strip() for w in overrides.values()):
+            raise _error(source, f"{key}.infeasible",
+                         f"expected {{pattern name: why}} over {sorted(DWYER_PATTERNS)}; "
+                         f"bad: {bad or 'a why that is not text'}")
+        entry = entry["tasks"]
+    tasks = _strings(entry, source, key)
+    if len(tasks) != 4 or len(set(tasks)) != 4:
+        raise _error(source, key, f"expected four different tasks [P, S, Q, R], got {tasks}")
+    binding = dict(zip("PSQR", tasks))
+    pairs: list[Pair] = []
+    for pname, template in DWYER_PATTERNS.items():
+        text = "".join(f"({binding[c]})" if c in binding else c for c in template)
+        pid = f"{name}/dwyer/{pname}/{index}"
+        if pname in overrides:
+            pairs.append(Pair(pid, name, path, text, "infeasible", "infeasible:unsatisfiable",
+                              "unsatisfiable", str(overrides[pname]).strip()))
+        else:
+            pairs.append(Pair(pid, name, path, text, "feasible", f"dwyer:{pname}"))
+    return pairs
+
+
 def _cell_pairs(name: str, spec: Mapping[str, Any], root: Path, source: str) -> list[Pair]:
     key = f"cells.{name}"
     if not isinstance(spec, Mapping) or "file" not in spec:
@@ -134,15 +171,7 @@ def _cell_pairs(name: str, spec: Mapping[str, Any], root: Path, source: str) -> 
         pairs.append(Pair(f"{name}/single/{atom}", name, path, f"F {atom}", "feasible",
                           f"single:{task_name(atom)}"))
     for i, tup in enumerate(spec.get("patterns", []) or []):
-        tasks = _strings(tup, source, f"{key}.patterns[{i}]")
-        if len(tasks) != 4 or len(set(tasks)) != 4:
-            raise _error(source, f"{key}.patterns[{i}]",
-                         f"expected four different tasks [P, S, Q, R], got {tasks}")
-        binding = dict(zip("PSQR", tasks))
-        for pname, template in DWYER_PATTERNS.items():
-            text = "".join(f"({binding[c]})" if c in binding else c for c in template)
-            pairs.append(Pair(f"{name}/dwyer/{pname}/{i}", name, path, text, "feasible",
-                              f"dwyer:{pname}"))
+        pairs.extend(_pattern_pairs(name, path, tup, source, f"{key}.patterns[{i}]", i))
     for i, job in enumerate(spec.get("jobs", []) or []):
         jkey = f"{key}.jobs[{i}]"
         if not isinstance(job, Mapping) or not {"name", "spec"} <= set(job):

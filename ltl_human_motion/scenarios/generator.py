@@ -475,6 +475,30 @@ def _accessible(cell_yaml: str, targets) -> bool:
     return True
 
 
+def _unordered_tasks(feasible: list[str], parts: set[str],
+                     rng: np.random.Generator, k: int = 4) -> list[str] | None:
+    """``k`` tasks for a Dwyer tuple, no two of them on the same part.
+
+    Two tasks on one part have a physical order (``carry(P1, Z)`` needs ``P1`` in hand
+    and leaves it there, so ``grasp(P1)`` cannot follow it): a random pattern may ask for
+    the other order, and the pair would not be feasible as labelled. None when the
+    cell's tasks do not allow ``k`` such tasks.
+    """
+    chosen: list[str] = []
+    used: set[str] = set()
+    for i in rng.permutation(len(feasible)):
+        task = feasible[int(i)]
+        args = {a.strip() for a in task.partition("(")[2].rstrip(")").split(",")}
+        on = args & parts
+        if on & used:
+            continue
+        chosen.append(task)
+        used |= on
+        if len(chosen) == k:
+            return chosen
+    return None
+
+
 def _specs(b: _Builder, rng: np.random.Generator) -> list[GeneratedPair]:
     """Labelled specifications for a built cell."""
     feasible: list[str] = []
@@ -500,7 +524,9 @@ def _specs(b: _Builder, rng: np.random.Generator) -> list[GeneratedPair]:
              for t in singles]
     if len(feasible) >= 4:
         for pname in rng.choice(list(DWYER_PATTERNS), size=2, replace=False):
-            tasks = list(rng.choice(feasible, size=4, replace=False))
+            tasks = _unordered_tasks(feasible, set(b.parts), rng)
+            if tasks is None:
+                continue
             binding = dict(zip("PSQR", tasks))
             text = "".join(f"({binding[c]})" if c in binding else c
                            for c in DWYER_PATTERNS[str(pname)])
