@@ -64,9 +64,13 @@ def _run_node(factory: Callable[[], Node], args: list[str] | None,
         return 0
     except (KeyboardInterrupt, ExternalShutdownException):
         return 0
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    except Exception as exc:
+        if not rclpy.ok():
+            return 0        # Ctrl-C (rclpy's handler shut the context down) mid-construction
+        if isinstance(exc, ValueError):
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
+        raise
     finally:
         if node is not None:
             node.destroy_node()
