@@ -6,6 +6,8 @@ motion passed every check of ``planning/verify.py`` unchanged.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -96,6 +98,20 @@ def test_unplannable_shorthand_still_says_why():
     with pytest.raises(PlanningError, match="no motion of its own"):
         from ltl_human_motion.planning.planner import task_kind
         task_kind("odd", ("R1",), {"odd": (("R",), "walk(R) & grasp(O1)")})
+
+
+def test_a_two_hand_shorthand_is_assemble_in_any_order_and_grouping():
+    from ltl_human_motion.planning.planner import task_kind
+    from ltl_human_motion.scene.termination import expand_task
+    from ltl_human_motion.tasks.model import CellModel
+    body = "(rightHand(R) & (leftHand(R)))"
+    assert task_kind("asm", ("R1",), {"asm": (("R",), body)}) == ("assemble", ("R1",))
+    cell = resolve_cell("demo_cell")
+    cell = replace(cell, shorthands={**cell.shorthands, "asm": (("R",), body)})
+    assert expand_task("asm", ["R1"], cell) == [("rightHand", ("R1",)), ("leftHand", ("R1",))]
+    model = CellModel.from_cell(cell)
+    from ltl_human_motion.ltl.formula import Atom
+    assert model.kind(Atom("asm", ("R1",))) == ("assemble", ("R1",))
 
 
 def test_kneel_next_to_the_table_steps_to_a_roomier_spot():

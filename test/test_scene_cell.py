@@ -204,6 +204,11 @@ def test_error_names_file_and_key(tmp_path):
      r"'Q' in body 'leftHand\(Q\)' is neither a parameter"),
     ("assemble(R): leftHand(R) & rightHand(R)", "grasp(R): leftHand(R)",
      r"'grasp' is already a task"),
+    ("assemble(R): leftHand(R) & rightHand(R)", "assemble(R): leftHand(R) | rightHand(R)",
+     r"shorthands\.assemble\(R\): shorthand body .*only a conjunction of tasks is allowed, "
+     r"not '\| rightHand\(R\)' at character 13"),
+    ("assemble(R): leftHand(R) & rightHand(R)", "assemble(R): leftHand(R) & X rightHand(R)",
+     r"shorthands\.assemble\(R\): .*not 'X' at character 15"),
     ("  O2:\n", "  R1:\n", r"names used for both an object and a region"),
     ("floor_z: 0.0", "floor_z: low", r"floor_z: expected a number"),
     ("workspace: {lo: [-3.0, -3.0, 0.0], hi: [3.0, 3.0, 2.5]}",

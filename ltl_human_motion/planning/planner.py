@@ -46,6 +46,7 @@ from ltl_human_motion.planning.navigation import (
     stand_clearance_map,
 )
 from ltl_human_motion.planning.placement import RegionEntry
+from ltl_human_motion.scene.tasks import two_hand_region
 
 Pose = tuple[float, float, float]
 
@@ -342,11 +343,8 @@ def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, 
     """
     if name in shorthands:
         params, body = shorthands[name]
-        text = body.replace(" ", "")
-        if len(params) == 1 and len(args) == 1:
-            p = params[0]
-            if {t for t in text.split("&")} == {f"leftHand({p})", f"rightHand({p})"}:
-                return "assemble", args
+        if len(args) == 1 and two_hand_region(params, body):
+            return "assemble", args
         raise PlanningError(f"shorthand {name} ({body}) has no motion of its own; only "
                             "two-hand shorthands like leftHand(R) & rightHand(R) can be "
                             "planned as one step", task=name, reason="unsupported")

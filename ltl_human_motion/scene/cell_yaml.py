@@ -24,7 +24,7 @@ from ltl_human_motion.errors import CellError
 from ltl_human_motion.scene.cell import Cell, Obstacle, Region, SceneObject
 from ltl_human_motion.scene.frames import ZUP_FROM_YUP, extents_zup_from_yup, zup_from_yup
 from ltl_human_motion.scene.shapes import Box, Cylinder, MeshShape, Shape, Sphere
-from ltl_human_motion.scene.tasks import TASK_ARGUMENTS
+from ltl_human_motion.scene.tasks import TASK_ARGUMENTS, shorthand_conjuncts
 from ltl_human_motion.scene.yaml_limits import YamlLimitError, load_yaml_limited
 from ltl_human_motion.scene.yaml_limits import short_repr as _r
 
@@ -42,7 +42,6 @@ __all__ = [
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _SHORTHAND_KEY = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\(([^()]*)\))?\s*$")
-_ATOM = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)\s*\(([^()]*)\)")
 _FRAMES = ("zup", "paper_yup")
 #: Any number of a cell (metres, or a size, a scale): a production cell is tens of metres
 #: across; beyond this, grids and meshes overflow (issue 17: x = 1e300).
@@ -372,13 +371,14 @@ def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Ce
             raise p.error(key, f"{_r(sname)} is already a task or shorthand")
         if not isinstance(body, str) or not body.strip():
             raise p.error(key, f"expected the body as a string, got {_r(body)}")
-        atoms = _ATOM.findall(body)
-        if not atoms:
-            raise p.error(key, f"body {_r(body)} contains no task")
+        try:
+            atoms = shorthand_conjuncts(body)
+        except ValueError as exc:
+            raise p.error(key, str(exc)) from None
         for task, args in atoms:
             if task not in TASK_ARGUMENTS and task not in shorthands:
                 raise p.error(key, f"unknown task {_r(task)} in body {_r(body)}")
-            for arg in (a.strip() for a in args.split(",") if a.strip()):
+            for arg in args:
                 if arg not in params and arg not in objects and arg not in regions:
                     try:
                         float(arg)

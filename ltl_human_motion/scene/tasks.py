@@ -7,7 +7,10 @@ cell), ``"duration"`` (seconds, a number). ``sit`` takes the object to sit on;
 
 from __future__ import annotations
 
-__all__ = ["GAIT_TASKS", "REGION_TASKS", "TASK_ARGUMENTS", "TASK_NAMES"]
+import re
+
+__all__ = ["GAIT_TASKS", "REGION_TASKS", "TASK_ARGUMENTS", "TASK_NAMES",
+           "shorthand_conjuncts", "two_hand_region"]
 
 TASK_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "wait": ("duration",),
@@ -35,3 +38,59 @@ GAIT_TASKS: frozenset[str] = frozenset({"walk", "carry"})
 
 #: Tasks whose termination condition puts (part of) the body into their region argument.
 REGION_TASKS: frozenset[str] = frozenset({"walk", "carry", "leftHand", "rightHand"})
+
+
+_BODY_TOKEN = re.compile(r"\s*(?:([A-Za-z_][A-Za-z0-9_]*)\s*(\(([^()]*)\))?|(&)|(\()|(\)))")
+
+
+def shorthand_conjuncts(body: str) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """The conjuncts of a shorthand body, e.g. ``"leftHand(R) & rightHand(R)"`` ->
+    ``(("leftHand", ("R",)), ("rightHand", ("R",)))``, arguments as written.
+
+    The body must be a conjunction of tasks: ``&`` between tasks, grouping parentheses
+    allowed, a task without arguments written bare (``standUp``).
+
+    Raises
+    ------
+    ValueError
+        Anything else (``|``, ``X``, ``!``, an empty or unbalanced body), naming the
+        position.
+    """
+    out: list[tuple[str, tuple[str, ...]]] = []
+    pos, depth, want_task = 0, 0, True
+    text = body.rstrip()
+    while pos < len(text):
+        pos += len(text[pos:]) - len(text[pos:].lstrip())
+        m = _BODY_TOKEN.match(text, pos)
+        if not m or m.end() == pos:
+            raise ValueError(f"shorthand body {body!r}: only a conjunction of tasks is "
+                             f"allowed, not {text[pos:].strip()[:20]!r} at character {pos + 1}")
+        name, _call, args, amp, lpar, rpar = m.groups()
+        if name is not None and name not in ("X", "F", "G", "U", "W", "R", "M") and want_task:
+            out.append((name, tuple(a.strip() for a in (args or "").split(",") if a.strip())))
+            want_task = False
+        elif amp and not want_task:
+            want_task = True
+        elif lpar and want_task:
+            depth += 1
+        elif rpar and not want_task and depth > 0:
+            depth -= 1
+        else:
+            raise ValueError(f"shorthand body {body!r}: only a conjunction of tasks is "
+                             f"allowed, not {m.group(0).strip()!r} at character {pos + 1}")
+        pos = m.end()
+    if want_task or depth:
+        raise ValueError(f"shorthand body {body!r}: incomplete conjunction of tasks")
+    return tuple(out)
+
+
+def two_hand_region(params: tuple[str, ...], body: str) -> bool:
+    """Whether a one-parameter shorthand is ``leftHand(R) & rightHand(R)`` (Table I's
+    ``assemble``), in any order or grouping."""
+    if len(params) != 1:
+        return False
+    try:
+        conj = set(shorthand_conjuncts(body))
+    except ValueError:
+        return False
+    return conj == {("leftHand", params), ("rightHand", params)}

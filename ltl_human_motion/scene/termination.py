@@ -48,7 +48,7 @@ from ltl_human_motion.scene.predicates import (
     enter_object,
     ground_enter,
 )
-from ltl_human_motion.scene.tasks import TASK_ARGUMENTS
+from ltl_human_motion.scene.tasks import TASK_ARGUMENTS, shorthand_conjuncts
 
 __all__ = [
     "DEFAULT_EPS",
@@ -101,14 +101,11 @@ def expand_task(task: str, args: Sequence[object], cell: Cell | None
         raise ValueError(f"shorthand {task} takes {len(params)} argument(s), got {len(args)}")
     binding = dict(zip(params, args))
     out: list[tuple[str, tuple[str, ...]]] = []
-    for conjunct in body.split("&"):
-        if re.sub(r"[A-Za-z_][A-Za-z0-9_]*\s*\([^()]*\)|[\s()]", "", conjunct):
-            raise ValueError(f"shorthand {task}: only conjunctions of tasks are supported, "
-                             f"got {body!r}")
-        c = conjunct.strip()
-        while c.startswith("(") and c.endswith(")") and c.count("(") > 1:
-            c = c[1:-1].strip()
-        name, sub = parse_task(c)
+    try:
+        conjuncts = shorthand_conjuncts(body)
+    except ValueError as exc:
+        raise ValueError(f"shorthand {task}: {exc}") from None
+    for name, sub in conjuncts:
         out.extend(expand_task(name, [binding.get(a, a) for a in sub], cell))
     return out
 

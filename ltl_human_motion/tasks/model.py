@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ltl_human_motion.ltl.formula import Atom
+from ltl_human_motion.scene.tasks import two_hand_region
 
 __all__ = ["DONE", "IMPLICIT_FETCH_PENALTY", "NOMINAL_DURATION", "WALK_SPEED", "CellModel",
            "CellState", "Limits"]
@@ -210,10 +211,8 @@ class CellModel:
             hit = (task.name, tuple(task.args))
             if task.name in self.shorthands:
                 params, body = self.shorthands[task.name]
-                text = body.replace(" ", "")
                 hit = ("shorthand", tuple(task.args))
-                if len(params) == 1 and len(task.args) == 1 and set(text.split("&")) == {
-                        f"leftHand({params[0]})", f"rightHand({params[0]})"}:
+                if len(task.args) == 1 and two_hand_region(params, body):
                     hit = ("assemble", tuple(task.args))
             self._kinds[task.key] = hit
         return hit
