@@ -19,7 +19,7 @@ from ltl_human_motion.scenarios.corpus import DWYER_PATTERNS, INFEASIBLE_REASONS
 from ltl_human_motion.scenarios.generator import generate_scenario
 from ltl_human_motion.scenarios.run import judge, run_pair
 from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
-from ltl_human_motion.scene.tasks import TASK_NAMES
+from ltl_human_motion.vocabulary import TASK_NAMES
 
 PAIRS = load_corpus()
 BY_ID = {p.id: p for p in PAIRS}

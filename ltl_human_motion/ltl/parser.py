@@ -56,12 +56,8 @@ from ltl_human_motion.ltl.formula import (
     Xor,
 )
 from ltl_human_motion.ltl.limits import MAX_NESTING, MAX_SPEC_CHARS, check_formula_limits
-from ltl_human_motion.ltl.vocabulary import (
-    REGION_ATOM,
-    TASK_SIGNATURES,
-    Vocabulary,
-    vocabulary_from,
-)
+from ltl_human_motion.ltl.vocabulary import Vocabulary, vocabulary_from
+from ltl_human_motion.vocabulary import REGION_ATOM, TASK_ARGUMENTS
 
 __all__ = ["ParsedSpec", "parse", "parse_spec"]
 
@@ -89,7 +85,7 @@ _PRECEDENCE = {"->": (1, True), "<->": (1, True), "|": (2, False), "xor": (3, Fa
 _BINARY_CLASS = {"->": Implies, "<->": Equiv, "xor": Xor, "U": Until, "R": Release,
                  "W": WeakUntil, "M": StrongRelease}
 _UNARY_CLASS = {"!": Not, "X": Next, "F": Finally, "G": Globally}
-_KIND_WORD = {"object": "an object", "region": "a region", "number": "a number"}
+_KIND_WORD = {"object": "an object", "region": "a region", "duration": "a number"}
 
 
 @dataclass(frozen=True)
@@ -372,8 +368,8 @@ class _Parser:
         args = [self.bindings.get(a.value, a.value) for a in arg_toks]
         if name in self.vocab.shorthands:
             return self.shorthand(tok, args, arg_toks)
-        if name in TASK_SIGNATURES or name == REGION_ATOM:
-            kinds = TASK_SIGNATURES.get(name, ("region",))
+        if name in TASK_ARGUMENTS or name == REGION_ATOM:
+            kinds = TASK_ARGUMENTS.get(name, ("region",))
             if len(args) != len(kinds):
                 wanted = ", ".join(kinds) if kinds else "no arguments"
                 raise self.error(f"task '{name}' takes {len(kinds)} argument"
@@ -387,12 +383,12 @@ class _Parser:
             return atom
         if self.free_atoms:
             return Atom(name, tuple(args))
-        known = sorted(set(TASK_SIGNATURES) | {REGION_ATOM} | set(self.vocab.shorthands))
+        known = sorted(set(TASK_ARGUMENTS) | {REGION_ATOM} | set(self.vocab.shorthands))
         raise self.error(f"unknown task '{name}'; expected one of: {', '.join(known)}",
                          tok.pos)
 
     def check_arg(self, value: str, tok: _Token, kind: str, task: str) -> str:
-        if kind == "number":
+        if kind == "duration":
             try:
                 number = float(value)
             except ValueError:

@@ -34,12 +34,8 @@ from ltl_human_motion.ltl.formula import (
     top_level_conjuncts,
 )
 from ltl_human_motion.ltl.parser import parse_spec
-from ltl_human_motion.ltl.vocabulary import (
-    ENTERING_TASKS,
-    REGION_ATOM,
-    Vocabulary,
-    vocabulary_from,
-)
+from ltl_human_motion.ltl.vocabulary import Vocabulary, vocabulary_from
+from ltl_human_motion.vocabulary import ENTERING_TASKS, REGION_ATOM
 
 __all__ = [
     "PAPER_SPECS", "Specification", "Task", "build_specification", "letter_of",

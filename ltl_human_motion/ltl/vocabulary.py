@@ -13,36 +13,14 @@ from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
 from ltl_human_motion.errors import CellError
+from ltl_human_motion.vocabulary import TASK_ARGUMENTS
 
 __all__ = [
-    "REGION_ATOM", "TASK_SIGNATURES", "CellVocabulary", "Vocabulary", "load_vocabulary",
-    "vocabulary_from",
+    "TASK_SIGNATURES", "CellVocabulary", "Vocabulary", "load_vocabulary", "vocabulary_from",
 ]
 
-#: Argument kinds of every Table I task: "object", "region" or "number".
-TASK_SIGNATURES: dict[str, tuple[str, ...]] = {
-    "grasp": ("object",),
-    "release": ("object",),
-    "carry": ("object", "region"),
-    "move": ("object", "region"),
-    "insert": ("object", "object"),
-    "extract": ("object", "object"),
-    "leftHand": ("region",),
-    "rightHand": ("region",),
-    "walk": ("region",),
-    "wait": ("number",),
-    "sit": ("object",),
-    "standUp": (),
-    "bend": (),
-    "stoop": (),
-    "kneel": (),
-}
-
-#: The region atom ``enter(R)``: true at a step whose task puts the body into R.
-REGION_ATOM = "enter"
-
-#: Tasks whose termination condition puts the body into their region argument.
-ENTERING_TASKS: dict[str, int] = {"walk": 0, "carry": 1, "leftHand": 0, "rightHand": 0}
+#: Deprecated name of :data:`ltl_human_motion.vocabulary.TASK_ARGUMENTS` (the same dict).
+TASK_SIGNATURES = TASK_ARGUMENTS
 
 
 @runtime_checkable

@@ -44,6 +44,7 @@ from ltl_human_motion.motion.ops import relative_root
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.timing import fitts_time, min_move_time
 from ltl_human_motion.motion.types import MotionPrimitive
+from ltl_human_motion.vocabulary import HAND_TASKS
 
 __all__ = [
     "GOAL_TASKS",
@@ -57,8 +58,6 @@ __all__ = [
     "seat_height_range",
 ]
 
-HAND_TASKS: tuple[str, ...] = ("grasp", "release", "move", "leftHand", "rightHand", "assemble",
-                               "insert", "extract")
 POSTURE_TASKS: tuple[str, ...] = ("bend", "stoop", "kneel", "sit", "standUp", "wait")
 GOAL_TASKS: tuple[str, ...] = HAND_TASKS + POSTURE_TASKS
 

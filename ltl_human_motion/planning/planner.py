@@ -46,7 +46,7 @@ from ltl_human_motion.planning.navigation import (
     stand_clearance_map,
 )
 from ltl_human_motion.planning.placement import RegionEntry
-from ltl_human_motion.scene.tasks import two_hand_region
+from ltl_human_motion.vocabulary import HAND_TASKS, two_hand_region
 
 Pose = tuple[float, float, float]
 
@@ -166,9 +166,6 @@ _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
 #: :meth:`SequencePlanner._arm_poses`).
 _ARM_POSES: dict[tuple, np.ndarray] = {}
 
-#: Tasks done with the hands: the arms are raised to the carry stance before them.
-HAND_TASKS = {"grasp", "release", "move", "insert", "extract", "leftHand", "rightHand",
-              "assemble"}
 
 
 @dataclass(frozen=True)

@@ -59,7 +59,6 @@ from ltl_human_motion.scene.shapes import (
     shape_enclosed_in,
     shapes_intersect,
 )
-from ltl_human_motion.scene.tasks import GAIT_TASKS, REGION_TASKS, TASK_ARGUMENTS, TASK_NAMES
 from ltl_human_motion.scene.termination import (
     DEFAULT_EPS,
     chest_height,
@@ -69,14 +68,13 @@ from ltl_human_motion.scene.termination import (
     termination_holds,
     termination_series,
 )
+from ltl_human_motion.vocabulary import TASK_ARGUMENTS, TASK_NAMES
 
 __all__ = [
     "BODY_CAPSULES",
     "BODY_PARTS",
     "DEFAULT_EPS",
-    "GAIT_TASKS",
     "PART_ALIASES",
-    "REGION_TASKS",
     "TASK_ARGUMENTS",
     "TASK_NAMES",
     "ZUP_FROM_YUP",

@@ -48,7 +48,7 @@ from ltl_human_motion.scene.predicates import (
     enter_object,
     ground_enter,
 )
-from ltl_human_motion.scene.tasks import TASK_ARGUMENTS, shorthand_conjuncts
+from ltl_human_motion.vocabulary import TASK_ARGUMENTS, shorthand_conjuncts
 
 __all__ = [
     "DEFAULT_EPS",

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ltl_human_motion.ltl.formula import Atom
-from ltl_human_motion.scene.tasks import two_hand_region
+from ltl_human_motion.vocabulary import two_hand_region
 
 __all__ = ["DONE", "IMPLICIT_FETCH_PENALTY", "NOMINAL_DURATION", "WALK_SPEED", "CellModel",
            "CellState", "Limits"]

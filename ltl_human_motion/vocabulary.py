@@ -1,15 +1,18 @@
-"""The tasks of Table I and the kinds of their arguments.
+"""The task vocabulary of Table I, in one place for every layer.
 
 Argument kinds: ``"object"`` (an object of the cell), ``"region"`` (a region of the
 cell), ``"duration"`` (seconds, a number). ``sit`` takes the object to sit on;
-``standUp``, ``bend``, ``stoop`` and ``kneel`` take none.
+``standUp``, ``bend``, ``stoop`` and ``kneel`` take none. The region atom ``enter(R)``
+is true at a step whose task puts the body into R (:data:`ENTERING_TASKS`). A cell's
+shorthands (``assemble(R): leftHand(R) & rightHand(R)``) are conjunctions of these
+tasks (:func:`shorthand_conjuncts`).
 """
 
 from __future__ import annotations
 
 import re
 
-__all__ = ["GAIT_TASKS", "REGION_TASKS", "TASK_ARGUMENTS", "TASK_NAMES",
+__all__ = ["ENTERING_TASKS", "HAND_TASKS", "REGION_ATOM", "TASK_ARGUMENTS", "TASK_NAMES",
            "shorthand_conjuncts", "two_hand_region"]
 
 TASK_ARGUMENTS: dict[str, tuple[str, ...]] = {
@@ -33,11 +36,17 @@ TASK_ARGUMENTS: dict[str, tuple[str, ...]] = {
 #: Table I task names in the paper's order.
 TASK_NAMES: tuple[str, ...] = tuple(TASK_ARGUMENTS)
 
-#: Tasks realised by gait primitives.
-GAIT_TASKS: frozenset[str] = frozenset({"walk", "carry"})
+#: The region atom ``enter(R)``: true at a step whose task puts the body into R.
+REGION_ATOM = "enter"
 
-#: Tasks whose termination condition puts (part of) the body into their region argument.
-REGION_TASKS: frozenset[str] = frozenset({"walk", "carry", "leftHand", "rightHand"})
+#: Tasks whose termination condition puts (part of) the body into a region, with the
+#: index of that region among their arguments.
+ENTERING_TASKS: dict[str, int] = {"walk": 0, "carry": 1, "leftHand": 0, "rightHand": 0}
+
+#: Tasks done with the hands (``assemble`` is the two-hand shorthand): goal primitives
+#: with a hand target, before which the arms are raised to the carry stance.
+HAND_TASKS: tuple[str, ...] = ("grasp", "release", "move", "leftHand", "rightHand",
+                               "assemble", "insert", "extract")
 
 
 _BODY_TOKEN = re.compile(r"\s*(?:([A-Za-z_][A-Za-z0-9_]*)\s*(\(([^()]*)\))?|(&)|(\()|(\)))")
