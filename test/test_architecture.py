@@ -35,6 +35,22 @@ def test_no_layer_below_the_cli_imports_it(layer: str) -> None:
     assert not {k: v for k, v in offenders.items() if v}
 
 
+def test_the_ltl_layer_reads_names_only_and_imports_no_scene() -> None:
+    offenders = {str(p.relative_to(PACKAGE)): sorted(m for m in _imports(p)
+                                                    if m.startswith("ltl_human_motion.scene"))
+                 for p in (PACKAGE / "ltl").rglob("*.py")}
+    assert not {k: v for k, v in offenders.items() if v}
+
+
+def test_every_layer_takes_the_task_vocabulary_from_one_module() -> None:
+    from ltl_human_motion import vocabulary
+    from ltl_human_motion.ltl import TASK_SIGNATURES
+    from ltl_human_motion.motion.goals import HAND_TASKS
+    from ltl_human_motion.scene import TASK_ARGUMENTS
+    assert TASK_SIGNATURES is TASK_ARGUMENTS is vocabulary.TASK_ARGUMENTS
+    assert HAND_TASKS is vocabulary.HAND_TASKS
+
+
 @pytest.mark.parametrize("module", ["ros/conversions.py", "ros/playback.py"])
 def test_ros_layer_uses_core_types_without_probes(module: str) -> None:
     tree = ast.parse((PACKAGE / module).read_text())

@@ -18,7 +18,7 @@ from ltl_human_motion.ltl import parse
 from ltl_human_motion.ltl.limits import MAX_NESTING, nesting_depth
 from ltl_human_motion.ltl.translate_builtin import translate_builtin
 from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
-from ltl_human_motion.scene.yaml_limits import MAX_YAML_EXPANDED_NODES
+from ltl_human_motion.yaml_limits import MAX_YAML_EXPANDED_NODES
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER_CELL = (ROOT / "config" / "paper_cell.yaml").read_text()

@@ -2,7 +2,8 @@
 
 A cell is anything with the attributes of :class:`CellVocabulary` (the scene module's
 ``Cell`` is one), a plain ``dict`` with the same keys, or a YAML file read by
-:func:`load_vocabulary`. Only names are used here; the geometry stays in ``scene/``.
+:func:`load_vocabulary`. Only names are used here; the geometry stays in ``scene/``,
+which this layer does not import.
 """
 
 from __future__ import annotations
@@ -128,30 +129,23 @@ def vocabulary_from(cell: Any) -> Vocabulary:
 
 
 def load_vocabulary(path: str | Path) -> Vocabulary:
-    """Read the names of a cell YAML file.
-
-    Uses ``ltl_human_motion.scene.cell.load_cell`` when the scene module provides it,
-    else reads the keys ``objects``, ``regions``, ``shorthands`` and ``final_region``.
+    """Read the names of a cell YAML file: the keys ``objects``, ``regions``,
+    ``shorthands`` and ``final_region`` (the geometry is the scene module's to read).
 
     Raises
     ------
     CellError
-        If the file is missing or malformed.
+        If the file is missing, too large or deep for
+        :func:`~ltl_human_motion.yaml_limits.load_yaml_limited`, or malformed.
     """
+    from ltl_human_motion.yaml_limits import YamlLimitError, load_yaml_limited
+
     path = Path(path)
     if not path.is_file():
         raise CellError(f"cell file not found: {path}")
     try:
-        from ltl_human_motion.scene.cell import load_cell
-    except ImportError:
-        load_cell = None
-    if load_cell is not None:
-        return vocabulary_from(load_cell(path))
-    import yaml
-
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        data = load_yaml_limited(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, YamlLimitError) as exc:
         raise CellError(f"{path}: cannot read cell description: {exc}") from None
     if not isinstance(data, Mapping):
         raise CellError(f"{path}: a cell description must be a YAML mapping")

@@ -24,9 +24,9 @@ from ltl_human_motion.errors import CellError
 from ltl_human_motion.scene.cell import Cell, Obstacle, Region, SceneObject
 from ltl_human_motion.scene.frames import ZUP_FROM_YUP, extents_zup_from_yup, zup_from_yup
 from ltl_human_motion.scene.shapes import Box, Cylinder, MeshShape, Shape, Sphere
-from ltl_human_motion.scene.yaml_limits import YamlLimitError, load_yaml_limited
-from ltl_human_motion.scene.yaml_limits import short_repr as _r
 from ltl_human_motion.vocabulary import TASK_ARGUMENTS, shorthand_conjuncts
+from ltl_human_motion.yaml_limits import YamlLimitError, load_yaml_limited
+from ltl_human_motion.yaml_limits import short_repr as _r
 
 __all__ = [
     "MAX_CELL_COORDINATE",
