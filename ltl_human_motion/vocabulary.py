@@ -11,9 +11,13 @@ tasks (:func:`shorthand_conjuncts`).
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from ltl_human_motion.errors import PlanningError
 
 __all__ = ["ENTERING_TASKS", "HAND_TASKS", "REGION_ATOM", "TASK_ARGUMENTS", "TASK_NAMES",
-           "shorthand_conjuncts", "two_hand_region"]
+           "TaskStep", "shorthand_conjuncts", "task_step", "two_hand_region"]
 
 TASK_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "wait": ("duration",),
@@ -103,3 +107,46 @@ def two_hand_region(params: tuple[str, ...], body: str) -> bool:
     except ValueError:
         return False
     return conj == {("leftHand", params), ("rightHand", params)}
+
+
+@dataclass(frozen=True)
+class TaskStep:
+    """One step of a task sequence as the planner takes it.
+
+    Attributes
+    ----------
+    text : str
+        The step as written in the sequence, e.g. ``"assemble(R1)"``.
+    kind : str
+        The goal task realising it: a Table I task, or ``"assemble"`` for a two-hand
+        shorthand.
+    args : tuple of str
+        The arguments of ``kind``.
+    """
+
+    text: str
+    kind: str
+    args: tuple[str, ...]
+
+
+def task_step(name: str, args: tuple[str, ...],
+              shorthands: Mapping[str, tuple[tuple[str, ...], str]],
+              text: str | None = None) -> TaskStep:
+    """The :class:`TaskStep` of task ``name(args)``, shorthands expanded.
+
+    Raises
+    ------
+    PlanningError
+        (reason ``"unsupported"``) for a shorthand with no motion of its own: only
+        ``leftHand(R) & rightHand(R)`` is one step (``assemble``).
+    """
+    args = tuple(str(a) for a in args)
+    text = text if text is not None else (f"{name}({', '.join(args)})" if args else name)
+    if name in shorthands:
+        params, body = shorthands[name]
+        if len(args) == 1 and two_hand_region(params, body):
+            return TaskStep(text, "assemble", args)
+        raise PlanningError(f"shorthand {name} ({body}) has no motion of its own; only "
+                            "two-hand shorthands like leftHand(R) & rightHand(R) can be "
+                            "planned as one step", task=name, reason="unsupported")
+    return TaskStep(text, name, args)

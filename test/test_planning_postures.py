@@ -69,12 +69,13 @@ def test_sit_on_the_seat_already_sat_on_stays_seated(stature: float) -> None:
     seat is not behind a seated worker); the walk after it stands up first."""
     from ltl_human_motion.planning.pipeline import get_library, resolve_cell
     from ltl_human_motion.planning.planner import SequencePlanner
+    from ltl_human_motion.vocabulary import task_step
 
     cell = resolve_cell("demo_cell")
     planner = SequencePlanner(cell, get_library(stature), np.random.default_rng(1))
     start = (float(cell.start_region.center[0]), float(cell.start_region.center[1]), 0.0)
-    steps = [("sit(stool)", "sit", ("stool",)), ("sit(stool)", "sit", ("stool",)),
-             ("walk(R1)", "walk", ("R1",))]
+    steps = [task_step("sit", ("stool",), {}), task_step("sit", ("stool",), {}),
+             task_step("walk", ("R1",), {})]
     plan = planner.plan(steps, start)
     first, second, walk = plan.steps
     assert second.kind == "sit (seated)"

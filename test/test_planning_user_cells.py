@@ -96,16 +96,17 @@ def test_walk_paths_are_checked_on_every_frame():
 
 def test_unplannable_shorthand_still_says_why():
     with pytest.raises(PlanningError, match="no motion of its own"):
-        from ltl_human_motion.planning.planner import task_kind
-        task_kind("odd", ("R1",), {"odd": (("R",), "walk(R) & grasp(O1)")})
+        from ltl_human_motion.vocabulary import task_step
+        task_step("odd", ("R1",), {"odd": (("R",), "walk(R) & grasp(O1)")})
 
 
 def test_a_two_hand_shorthand_is_assemble_in_any_order_and_grouping():
-    from ltl_human_motion.planning.planner import task_kind
     from ltl_human_motion.scene.termination import expand_task
     from ltl_human_motion.tasks.model import CellModel
+    from ltl_human_motion.vocabulary import TaskStep, task_step
     body = "(rightHand(R) & (leftHand(R)))"
-    assert task_kind("asm", ("R1",), {"asm": (("R",), body)}) == ("assemble", ("R1",))
+    assert task_step("asm", ("R1",), {"asm": (("R",), body)}) == TaskStep("asm(R1)", "assemble",
+                                                                          ("R1",))
     cell = resolve_cell("demo_cell")
     cell = replace(cell, shorthands={**cell.shorthands, "asm": (("R",), body)})
     assert expand_task("asm", ["R1"], cell) == [("rightHand", ("R1",)), ("leftHand", ("R1",))]

@@ -29,10 +29,11 @@ from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.blend import JUNCTION_SPREAD, concatenate
 from ltl_human_motion.planning.feasibility import check_steps
 from ltl_human_motion.planning.footlock import lock_feet
-from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner, task_kind
+from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, failure_error, verify_motion
 from ltl_human_motion.scene.cell_yaml import resolve_cell
+from ltl_human_motion.vocabulary import task_step
 
 __all__ = ["SynthesisOptions", "get_library", "resolve_cell", "synthesize"]
 
@@ -336,10 +337,11 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
                     options, t_automaton, t_sequence, t_library, stature
                     ) -> SynthesizedMotion:
     t_start = time.perf_counter()
-    steps = [(t.key, t.name, tuple(t.args)) for t in seq.tasks]
+    written = [(t.name, tuple(t.args)) for t in seq.tasks]
+    steps = [task_step(name, args, cell.shorthands, t.key)
+             for (name, args), t in zip(written, seq.tasks)]
     planner = SequencePlanner(cell, library, rng, options.planner)
-    kind, args = task_kind(steps[0][1], steps[0][2], cell.shorthands)   # lassos are non-empty
-    start = _start_pose(cell, planner.target_of(kind, args), rng)
+    start = _start_pose(cell, planner.target_of(steps[0].kind, steps[0].args), rng)
     t0 = time.perf_counter()
     plan = planner.plan(steps, start)
     t_planning = time.perf_counter() - t0
@@ -377,10 +379,10 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
         checkpoint("blending")
         synth = SynthesizedMotion(motion=motion, root_yaw=root_yaw, task_index=task_index,
                                   timeline=timeline, objects=tracks, spec=spec_text,
-                                  sequence=[s[0] for s in steps], seed=int(seed))
+                                  sequence=[s.text for s in steps], seed=int(seed))
 
         t0 = time.perf_counter()
-        report = verify_motion(synth, cell, specification, seq, [(s[1], s[2]) for s in steps],
+        report = verify_motion(synth, cell, specification, seq, written,
                                options.verification, held=held, stature=stature,
                                blend_frames=library.overlap, raise_on_failure=False)
         t_verify += time.perf_counter() - t0

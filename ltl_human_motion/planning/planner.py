@@ -46,7 +46,7 @@ from ltl_human_motion.planning.navigation import (
     stand_clearance_map,
 )
 from ltl_human_motion.planning.placement import RegionEntry
-from ltl_human_motion.vocabulary import HAND_TASKS, two_hand_region
+from ltl_human_motion.vocabulary import HAND_TASKS, TaskStep
 
 Pose = tuple[float, float, float]
 
@@ -331,21 +331,6 @@ def grip_frame(mp: MotionPrimitive) -> int:
     if mp.task == "extract" and "hold_frames" in mp.meta:
         return int(mp.meta["hold_frames"][0])
     return int(mp.meta.get("contact_frame", mp.n_frames - 1))
-
-
-def task_kind(name: str, args: tuple[str, ...], shorthands: dict) -> tuple[str, tuple[str, ...]]:
-    """The goal-primitive task realising a step and its arguments.
-
-    A shorthand whose expansion is ``leftHand(R) & rightHand(R)`` becomes ``assemble``.
-    """
-    if name in shorthands:
-        params, body = shorthands[name]
-        if len(args) == 1 and two_hand_region(params, body):
-            return "assemble", args
-        raise PlanningError(f"shorthand {name} ({body}) has no motion of its own; only "
-                            "two-hand shorthands like leftHand(R) & rightHand(R) can be "
-                            "planned as one step", task=name, reason="unsupported")
-    return name, args
 
 
 class SequencePlanner:
@@ -928,15 +913,14 @@ class SequencePlanner:
         return len(res.primitives)
 
     # ---------------------------------------------------------------- tasks
-    def plan(self, tasks: list[tuple[str, str, tuple[str, ...]]], start: Pose) -> Plan:
-        """Plan every step; ``tasks`` holds (text, name, args) per step."""
+    def plan(self, tasks: list[TaskStep], start: Pose) -> Plan:
+        """Plan every step (:func:`~ltl_human_motion.vocabulary.task_step` makes them)."""
         self.pose = start
         self._stand_still(-1, 0.3)
-        for i, (text, name, args) in enumerate(tasks):
-            kind, args = task_kind(name, args, self.cell.shorthands)
+        for i, task in enumerate(tasks):
             first = len(self.segments)
-            facing = self._seated_work(tasks[i + 1:]) if kind == "sit" else None
-            step = self._plan_step(i, text, kind, args, facing=facing)
+            facing = self._seated_work(tasks[i + 1:]) if task.kind == "sit" else None
+            step = self._plan_step(i, task.text, task.kind, task.args, facing=facing)
             step.first_segment = first
             step.last_segment = len(self.segments) - 1
             self.steps.append(step)
@@ -946,14 +930,13 @@ class SequencePlanner:
             self._add(self._sit_still(0.3), self.pose, -1, self.overlap)
         return Plan(self.segments, self.steps, start, self.expanded)
 
-    def _seated_work(self, rest: list[tuple[str, str, tuple[str, ...]]]) -> np.ndarray | None:
+    def _seated_work(self, rest: list[TaskStep]) -> np.ndarray | None:
         """Target (3,) of the first hand task done seated after a sit (the tasks in
         ``rest``, up to the first that needs standing), or None."""
-        for _text, name, args in rest:
-            kind, args = task_kind(name, args, self.cell.shorthands)
-            if kind in SEATED_HAND_TASKS:
-                return self.target_of(kind, args)
-            if kind != "wait":
+        for task in rest:
+            if task.kind in SEATED_HAND_TASKS:
+                return self.target_of(task.kind, task.args)
+            if task.kind != "wait":
                 return None
         return None
 
