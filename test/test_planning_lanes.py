@@ -1,6 +1,7 @@
-"""Walking lanes: overhead parts are no tall parts, and the navigation field prefers
+"""Walking lanes: overhead parts are no tall parts, the navigation field prefers
 roomy floor to a gap the body barely fits (scenario families timeout:grasp and
-planning:*:budget in the cells with clutter and the 0.8 m aisle)."""
+planning:*:budget in the cells with clutter and the 0.8 m aisle), and squeezes through
+a gap only the footprints leave (the aisle's planning:*:blocked)."""
 
 from __future__ import annotations
 
@@ -69,3 +70,55 @@ def test_narrow_floor_counts_longer() -> None:
     assert np.isfinite(plain.distance(*start)[0]) and np.isfinite(lanes.distance(*start)[0])
     assert lanes.distance(*start)[0] > plain.distance(*start)[0]
     assert lanes.distance(*start)[0] <= (1.0 + NARROW_COST) * plain.distance(*start)[0] + 1e-9
+
+
+CORRIDOR = """
+name: corridor
+frame: zup
+workspace: {lo: [-1.0, -2.0, 0.0], hi: [5.0, 2.0, 2.5]}
+start_region: R0
+regions:
+  R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}
+  R_in: {lo: [2.2, -0.3, 0.0], hi: [2.8, 0.3, 2.0]}     # in the corridor
+obstacles:
+  wall_left:                           # tall walls 0.8 m apart, x from 1.0 to 4.0
+    shape: box
+    position: [2.5, 0.65, 1.0]
+    size: [3.0, 0.5, 2.0]
+  wall_right:
+    shape: box
+    position: [2.5, -0.65, 1.0]
+    size: [3.0, 0.5, 2.0]
+"""
+
+
+def test_walk_squeezes_through_a_narrow_corridor() -> None:
+    """Tall walls 0.8 m apart: the walking map (arms at shoulder width) leaves no way in,
+    so the field squeezes on the footprint map; the walk the search finds keeps every
+    frame clear of the walls, as the verifier checks (the aisle cell's family
+    planning:*:blocked / walk:unreachable)."""
+    from ltl_human_motion.planning.pipeline import get_library
+    from ltl_human_motion.planning.planner import SequencePlanner, body_clear_every_frame
+    cell = cell_from_yaml(CORRIDOR)
+    lib = get_library(1.75)
+    planner = SequencePlanner(cell, lib, np.random.default_rng(0))
+    planner.pose = (0.0, 0.0, 0.0)
+    assert planner.clearance(np.array([[2.5, 0.0]]))[0] <= planner.options.body_radius
+    goal = planner._region_goal(cell.region("R_in"), "walk into R_in", "walk(R_in)")
+    assert goal.clearance is planner.stand_map
+    walked = planner._walk(goal, "walk(R_in)", 0, carry=False)
+    assert walked > 0
+    world = np.concatenate([s.positions for s in planner.segments])
+    assert body_clear_every_frame(world, cell, lib.skeleton.stature)
+    assert 1.0 < planner.pose[0] < 4.0 and abs(planner.pose[1]) < 0.4   # in the corridor
+
+
+def test_roomy_floor_needs_no_squeeze() -> None:
+    """Where the walking map has a way, the field keeps to it (no squeeze)."""
+    from ltl_human_motion.planning.pipeline import get_library
+    from ltl_human_motion.planning.planner import SequencePlanner
+    cell = cell_from_yaml(CORRIDOR.replace("0.65", "0.95"))      # 1.4 m apart
+    planner = SequencePlanner(cell, get_library(1.75), np.random.default_rng(0))
+    planner.pose = (0.0, 0.0, 0.0)
+    goal = planner._region_goal(cell.region("R_in"), "walk into R_in", "walk(R_in)")
+    assert goal.clearance is planner.clearance

@@ -217,8 +217,8 @@ SUBSET: dict[str, str | None] = {
                              "the bracket: the elbow hits the rack side panel)",
     "under_shelf/job/low_shelf_assemble": "planning:grasp:blocked (part under a low board)",
     "bins/job/bin_to_bin": None,
-    "aisle/single/walk(R2)": "planning:walk:unreachable (an aisle 0.8 m wide; passed only "
-                             "on navigation maps cached by older code)",
+    "aisle/single/walk(R2)": None,
+    "aisle/single/grasp(O1)": None,
     "cluttered/single/walk(R2)": None,
     "bins/single/grasp(O2)": None,
     "machine_tending/single/extract(done, fixture)": None,

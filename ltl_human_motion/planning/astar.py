@@ -48,12 +48,17 @@ class Goal:
         ``heading(x (M,), y (M,)) -> (M,)``: direction the walk should head; the
         heuristic adds the time to turn towards it.
     description : str
+    clearance : callable or None
+        ``clearance(xy (M, 2)) -> (M,)``: the floor clearance map the walk to this goal
+        keeps ``body_radius`` on, when not the caller's default (a squeeze through a
+        narrow aisle keeps it on the obstacles' footprints).
     """
 
     reached: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
     distance: Callable[[np.ndarray, np.ndarray], np.ndarray]
     heading: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     description: str = ""
+    clearance: Callable[[np.ndarray], np.ndarray] | None = None
 
 
 @dataclass

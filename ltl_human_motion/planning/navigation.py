@@ -49,6 +49,9 @@ class FloorGrid:
     free : ndarray of bool, shape (nx, ny)
     graph : scipy.sparse.csr_matrix, shape (nx * ny, nx * ny)
         8-connected free neighbours, both directions, weighted by the step length.
+    clearance : callable or None
+        The floor clearance map the free cells come from (set by :func:`floor_grid`):
+        a walk led by a field on this grid keeps its clearance on that map.
     """
 
     def __init__(self, lo: np.ndarray, hi: np.ndarray,
@@ -59,6 +62,7 @@ class FloorGrid:
         if lo.shape != (2,) or hi.shape != (2,) or np.any(hi <= lo):
             raise ValueError(f"need lo < hi of shape (2,), got {lo} and {hi}")
         self.lo, self.res = lo, float(resolution)
+        self.clearance: Callable[[np.ndarray], np.ndarray] | None = None
         self.shape = tuple(np.maximum(np.ceil((hi - lo) / resolution).astype(int) + 1, 2))
         nx, ny = self.shape
         gx, gy = np.meshgrid(lo[0] + np.arange(nx) * self.res, lo[1] + np.arange(ny) * self.res,
@@ -412,10 +416,13 @@ def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: 
         narrow = (passage - clearance(xy)) / max(passage - radius, 1e-9)
         return 1.0 + NARROW_COST * np.clip(narrow, 0.0, 1.0)
 
-    return _GRID_CACHE.get_or_build(
-        key, lambda: FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution,
-                               None if passage is None else cell_cost),
-        owner=clearance)
+    def build() -> FloorGrid:
+        grid = FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution,
+                         None if passage is None else cell_cost)
+        grid.clearance = clearance
+        return grid
+
+    return _GRID_CACHE.get_or_build(key, build, owner=clearance)
 
 
 _STAND_CACHE: dict[str, ClearanceMap] = {}

@@ -40,6 +40,7 @@ from ltl_human_motion.planning.astar import (
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.gait_index import gait_index
 from ltl_human_motion.planning.navigation import (
+    TALL_EXTRA,
     NavigationField,
     clearance_maps,
     floor_grid,
@@ -148,6 +149,10 @@ PALM_IN_PART = 0.01
 #: about half the hip and shoulder width of a 1.75 m worker (0.2 m) plus the gait's
 #: sway, more than ``PlannerOptions.body_radius`` (the least a walk needs).
 PASSAGE_RADIUS = 0.25
+#: The same on the footprint map of a squeeze (:meth:`SequencePlanner._field`): half
+#: the 0.8 m aisle of the corpus, whose walls the walking map counts ``TALL_EXTRA``
+#: closer; the field leads along the middle of such a gap.
+SQUEEZE_PASSAGE = PASSAGE_RADIUS + TALL_EXTRA
 
 #: How far beyond its container an extract pulls the part, metres.
 PULL_MARGIN = 0.03
@@ -464,32 +469,48 @@ class SequencePlanner:
         return self.clearance(xy)
 
     def _field(self, goal_cells, key: tuple | None = None) -> NavigationField:
-        """The navigation field of ``goal_cells`` on the floor grid. ``key``: numbers that
-        determine the goal cells on this floor; fields with a key are kept (a target that
-        does not move between items, e.g. an assembly region, reuses its field).
+        """The navigation field of ``goal_cells`` on the floor grid. ``goal_cells(xy (N, 2),
+        clearance) -> bool (N,)`` gets the clearance map of the grid it is solved on.
+        ``key``: numbers that determine the goal cells on this floor; fields with a key
+        are kept (a target that does not move between items, e.g. an assembly region,
+        reuses its field).
 
         The field keeps to lanes with ``PASSAGE_RADIUS`` of clearance where they lead from
         the worker to a goal; else it uses all floor the walk may take, counting floor
         with less clearance longer. Either way the search does not squeeze the gait
         through a gap the body barely fits (and exhaust its budget there) where a roomier
-        way exists."""
-        roomy = self._field_with(PASSAGE_RADIUS, goal_cells, key)
+        way exists. Only where the walking map leaves no way at all (a narrow aisle
+        between racks) does the field squeeze: it is solved on the footprint map
+        (:attr:`stand_map`, no allowance for the arms at tall parts), whose walks the
+        search then keeps clear with the whole-body check. The walk keeps its clearance
+        on ``field.grid.clearance``."""
+        roomy = self._field_with(self.clearance, PASSAGE_RADIUS, goal_cells, key)
         if roomy.has_goal and roomy.reachable_from(self.pose[0], self.pose[1]):
             return roomy
-        return self._field_with(self.options.body_radius, goal_cells, key)
+        tight = self._field_with(self.clearance, self.options.body_radius, goal_cells, key)
+        if tight.has_goal and tight.reachable_from(self.pose[0], self.pose[1]):
+            return tight
+        squeeze = self._field_with(self.stand_map, self.options.body_radius, goal_cells, key)
+        if squeeze.has_goal and squeeze.reachable_from(self.pose[0], self.pose[1]):
+            return squeeze
+        return tight
 
-    def _field_with(self, radius: float, goal_cells, key: tuple | None) -> NavigationField:
-        """:meth:`_field` on the floor grid whose free cells keep ``radius``."""
-        grid = floor_grid(self.clearance, self.cell.workspace_lo[:2],
+    def _field_with(self, clearance, radius: float, goal_cells, key: tuple | None
+                    ) -> NavigationField:
+        """:meth:`_field` on the floor grid of map ``clearance`` whose free cells keep
+        ``radius``."""
+        passage = SQUEEZE_PASSAGE if clearance is self.stand_map else PASSAGE_RADIUS
+        grid = floor_grid(clearance, self.cell.workspace_lo[:2],
                           self.cell.workspace_hi[:2], radius, self.options.grid_resolution,
-                          passage=PASSAGE_RADIUS if radius < PASSAGE_RADIUS else None)
+                          passage=passage if radius < passage else None)
+        cells = functools.partial(goal_cells, clearance=clearance)
         if key is None:
-            return NavigationField.on_grid(grid, goal_cells)
+            return NavigationField.on_grid(grid, cells)
         full = (id(grid), *key)
         hit = _FIELD_CACHE.get(full)
         if hit is not None and hit[0] is grid:         # the grid is held, its id unique
             return hit[1]
-        field = NavigationField.on_grid(grid, goal_cells)
+        field = NavigationField.on_grid(grid, cells)
         if len(_FIELD_CACHE) >= 16:
             _FIELD_CACHE.pop(next(iter(_FIELD_CACHE)))
         _FIELD_CACHE[full] = (grid, field)
@@ -510,17 +531,19 @@ class SequencePlanner:
         def distance(x: np.ndarray, y: np.ndarray) -> np.ndarray:
             return np.maximum(field.distance(x, y) - slack, 0.0)
 
-        return Goal(reached, distance, field.heading, desc)
+        return Goal(reached, distance, field.heading, desc, clearance=field.grid.clearance)
 
     def _ideal_placement(self, target: np.ndarray, placement: tuple[float, float],
-                         x: np.ndarray, y: np.ndarray, room: bool = False
+                         x: np.ndarray, y: np.ndarray, room: bool = False,
+                         walk_map: Callable[[np.ndarray], np.ndarray] | None = None
                          ) -> tuple[np.ndarray, ...]:
         """Root pose (x*, y*, yaw*) from which the goal primitive reaches ``target``,
         facing it from the side of (x, y), and whether that spot is free.
 
         Where the ideal spot is too close to an obstacle (a bench in front), the worker
         stands up to ``max_step_back`` further back. Arrays shaped like ``x``. With
-        ``room``, also the floor clearance at (x, y) itself (from the same map lookup).
+        ``room``, also the floor clearance at (x, y) itself on ``walk_map`` (default the
+        walking map).
         """
         d, lat = placement
         yaw = np.arctan2(target[1] - y, target[0] - x) - np.arctan2(lat, d)
@@ -538,8 +561,8 @@ class SequencePlanner:
                free.any(axis=-1))
         if not room:
             return out
-        return (*out, self._clearance(np.stack([x, y], axis=-1).reshape(-1, 2)
-                                      ).reshape(np.shape(x)))
+        walk_map = self._clearance if walk_map is None else walk_map
+        return (*out, walk_map(np.stack([x, y], axis=-1).reshape(-1, 2)).reshape(np.shape(x)))
 
     def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
                     task: str, adjust: float | None = None,
@@ -560,14 +583,14 @@ class SequencePlanner:
         offset = float(np.arctan2(placement[1], placement[0]))
         adjust = self.options.adjust_radius if adjust is None else float(adjust)
 
-        def ring(xy: np.ndarray) -> np.ndarray:
+        def ring(xy: np.ndarray, clearance=None) -> np.ndarray:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
             out = (r >= dist - tol) & (r <= dist + self._back_limit) & side(xy[:, 0], xy[:, 1])
             # The floor clearance only where the distance fits (few of the cells).
             out[out] = self.stand_map(xy[out]) > self.options.stand_clearance
             return out
 
-        def near_ring(xy: np.ndarray) -> np.ndarray:
+        def near_ring(xy: np.ndarray, clearance=None) -> np.ndarray:
             # Where a walk may end to step in (a rack: the walking map keeps tall
             # parts further off than a worker standing at them needs).
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
@@ -576,7 +599,7 @@ class SequencePlanner:
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             px, py, pyaw, free, here = self._ideal_placement(target, placement, x, y,
-                                                             room=True)
+                                                             room=True, walk_map=walk_map)
             # Turning on the spot needs room for the hips; facing nearly right needs none.
             room = here > self.options.turn_clearance
             facing = np.abs(wrap_angle(pyaw - yaw)) <= self.options.heading_tolerance
@@ -595,6 +618,7 @@ class SequencePlanner:
             field = self._field(ring, ring_key())
         if not field.has_goal:
             field = self._field(near_ring, ("near", *ring_key(), adjust))
+        walk_map = field.grid.clearance                # read by reached()
         goal = self._goal_from_field(field, reached, desc, task)
         base_heading = field.heading
 
@@ -668,9 +692,10 @@ class SequencePlanner:
                             stature, float(capsule_radii(stature).max()))
         room = self.options.turn_clearance
 
-        def cells(xy: np.ndarray) -> np.ndarray:
+        def cells(xy: np.ndarray, clearance: Callable[[np.ndarray], np.ndarray]
+                  ) -> np.ndarray:
             out = entry.cells(xy)
-            out[out] = self._clearance(xy[out]) > room
+            out[out] = clearance(xy[out]) > room
             return out
 
         field = self._field(cells, ("region", *entry.lo.tolist(), *entry.hi.tolist(),
@@ -899,7 +924,8 @@ class SequencePlanner:
         for _repair in range(WALK_REPAIRS + 1):
             self.rng.bit_generator.state = noise_state      # the same costs every time
             res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
-                        clearance=self._clearance, body_radius=self.options.body_radius,
+                        clearance=goal.clearance or self._clearance,
+                        body_radius=self.options.body_radius,
                         heuristic_speed=self.options.heuristic_speed,
                         turn_rate=self.options.turn_rate, carry=carry,
                         budget=budget or self.options.budget, rng=self.rng,
@@ -1220,7 +1246,7 @@ class SequencePlanner:
         def roomy(x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None = None) -> np.ndarray:
             return self._clearance(np.stack([x, y], axis=-1)) > room
 
-        field = self._field(lambda xy: roomy(xy[:, 0], xy[:, 1]), ("room", room))
+        field = self._field(lambda xy, clearance: roomy(xy[:, 0], xy[:, 1]), ("room", room))
         goal = self._goal_from_field(field, roomy, f"find room for {text}", text)
         return self._walk(goal, text, -1, carry=bool(self.held))
 
