@@ -220,6 +220,8 @@ SUBSET: dict[str, str | None] = {
     "aisle/single/walk(R2)": None,
     "aisle/single/grasp(O1)": None,
     "cluttered/single/walk(R2)": None,
+    "cluttered/single/grasp(O1)": None,
+    "wall_gap/single/carry(O1, R1)": None,
     "bins/single/grasp(O2)": None,
     "machine_tending/single/extract(done, fixture)": None,
     "shelf_heights/single/grasp(O_shoulder)": None,

@@ -153,6 +153,10 @@ PASSAGE_RADIUS = 0.25
 #: the 0.8 m aisle of the corpus, whose walls the walking map counts ``TALL_EXTRA``
 #: closer; the field leads along the middle of such a gap.
 SQUEEZE_PASSAGE = PASSAGE_RADIUS + TALL_EXTRA
+#: Node budget of a squeezing walk: along a gap the body barely fits the search gets
+#: through at once or not at all (the aisle's walks take under 20 nodes; a goal the
+#: body cannot stand at took the whole 8000 and the pair's time limit).
+SQUEEZE_NODES = 1000
 
 #: How far beyond its container an extract pulls the part, metres.
 PULL_MARGIN = 0.03
@@ -162,6 +166,15 @@ EXTRACT_CHECK_STRIDE = 4
 
 #: The other hand of each hand joint.
 OTHER_HAND = {"l_hand": "r_hand", "r_hand": "l_hand"}
+
+#: A walk's search that expands this many nodes without getting nearer the goal stalls
+#: (in front of a gap the walking body does not pass: the cell with crates floods 7000
+#: nodes there; searches that get through a tight spot went up to about 2500 nodes
+#: without progress there); its goal then reroutes around a disc of
+#: ``STALL_BLOCK_RADIUS`` (m) at the closest approach, up to ``MAX_REROUTES`` times.
+STALL_NODES = 3500
+STALL_BLOCK_RADIUS = 0.3
+MAX_REROUTES = 2
 
 #: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
@@ -468,7 +481,8 @@ class SequencePlanner:
     def _clearance(self, xy: np.ndarray) -> np.ndarray:
         return self.clearance(xy)
 
-    def _field(self, goal_cells, key: tuple | None = None) -> NavigationField:
+    def _field(self, goal_cells, key: tuple | None = None, squeeze: bool = False
+               ) -> NavigationField:
         """The navigation field of ``goal_cells`` on the floor grid. ``goal_cells(xy (N, 2),
         clearance) -> bool (N,)`` gets the clearance map of the grid it is solved on.
         ``key``: numbers that determine the goal cells on this floor; fields with a key
@@ -479,21 +493,31 @@ class SequencePlanner:
         the worker to a goal; else it uses all floor the walk may take, counting floor
         with less clearance longer. Either way the search does not squeeze the gait
         through a gap the body barely fits (and exhaust its budget there) where a roomier
-        way exists. Only where the walking map leaves no way at all (a narrow aisle
-        between racks) does the field squeeze: it is solved on the footprint map
-        (:attr:`stand_map`, no allowance for the arms at tall parts), whose walks the
-        search then keeps clear with the whole-body check. The walk keeps its clearance
-        on ``field.grid.clearance``."""
+        way exists. With ``squeeze`` (where the walking map leaves no way at all: a
+        narrow aisle between racks, see :meth:`_led`) the field is solved on the
+        footprint map (:attr:`stand_map`, no allowance for the arms at tall parts),
+        whose walks the search keeps clear with the whole-body check. The walk keeps its
+        clearance on ``field.grid.clearance``."""
+        if squeeze:
+            return self._field_with(self.stand_map, self.options.body_radius, goal_cells, key)
         roomy = self._field_with(self.clearance, PASSAGE_RADIUS, goal_cells, key)
-        if roomy.has_goal and roomy.reachable_from(self.pose[0], self.pose[1]):
+        if self._leads(roomy):
             return roomy
-        tight = self._field_with(self.clearance, self.options.body_radius, goal_cells, key)
-        if tight.has_goal and tight.reachable_from(self.pose[0], self.pose[1]):
-            return tight
-        squeeze = self._field_with(self.stand_map, self.options.body_radius, goal_cells, key)
-        if squeeze.has_goal and squeeze.reachable_from(self.pose[0], self.pose[1]):
-            return squeeze
-        return tight
+        return self._field_with(self.clearance, self.options.body_radius, goal_cells, key)
+
+    def _leads(self, field: NavigationField) -> bool:
+        """Whether ``field`` leads from the worker's spot to a goal cell."""
+        return field.has_goal and field.reachable_from(self.pose[0], self.pose[1])
+
+    def _led(self, solve: Callable[[bool], tuple]) -> tuple:
+        """``solve(False)`` (a field on the walking map, and what made it), or where that
+        field leads nowhere and ``solve(True)``'s (the squeeze, see :meth:`_field`) does,
+        the latter."""
+        plain = solve(False)
+        if self._leads(plain[0]):
+            return plain
+        squeezed = solve(True)
+        return squeezed if self._leads(squeezed[0]) else plain
 
     def _field_with(self, clearance, radius: float, goal_cells, key: tuple | None
                     ) -> NavigationField:
@@ -516,8 +540,13 @@ class SequencePlanner:
         _FIELD_CACHE[full] = (grid, field)
         return field
 
-    def _goal_from_field(self, field: NavigationField, reached, desc: str,
-                         task: str) -> Goal:
+    def _goal_from_field(self, field: NavigationField, reached, desc: str, task: str,
+                         heading: Callable[[NavigationField], Callable] | None = None
+                         ) -> Goal:
+        """The walk's :class:`Goal` led by ``field``; ``heading(field)``: the heuristic's
+        direction (default the field's). A search that stalls (in front of a gap the body
+        does not pass) may reroute: the same goal on the field with the floor around the
+        stall blocked (``STALL_BLOCK_RADIUS``), while it still leads to the goal."""
         if not field.has_goal:
             raise PlanningError(f"task {task}: {desc}: every place to stand there is blocked "
                                 "by obstacles; the region is unreachable", task=task,
@@ -531,7 +560,14 @@ class SequencePlanner:
         def distance(x: np.ndarray, y: np.ndarray) -> np.ndarray:
             return np.maximum(field.distance(x, y) - slack, 0.0)
 
-        return Goal(reached, distance, field.heading, desc, clearance=field.grid.clearance)
+        def reroute(at: tuple[float, float]) -> Goal | None:
+            around = field.without(at, STALL_BLOCK_RADIUS)
+            if not (around.has_goal and around.reachable_from(self.pose[0], self.pose[1])):
+                return None
+            return self._goal_from_field(around, reached, desc, task, heading)
+
+        return Goal(reached, distance, field.heading if heading is None else heading(field),
+                    desc, clearance=field.grid.clearance, reroute=reroute)
 
     def _ideal_placement(self, target: np.ndarray, placement: tuple[float, float],
                          x: np.ndarray, y: np.ndarray, room: bool = False,
@@ -611,23 +647,26 @@ class SequencePlanner:
             return ("ring", tx, ty, dist, tol, float(self._back_limit),
                     float(self.options.stand_clearance), sector)
 
-        self._back_limit = tol
-        field = self._field(ring, ring_key())
-        if not field.has_goal:
-            self._back_limit = self.options.max_step_back
-            field = self._field(ring, ring_key())
-        if not field.has_goal:
-            field = self._field(near_ring, ("near", *ring_key(), adjust))
+        def solve(squeeze: bool) -> tuple[NavigationField, float]:
+            self._back_limit = tol
+            field = self._field(ring, ring_key(), squeeze)
+            if not field.has_goal:
+                self._back_limit = self.options.max_step_back
+                field = self._field(ring, ring_key(), squeeze)
+            if not field.has_goal:
+                field = self._field(near_ring, ("near", *ring_key(), adjust), squeeze)
+            return field, self._back_limit
+
+        field, self._back_limit = self._led(solve)
         walk_map = field.grid.clearance                # read by reached()
-        goal = self._goal_from_field(field, reached, desc, task)
-        base_heading = field.heading
 
-        def heading(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-            near = np.hypot(tx - x, ty - y) <= dist + 2 * tol
-            return np.where(near, np.arctan2(ty - y, tx - x) - offset, base_heading(x, y))
+        def heading(led: NavigationField) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+            def towards(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+                near = np.hypot(tx - x, ty - y) <= dist + 2 * tol
+                return np.where(near, np.arctan2(ty - y, tx - x) - offset, led.heading(x, y))
+            return towards
 
-        goal.heading = heading
-        return goal
+        return self._goal_from_field(field, reached, desc, task, heading)
 
     def _adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str) -> bool:
         """Step and turn on the spot to the ideal placement for ``target`` (if needed).
@@ -698,8 +737,8 @@ class SequencePlanner:
             out[out] = clearance(xy[out]) > room
             return out
 
-        field = self._field(cells, ("region", *entry.lo.tolist(), *entry.hi.tolist(),
-                                    stature, carrying, room))
+        key = ("region", *entry.lo.tolist(), *entry.hi.tolist(), stature, carrying, room)
+        field, = self._led(lambda squeeze: (self._field(cells, key, squeeze),))
         return self._goal_from_field(field, entry.enters, desc, task)
 
     # ---------------------------------------------------------------- segments
@@ -921,30 +960,44 @@ class SequencePlanner:
         again (at most ``WALK_REPAIRS`` times)."""
         forbidden: set[tuple[int, int, int, int]] = set()
         noise_state = self.rng.bit_generator.state
-        for _repair in range(WALK_REPAIRS + 1):
+        budget = budget or self.options.budget
+        if goal.clearance is self.stand_map:
+            budget = replace(budget, max_nodes=min(budget.max_nodes, SQUEEZE_NODES))
+        used, repairs, reroutes = 0, 0, 0
+        while True:
             self.rng.bit_generator.state = noise_state      # the same costs every time
+            stall = STALL_NODES if goal.reroute is not None and reroutes < MAX_REROUTES \
+                else None
             res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
                         clearance=goal.clearance or self._clearance,
                         body_radius=self.options.body_radius,
                         heuristic_speed=self.options.heuristic_speed,
                         turn_rate=self.options.turn_rate, carry=carry,
-                        budget=budget or self.options.budget, rng=self.rng,
-                        cost_noise=self.options.cost_noise, body_clear=self._body_clear,
-                        forbidden=frozenset(forbidden))
+                        budget=replace(budget, max_nodes=budget.max_nodes - used),
+                        rng=self.rng, cost_noise=self.options.cost_noise,
+                        body_clear=self._body_clear, forbidden=frozenset(forbidden),
+                        stall_nodes=stall)
             self.expanded += res.expanded
+            used += res.expanded
+            if isinstance(res, SearchFailure) and res.reason == "stalled":
+                # Walk around the spot the search could not get past, or search on.
+                reroutes += 1
+                goal = goal.reroute(res.closest_at) or replace(goal, reroute=None)
+                continue
             if isinstance(res, SearchFailure):
                 break
             bad = self._first_collision(res.primitives, res.poses)
             if bad is None:
                 break
-            forbidden.add((res.primitives[bad], *placement_key(*res.poses[bad])))
-        else:
-            raise PlanningError(f"task {task}: {goal.description}: every path found "
-                                f"({WALK_REPAIRS + 1}) collides on a frame the search did "
-                                "not sample", task=task, reason="blocked")
+            forbidden |= self._forbid(res.primitives, res.poses, bad)
+            repairs += 1
+            if repairs > WALK_REPAIRS:
+                raise PlanningError(f"task {task}: {goal.description}: every path found "
+                                    f"({WALK_REPAIRS + 1}) collides on a frame the search "
+                                    "did not sample", task=task, reason="blocked")
         if isinstance(res, SearchFailure):
             if res.reason == "budget":
-                why = (f"the search budget ran out ({res.expanded} nodes; closest approach "
+                why = (f"the search budget ran out ({used} nodes; closest approach "
                        f"{res.closest:.2f} m)")
             else:
                 why = (f"obstacles block every way to the target (searched {res.expanded} "
@@ -957,6 +1010,22 @@ class SequencePlanner:
             self.pose = res.end_pose
             self.gait_state = None  # every walk ends with a stop primitive
         return len(res.primitives)
+
+    def _forbid(self, primitives: list[int], poses: list[Pose], bad: int
+                ) -> set[tuple[int, int, int, int]]:
+        """What a search must not take again after primitive ``bad`` of its path collided:
+        that primitive from its pose, and where it is a stop (the arms swing forward as
+        the worker stops at furniture) that ends a walk, every gait stop from there and
+        from the neighbouring closed-set cells: the stops from one spot sweep nearly the
+        same space, and forbidding them one at a time, one cell at a time, used up the
+        ``WALK_REPAIRS``."""
+        i, j, k = placement_key(*poses[bad])
+        prim = primitives[bad]
+        if bad == 0 or not self.index.stops[prim] or self.index.standing[prim]:
+            return {(prim, i, j, k)}               # the first move, a turn on the spot
+        stops = np.flatnonzero(self.index.stops & ~self.index.standing).tolist()
+        return {(int(p), i + di, j + dj, k) for p in stops
+                for di in (-1, 0, 1) for dj in (-1, 0, 1)}
 
     # ---------------------------------------------------------------- tasks
     def plan(self, tasks: list[tuple[str, str, tuple[str, ...]]], start: Pose) -> Plan:
