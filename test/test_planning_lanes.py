@@ -194,3 +194,24 @@ def test_a_colliding_stop_forbids_the_stops_around_it() -> None:
     assert len(wide) == 9 * n_stops and (stop, *placement_key(*poses[1])) in wide
     assert planner._forbid([stop], poses[:1], 0) == {(stop, *placement_key(*poses[0]))}
     assert len(planner._forbid([walk, turn], poses, 1)) == 1
+
+
+def test_arms_come_up_after_a_step_aside_from_a_board_at_elbow_height() -> None:
+    """In the 0.8 m aisle, a board 1.2 m up on the right: raising the arms there swings
+    the right elbow into it, and no step back helps; a step aside does (the aisle's
+    planning:?:blocked of assemble, leftHand and rightHand in R2)."""
+    from pathlib import Path
+
+    from ltl_human_motion.planning.pipeline import get_library
+    from ltl_human_motion.planning.planner import SequencePlanner, body_clear_every_frame
+    from ltl_human_motion.scene.cell_yaml import resolve_cell
+    cell = resolve_cell(Path(__file__).resolve().parents[1] / "scenarios" / "cells"
+                        / "aisle.yaml")
+    lib = get_library(1.75)
+    planner = SequencePlanner(cell, lib, np.random.default_rng(0))
+    planner.pose = (1.2, -0.1, 0.0)
+    planner._stand_still(-1, 0.3)
+    planner._arm_transition(False, -1)
+    assert abs(planner.pose[1] + 0.1) > 0.05                 # stepped aside
+    world = np.concatenate([s.positions for s in planner.segments])
+    assert body_clear_every_frame(world, cell, lib.skeleton.stature)

@@ -219,6 +219,7 @@ SUBSET: dict[str, str | None] = {
     "bins/job/bin_to_bin": None,
     "aisle/single/walk(R2)": None,
     "aisle/single/grasp(O1)": None,
+    "aisle/single/assemble(R2)": None,
     "cluttered/single/walk(R2)": None,
     "cluttered/single/grasp(O1)": None,
     "wall_gap/single/carry(O1, R1)": None,

@@ -112,6 +112,8 @@ WALK_REPAIRS = 4
 #: and the clearance beyond ``PlannerOptions.body_radius`` the step must reach (m).
 STEP_OUT_DISTANCES: tuple[float, ...] = (0.1, 0.2, 0.3)
 STEP_OUT_MARGIN = 0.02
+#: Steps aside (m, left positive) tried when no backward step clears what follows.
+SIDE_STEPS: tuple[float, ...] = (0.1, -0.1, 0.2, -0.2)
 
 #: Hand tasks a seated worker does from the seat (others make the worker stand up).
 SEATED_HAND_TASKS = ("leftHand", "rightHand", "assemble")
@@ -931,18 +933,25 @@ class SequencePlanner:
 
     def _step_back(self, carrying: bool, label: int, then: MotionPrimitive) -> bool:
         """Step back from an obstacle in front so that ``then`` is clear afterwards: the
-        gait index's 0.3 m step back, else a model-made step of ``STEP_OUT_DISTANCES``.
-        Returns False (nothing added) when no step and ``then`` are both clear."""
+        gait index's 0.3 m step back, else a model-made step of ``STEP_OUT_DISTANCES``,
+        else a step aside of ``SIDE_STEPS`` (a board at elbow height beside the worker,
+        in an aisle). Returns False (nothing added) when no step and ``then`` are both
+        clear."""
         from ltl_human_motion.planning.turns import make_step_primitive
         task = "carry" if carrying else "walk"
-        steps = [mp for mp in self.index.primitives
-                 if mp.task == task and mp.meta.get("step") == [-0.3, 0.0]
-                 and not mp.meta.get("turn")][:1]
         lib = self.library
-        steps += [make_step_primitive(self._stance(carrying), lib.standing_height, -back, 0.0,
-                                      0.0, lib.skeleton, lib.fps, task)
-                  for back in STEP_OUT_DISTANCES]
-        for mp in steps:
+
+        def steps():
+            yield from [mp for mp in self.index.primitives
+                        if mp.task == task and mp.meta.get("step") == [-0.3, 0.0]
+                        and not mp.meta.get("turn")][:1]
+            moves = [(-back, 0.0) for back in STEP_OUT_DISTANCES] + [(0.0, side)
+                                                                     for side in SIDE_STEPS]
+            for dx, dy in moves:                       # made when tried
+                yield make_step_primitive(self._stance(carrying), lib.standing_height, dx, dy,
+                                          0.0, lib.skeleton, lib.fps, task)
+
+        for mp in steps():
             pose = self._hand_over_pose(mp, self.pose)
             if self._placed_clear(mp, self.pose) and self._placed_clear(then, pose):
                 self._add(mp, self.pose, label, self.overlap)
