@@ -215,7 +215,7 @@ def test_fields_with_a_key_are_reused_between_planners(paper) -> None:
     a = SequencePlanner(paper, lib, np.random.default_rng(0))
     b = SequencePlanner(paper, lib, np.random.default_rng(1))
 
-    def goal(xy: np.ndarray) -> np.ndarray:
+    def goal(xy: np.ndarray, clearance=None) -> np.ndarray:
         return np.hypot(xy[:, 0] - 1.0, xy[:, 1] + 1.0) < 0.6
 
     first = a._field(goal, ("test", 1.0, -1.0, 0.6))

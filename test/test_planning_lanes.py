@@ -1,11 +1,13 @@
-"""Walking lanes: overhead parts are no tall parts, and the navigation field prefers
+"""Walking lanes: overhead parts are no tall parts, the navigation field prefers
 roomy floor to a gap the body barely fits (scenario families timeout:grasp and
-planning:*:budget in the cells with clutter and the 0.8 m aisle)."""
+planning:*:budget in the cells with clutter and the 0.8 m aisle), and squeezes through
+a gap only the footprints leave (the aisle's planning:*:blocked)."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from ltl_human_motion.planning.astar import placement_key
 from ltl_human_motion.planning.navigation import (
     NARROW_COST,
     ClearanceMap,
@@ -69,3 +71,147 @@ def test_narrow_floor_counts_longer() -> None:
     assert np.isfinite(plain.distance(*start)[0]) and np.isfinite(lanes.distance(*start)[0])
     assert lanes.distance(*start)[0] > plain.distance(*start)[0]
     assert lanes.distance(*start)[0] <= (1.0 + NARROW_COST) * plain.distance(*start)[0] + 1e-9
+
+
+CORRIDOR = """
+name: corridor
+frame: zup
+workspace: {lo: [-1.0, -2.0, 0.0], hi: [5.0, 2.0, 2.5]}
+start_region: R0
+regions:
+  R0: {lo: [-0.3, -0.3, 0.0], hi: [0.3, 0.3, 0.1]}
+  R_in: {lo: [2.2, -0.3, 0.0], hi: [2.8, 0.3, 2.0]}     # in the corridor
+obstacles:
+  wall_left:                           # tall walls 0.8 m apart, x from 1.0 to 4.0
+    shape: box
+    position: [2.5, 0.65, 1.0]
+    size: [3.0, 0.5, 2.0]
+  wall_right:
+    shape: box
+    position: [2.5, -0.65, 1.0]
+    size: [3.0, 0.5, 2.0]
+"""
+
+
+def test_walk_squeezes_through_a_narrow_corridor() -> None:
+    """Tall walls 0.8 m apart: the walking map (arms at shoulder width) leaves no way in,
+    so the field squeezes on the footprint map; the walk the search finds keeps every
+    frame clear of the walls, as the verifier checks (the aisle cell's family
+    planning:*:blocked / walk:unreachable)."""
+    from ltl_human_motion.planning.pipeline import get_library
+    from ltl_human_motion.planning.planner import SequencePlanner, body_clear_every_frame
+    cell = cell_from_yaml(CORRIDOR)
+    lib = get_library(1.75)
+    planner = SequencePlanner(cell, lib, np.random.default_rng(0))
+    planner.pose = (0.0, 0.0, 0.0)
+    assert planner.clearance(np.array([[2.5, 0.0]]))[0] <= planner.options.body_radius
+    goal = planner._region_goal(cell.region("R_in"), "walk into R_in", "walk(R_in)")
+    assert goal.clearance is planner.stand_map
+    walked = planner._walk(goal, "walk(R_in)", 0, carry=False)
+    assert walked > 0
+    world = np.concatenate([s.positions for s in planner.segments])
+    assert body_clear_every_frame(world, cell, lib.skeleton.stature)
+    assert 1.0 < planner.pose[0] < 4.0 and abs(planner.pose[1]) < 0.4   # in the corridor
+
+
+def test_roomy_floor_needs_no_squeeze() -> None:
+    """Where the walking map has a way, the field keeps to it (no squeeze)."""
+    from ltl_human_motion.planning.pipeline import get_library
+    from ltl_human_motion.planning.planner import SequencePlanner
+    cell = cell_from_yaml(CORRIDOR.replace("0.65", "0.95"))      # 1.4 m apart
+    planner = SequencePlanner(cell, get_library(1.75), np.random.default_rng(0))
+    planner.pose = (0.0, 0.0, 0.0)
+    goal = planner._region_goal(cell.region("R_in"), "walk into R_in", "walk(R_in)")
+    assert goal.clearance is planner.clearance
+
+
+def test_field_without_a_spot_leads_around_it() -> None:
+    """Blocking a disc on the straight way keeps the goal cells and lengthens the way."""
+    cell = cell_from_yaml(CELL)
+    clearance = ClearanceMap(cell)
+    lo, hi = np.asarray(cell.workspace_lo[:2]), np.asarray(cell.workspace_hi[:2])
+
+    def goal(xy: np.ndarray) -> np.ndarray:
+        return np.hypot(xy[:, 0] - 1.5, xy[:, 1]) < 0.1
+
+    field = NavigationField.on_grid(floor_grid(clearance, lo, hi, 0.15, 0.05), goal)
+    around = field.without((0.5, 0.0), 0.3)
+    start = (np.array([-0.5]), np.array([0.0]))
+    np.testing.assert_array_equal(around.goal_cells, field.goal_cells)
+    assert around.reachable_from(-0.5, 0.0)
+    assert around.distance(*start)[0] > field.distance(*start)[0] + 0.05
+    assert not np.isfinite(around.distance(np.array([0.5]), np.array([0.0]))[0])
+    assert field.grid.free[field.grid.free].size > around.grid.free[around.grid.free].size
+
+
+def test_stalled_search_walks_around_a_gap_the_body_does_not_pass() -> None:
+    """The cell with crates: from the far corner the field leads between two crates 0.45
+    m apart, one as high as the swinging hands, and the search used to flood the floor
+    before the gap until its budget ran out (planning:grasp:budget); it stalls there,
+    walks around, and the walk is clear on every frame."""
+    from pathlib import Path
+
+    from ltl_human_motion.planning.pipeline import get_library
+    from ltl_human_motion.planning.planner import (
+        STALL_NODES,
+        SequencePlanner,
+        body_clear_every_frame,
+    )
+    from ltl_human_motion.scene.cell_yaml import resolve_cell
+    root = Path(__file__).resolve().parents[1]
+    cell = resolve_cell(root / "scenarios" / "cells" / "cluttered.yaml")
+    lib = get_library(1.75)
+    planner = SequencePlanner(cell, lib, np.random.default_rng(0))
+    planner.pose = (-1.39, 1.26, 2.39)
+    target = planner.target_of("grasp", ("O1",))
+    goal = planner._reach_goal(target, planner._placement("grasp", target, "grasp(O1)"),
+                               "reach grasp(O1)", "grasp(O1)")
+    assert goal.reroute is not None
+    walked = planner._walk(goal, "grasp(O1)", -1, carry=False)
+    assert walked > 0 and STALL_NODES < planner.expanded < planner.options.budget.max_nodes
+    world = np.concatenate([s.positions for s in planner.segments])
+    assert body_clear_every_frame(world, cell, lib.skeleton.stature)
+    assert np.hypot(planner.pose[0] - target[0], planner.pose[1] - target[1]) < 0.8
+
+
+def test_a_colliding_stop_forbids_the_stops_around_it() -> None:
+    """A walk's last stop that hit the table on a frame the search did not sample: the
+    repair forbids every gait stop from that spot and the closed-set cells around it
+    (one at a time, the next search stopped a grid cell over and hit it again, five
+    times: wall_gap's planning:grasp:blocked); a first move or a turn on the spot is
+    forbidden alone."""
+    from ltl_human_motion.planning.pipeline import get_library
+    from ltl_human_motion.planning.planner import SequencePlanner
+    planner = SequencePlanner(cell_from_yaml(CELL), get_library(1.75),
+                              np.random.default_rng(0))
+    index = planner.index
+    stop = int(np.flatnonzero(index.stops & ~index.standing)[0])
+    walk = int(np.flatnonzero(~index.stops & ~index.carry)[0])
+    turn = int(np.flatnonzero(index.standing)[0])
+    poses = [(0.0, 0.0, 0.0), (0.5, 0.1, 0.2)]
+    wide = planner._forbid([walk, stop], poses, 1)
+    n_stops = int(np.sum(index.stops & ~index.standing))
+    assert len(wide) == 9 * n_stops and (stop, *placement_key(*poses[1])) in wide
+    assert planner._forbid([stop], poses[:1], 0) == {(stop, *placement_key(*poses[0]))}
+    assert len(planner._forbid([walk, turn], poses, 1)) == 1
+
+
+def test_arms_come_up_after_a_step_aside_from_a_board_at_elbow_height() -> None:
+    """In the 0.8 m aisle, a board 1.2 m up on the right: raising the arms there swings
+    the right elbow into it, and no step back helps; a step aside does (the aisle's
+    planning:?:blocked of assemble, leftHand and rightHand in R2)."""
+    from pathlib import Path
+
+    from ltl_human_motion.planning.pipeline import get_library
+    from ltl_human_motion.planning.planner import SequencePlanner, body_clear_every_frame
+    from ltl_human_motion.scene.cell_yaml import resolve_cell
+    cell = resolve_cell(Path(__file__).resolve().parents[1] / "scenarios" / "cells"
+                        / "aisle.yaml")
+    lib = get_library(1.75)
+    planner = SequencePlanner(cell, lib, np.random.default_rng(0))
+    planner.pose = (1.2, -0.1, 0.0)
+    planner._stand_still(-1, 0.3)
+    planner._arm_transition(False, -1)
+    assert abs(planner.pose[1] + 0.1) > 0.05                 # stepped aside
+    world = np.concatenate([s.positions for s in planner.segments])
+    assert body_clear_every_frame(world, cell, lib.skeleton.stature)

@@ -20,6 +20,13 @@ from ltl_human_motion.planning.gait_index import GaitIndex
 
 Pose = tuple[float, float, float]
 
+#: How much nearer the goal (metres of the heuristic's distance) the closest approach
+#: must come to count as progress for ``stall_nodes``.
+STALL_PROGRESS = 0.05
+#: A search stuck closer than this to the goal (metres of the heuristic's distance) does
+#: not stall: it is finding a way to stand there, not a way around an obstacle.
+STALL_FAR = 0.5
+
 
 @dataclass(frozen=True)
 class SearchBudget:
@@ -48,12 +55,21 @@ class Goal:
         ``heading(x (M,), y (M,)) -> (M,)``: direction the walk should head; the
         heuristic adds the time to turn towards it.
     description : str
+    clearance : callable or None
+        ``clearance(xy (M, 2)) -> (M,)``: the floor clearance map the walk to this goal
+        keeps ``body_radius`` on, when not the caller's default (a squeeze through a
+        narrow aisle keeps it on the obstacles' footprints).
+    reroute : callable or None
+        ``reroute((x, y)) -> Goal | None``: the same goal with a heuristic that avoids the
+        floor around (x, y), where a search stalled (None: no other way).
     """
 
     reached: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
     distance: Callable[[np.ndarray, np.ndarray], np.ndarray]
     heading: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     description: str = ""
+    clearance: Callable[[np.ndarray], np.ndarray] | None = None
+    reroute: Callable[[tuple[float, float]], Goal | None] | None = None
 
 
 @dataclass
@@ -81,12 +97,15 @@ class SearchResult:
 
 @dataclass
 class SearchFailure:
-    """Why a search ended without reaching the goal: ``"blocked"`` or ``"budget"``."""
+    """Why a search ended without reaching the goal: ``"blocked"``, ``"budget"`` or
+    ``"stalled"`` (no progress for ``stall_nodes``); ``closest_at``: the floor point
+    (x, y) of the closest approach."""
 
     reason: str
     expanded: int
     seconds: float
     closest: float = field(default=float("inf"))
+    closest_at: tuple[float, float] | None = None
 
 
 def placement_key(x: float, y: float, yaw: float, grid: float = 0.08, yaw_bins: int = 24
@@ -127,6 +146,35 @@ def _body_at(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float
     return body
 
 
+def _stop_after(index: GaitIndex, prim: int, at: Pose, goal: Goal, allowed: np.ndarray,
+                clearance: Callable[[np.ndarray], np.ndarray], body_radius: float,
+                body_clear: Callable[[np.ndarray, np.ndarray], np.ndarray] | None,
+                forbidden: frozenset[tuple[int, int, int, int]], grid: float, yaw_bins: int
+                ) -> tuple[int, np.ndarray] | None:
+    """A stop primitive that may follow ``prim`` at pose ``at``, is not ``forbidden``
+    there, keeps clear and ends in the goal: (its index, its end pose (3,)), or None."""
+    stop_ids = index.successors(prim)
+    stop_ids = stop_ids[index.stops[stop_ids] & allowed[stop_ids]]
+    if forbidden and stop_ids.size:
+        there = placement_key(*at, grid, yaw_bins)
+        stop_ids = stop_ids[[(int(p), *there) not in forbidden for p in stop_ids.tolist()]]
+    if stop_ids.size == 0:
+        return None
+    mx, my, myaw = at
+    stop_ends = _place(index, stop_ids, mx, my, myaw)
+    stop_ok = goal.reached(stop_ends[:, 0], stop_ends[:, 1], stop_ends[:, 2])
+    stop_ok &= _path_clearance(index, stop_ids, mx, my, myaw, clearance) > body_radius
+    if stop_ok.any() and body_clear is not None and index.body.size:
+        # The arms swing as the worker stops: check the whole body, as for every move.
+        cand = stop_ids[stop_ok]
+        stop_ok[stop_ok] = body_clear(_body_at(index, cand, mx, my, myaw),
+                                      index.standing[cand])
+    if not stop_ok.any():
+        return None
+    k = int(np.flatnonzero(stop_ok)[0])
+    return int(stop_ids[k]), stop_ends[k]
+
+
 def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | None = None,
           clearance: Callable[[np.ndarray], np.ndarray], body_radius: float = 0.25,
           heuristic_speed: float = 0.7, turn_rate: float = 2.0, carry: bool = False,
@@ -134,7 +182,8 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
           body_clear: Callable[[np.ndarray], np.ndarray] | None = None,
           near_radius: float = 0.6,
           cost_noise: float = 0.0, grid: float = 0.08, yaw_bins: int = 24,
-          forbidden: frozenset[tuple[int, int, int, int]] = frozenset()
+          forbidden: frozenset[tuple[int, int, int, int]] = frozenset(),
+          stall_nodes: int | None = None
           ) -> SearchResult | SearchFailure:
     """Search a sequence of gait primitives from ``start`` until ``goal.reached``.
 
@@ -169,6 +218,11 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     forbidden : frozenset of (primitive, i, j, k)
         Primitives never taken from a pose, keyed by :func:`placement_key` of that pose
         (the caller found them colliding on a closer look).
+    stall_nodes : int or None
+        End with ``"stalled"`` once this many nodes were expanded without bringing the
+        closest approach ``STALL_PROGRESS`` nearer, while further than ``STALL_FAR``
+        from the goal (the heuristic leads into a gap the body does not pass, and the
+        search floods the floor before it).
 
     Returns
     -------
@@ -203,6 +257,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     closed: set[tuple[int, int, int]] = set()
     expanded = 0
     closest = float(goal.distance(np.array([sx]), np.array([sy]))[0])
+    closest_at, progress, progress_at = (sx, sy), closest, 0
     while open_heap:
         checkpoint("planning")
         _, node = heapq.heappop(open_heap)
@@ -216,7 +271,12 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         if expanded > budget.max_nodes or (
                 budget.max_seconds is not None
                 and time.perf_counter() - t0 > budget.max_seconds):
-            return SearchFailure("budget", expanded, time.perf_counter() - t0, closest)
+            return SearchFailure("budget", expanded, time.perf_counter() - t0, closest,
+                                 closest_at)
+        if (stall_nodes is not None and expanded - progress_at > stall_nodes
+                and closest > STALL_FAR):
+            return SearchFailure("stalled", expanded, time.perf_counter() - t0, closest,
+                                 closest_at)
         succ = index.starts if prims[node] < 0 else index.successors(prims[node])
         succ = succ[allowed[succ]]
         if forbidden:
@@ -246,24 +306,13 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         if not done.any() and near.any():
             # Reached while still walking: finish with a stop primitive if one lands there.
             for m in np.flatnonzero(near):
-                stop_ids = index.successors(int(succ[m]))
-                stop_ids = stop_ids[index.stops[stop_ids] & allowed[stop_ids]]
-                if stop_ids.size == 0:
-                    continue
-                mx, my, myaw = (float(v) for v in ends[m])
-                stop_ends = _place(index, stop_ids, mx, my, myaw)
-                stop_ok = goal.reached(stop_ends[:, 0], stop_ends[:, 1], stop_ends[:, 2])
-                stop_ok &= _path_clearance(index, stop_ids, mx, my, myaw, clearance) > body_radius
-                if stop_ok.any() and body_clear is not None and index.body.size:
-                    # The arms swing as the worker stops: check the whole body, as above.
-                    cand = stop_ids[stop_ok]
-                    stop_ok[stop_ok] = body_clear(_body_at(index, cand, mx, my, myaw),
-                                                  index.standing[cand])
-                if stop_ok.any():
-                    k = int(np.flatnonzero(stop_ok)[0])
-                    tail = [(int(stop_ids[k]), (mx, my, myaw))]
+                at = (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2]))
+                stop = _stop_after(index, int(succ[m]), at, goal, allowed, clearance,
+                                   body_radius, body_clear, forbidden, grid, yaw_bins)
+                if stop is not None:
+                    tail = [(stop[0], at)]
                     done[m] = True
-                    ends[m] = stop_ends[k]
+                    ends[m] = stop[1]
                     break
         if done.any():
             best = int(np.argmin(np.where(done, g_new, np.inf)))
@@ -285,7 +334,13 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         keep = np.isfinite(h_new)
         if not keep.any():
             continue
-        closest = min(closest, float(goal.distance(ends[keep, 0], ends[keep, 1]).min()))
+        left = goal.distance(ends[keep, 0], ends[keep, 1])
+        m = int(np.argmin(left))
+        if left[m] < closest:
+            closest, closest_at = float(left[m]), (float(ends[keep][m, 0]),
+                                                   float(ends[keep][m, 1]))
+            if closest < progress - STALL_PROGRESS:
+                progress, progress_at = closest, expanded
         succ, ends, g_new = succ[keep], ends[keep], g_new[keep]
         f_new = g_new + h_new[keep]
         for prim, end, g, f in zip(succ.tolist(), ends.tolist(), g_new.tolist(),
@@ -295,4 +350,4 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
             poses.append((end[0], end[1], end[2]))
             g_cost.append(g)
             heapq.heappush(open_heap, (f, len(prims) - 1))
-    return SearchFailure("blocked", expanded, time.perf_counter() - t0, closest)
+    return SearchFailure("blocked", expanded, time.perf_counter() - t0, closest, closest_at)

@@ -49,6 +49,9 @@ class FloorGrid:
     free : ndarray of bool, shape (nx, ny)
     graph : scipy.sparse.csr_matrix, shape (nx * ny, nx * ny)
         8-connected free neighbours, both directions, weighted by the step length.
+    clearance : callable or None
+        The floor clearance map the free cells come from (set by :func:`floor_grid`):
+        a walk led by a field on this grid keeps its clearance on that map.
     """
 
     def __init__(self, lo: np.ndarray, hi: np.ndarray,
@@ -59,16 +62,23 @@ class FloorGrid:
         if lo.shape != (2,) or hi.shape != (2,) or np.any(hi <= lo):
             raise ValueError(f"need lo < hi of shape (2,), got {lo} and {hi}")
         self.lo, self.res = lo, float(resolution)
+        self.clearance: Callable[[np.ndarray], np.ndarray] | None = None
         self.shape = tuple(np.maximum(np.ceil((hi - lo) / resolution).astype(int) + 1, 2))
         nx, ny = self.shape
         gx, gy = np.meshgrid(lo[0] + np.arange(nx) * self.res, lo[1] + np.arange(ny) * self.res,
                              indexing="ij")
         self.centres = np.stack([gx.ravel(), gy.ravel()], axis=-1)
-        self.free = np.asarray(free(self.centres), dtype=bool).reshape(self.shape)
+        self.cost = (np.ones(nx * ny) if cell_cost is None
+                     else np.asarray(cell_cost(self.centres), dtype=np.float64))
+        self._connect(np.asarray(free(self.centres), dtype=bool).reshape(self.shape))
+
+    def _connect(self, free: np.ndarray) -> None:
+        """Set the free cells (nx, ny) and the graph joining free neighbours."""
+        nx, ny = self.shape
+        self.free = free
         self.free.flags.writeable = False              # grids are shared (floor_grid)
         ids = np.arange(nx * ny).reshape(self.shape)
-        cost = (np.ones(nx * ny) if cell_cost is None
-                else np.asarray(cell_cost(self.centres), dtype=np.float64))
+        cost = self.cost
         rows, cols, weights = [], [], []
         for dx, dy in _NEIGHBOURS:
             a = ids[0:nx - dx, max(0, -dy):ny - max(0, dy)]
@@ -83,6 +93,16 @@ class FloorGrid:
         self.graph = coo_matrix((np.concatenate([w, w]), (np.concatenate([r, c]),
                                                           np.concatenate([c, r]))),
                                 shape=(nx * ny, nx * ny)).tocsr()
+
+    def blocked(self, centre: tuple[float, float], radius: float) -> FloorGrid:
+        """A copy of this grid whose cells within ``radius`` of ``centre`` (x, y) are not
+        free (same cell costs and clearance map)."""
+        grid = FloorGrid.__new__(FloorGrid)
+        grid.lo, grid.res, grid.shape, grid.centres = self.lo, self.res, self.shape, self.centres
+        grid.clearance, grid.cost = self.clearance, self.cost
+        near = np.hypot(self.centres[:, 0] - centre[0], self.centres[:, 1] - centre[1]) <= radius
+        grid._connect(self.free & ~near.reshape(self.shape))
+        return grid
 
 
 class NavigationField:
@@ -114,6 +134,7 @@ class NavigationField:
         self.lo, self.res, self.shape, self.free = grid.lo, grid.res, grid.shape, grid.free
         nx, ny = self.shape
         goal_cells = np.asarray(goal(grid.centres), dtype=bool).reshape(self.shape) & self.free
+        self.goal_cells = goal_cells
         self.has_goal = bool(goal_cells.any())
         if self.has_goal:
             dist = dijkstra(grid.graph, directed=True, indices=np.flatnonzero(goal_cells),
@@ -126,8 +147,14 @@ class NavigationField:
         filled = np.where(np.isfinite(self.dist), self.dist, big)
         gxd, gyd = np.gradient(filled, self.res)
         self.descent = np.arctan2(-gyd, -gxd)
-        for arr in (self.dist, self.descent):
+        for arr in (self.dist, self.descent, self.goal_cells):
             arr.flags.writeable = False                # fields may be shared (cached)
+
+    def without(self, centre: tuple[float, float], radius: float) -> NavigationField:
+        """The field of the same goal cells with the floor within ``radius`` of
+        ``centre`` (x, y) blocked: the way around a spot the walk cannot pass."""
+        cells = self.goal_cells.ravel()
+        return NavigationField.on_grid(self.grid.blocked(centre, radius), lambda xy: cells)
 
     def _cells(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         i = np.clip(np.rint((np.asarray(x) - self.lo[0]) / self.res).astype(int), 0,
@@ -412,10 +439,13 @@ def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: 
         narrow = (passage - clearance(xy)) / max(passage - radius, 1e-9)
         return 1.0 + NARROW_COST * np.clip(narrow, 0.0, 1.0)
 
-    return _GRID_CACHE.get_or_build(
-        key, lambda: FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution,
-                               None if passage is None else cell_cost),
-        owner=clearance)
+    def build() -> FloorGrid:
+        grid = FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution,
+                         None if passage is None else cell_cost)
+        grid.clearance = clearance
+        return grid
+
+    return _GRID_CACHE.get_or_build(key, build, owner=clearance)
 
 
 _STAND_CACHE: dict[str, ClearanceMap] = {}

@@ -40,6 +40,7 @@ from ltl_human_motion.planning.astar import (
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.gait_index import gait_index
 from ltl_human_motion.planning.navigation import (
+    TALL_EXTRA,
     NavigationField,
     clearance_maps,
     floor_grid,
@@ -112,6 +113,8 @@ WALK_REPAIRS = 4
 #: and the clearance beyond ``PlannerOptions.body_radius`` the step must reach (m).
 STEP_OUT_DISTANCES: tuple[float, ...] = (0.1, 0.2, 0.3)
 STEP_OUT_MARGIN = 0.02
+#: Steps aside (m, left positive) tried when no backward step clears what follows.
+SIDE_STEPS: tuple[float, ...] = (0.1, -0.1, 0.2, -0.2)
 
 #: Hand tasks a seated worker does from the seat (others make the worker stand up).
 SEATED_HAND_TASKS = ("leftHand", "rightHand", "assemble")
@@ -149,6 +152,14 @@ PALM_IN_PART = 0.01
 #: about half the hip and shoulder width of a 1.75 m worker (0.2 m) plus the gait's
 #: sway, more than ``PlannerOptions.body_radius`` (the least a walk needs).
 PASSAGE_RADIUS = 0.25
+#: The same on the footprint map of a squeeze (:meth:`SequencePlanner._field`): half
+#: the 0.8 m aisle of the corpus, whose walls the walking map counts ``TALL_EXTRA``
+#: closer; the field leads along the middle of such a gap.
+SQUEEZE_PASSAGE = PASSAGE_RADIUS + TALL_EXTRA
+#: Node budget of a squeezing walk: along a gap the body barely fits the search gets
+#: through at once or not at all (the aisle's walks take under 20 nodes; a goal the
+#: body cannot stand at took the whole 8000 and the pair's time limit).
+SQUEEZE_NODES = 1000
 
 #: How far beyond its container an extract pulls the part, metres.
 PULL_MARGIN = 0.03
@@ -158,6 +169,15 @@ EXTRACT_CHECK_STRIDE = 4
 
 #: The other hand of each hand joint.
 OTHER_HAND = {"l_hand": "r_hand", "r_hand": "l_hand"}
+
+#: A walk's search that expands this many nodes without getting nearer the goal stalls
+#: (in front of a gap the walking body does not pass: the cell with crates floods 7000
+#: nodes there; searches that get through a tight spot went up to about 2500 nodes
+#: without progress there); its goal then reroutes around a disc of
+#: ``STALL_BLOCK_RADIUS`` (m) at the closest approach, up to ``MAX_REROUTES`` times.
+STALL_NODES = 3500
+STALL_BLOCK_RADIUS = 0.3
+MAX_REROUTES = 2
 
 #: Navigation fields by floor grid and goal (see :meth:`SequencePlanner._field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
@@ -443,40 +463,72 @@ class SequencePlanner:
     def _clearance(self, xy: np.ndarray) -> np.ndarray:
         return self.clearance(xy)
 
-    def _field(self, goal_cells, key: tuple | None = None) -> NavigationField:
-        """The navigation field of ``goal_cells`` on the floor grid. ``key``: numbers that
-        determine the goal cells on this floor; fields with a key are kept (a target that
-        does not move between items, e.g. an assembly region, reuses its field).
+    def _field(self, goal_cells, key: tuple | None = None, squeeze: bool = False
+               ) -> NavigationField:
+        """The navigation field of ``goal_cells`` on the floor grid. ``goal_cells(xy (N, 2),
+        clearance) -> bool (N,)`` gets the clearance map of the grid it is solved on.
+        ``key``: numbers that determine the goal cells on this floor; fields with a key
+        are kept (a target that does not move between items, e.g. an assembly region,
+        reuses its field).
 
         The field keeps to lanes with ``PASSAGE_RADIUS`` of clearance where they lead from
         the worker to a goal; else it uses all floor the walk may take, counting floor
         with less clearance longer. Either way the search does not squeeze the gait
         through a gap the body barely fits (and exhaust its budget there) where a roomier
-        way exists."""
-        roomy = self._field_with(PASSAGE_RADIUS, goal_cells, key)
-        if roomy.has_goal and roomy.reachable_from(self.pose[0], self.pose[1]):
+        way exists. With ``squeeze`` (where the walking map leaves no way at all: a
+        narrow aisle between racks, see :meth:`_led`) the field is solved on the
+        footprint map (:attr:`stand_map`, no allowance for the arms at tall parts),
+        whose walks the search keeps clear with the whole-body check. The walk keeps its
+        clearance on ``field.grid.clearance``."""
+        if squeeze:
+            return self._field_with(self.stand_map, self.options.body_radius, goal_cells, key)
+        roomy = self._field_with(self.clearance, PASSAGE_RADIUS, goal_cells, key)
+        if self._leads(roomy):
             return roomy
-        return self._field_with(self.options.body_radius, goal_cells, key)
+        return self._field_with(self.clearance, self.options.body_radius, goal_cells, key)
 
-    def _field_with(self, radius: float, goal_cells, key: tuple | None) -> NavigationField:
-        """:meth:`_field` on the floor grid whose free cells keep ``radius``."""
-        grid = floor_grid(self.clearance, self.cell.workspace_lo[:2],
+    def _leads(self, field: NavigationField) -> bool:
+        """Whether ``field`` leads from the worker's spot to a goal cell."""
+        return field.has_goal and field.reachable_from(self.pose[0], self.pose[1])
+
+    def _led(self, solve: Callable[[bool], tuple]) -> tuple:
+        """``solve(False)`` (a field on the walking map, and what made it), or where that
+        field leads nowhere and ``solve(True)``'s (the squeeze, see :meth:`_field`) does,
+        the latter."""
+        plain = solve(False)
+        if self._leads(plain[0]):
+            return plain
+        squeezed = solve(True)
+        return squeezed if self._leads(squeezed[0]) else plain
+
+    def _field_with(self, clearance, radius: float, goal_cells, key: tuple | None
+                    ) -> NavigationField:
+        """:meth:`_field` on the floor grid of map ``clearance`` whose free cells keep
+        ``radius``."""
+        passage = SQUEEZE_PASSAGE if clearance is self.stand_map else PASSAGE_RADIUS
+        grid = floor_grid(clearance, self.cell.workspace_lo[:2],
                           self.cell.workspace_hi[:2], radius, self.options.grid_resolution,
-                          passage=PASSAGE_RADIUS if radius < PASSAGE_RADIUS else None)
+                          passage=passage if radius < passage else None)
+        cells = functools.partial(goal_cells, clearance=clearance)
         if key is None:
-            return NavigationField.on_grid(grid, goal_cells)
+            return NavigationField.on_grid(grid, cells)
         full = (id(grid), *key)
         hit = _FIELD_CACHE.get(full)
         if hit is not None and hit[0] is grid:         # the grid is held, its id unique
             return hit[1]
-        field = NavigationField.on_grid(grid, goal_cells)
+        field = NavigationField.on_grid(grid, cells)
         if len(_FIELD_CACHE) >= 16:
             _FIELD_CACHE.pop(next(iter(_FIELD_CACHE)))
         _FIELD_CACHE[full] = (grid, field)
         return field
 
-    def _goal_from_field(self, field: NavigationField, reached, desc: str,
-                         task: str) -> Goal:
+    def _goal_from_field(self, field: NavigationField, reached, desc: str, task: str,
+                         heading: Callable[[NavigationField], Callable] | None = None
+                         ) -> Goal:
+        """The walk's :class:`Goal` led by ``field``; ``heading(field)``: the heuristic's
+        direction (default the field's). A search that stalls (in front of a gap the body
+        does not pass) may reroute: the same goal on the field with the floor around the
+        stall blocked (``STALL_BLOCK_RADIUS``), while it still leads to the goal."""
         if not field.has_goal:
             raise PlanningError(f"task {task}: {desc}: every place to stand there is blocked "
                                 "by obstacles; the region is unreachable", task=task,
@@ -490,17 +542,26 @@ class SequencePlanner:
         def distance(x: np.ndarray, y: np.ndarray) -> np.ndarray:
             return np.maximum(field.distance(x, y) - slack, 0.0)
 
-        return Goal(reached, distance, field.heading, desc)
+        def reroute(at: tuple[float, float]) -> Goal | None:
+            around = field.without(at, STALL_BLOCK_RADIUS)
+            if not (around.has_goal and around.reachable_from(self.pose[0], self.pose[1])):
+                return None
+            return self._goal_from_field(around, reached, desc, task, heading)
+
+        return Goal(reached, distance, field.heading if heading is None else heading(field),
+                    desc, clearance=field.grid.clearance, reroute=reroute)
 
     def _ideal_placement(self, target: np.ndarray, placement: tuple[float, float],
-                         x: np.ndarray, y: np.ndarray, room: bool = False
+                         x: np.ndarray, y: np.ndarray, room: bool = False,
+                         walk_map: Callable[[np.ndarray], np.ndarray] | None = None
                          ) -> tuple[np.ndarray, ...]:
         """Root pose (x*, y*, yaw*) from which the goal primitive reaches ``target``,
         facing it from the side of (x, y), and whether that spot is free.
 
         Where the ideal spot is too close to an obstacle (a bench in front), the worker
         stands up to ``max_step_back`` further back. Arrays shaped like ``x``. With
-        ``room``, also the floor clearance at (x, y) itself (from the same map lookup).
+        ``room``, also the floor clearance at (x, y) itself on ``walk_map`` (default the
+        walking map).
         """
         d, lat = placement
         yaw = np.arctan2(target[1] - y, target[0] - x) - np.arctan2(lat, d)
@@ -518,8 +579,8 @@ class SequencePlanner:
                free.any(axis=-1))
         if not room:
             return out
-        return (*out, self._clearance(np.stack([x, y], axis=-1).reshape(-1, 2)
-                                      ).reshape(np.shape(x)))
+        walk_map = self._clearance if walk_map is None else walk_map
+        return (*out, walk_map(np.stack([x, y], axis=-1).reshape(-1, 2)).reshape(np.shape(x)))
 
     def _reach_goal(self, target: np.ndarray, placement: tuple[float, float], desc: str,
                     task: str, adjust: float | None = None,
@@ -540,14 +601,14 @@ class SequencePlanner:
         offset = float(np.arctan2(placement[1], placement[0]))
         adjust = self.options.adjust_radius if adjust is None else float(adjust)
 
-        def ring(xy: np.ndarray) -> np.ndarray:
+        def ring(xy: np.ndarray, clearance=None) -> np.ndarray:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
             out = (r >= dist - tol) & (r <= dist + self._back_limit) & side(xy[:, 0], xy[:, 1])
             # The floor clearance only where the distance fits (few of the cells).
             out[out] = self.stand_map(xy[out]) > self.options.stand_clearance
             return out
 
-        def near_ring(xy: np.ndarray) -> np.ndarray:
+        def near_ring(xy: np.ndarray, clearance=None) -> np.ndarray:
             # Where a walk may end to step in (a rack: the walking map keeps tall
             # parts further off than a worker standing at them needs).
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
@@ -556,7 +617,7 @@ class SequencePlanner:
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             px, py, pyaw, free, here = self._ideal_placement(target, placement, x, y,
-                                                             room=True)
+                                                             room=True, walk_map=walk_map)
             # Turning on the spot needs room for the hips; facing nearly right needs none.
             room = here > self.options.turn_clearance
             facing = np.abs(wrap_angle(pyaw - yaw)) <= self.options.heading_tolerance
@@ -568,22 +629,26 @@ class SequencePlanner:
             return ("ring", tx, ty, dist, tol, float(self._back_limit),
                     float(self.options.stand_clearance), sector)
 
-        self._back_limit = tol
-        field = self._field(ring, ring_key())
-        if not field.has_goal:
-            self._back_limit = self.options.max_step_back
-            field = self._field(ring, ring_key())
-        if not field.has_goal:
-            field = self._field(near_ring, ("near", *ring_key(), adjust))
-        goal = self._goal_from_field(field, reached, desc, task)
-        base_heading = field.heading
+        def solve(squeeze: bool) -> tuple[NavigationField, float]:
+            self._back_limit = tol
+            field = self._field(ring, ring_key(), squeeze)
+            if not field.has_goal:
+                self._back_limit = self.options.max_step_back
+                field = self._field(ring, ring_key(), squeeze)
+            if not field.has_goal:
+                field = self._field(near_ring, ("near", *ring_key(), adjust), squeeze)
+            return field, self._back_limit
 
-        def heading(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-            near = np.hypot(tx - x, ty - y) <= dist + 2 * tol
-            return np.where(near, np.arctan2(ty - y, tx - x) - offset, base_heading(x, y))
+        field, self._back_limit = self._led(solve)
+        walk_map = field.grid.clearance                # read by reached()
 
-        goal.heading = heading
-        return goal
+        def heading(led: NavigationField) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+            def towards(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+                near = np.hypot(tx - x, ty - y) <= dist + 2 * tol
+                return np.where(near, np.arctan2(ty - y, tx - x) - offset, led.heading(x, y))
+            return towards
+
+        return self._goal_from_field(field, reached, desc, task, heading)
 
     def _adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str) -> bool:
         """Step and turn on the spot to the ideal placement for ``target`` (if needed).
@@ -648,13 +713,14 @@ class SequencePlanner:
                             stature, float(capsule_radii(stature).max()))
         room = self.options.turn_clearance
 
-        def cells(xy: np.ndarray) -> np.ndarray:
+        def cells(xy: np.ndarray, clearance: Callable[[np.ndarray], np.ndarray]
+                  ) -> np.ndarray:
             out = entry.cells(xy)
-            out[out] = self._clearance(xy[out]) > room
+            out[out] = clearance(xy[out]) > room
             return out
 
-        field = self._field(cells, ("region", *entry.lo.tolist(), *entry.hi.tolist(),
-                                    stature, carrying, room))
+        key = ("region", *entry.lo.tolist(), *entry.hi.tolist(), stature, carrying, room)
+        field, = self._led(lambda squeeze: (self._field(cells, key, squeeze),))
         return self._goal_from_field(field, entry.enters, desc, task)
 
     # ---------------------------------------------------------------- segments
@@ -847,18 +913,25 @@ class SequencePlanner:
 
     def _step_back(self, carrying: bool, label: int, then: MotionPrimitive) -> bool:
         """Step back from an obstacle in front so that ``then`` is clear afterwards: the
-        gait index's 0.3 m step back, else a model-made step of ``STEP_OUT_DISTANCES``.
-        Returns False (nothing added) when no step and ``then`` are both clear."""
+        gait index's 0.3 m step back, else a model-made step of ``STEP_OUT_DISTANCES``,
+        else a step aside of ``SIDE_STEPS`` (a board at elbow height beside the worker,
+        in an aisle). Returns False (nothing added) when no step and ``then`` are both
+        clear."""
         from ltl_human_motion.planning.turns import make_step_primitive
         task = "carry" if carrying else "walk"
-        steps = [mp for mp in self.index.primitives
-                 if mp.task == task and mp.meta.get("step") == [-0.3, 0.0]
-                 and not mp.meta.get("turn")][:1]
         lib = self.library
-        steps += [make_step_primitive(self._stance(carrying), lib.standing_height, -back, 0.0,
-                                      0.0, lib.skeleton, lib.fps, task)
-                  for back in STEP_OUT_DISTANCES]
-        for mp in steps:
+
+        def steps():
+            yield from [mp for mp in self.index.primitives
+                        if mp.task == task and mp.meta.get("step") == [-0.3, 0.0]
+                        and not mp.meta.get("turn")][:1]
+            moves = [(-back, 0.0) for back in STEP_OUT_DISTANCES] + [(0.0, side)
+                                                                     for side in SIDE_STEPS]
+            for dx, dy in moves:                       # made when tried
+                yield make_step_primitive(self._stance(carrying), lib.standing_height, dx, dy,
+                                          0.0, lib.skeleton, lib.fps, task)
+
+        for mp in steps():
             pose = self._hand_over_pose(mp, self.pose)
             if self._placed_clear(mp, self.pose) and self._placed_clear(then, pose):
                 self._add(mp, self.pose, label, self.overlap)
@@ -876,29 +949,44 @@ class SequencePlanner:
         again (at most ``WALK_REPAIRS`` times)."""
         forbidden: set[tuple[int, int, int, int]] = set()
         noise_state = self.rng.bit_generator.state
-        for _repair in range(WALK_REPAIRS + 1):
+        budget = budget or self.options.budget
+        if goal.clearance is self.stand_map:
+            budget = replace(budget, max_nodes=min(budget.max_nodes, SQUEEZE_NODES))
+        used, repairs, reroutes = 0, 0, 0
+        while True:
             self.rng.bit_generator.state = noise_state      # the same costs every time
+            stall = STALL_NODES if goal.reroute is not None and reroutes < MAX_REROUTES \
+                else None
             res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
-                        clearance=self._clearance, body_radius=self.options.body_radius,
+                        clearance=goal.clearance or self._clearance,
+                        body_radius=self.options.body_radius,
                         heuristic_speed=self.options.heuristic_speed,
                         turn_rate=self.options.turn_rate, carry=carry,
-                        budget=budget or self.options.budget, rng=self.rng,
-                        cost_noise=self.options.cost_noise, body_clear=self._body_clear,
-                        forbidden=frozenset(forbidden))
+                        budget=replace(budget, max_nodes=budget.max_nodes - used),
+                        rng=self.rng, cost_noise=self.options.cost_noise,
+                        body_clear=self._body_clear, forbidden=frozenset(forbidden),
+                        stall_nodes=stall)
             self.expanded += res.expanded
+            used += res.expanded
+            if isinstance(res, SearchFailure) and res.reason == "stalled":
+                # Walk around the spot the search could not get past, or search on.
+                reroutes += 1
+                goal = goal.reroute(res.closest_at) or replace(goal, reroute=None)
+                continue
             if isinstance(res, SearchFailure):
                 break
             bad = self._first_collision(res.primitives, res.poses)
             if bad is None:
                 break
-            forbidden.add((res.primitives[bad], *placement_key(*res.poses[bad])))
-        else:
-            raise PlanningError(f"task {task}: {goal.description}: every path found "
-                                f"({WALK_REPAIRS + 1}) collides on a frame the search did "
-                                "not sample", task=task, reason="blocked")
+            forbidden |= self._forbid(res.primitives, res.poses, bad)
+            repairs += 1
+            if repairs > WALK_REPAIRS:
+                raise PlanningError(f"task {task}: {goal.description}: every path found "
+                                    f"({WALK_REPAIRS + 1}) collides on a frame the search "
+                                    "did not sample", task=task, reason="blocked")
         if isinstance(res, SearchFailure):
             if res.reason == "budget":
-                why = (f"the search budget ran out ({res.expanded} nodes; closest approach "
+                why = (f"the search budget ran out ({used} nodes; closest approach "
                        f"{res.closest:.2f} m)")
             else:
                 why = (f"obstacles block every way to the target (searched {res.expanded} "
@@ -911,6 +999,22 @@ class SequencePlanner:
             self.pose = res.end_pose
             self.gait_state = None  # every walk ends with a stop primitive
         return len(res.primitives)
+
+    def _forbid(self, primitives: list[int], poses: list[Pose], bad: int
+                ) -> set[tuple[int, int, int, int]]:
+        """What a search must not take again after primitive ``bad`` of its path collided:
+        that primitive from its pose, and where it is a stop (the arms swing forward as
+        the worker stops at furniture) that ends a walk, every gait stop from there and
+        from the neighbouring closed-set cells: the stops from one spot sweep nearly the
+        same space, and forbidding them one at a time, one cell at a time, used up the
+        ``WALK_REPAIRS``."""
+        i, j, k = placement_key(*poses[bad])
+        prim = primitives[bad]
+        if bad == 0 or not self.index.stops[prim] or self.index.standing[prim]:
+            return {(prim, i, j, k)}               # the first move, a turn on the spot
+        stops = np.flatnonzero(self.index.stops & ~self.index.standing).tolist()
+        return {(int(p), i + di, j + dj, k) for p in stops
+                for di in (-1, 0, 1) for dj in (-1, 0, 1)}
 
     # ---------------------------------------------------------------- tasks
     def plan(self, tasks: list[TaskStep], start: Pose) -> Plan:
@@ -1198,7 +1302,7 @@ class SequencePlanner:
         def roomy(x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None = None) -> np.ndarray:
             return self._clearance(np.stack([x, y], axis=-1)) > room
 
-        field = self._field(lambda xy: roomy(xy[:, 0], xy[:, 1]), ("room", room))
+        field = self._field(lambda xy, clearance: roomy(xy[:, 0], xy[:, 1]), ("room", room))
         goal = self._goal_from_field(field, roomy, f"find room for {text}", text)
         return self._walk(goal, text, -1, carry=bool(self.held))
 
