@@ -213,8 +213,7 @@ SUBSET: dict[str, str | None] = {
     "floor_parts/job/stoop_pick": None,
     "stations/job/big_box": None,
     "paper_cell/job/stand_up": None,
-    "kitting/job/kit_three": "planning:grasp:blocked (bolt by the left hand, the right holding "
-                             "the bracket: the elbow hits the rack side panel)",
+    "kitting/job/kit_three": None,
     "under_shelf/job/low_shelf_assemble": "planning:grasp:blocked (part under a low board)",
     "bins/job/bin_to_bin": None,
     "aisle/single/walk(R2)": None,
