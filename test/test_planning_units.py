@@ -7,7 +7,14 @@ import pytest
 
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import MotionPrimitive
-from ltl_human_motion.planning.astar import Goal, SearchBudget, SearchFailure, SearchResult, astar
+from ltl_human_motion.planning.astar import (
+    Goal,
+    SearchBudget,
+    SearchFailure,
+    SearchOptions,
+    SearchResult,
+    astar,
+)
 from ltl_human_motion.planning.blend import PlacedSegment, blend_weights, concatenate
 from ltl_human_motion.planning.gait_index import GaitIndex
 from ltl_human_motion.planning.navigation import NavigationField
@@ -101,7 +108,8 @@ def _point_goal(x: float, y: float, radius: float = 0.2) -> Goal:
 def test_astar_reaches_a_goal_behind_the_start_with_a_chain_of_primitives() -> None:
     index = _straight_and_turning_gait()
     res = astar(index, (0.0, 0.0, 0.0), _point_goal(-1.5, 0.5),
-                clearance=lambda xy: np.full(len(xy), np.inf), heuristic_speed=0.5)
+                clearance=lambda xy: np.full(len(xy), np.inf),
+                options=SearchOptions(heuristic_speed=0.5, cost_noise=0.0))
     assert isinstance(res, SearchResult)
     assert len(res.primitives) == len(res.poses) > 3
     assert np.hypot(res.end_pose[0] + 1.5, res.end_pose[1] - 0.5) <= 0.2
@@ -116,7 +124,7 @@ def test_astar_reports_blocked_and_budget_failures() -> None:
     index = _straight_and_turning_gait()
     walls = astar(index, (0.0, 0.0, 0.0), _point_goal(3.0, 0.0),
                   clearance=lambda xy: np.where(np.hypot(xy[:, 0], xy[:, 1]) > 0.8, -1.0, 1.0),
-                  body_radius=0.1)
+                  options=SearchOptions(body_radius=0.1))
     assert isinstance(walls, SearchFailure) and walls.reason == "blocked"
     tiny = astar(index, (0.0, 0.0, 0.0), _point_goal(30.0, 0.0),
                  clearance=lambda xy: np.full(len(xy), np.inf),
@@ -176,3 +184,10 @@ def test_steps_and_turns_keep_every_body_part_out_of_the_others(stature: float) 
         arm = [JOINT_INDEX[f"{s}_{j}"] for s in "lr" for j in ("elbow", "wrist", "hand")]
         d = np.linalg.norm(mp.poses[:, arm] - mp.poses[:, parents[arm]], axis=-1)
         assert np.abs(d - bones[arm]).max() < 1e-9
+
+
+def test_the_planner_and_a_bare_search_use_the_same_search_settings() -> None:
+    from ltl_human_motion.planning.planner import PlannerOptions
+    assert PlannerOptions().search == SearchOptions()
+    tuned = PlannerOptions(heuristic_speed=0.4, body_radius=0.2).search
+    assert (tuned.heuristic_speed, tuned.body_radius) == (0.4, 0.2)

@@ -29,6 +29,40 @@ STALL_FAR = 0.5
 
 
 @dataclass(frozen=True)
+class SearchOptions:
+    """The settings of every gait search (one home for their defaults; the planner's
+    :class:`~ltl_human_motion.planning.planner.PlannerOptions` builds one).
+
+    Attributes
+    ----------
+    body_radius : float
+        Clearance the walking root keeps from obstacle footprints, metres.
+    heuristic_speed : float
+        Relaxed walking speed of the heuristic, m/s (paper Sec. III-B): below the gait's
+        speed, so the search stays greedy but fast.
+    turn_rate : float
+        Relaxed turning speed of the heuristic's heading term, rad/s.
+    cost_noise : float
+        Seeded relative noise on primitive costs: different seeds, different paths.
+    near_radius : float
+        Primitives whose root path comes this close to an obstacle get the whole-body
+        test, metres.
+    grid : float
+        Closed-set lattice in x and y, metres.
+    yaw_bins : int
+        Closed-set heading bins.
+    """
+
+    body_radius: float = 0.15
+    heuristic_speed: float = 0.25
+    turn_rate: float = 0.8
+    cost_noise: float = 0.15
+    near_radius: float = 0.6
+    grid: float = 0.08
+    yaw_bins: int = 24
+
+
+@dataclass(frozen=True)
 class SearchBudget:
     """Limits of one search: expanded nodes, and optionally wall-clock seconds.
 
@@ -176,12 +210,10 @@ def _stop_after(index: GaitIndex, prim: int, at: Pose, goal: Goal, allowed: np.n
 
 
 def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | None = None,
-          clearance: Callable[[np.ndarray], np.ndarray], body_radius: float = 0.25,
-          heuristic_speed: float = 0.7, turn_rate: float = 2.0, carry: bool = False,
+          clearance: Callable[[np.ndarray], np.ndarray],
+          options: SearchOptions = SearchOptions(), carry: bool = False,
           budget: SearchBudget = SearchBudget(), rng: np.random.Generator | None = None,
           body_clear: Callable[[np.ndarray], np.ndarray] | None = None,
-          near_radius: float = 0.6,
-          cost_noise: float = 0.0, grid: float = 0.08, yaw_bins: int = 24,
           forbidden: frozenset[tuple[int, int, int, int]] = frozenset(),
           stall_nodes: int | None = None
           ) -> SearchResult | SearchFailure:
@@ -198,23 +230,19 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     clearance : callable
         ``clearance(xy (M, 2)) -> (M,)`` signed distance of floor points from the
         obstacles' footprints.
-    body_radius : float
-        Clearance the root path must keep, metres.
-    heuristic_speed : float
-        Relaxed walking speed of the heuristic, m/s.
-    turn_rate : float
-        Turning speed of the heuristic's heading term, rad/s.
+    options : SearchOptions
+        Clearance, heuristic speeds, cost noise and the closed-set lattice.
     carry : bool
         Use carry primitives (arms holding an object) instead of walk primitives.
     budget : SearchBudget
-    rng, cost_noise
-        Seeded multiplicative noise on primitive costs, for varied but valid paths.
+    rng : numpy.random.Generator, optional
+        Draws the seeded multiplicative noise on primitive costs (``options.cost_noise``),
+        for varied but valid paths.
     body_clear : callable, optional
         ``body_clear(poses (M, S, J, 3), standing (M,)) -> bool (M,)``: whole-body obstacle
         test (``standing``: the primitive starts where the last one ended), run on
         standing primitives (turns, steps) and on primitives whose root path comes within
-        ``near_radius`` of an obstacle.
-    near_radius : float
+        ``options.near_radius`` of an obstacle.
     forbidden : frozenset of (primitive, i, j, k)
         Primitives never taken from a pose, keyed by :func:`placement_key` of that pose
         (the caller found them colliding on a closer look).
@@ -229,6 +257,9 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     SearchResult or SearchFailure
     """
     t0 = time.perf_counter()
+    body_radius, near_radius, cost_noise = options.body_radius, options.near_radius, \
+        options.cost_noise
+    grid, yaw_bins = options.grid, options.yaw_bins
     sx, sy, syaw = start
     if bool(goal.reached(np.array([sx]), np.array([sy]), np.array([syaw]))[0]):
         return SearchResult([], [], start, 0, time.perf_counter() - t0)
@@ -238,7 +269,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     noise = (1.0 + cost_noise * rng.random(len(index.cost)) if (rng is not None and cost_noise)
              else np.ones(len(index.cost)))
     step_cost = index.cost * noise
-    inv_v = 1.0 / heuristic_speed
+    inv_v = 1.0 / options.heuristic_speed
     yaw_scale = yaw_bins / (2.0 * np.pi)
 
     # Node arrays: parent, primitive, pose, g.
@@ -249,7 +280,8 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     def heuristic(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
         h = goal.distance(x, y) * inv_v
         if goal.heading is not None:
-            h = h + np.abs((goal.heading(x, y) - yaw + np.pi) % (2.0 * np.pi) - np.pi) / turn_rate
+            off = np.abs((goal.heading(x, y) - yaw + np.pi) % (2.0 * np.pi) - np.pi)
+            h = h + off / options.turn_rate
         return h
 
     h0 = float(heuristic(np.array([sx]), np.array([sy]), np.array([syaw]))[0])

@@ -34,6 +34,7 @@ from ltl_human_motion.planning.astar import (
     Goal,
     SearchBudget,
     SearchFailure,
+    SearchOptions,
     astar,
     placement_key,
 )
@@ -226,19 +227,26 @@ class PlannerOptions:
         when an obstacle (a bench) is in the way; the goal primitive leans further.
     """
 
-    heuristic_speed: float = 0.25
-    turn_rate: float = 0.8
+    heuristic_speed: float = SearchOptions.heuristic_speed
+    turn_rate: float = SearchOptions.turn_rate
     budget: SearchBudget = field(default_factory=SearchBudget)
-    cost_noise: float = 0.15
+    cost_noise: float = SearchOptions.cost_noise
     reach_tolerance: float = 0.15
     heading_tolerance: float = 0.35
-    body_radius: float = 0.15
+    body_radius: float = SearchOptions.body_radius
     goal_attempts: int = 6
     adjust_radius: float = 0.3
     turn_clearance: float = 0.26
     stand_clearance: float = 0.22
     max_step_back: float = 0.35
     grid_resolution: float = 0.05
+
+    @property
+    def search(self) -> SearchOptions:
+        """The gait-search settings these options give."""
+        return SearchOptions(body_radius=self.body_radius,
+                             heuristic_speed=self.heuristic_speed,
+                             turn_rate=self.turn_rate, cost_noise=self.cost_noise)
 
 
 @dataclass
@@ -959,12 +967,9 @@ class SequencePlanner:
                 else None
             res = astar(self.index, self.pose, goal, start_primitive=self.gait_state,
                         clearance=goal.clearance or self._clearance,
-                        body_radius=self.options.body_radius,
-                        heuristic_speed=self.options.heuristic_speed,
-                        turn_rate=self.options.turn_rate, carry=carry,
+                        options=self.options.search, carry=carry,
                         budget=replace(budget, max_nodes=budget.max_nodes - used),
-                        rng=self.rng, cost_noise=self.options.cost_noise,
-                        body_clear=self._body_clear, forbidden=frozenset(forbidden),
+                        rng=self.rng, body_clear=self._body_clear, forbidden=frozenset(forbidden),
                         stall_nodes=stall)
             self.expanded += res.expanded
             used += res.expanded
