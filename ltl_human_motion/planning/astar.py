@@ -169,6 +169,104 @@ def _path_clearance(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: 
     return clearance(pts).reshape(p.shape[:2]).min(axis=1)
 
 
+def _clear_successors(index: GaitIndex, prim: int, pose: Pose, allowed: np.ndarray,
+                      clearance: Callable[[np.ndarray], np.ndarray],
+                      body_clear: Callable[[np.ndarray, np.ndarray], np.ndarray] | None,
+                      forbidden: frozenset[tuple[int, int, int, int]],
+                      options: SearchOptions) -> tuple[np.ndarray, np.ndarray] | None:
+    """The primitives that may follow ``prim`` (-1: standing) at ``pose`` and keep clear:
+    their ids (M,) and end poses (M, 3), or None."""
+    px, py, pyaw = pose
+    succ = index.starts if prim < 0 else index.successors(prim)
+    succ = succ[allowed[succ]]
+    if forbidden:
+        here = placement_key(px, py, pyaw, options.grid, options.yaw_bins)
+        succ = succ[[(int(p), *here) not in forbidden for p in succ.tolist()]]
+    if succ.size == 0:
+        return None
+    ends = _place(index, succ, px, py, pyaw)
+    gap = _path_clearance(index, succ, px, py, pyaw, clearance)
+    clear = gap > options.body_radius
+    if not clear.any():
+        return None
+    succ, ends, gap = succ[clear], ends[clear], gap[clear]
+    if body_clear is not None and index.body.size:
+        exact = index.standing[succ] | (gap < options.near_radius)
+        if exact.any():
+            ok = np.ones(len(succ), dtype=bool)
+            ok[exact] = body_clear(_body_at(index, succ[exact], px, py, pyaw),
+                                   index.standing[succ[exact]])
+            if not ok.any():
+                return None
+            succ, ends = succ[ok], ends[ok]
+    return succ, ends
+
+
+def _arrivals(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, goal: Goal,
+              allowed: np.ndarray, clearance: Callable[[np.ndarray], np.ndarray],
+              body_clear: Callable[[np.ndarray, np.ndarray], np.ndarray] | None,
+              forbidden: frozenset[tuple[int, int, int, int]], options: SearchOptions
+              ) -> tuple[np.ndarray, list[tuple[int, Pose]]]:
+    """Which successors (M,) end the search: a stop primitive in the goal, or a walking
+    one in the goal that a stop primitive can finish (the first such; its end pose in
+    ``ends`` becomes the stop's, and the stop is returned as the tail to append)."""
+    near = goal.reached(ends[:, 0], ends[:, 1], ends[:, 2])
+    done = near & index.stops[succ]
+    tail: list[tuple[int, Pose]] = []
+    if not done.any() and near.any():
+        for m in np.flatnonzero(near):
+            at = (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2]))
+            stop = _stop_after(index, int(succ[m]), at, goal, allowed, clearance,
+                               options.body_radius, body_clear, forbidden, options.grid,
+                               options.yaw_bins)
+            if stop is not None:
+                tail = [(stop[0], at)]
+                done[m] = True
+                ends[m] = stop[1]
+                break
+    return done, tail
+
+
+def _heuristic(goal: Goal, options: SearchOptions, x: np.ndarray, y: np.ndarray,
+               yaw: np.ndarray) -> np.ndarray:
+    """Relaxed time (M,) to the goal from poses (M,): distance at the heuristic speed plus
+    the heading error at the turn rate."""
+    h = goal.distance(x, y) * (1.0 / options.heuristic_speed)
+    if goal.heading is not None:
+        off = np.abs((goal.heading(x, y) - yaw + np.pi) % (2.0 * np.pi) - np.pi)
+        h = h + off / options.turn_rate
+    return h
+
+
+def _over_budget(budget: SearchBudget, t0: float, expanded: int, stall_nodes: int | None,
+                 since_progress: int, closest: float) -> str:
+    """``"budget"`` or ``"stalled"`` when the search must end, else ``""``."""
+    if expanded > budget.max_nodes or (budget.max_seconds is not None
+                                       and time.perf_counter() - t0 > budget.max_seconds):
+        return "budget"
+    if stall_nodes is not None and since_progress > stall_nodes and closest > STALL_FAR:
+        return "stalled"
+    return ""
+
+
+def _chain(node: int, last: int, parents: list[int], prims: list[int], poses: list[Pose],
+           tail: list[tuple[int, Pose]]) -> tuple[list[int], list[Pose]]:
+    """The primitives from the start to ``node``, then ``last`` and ``tail``, with the
+    pose each starts from."""
+    chain, chain_poses = [last], [poses[node]]
+    n = node
+    while parents[n] >= 0:
+        chain.append(prims[n])
+        chain_poses.append(poses[parents[n]])
+        n = parents[n]
+    chain.reverse()
+    chain_poses.reverse()
+    for prim_id, pose in tail:
+        chain.append(prim_id)
+        chain_poses.append(pose)
+    return chain, chain_poses
+
+
 def _body_at(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float
              ) -> np.ndarray:
     """Sampled body poses of primitives ``ids`` placed at (x, y, yaw), shape (M, B, J, 3)."""
@@ -257,9 +355,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     SearchResult or SearchFailure
     """
     t0 = time.perf_counter()
-    body_radius, near_radius, cost_noise = options.body_radius, options.near_radius, \
-        options.cost_noise
-    grid, yaw_bins = options.grid, options.yaw_bins
+    cost_noise, grid, yaw_bins = options.cost_noise, options.grid, options.yaw_bins
     sx, sy, syaw = start
     if bool(goal.reached(np.array([sx]), np.array([sy]), np.array([syaw]))[0]):
         return SearchResult([], [], start, 0, time.perf_counter() - t0)
@@ -269,7 +365,6 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     noise = (1.0 + cost_noise * rng.random(len(index.cost)) if (rng is not None and cost_noise)
              else np.ones(len(index.cost)))
     step_cost = index.cost * noise
-    inv_v = 1.0 / options.heuristic_speed
     yaw_scale = yaw_bins / (2.0 * np.pi)
 
     # Node arrays: parent, primitive, pose, g.
@@ -277,14 +372,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     prims: list[int] = [-1 if start_primitive is None else start_primitive]
     poses: list[Pose] = [start]
     g_cost: list[float] = [0.0]
-    def heuristic(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-        h = goal.distance(x, y) * inv_v
-        if goal.heading is not None:
-            off = np.abs((goal.heading(x, y) - yaw + np.pi) % (2.0 * np.pi) - np.pi)
-            h = h + off / options.turn_rate
-        return h
-
-    h0 = float(heuristic(np.array([sx]), np.array([sy]), np.array([syaw]))[0])
+    h0 = float(_heuristic(goal, options, np.array([sx]), np.array([sy]), np.array([syaw]))[0])
     open_heap: list[tuple[float, int]] = [(h0, 0)]
     closed: set[tuple[int, int, int]] = set()
     expanded = 0
@@ -300,69 +388,25 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
             continue
         closed.add(key)
         expanded += 1
-        if expanded > budget.max_nodes or (
-                budget.max_seconds is not None
-                and time.perf_counter() - t0 > budget.max_seconds):
-            return SearchFailure("budget", expanded, time.perf_counter() - t0, closest,
+        over = _over_budget(budget, t0, expanded, stall_nodes, expanded - progress_at,
+                            closest)
+        if over:
+            return SearchFailure(over, expanded, time.perf_counter() - t0, closest,
                                  closest_at)
-        if (stall_nodes is not None and expanded - progress_at > stall_nodes
-                and closest > STALL_FAR):
-            return SearchFailure("stalled", expanded, time.perf_counter() - t0, closest,
-                                 closest_at)
-        succ = index.starts if prims[node] < 0 else index.successors(prims[node])
-        succ = succ[allowed[succ]]
-        if forbidden:
-            here = placement_key(px, py, pyaw, grid, yaw_bins)
-            succ = succ[[(int(p), *here) not in forbidden for p in succ.tolist()]]
-        if succ.size == 0:
+        found = _clear_successors(index, prims[node], poses[node], allowed, clearance,
+                                  body_clear, forbidden, options)
+        if found is None:
             continue
-        ends = _place(index, succ, px, py, pyaw)
-        gap = _path_clearance(index, succ, px, py, pyaw, clearance)
-        clear = gap > body_radius
-        if not clear.any():
-            continue
-        succ, ends, gap = succ[clear], ends[clear], gap[clear]
-        if body_clear is not None and index.body.size:
-            exact = index.standing[succ] | (gap < near_radius)
-            if exact.any():
-                ok = np.ones(len(succ), dtype=bool)
-                ok[exact] = body_clear(_body_at(index, succ[exact], px, py, pyaw),
-                                       index.standing[succ[exact]])
-                if not ok.any():
-                    continue
-                succ, ends = succ[ok], ends[ok]
-        near = goal.reached(ends[:, 0], ends[:, 1], ends[:, 2])
-        done = near & index.stops[succ]
+        succ, ends = found
+        done, tail = _arrivals(index, succ, ends, goal, allowed, clearance, body_clear,
+                               forbidden, options)
         g_new = g_cost[node] + step_cost[succ]
-        tail: list[tuple[int, Pose]] = []
-        if not done.any() and near.any():
-            # Reached while still walking: finish with a stop primitive if one lands there.
-            for m in np.flatnonzero(near):
-                at = (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2]))
-                stop = _stop_after(index, int(succ[m]), at, goal, allowed, clearance,
-                                   body_radius, body_clear, forbidden, grid, yaw_bins)
-                if stop is not None:
-                    tail = [(stop[0], at)]
-                    done[m] = True
-                    ends[m] = stop[1]
-                    break
         if done.any():
             best = int(np.argmin(np.where(done, g_new, np.inf)))
-            chain = [int(succ[best])]
-            chain_poses = [poses[node]]
-            n = node
-            while parents[n] >= 0:
-                chain.append(prims[n])
-                chain_poses.append(poses[parents[n]])
-                n = parents[n]
-            chain.reverse()
-            chain_poses.reverse()
-            for prim_id, pose in tail:
-                chain.append(prim_id)
-                chain_poses.append(pose)
+            chain, chain_poses = _chain(node, int(succ[best]), parents, prims, poses, tail)
             end = tuple(float(v) for v in ends[best])
             return SearchResult(chain, chain_poses, end, expanded, time.perf_counter() - t0)
-        h_new = heuristic(ends[:, 0], ends[:, 1], ends[:, 2])
+        h_new = _heuristic(goal, options, ends[:, 0], ends[:, 1], ends[:, 2])
         keep = np.isfinite(h_new)
         if not keep.any():
             continue
