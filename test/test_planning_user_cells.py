@@ -123,6 +123,18 @@ def test_kneel_next_to_the_table_steps_to_a_roomier_spot():
     assert motion.sequence[k:k + 2] == ["grasp(O1)", "kneel"]
 
 
+def test_a_hand_task_out_of_reach_of_the_seat_stands_up_and_walks_first():
+    """sit(stool) then assemble(R1) 2.6 m away (demo cell): no seated worker reaches it
+    (it was tried from the seat and refused as out of reach); the worker stands up and
+    walks to the bench."""
+    motion = _verified("F(sit(stool) & X assemble(R1))", "demo_cell")
+    k = motion.sequence.index("sit(stool)")
+    assert motion.sequence[k + 1] == "assemble(R1)"
+    names = [seg[0] for seg in motion.stats["segments"]]
+    sat = next(i for i, n in enumerate(names) if n.startswith("sit"))
+    assert any(n.startswith("standUp") for n in names[sat:])
+
+
 @pytest.mark.parametrize("spec", ["F(sit(stool) & X wait(2.0))", "F(sit(stool) & X standUp)"])
 def test_seated_tasks_stay_on_the_seat(spec):
     """A wait after sit holds the seated pose (it used to stand up in one blend: a knee

@@ -39,6 +39,7 @@ from ltl_human_motion.planning.astar import (
     placement_key,
 )
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
+from ltl_human_motion.planning.feasibility import reach_envelope
 from ltl_human_motion.planning.gait_index import gait_index
 from ltl_human_motion.planning.navigation import (
     TALL_EXTRA,
@@ -1057,7 +1058,9 @@ class SequencePlanner:
         expanded0 = self.expanded
         if self.seat is None:
             self._step_out()
-        if self.seat is not None and kind not in ("standUp", "wait", "sit", *SEATED_HAND_TASKS):
+        if self.seat is not None and (
+                kind not in ("standUp", "wait", "sit", *SEATED_HAND_TASKS)
+                or (kind in SEATED_HAND_TASKS and self._beyond_seated_reach(kind, args))):
             self._goal_segment("standUp", self.seat, -1, text)
             self.seat = None
         if kind == "sit" and self.seat is not None:
@@ -1098,6 +1101,16 @@ class SequencePlanner:
             self._stand_still(i, STAND_UP_IN_PLACE_SECONDS)
             return StepPlan(text, "standUp (standing)", None, expanded=0, primitive="stand")
         return self._goal_step(i, text, kind, args, keep_hold, facing, expanded0)
+
+    def _beyond_seated_reach(self, kind: str, args: tuple[str, ...]) -> bool:
+        """Whether the target of a hand task lies further from the seat than even a
+        standing worker reaches at its height (the worker stands up and walks to it)."""
+        target = self.target_of(kind, args)
+        if target is None or self.seat is None:
+            return False
+        envelope = reach_envelope(self.library.skeleton.stature)
+        away = float(np.hypot(*(np.asarray(target[:2]) - np.asarray(self.seat[:2]))))
+        return away > envelope.horizontal(float(target[2]), float(target[2]))
 
     def _goal_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
                    keep_hold: bool, facing: np.ndarray | None, expanded0: int) -> StepPlan:
