@@ -49,6 +49,7 @@ from ltl_human_motion.vocabulary import HAND_TASKS
 __all__ = [
     "GOAL_TASKS",
     "HAND_TASKS",
+    "LOW_BOARD_HEIGHT",
     "chest_height",
     "knee_height",
     "make_goal_primitive",
@@ -97,6 +98,26 @@ _LEVEL_TIME = 1.3
 #: self-penetration check of planning.biomechanics (capsule axis outside the other
 #: capsule): the seeded timing and the blend of the start pose move the arm by a few mm.
 _SELF_CLEARANCE = 0.005
+#: A board this low over a hand target (underside height above the floor, fraction of
+#: stature; 0.525 m at 1.75 m) is too low for the shoulders of a stoop: the hand goes down
+#: in front of its edge and in under it, from a deep crouch (:func:`make_goal_primitive`'s
+#: ``board``).
+LOW_BOARD_HEIGHT = 0.30
+#: Clearance (m) the contact posture of a reach under a low board keeps from the board
+#: beyond the body's capsules (the seeded timing and the start pose's blend move the
+#: body by a few cm).
+_BOARD_CLEARANCE = 0.02
+#: Horizontal distance of the under path's drop point in front of the board's edge, m
+#: (the hand capsule's radius and a margin).
+_BOARD_FRONT = 0.10
+#: Height over a low board's top the hand rises to in front of its edge before it goes
+#: home, m (the hand capsule's radius and a margin).
+_BOARD_RISE = 0.10
+#: Fraction of the return time at which the hand has risen in front of a low board and
+#: the body starts to straighten (level path: half of it).
+_BOARD_LEAVE = 0.6
+#: Points sampled along every body capsule for the board check of a posture.
+_CAPSULE_SAMPLES = 5
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -337,13 +358,34 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
     return out
 
 
+def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
+                 stature: float) -> np.ndarray:
+    """How deep the body's capsules of poses (C, J, 3) go into a board beyond x = edge
+    between heights bottom and top (``board = (edge, bottom, top)``, start frame), plus
+    ``_BOARD_CLEARANCE``, metres (C,); negative: clear."""
+    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    edge, bottom, top = board
+    ia, ib = capsule_ends()
+    s = np.linspace(0.0, 1.0, _CAPSULE_SAMPLES)[:, None, None, None]
+    pts = poses[:, ia] + s * (poses[:, ib] - poses[:, ia])          # (S, C, K, 3)
+    x, z = pts[..., 0], pts[..., 2]
+    dz = np.maximum(bottom - z, z - top)
+    out_x, out_z = np.maximum(edge - x, 0.0), np.maximum(dz, 0.0)
+    dist = np.where((x >= edge) & (dz <= 0.0), -np.minimum(x - edge, -dz),
+                    np.hypot(out_x, out_z))
+    depth = capsule_radii(stature) + _BOARD_CLEARANCE - dist
+    return depth.max(axis=(0, 2))
+
+
 def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
-          task: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+          task: str | None = None, board: tuple[float, float, float] | None = None
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Costs of trunk flexion / pelvis drop candidates for hand targets.
 
     A candidate is infeasible when a hand cannot reach its target, or when its posture
     with the hands on the targets (:func:`_contact_poses`) puts a body part through
-    another (a low reach with the hand in the thigh).
+    another (a low reach with the hand in the thigh) or into the low ``board`` (edge,
+    bottom, top) over the targets.
 
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
@@ -358,9 +400,11 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         from ltl_human_motion.planning.biomechanics import self_penetration
         poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
                                task)
-        depth = self_penetration(poses, skeleton.stature)[0].max(axis=1)
+        blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
+        if board is not None:
+            blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
         feasible = feasible.copy()
-        feasible[idx[depth > -_SELF_CLEARANCE]] = False
+        feasible[idx[blocked]] = False
     cost = np.where(feasible, cost, np.inf)
     return P, D, shift, cost
 
@@ -432,8 +476,9 @@ def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray,
 
 
 def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
-                 task: str, target: np.ndarray) -> tuple[float, float, float]:
-    P, D, S, cost = _grid(skeleton, st, targets, active, task)
+                 task: str, target: np.ndarray,
+                 board: tuple[float, float, float] | None = None) -> tuple[float, float, float]:
+    P, D, S, cost = _grid(skeleton, st, targets, active, task, board)
     i = int(np.argmin(cost))
     if not np.isfinite(cost[i]):
         raise ValueError(
@@ -544,11 +589,17 @@ def _frames(skeleton: Skeleton, st: _Start, t: np.ndarray, pelvis: np.ndarray,
 
 def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: np.ndarray,
                 rel_goal: np.ndarray, lift: float, t1: float, t2: float, total: float,
-                H: float, arm: float) -> list[tuple[float, np.ndarray]]:
+                H: float, arm: float, board: tuple[float, float, float] | None = None
+                ) -> list[tuple[float, np.ndarray]]:
     """Shoulder-to-palm keys of the level path (see :data:`HAND_PATHS`): home, the turn
     point near the body at the approach height, above the target, the target (held), and
     back the same way. Arrays (2, 3); ``sh1`` (2, 3): the shoulders in the reach posture;
-    ``arm``: the arm's length (the turn point keeps the elbow clearly bent, not folded)."""
+    ``arm``: the arm's length (the turn point keeps the elbow clearly bent, not folded);
+    ``board`` (edge, bottom, top): a low board over the targets (start frame): the turn
+    point goes out to ``_BOARD_FRONT`` before its edge, and the hand rises there to
+    ``_BOARD_RISE`` over its top before it goes home (down in front of the edge, then in
+    under the board, and out and up the same way)."""
+    front = None if board is None else board[0] - _BOARD_FRONT
     rel_above, rel_near = rel_goal.copy(), rel_goal.copy()
     for k in active:
         above = targets[k] + np.array([0.0, 0.0, lift])
@@ -557,12 +608,21 @@ def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: n
         dh = float(np.linalg.norm(flat))
         unfolded = np.sqrt(max((_LEVEL_MIN_EXTENSION * arm) ** 2 - rel_above[k, 2] ** 2, 0.0))
         near = min(dh, max(_LEVEL_NEAR * H, unfolded))
+        if front is not None and flat[0] > 1e-9:
+            near = min(dh, max(near, dh * (front - sh1[k, 0]) / flat[0]))
         rel_near[k, :2] = flat * (near / dh) if dh > 1e-9 else flat
         rel_near[k, 2] = rel_above[k, 2]
     r = total - t2
-    return [(0.0, rel_home), (0.5 * t1, rel_near), (0.8 * t1, rel_above), (t1, rel_goal),
-            (t2, rel_goal), (t2 + 0.2 * r, rel_above), (t2 + 0.5 * r, rel_near),
-            (total, rel_home)]
+    if board is None:
+        return [(0.0, rel_home), (0.5 * t1, rel_near), (0.8 * t1, rel_above), (t1, rel_goal),
+                (t2, rel_goal), (t2 + 0.2 * r, rel_above), (t2 + 0.5 * r, rel_near),
+                (total, rel_home)]
+    rel_rise = rel_near.copy()
+    for k in active:
+        rel_rise[k, 2] = board[2] + _BOARD_RISE - sh1[k, 2]
+    return [(0.0, rel_home), (0.3 * t1, rel_rise), (0.5 * t1, rel_near), (0.8 * t1, rel_above),
+            (t1, rel_goal), (t2, rel_goal), (t2 + 0.2 * r, rel_above),
+            (t2 + 0.45 * r, rel_near), (t2 + _BOARD_LEAVE * r, rel_rise), (total, rel_home)]
 
 
 def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> float:
@@ -574,10 +634,12 @@ def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> float:
 
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
-               fps: float, path: str = "arc", travel: float | None = None) -> MotionPrimitive:
+               fps: float, path: str = "arc", travel: float | None = None,
+               board: tuple[float, float, float] | None = None) -> MotionPrimitive:
     H = skeleton.stature
     travel = _INSERT_TRAVEL if travel is None else float(travel)
-    level = path == "level" and task in LEVEL_PATH_TASKS
+    board = board if task in LEVEL_PATH_TASKS else None
+    level = (path == "level" or board is not None) and task in LEVEL_PATH_TASKS
     if target is None:
         raise ValueError(f"{task} needs a target position (3,) in the start frame")
     target = np.asarray(target, dtype=np.float64)
@@ -595,7 +657,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         a[2] = 0.0
         n = np.linalg.norm(a)
         approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
-    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target)
+    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board)
     # timing
     jitter = rng.uniform(0.9, 1.1)
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
@@ -620,7 +682,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     t1, t2 = t_reach, t_reach + hold
     # body posture leads the hand: it is reached at 85 % of the reach time (level path:
     # before the hand comes in, and kept until it is out again)
-    body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + 0.5 * t_ret, 1.0), (total, 0.0)] if level
+    leave = 0.5 if board is None else _BOARD_LEAVE
+    body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + leave * t_ret, 1.0), (total, 0.0)] if level
                  else [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)])
     sb = _profile(t, body_keys)
     pelvis = np.tile(st.pelvis, (T, 1))
@@ -661,7 +724,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                     lift[k, 2] = _APPROACH_LIFT
             if level:
                 keys = _level_keys(targets, active, sh1, rel_home, rel_goal, _APPROACH_LIFT,
-                                   t1, t2, total, H, _arm_length(skeleton))
+                                   t1, t2, total, H, _arm_length(skeleton),
+                                   board)
             elif np.any(lift):
                 rel_above = rel_goal + lift
                 keys = [(0.0, rel_home), (0.7 * t1, rel_above), (t1, rel_goal), (t2, rel_goal),
@@ -669,13 +733,14 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     rel = _arc_keys(t, keys)
     if level:
         # Straight legs (an arc about the shoulder bulges forward, into the shelf), except
-        # a leg to or from home passing the shoulder nearer than a folded elbow allows.
+        # a leg to or from home passing the shoulder nearer than a folded elbow allows
+        # (under a low board every leg: the arc would swing the hand into its edge).
         straight = _interp_keys(t, keys)
         least = _LEVEL_MIN_EXTENSION * _arm_length(skeleton)
         for (t0, v0), (t1_, v1) in itertools.pairwise(keys):
             leg = (t >= t0) & (t <= t1_)
             for k in active:
-                if _segment_origin_distance(v0[k], v1[k]) >= least:
+                if board is not None or _segment_origin_distance(v0[k], v1[k]) >= least:
                     rel[leg, k] = straight[leg, k]
     # a small seeded bow of the hand path (outward and up), zero at every key pose (level
     # path: only between home and the turn point)
@@ -725,6 +790,14 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
             "posture": _posture_name(world[f1], skeleton)}
     return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
                    f"goals.make_goal_primitive({task!r}, target={_fmt(target)})", meta)
+
+
+def _check_board(board: tuple[float, float, float]) -> tuple[float, float, float]:
+    """``board`` as three floats (edge, bottom, top); ValueError if malformed."""
+    b = np.asarray(board, dtype=np.float64)
+    if b.shape != (3,) or not np.all(np.isfinite(b)) or not b[1] <= b[2]:
+        raise ValueError(f"board must be (edge, bottom, top) with bottom <= top, got {board!r}")
+    return float(b[0]), float(b[1]), float(b[2])
 
 
 def _fmt(target: np.ndarray | None) -> str:
@@ -918,7 +991,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
                         start_pose: np.ndarray | None = None,
                         rng: np.random.Generator | None = None, duration: float | None = None,
                         hand: str = "auto", fps: float = LIBRARY_FPS,
-                        path: str = "arc", travel: float | None = None) -> MotionPrimitive:
+                        path: str = "arc", travel: float | None = None,
+                        board: tuple[float, float, float] | None = None) -> MotionPrimitive:
     """A goal primitive for one Table I task, made for the exact target.
 
     Parameters
@@ -954,6 +1028,11 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     travel : float, optional
         Length of the straight push of insert and pull of extract, metres (default
         8 cm; a part deep in a fixture needs a longer pull to come out).
+    board : (edge, bottom, top), optional
+        A low board over the target of grasp, release or move (start frame: its front
+        edge at x = edge, its underside and top at heights bottom and top, metres): the
+        posture keeps every body part clear of it and the hand takes the level path with
+        its turn point in front of the edge (down there, then in under the board).
 
     Returns
     -------
@@ -981,7 +1060,10 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     if task in HAND_TASKS:
         if travel is not None and not 0.0 < float(travel) <= _MAX_TRAVEL:
             raise ValueError(f"travel must be in (0, {_MAX_TRAVEL}] m, got {travel!r}")
-        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel)
+        if board is not None:
+            board = _check_board(board)
+        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel,
+                          board)
     if task in ("bend", "stoop", "kneel"):
         return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
     if task == "wait":
@@ -1040,7 +1122,8 @@ def _wait(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: fl
 
 
 @lru_cache(maxsize=512)
-def _placement(task: str, height: float, stature: float, hand: str) -> tuple[float, float]:
+def _placement(task: str, height: float, stature: float, hand: str,
+               board: tuple[float, float, float] | None = None) -> tuple[float, float]:
     skeleton = Skeleton(stature)
     H = stature
     if task in ("sit", "standUp"):
@@ -1056,7 +1139,8 @@ def _placement(task: str, height: float, stature: float, hand: str) -> tuple[flo
         target = np.array([x, lateral, height])
         targets, active, _ = _hand_targets(task, target, "both" if both else (
             "l_hand" if lateral > 0 else "r_hand"))
-        _, _, _, cost = _grid(skeleton, st, targets, active, task)
+        _, _, _, cost = _grid(skeleton, st, targets, active, task, None if board is None
+                              else (x - board[0], board[1], board[2]))
         c = float(np.min(cost))
         if c < best[0]:
             best = (c, float(x))
@@ -1066,7 +1150,8 @@ def _placement(task: str, height: float, stature: float, hand: str) -> tuple[flo
 
 
 def reach_placement(task: str, target_height: float, skeleton: Skeleton,
-                    hand: str = "auto") -> tuple[float, float]:
+                    hand: str = "auto", board: tuple[float, float, float] | None = None
+                    ) -> tuple[float, float]:
     """Where to put the target relative to the standing root for a comfortable posture.
 
     Parameters
@@ -1077,6 +1162,10 @@ def reach_placement(task: str, target_height: float, skeleton: Skeleton,
     skeleton : Skeleton
     hand : str
         ``"auto"`` uses the right hand for one-handed tasks (leftHand: left).
+    board : (depth, bottom, top), optional
+        A low board over the target of grasp, release or move: the target lies ``depth``
+        behind its front edge, under its underside at height ``bottom`` (top: ``top``).
+        The worker then stands where the crouched body stays in front of the edge.
 
     Returns
     -------
@@ -1098,5 +1187,9 @@ def reach_placement(task: str, target_height: float, skeleton: Skeleton,
     if not (lo - 1e-9 <= h <= hi + 1e-9):
         raise ValueError(f"{task}: target height {h:.3f} m is outside [{lo:.3f}, {hi:.3f}] m "
                          f"for a {skeleton.stature:.2f} m worker")
-    return _placement(task, round(h, 4), float(skeleton.stature), hand)
+    if board is not None and task in LEVEL_PATH_TASKS:
+        board = tuple(round(v, 4) for v in _check_board(board))
+    else:
+        board = None
+    return _placement(task, round(h, 4), float(skeleton.stature), hand, board)
 
