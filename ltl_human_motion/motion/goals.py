@@ -99,10 +99,10 @@ _LEVEL_TIME = 1.3
 #: capsule): the seeded timing and the blend of the start pose move the arm by a few mm.
 _SELF_CLEARANCE = 0.005
 #: A board this low over a hand target (underside height above the floor, fraction of
-#: stature; 0.525 m at 1.75 m) is too low for the shoulders of a stoop: the hand goes down
-#: in front of its edge and in under it, from a deep crouch (:func:`make_goal_primitive`'s
-#: ``board``).
-LOW_BOARD_HEIGHT = 0.30
+#: stature; 0.60 m at 1.75 m) is below the shoulders of a stoop (0.7-0.9 m measured on
+#: the under_shelf cell): the hand goes down in front of its edge and in under it, from a
+#: deep crouch (:func:`make_goal_primitive`'s ``board``).
+LOW_BOARD_HEIGHT = 0.34
 #: Clearance (m) the contact posture of a reach under a low board keeps from the board
 #: beyond the body's capsules (the seeded timing and the start pose's blend move the
 #: body by a few cm).
@@ -110,12 +110,6 @@ _BOARD_CLEARANCE = 0.02
 #: Horizontal distance of the under path's drop point in front of the board's edge, m
 #: (the hand capsule's radius and a margin).
 _BOARD_FRONT = 0.10
-#: Height over a low board's top the hand rises to in front of its edge before it goes
-#: home, m (the hand capsule's radius and a margin).
-_BOARD_RISE = 0.10
-#: Fraction of the return time at which the hand has risen in front of a low board and
-#: the body starts to straighten (level path: half of it).
-_BOARD_LEAVE = 0.6
 #: Points sampled along every body capsule for the board check of a posture.
 _CAPSULE_SAMPLES = 5
 
@@ -596,9 +590,8 @@ def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: n
     back the same way. Arrays (2, 3); ``sh1`` (2, 3): the shoulders in the reach posture;
     ``arm``: the arm's length (the turn point keeps the elbow clearly bent, not folded);
     ``board`` (edge, bottom, top): a low board over the targets (start frame): the turn
-    point goes out to ``_BOARD_FRONT`` before its edge, and the hand rises there to
-    ``_BOARD_RISE`` over its top before it goes home (down in front of the edge, then in
-    under the board, and out and up the same way)."""
+    point goes out to ``_BOARD_FRONT`` before its edge (down in front of the edge, then
+    in under the board, and out and up the same way)."""
     front = None if board is None else board[0] - _BOARD_FRONT
     rel_above, rel_near = rel_goal.copy(), rel_goal.copy()
     for k in active:
@@ -613,16 +606,9 @@ def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: n
         rel_near[k, :2] = flat * (near / dh) if dh > 1e-9 else flat
         rel_near[k, 2] = rel_above[k, 2]
     r = total - t2
-    if board is None:
-        return [(0.0, rel_home), (0.5 * t1, rel_near), (0.8 * t1, rel_above), (t1, rel_goal),
-                (t2, rel_goal), (t2 + 0.2 * r, rel_above), (t2 + 0.5 * r, rel_near),
-                (total, rel_home)]
-    rel_rise = rel_near.copy()
-    for k in active:
-        rel_rise[k, 2] = board[2] + _BOARD_RISE - sh1[k, 2]
-    return [(0.0, rel_home), (0.3 * t1, rel_rise), (0.5 * t1, rel_near), (0.8 * t1, rel_above),
-            (t1, rel_goal), (t2, rel_goal), (t2 + 0.2 * r, rel_above),
-            (t2 + 0.45 * r, rel_near), (t2 + _BOARD_LEAVE * r, rel_rise), (total, rel_home)]
+    return [(0.0, rel_home), (0.5 * t1, rel_near), (0.8 * t1, rel_above), (t1, rel_goal),
+            (t2, rel_goal), (t2 + 0.2 * r, rel_above), (t2 + 0.5 * r, rel_near),
+            (total, rel_home)]
 
 
 def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> float:
@@ -682,8 +668,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     t1, t2 = t_reach, t_reach + hold
     # body posture leads the hand: it is reached at 85 % of the reach time (level path:
     # before the hand comes in, and kept until it is out again)
-    leave = 0.5 if board is None else _BOARD_LEAVE
-    body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + leave * t_ret, 1.0), (total, 0.0)] if level
+    body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + 0.5 * t_ret, 1.0), (total, 0.0)] if level
                  else [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)])
     sb = _profile(t, body_keys)
     pelvis = np.tile(st.pelvis, (T, 1))
@@ -756,6 +741,14 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         amp += _LOW_REACH_WIDE * H * float(np.clip((0.6 * H - targets[k][2]) / (0.15 * H),
                                                    0.0, 1.0))
         rel[:, k] += amp * bow[:, None] * out_dir
+        if board is not None:
+            # Between home and the turn point the palm goes straight in the world (the
+            # body's own motion would swing a shoulder-relative path into the edge).
+            away = (t <= out_end) | (t >= back_start)
+            near = sh1[k] + keys[1][1][k]
+            line = _interp_keys(t, [(0.0, st.hands[k]), (out_end, near), (back_start, near),
+                                    (total, st.hands[k])])
+            rel[away, k] = line[away] - shoulders[away, k] + amp * bow[away, None] * out_dir
     # small manipulation movements while the hands are in the region
     if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
         env = _profile(t, [(t1, 0.0), (t1 + 0.2, 1.0), (t2 - 0.2, 1.0), (t2, 0.0)])
