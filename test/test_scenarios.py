@@ -215,7 +215,7 @@ SUBSET: dict[str, str | None] = {
     "paper_cell/job/stand_up": None,
     "kitting/job/kit_three": "planning:grasp:blocked (bolt by the left hand, the right holding "
                              "the bracket: the elbow hits the rack side panel)",
-    "under_shelf/job/low_shelf_assemble": "planning:grasp:blocked (part under a low board)",
+    "under_shelf/job/low_shelf_assemble": None,
     "bins/job/bin_to_bin": None,
     "aisle/single/walk(R2)": None,
     "aisle/single/grasp(O1)": None,
