@@ -618,14 +618,9 @@ def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.linalg.norm(a + s * d))
 
 
-def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
-               rng: np.random.Generator, duration: float | None, hand: str,
-               fps: float, path: str = "arc", travel: float | None = None,
-               board: tuple[float, float, float] | None = None) -> MotionPrimitive:
-    H = skeleton.stature
-    travel = _INSERT_TRAVEL if travel is None else float(travel)
-    board = board if task in LEVEL_PATH_TASKS else None
-    level = (path == "level" or board is not None) and task in LEVEL_PATH_TASKS
+def _checked_target(task: str, target: np.ndarray | None, skeleton: Skeleton) -> np.ndarray:
+    """``target`` (3,) of a hand task as floats; ValueError if missing, malformed or out of
+    the task's height range."""
     if target is None:
         raise ValueError(f"{task} needs a target position (3,) in the start frame")
     target = np.asarray(target, dtype=np.float64)
@@ -633,20 +628,17 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         raise ValueError(f"target must be a finite array of shape (3,), got {target.shape}")
     if target[2] < 0.0 or target[2] > max_reach(task, skeleton):
         raise ValueError(f"{task}: target height {target[2]:.3f} m is outside [0, "
-                         f"{max_reach(task, skeleton):.3f}] m for a {H:.2f} m worker")
-    targets, active, hand_name = _hand_targets(task, target, hand)
-    # insert pushes into the target from a point before it; extract pulls back from it
-    approach = np.zeros(3)
-    if task in ("insert", "extract"):
-        sh = st.shoulders[active[0]]
-        a = target - sh
-        a[2] = 0.0
-        n = np.linalg.norm(a)
-        approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
-    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board)
-    # timing
+                         f"{max_reach(task, skeleton):.3f}] m for a {skeleton.stature:.2f} m "
+                         f"worker")
+    return target
+
+
+def _reach_times(task: str, dist: float, pitch1: float, drop1: float, H: float, level: bool,
+                 duration: float | None, rng: np.random.Generator
+                 ) -> tuple[float, float, float]:
+    """Reach, hold and return times (s) of a hand task whose palm travels ``dist`` (m) into
+    a posture of trunk flexion ``pitch1`` and pelvis drop ``drop1``."""
     jitter = rng.uniform(0.9, 1.1)
-    dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach = float(np.clip(0.5 + 0.55 * dist + 0.35 * pitch1 + 1.2 * drop1 / H, 0.6, 2.2))
     # never faster than people reach (Fitts' law) nor than a peak palm speed of
     # HAND_GOAL_PEAK_SPEED along the arced path (motion.timing)
@@ -662,6 +654,112 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         if hold < 0.1 + (0.6 if task in ("insert", "extract") else 0.0):
             raise ValueError(f"{task}: duration {duration:.2f} s is too short; this motion "
                              f"needs at least {t_reach + t_ret + 0.1:.2f} s")
+    return t_reach, hold, t_ret
+
+
+def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
+               rel_home: np.ndarray, rel_goal: np.ndarray, rel_pre: np.ndarray,
+               times: tuple[float, float, float], level: bool,
+               board: tuple[float, float, float] | None, H: float, arm: float
+               ) -> tuple[list[tuple[float, np.ndarray]], float]:
+    """Shoulder-to-palm keys (arrays (2, 3)) of a hand task and its contact time (s);
+    ``times``: (t1 reach end, t2 hold end, total), ``rel_pre``: where insert's push starts
+    and extract's pull ends."""
+    t1, t2, total = times
+    if task == "insert":
+        push = min(0.5, 0.6 * (t2 - t1))
+        return [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
+                (total, rel_home)], t1 + push
+    if task == "extract":
+        pull = min(0.5, 0.6 * (t2 - t1))
+        return [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
+                (total, rel_home)], t2
+    keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
+    if task in ("grasp", "release", "move"):
+        # Parts rest on surfaces: come down onto a target below the shoulder from
+        # _APPROACH_LIFT above it, and lift off the same way.
+        lift = np.zeros_like(rel_goal)
+        for k in active:
+            if targets[k][2] < sh1[k][2] - 0.1:
+                lift[k, 2] = _APPROACH_LIFT
+        if level:
+            keys = _level_keys(targets, active, sh1, rel_home, rel_goal, _APPROACH_LIFT,
+                               t1, t2, total, H, arm, board)
+        elif np.any(lift):
+            rel_above = rel_goal + lift
+            keys = [(0.0, rel_home), (0.7 * t1, rel_above), (t1, rel_goal), (t2, rel_goal),
+                    (t2 + 0.3 * (total - t2), rel_above), (total, rel_home)]
+    return keys, t1
+
+
+def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
+               times: tuple[float, float, float], active: tuple, targets: np.ndarray,
+               shoulders: np.ndarray, sh1: np.ndarray, st: _Start, level: bool,
+               board: tuple[float, float, float] | None, dist: float, H: float, arm: float,
+               rng: np.random.Generator) -> np.ndarray:
+    """Shoulder-to-palm vectors (T, 2, 3) through ``keys`` at times ``t`` (T,), with a
+    small seeded bow; ``times``: (reach end, hold end, total), ``shoulders`` (T, 2, 3):
+    the moving shoulders, ``sh1`` (2, 3): at the reach's end."""
+    rel = _arc_keys(t, keys)
+    if level:
+        # Straight legs (an arc about the shoulder bulges forward, into the shelf), except
+        # a leg to or from home passing the shoulder nearer than a folded elbow allows
+        # (under a low board every leg: the arc would swing the hand into its edge).
+        straight = _interp_keys(t, keys)
+        least = _LEVEL_MIN_EXTENSION * arm
+        for (t0, v0), (t1_, v1) in itertools.pairwise(keys):
+            leg = (t >= t0) & (t <= t1_)
+            for k in active:
+                if board is not None or _segment_origin_distance(v0[k], v1[k]) >= least:
+                    rel[leg, k] = straight[leg, k]
+    # a small seeded bow of the hand path (outward and up), zero at every key pose (level
+    # path: only between home and the turn point)
+    t1, t2, total = times
+    out_end, back_start = (keys[1][0], keys[-2][0]) if level else (t1, t2)
+    s_out = _profile(t, [(0.0, 0.0), (out_end, 1.0)])
+    s_back = _profile(t, [(back_start, 0.0), (total, 1.0)])
+    bow = np.sin(np.pi * s_out) * (t <= out_end) + np.sin(np.pi * s_back) * (t >= back_start)
+    for k in active:
+        out_dir = np.array([0.0, 1.0 if k == 0 else -1.0, 0.6])
+        out_dir /= np.linalg.norm(out_dir)
+        amp = rng.uniform(0.02, 0.05) * min(1.0, dist / 0.5)
+        # a hand going down past the thigh swings wide of it (no hand through the leg)
+        amp += _LOW_REACH_WIDE * H * float(np.clip((0.6 * H - targets[k][2]) / (0.15 * H),
+                                                   0.0, 1.0))
+        rel[:, k] += amp * bow[:, None] * out_dir
+        if board is not None:
+            # Between home and the turn point the palm goes straight in the world (the
+            # body's own motion would swing a shoulder-relative path into the edge).
+            away = (t <= out_end) | (t >= back_start)
+            near = sh1[k] + keys[1][1][k]
+            line = _interp_keys(t, [(0.0, st.hands[k]), (out_end, near), (back_start, near),
+                                    (total, st.hands[k])])
+            rel[away, k] = line[away] - shoulders[away, k] + amp * bow[away, None] * out_dir
+    return rel
+
+
+def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
+               rng: np.random.Generator, duration: float | None, hand: str,
+               fps: float, path: str = "arc", travel: float | None = None,
+               board: tuple[float, float, float] | None = None) -> MotionPrimitive:
+    H = skeleton.stature
+    arm = _arm_length(skeleton)
+    travel = _INSERT_TRAVEL if travel is None else float(travel)
+    board = board if task in LEVEL_PATH_TASKS else None
+    level = (path == "level" or board is not None) and task in LEVEL_PATH_TASKS
+    target = _checked_target(task, target, skeleton)
+    targets, active, hand_name = _hand_targets(task, target, hand)
+    # insert pushes into the target from a point before it; extract pulls back from it
+    approach = np.zeros(3)
+    if task in ("insert", "extract"):
+        sh = st.shoulders[active[0]]
+        a = target - sh
+        a[2] = 0.0
+        n = np.linalg.norm(a)
+        approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
+    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board)
+    dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
+    t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
     total = t_reach + hold + t_ret
     T = _n_frames(total, fps)
     t = np.arange(T) / fps
@@ -687,68 +785,10 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     for k in active:
         rel_goal[k] = targets[k] - sh1[k]
         rel_pre[k] = targets[k] - travel * approach - sh1[k]
-    if task == "insert":
-        push = min(0.5, 0.6 * hold)
-        keys = [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
-                (total, rel_home)]
-        contact_t = t1 + push
-    elif task == "extract":
-        pull = min(0.5, 0.6 * hold)
-        keys = [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
-                (total, rel_home)]
-        contact_t = t2
-    else:
-        keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
-        contact_t = t1
-        if task in ("grasp", "release", "move"):
-            # Parts rest on surfaces: come down onto a target below the shoulder from
-            # _APPROACH_LIFT above it, and lift off the same way.
-            lift = np.zeros_like(rel_goal)
-            for k in active:
-                if targets[k][2] < sh1[k][2] - 0.1:
-                    lift[k, 2] = _APPROACH_LIFT
-            if level:
-                keys = _level_keys(targets, active, sh1, rel_home, rel_goal, _APPROACH_LIFT,
-                                   t1, t2, total, H, _arm_length(skeleton),
-                                   board)
-            elif np.any(lift):
-                rel_above = rel_goal + lift
-                keys = [(0.0, rel_home), (0.7 * t1, rel_above), (t1, rel_goal), (t2, rel_goal),
-                        (t2 + 0.3 * (total - t2), rel_above), (total, rel_home)]
-    rel = _arc_keys(t, keys)
-    if level:
-        # Straight legs (an arc about the shoulder bulges forward, into the shelf), except
-        # a leg to or from home passing the shoulder nearer than a folded elbow allows
-        # (under a low board every leg: the arc would swing the hand into its edge).
-        straight = _interp_keys(t, keys)
-        least = _LEVEL_MIN_EXTENSION * _arm_length(skeleton)
-        for (t0, v0), (t1_, v1) in itertools.pairwise(keys):
-            leg = (t >= t0) & (t <= t1_)
-            for k in active:
-                if board is not None or _segment_origin_distance(v0[k], v1[k]) >= least:
-                    rel[leg, k] = straight[leg, k]
-    # a small seeded bow of the hand path (outward and up), zero at every key pose (level
-    # path: only between home and the turn point)
-    out_end, back_start = (keys[1][0], keys[-2][0]) if level else (t1, t2)
-    s_out = _profile(t, [(0.0, 0.0), (out_end, 1.0)])
-    s_back = _profile(t, [(back_start, 0.0), (total, 1.0)])
-    bow = np.sin(np.pi * s_out) * (t <= out_end) + np.sin(np.pi * s_back) * (t >= back_start)
-    for k in active:
-        out_dir = np.array([0.0, 1.0 if k == 0 else -1.0, 0.6])
-        out_dir /= np.linalg.norm(out_dir)
-        amp = rng.uniform(0.02, 0.05) * min(1.0, dist / 0.5)
-        # a hand going down past the thigh swings wide of it (no hand through the leg)
-        amp += _LOW_REACH_WIDE * H * float(np.clip((0.6 * H - targets[k][2]) / (0.15 * H),
-                                                   0.0, 1.0))
-        rel[:, k] += amp * bow[:, None] * out_dir
-        if board is not None:
-            # Between home and the turn point the palm goes straight in the world (the
-            # body's own motion would swing a shoulder-relative path into the edge).
-            away = (t <= out_end) | (t >= back_start)
-            near = sh1[k] + keys[1][1][k]
-            line = _interp_keys(t, [(0.0, st.hands[k]), (out_end, near), (back_start, near),
-                                    (total, st.hands[k])])
-            rel[away, k] = line[away] - shoulders[away, k] + amp * bow[away, None] * out_dir
+    keys, contact_t = _hand_keys(task, targets, active, sh1, rel_home, rel_goal, rel_pre,
+                                 (t1, t2, total), level, board, H, arm)
+    rel = _hand_path(t, keys, (t1, t2, total), active, targets, shoulders, sh1, st, level,
+                     board, dist, H, arm, rng)
     # small manipulation movements while the hands are in the region
     if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
         env = _profile(t, [(t1, 0.0), (t1 + 0.2, 1.0), (t2 - 0.2, 1.0), (t2, 0.0)])
@@ -766,7 +806,24 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         if k not in active:
             hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04]) * \
                 sb[:, None]
-    # palm direction and elbow pole blend from the start pose to the reaching posture
+    hand_dir, elbow_pole = _hand_orientation(task, active, st, t, (t1, t2, total), rel_goal)
+    world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
+    contact = min(round(contact_t * fps), T - 1)
+    meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
+            "hold_frames": [f1, f2], "trunk_flexion": pitch1, "pelvis_drop": drop1,
+            "posture": _posture_name(world[f1], skeleton)}
+    return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
+                   f"goals.make_goal_primitive({task!r}, target={_fmt(target)})", meta)
+
+
+def _hand_orientation(task: str, active: tuple, st: _Start, t: np.ndarray,
+                      times: tuple[float, float, float], rel_goal: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """Palm directions and elbow poles (T, 2, 3): blended from the start pose's to the
+    reaching posture's over the reach and back over the return (``times``: reach end,
+    hold end, total)."""
+    t1, t2, total = times
+    T = t.size
     s_hand = _interp_keys(t, [(0.0, 0.0), (t1, 1.0), (t2, 1.0), (total, 0.0)])
     hand_dir = np.broadcast_to(st.hand_dir, (T, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy()
@@ -776,13 +833,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         hand_dir[:, k] = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
         elbow_pole[:, k] = ((1 - s_hand)[:, None] * st.elbow_pole[k]
                             + s_hand[:, None] * _goal_elbow_pole(k))
-    world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
-    contact = min(round(contact_t * fps), T - 1)
-    meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
-            "hold_frames": [f1, f2], "trunk_flexion": pitch1, "pelvis_drop": drop1,
-            "posture": _posture_name(world[f1], skeleton)}
-    return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
-                   f"goals.make_goal_primitive({task!r}, target={_fmt(target)})", meta)
+    return hand_dir, elbow_pole
 
 
 def _check_board(board: tuple[float, float, float]) -> tuple[float, float, float]:
@@ -1068,13 +1119,19 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         return _finish(f"sit_{_fmt(tgt)}", "sit", world, st, fps,
                        f"goals.make_goal_primitive('sit', target={_fmt(tgt)})", meta,
                        start_exact=True, end_exact=False)
-    # standUp: sitting down on a seat behind the standing pose, played backwards and
-    # re-rooted at the seated pelvis
+    return _stand_up(skeleton, st, rng, duration, fps, target)
+
+
+def _stand_up(skeleton: Skeleton, st: _Start, rng: np.random.Generator,
+              duration: float | None, fps: float, target: np.ndarray | None
+              ) -> MotionPrimitive:
+    """standUp from the seat height of ``target`` (default 0.26 H): sitting down on a seat
+    behind the standing pose, played backwards and re-rooted at the seated pelvis."""
     H = skeleton.stature
     seat_z = 0.26 * H if target is None else float(np.asarray(target, dtype=np.float64)[2])
     dist, _ = reach_placement("sit", seat_z, skeleton)
-    world, meta, tgt = _sit(skeleton, st, rng, duration, fps, np.array([dist, 0.0, seat_z]),
-                            nominal=STAND_UP_SECONDS)
+    world, _, _ = _sit(skeleton, st, rng, duration, fps, np.array([dist, 0.0, seat_z]),
+                        nominal=STAND_UP_SECONDS)
     world = world[::-1].copy()
     world[..., :2] -= world[0, 0, :2]
     # Table I's condition (head above chest height) already holds for an upright seated
