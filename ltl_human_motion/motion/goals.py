@@ -110,6 +110,10 @@ _BOARD_CLEARANCE = 0.02
 #: Horizontal distance of the under path's drop point in front of the board's edge, m
 #: (the hand capsule's radius and a margin).
 _BOARD_FRONT = 0.10
+#: How much nearer the worker a low board's edge may be than where reach_placement puts
+#: it, m: the walk ends within a few cm and degrees of the standing place, and the edge
+#: across a turned worker comes nearer on one side.
+_BOARD_PLACE_MARGIN = 0.04
 #: Points sampled along every body capsule for the board check of a posture.
 _CAPSULE_SAMPLES = 5
 
@@ -1190,7 +1194,7 @@ def _placement(task: str, height: float, stature: float, hand: str,
         targets, active, _ = _hand_targets(task, target, "both" if both else (
             "l_hand" if lateral > 0 else "r_hand"))
         _, _, _, cost = _grid(skeleton, st, targets, active, task, None if board is None
-                              else (x - board[0], board[1], board[2]))
+                              else (x - board[0] - _BOARD_PLACE_MARGIN, board[1], board[2]))
         c = float(np.min(cost))
         if c < best[0]:
             best = (c, float(x))
