@@ -82,7 +82,7 @@ def _board_clearance(world: np.ndarray, board: tuple[float, float, float]) -> fl
 
 
 @pytest.mark.parametrize(("height", "depth", "bottom"),
-                         [(0.08, 0.12, 0.40), (0.06, 0.15, 0.45), (0.21, 0.12, 0.54)])
+                         [(0.08, 0.12, 0.40), (0.06, 0.10, 0.45), (0.21, 0.12, 0.54)])
 def test_reach_under_a_low_board_keeps_the_body_clear_of_it(height: float, depth: float,
                                                             bottom: float) -> None:
     """A part under a low board (on the floor, on a cupboard's bottom board): the worker

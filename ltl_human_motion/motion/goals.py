@@ -1189,15 +1189,19 @@ def _placement(task: str, height: float, stature: float, hand: str,
                                 else -0.07 * H)
     st = _Start(skeleton, None)
     best = (np.inf, None)
-    for x in np.linspace(0.12 * H, 0.45 * H, 12):
-        target = np.array([x, lateral, height])
-        targets, active, _ = _hand_targets(task, target, "both" if both else (
-            "l_hand" if lateral > 0 else "r_hand"))
-        _, _, _, cost = _grid(skeleton, st, targets, active, task, None if board is None
-                              else (x - board[0] - _BOARD_PLACE_MARGIN, board[1], board[2]))
-        c = float(np.min(cost))
-        if c < best[0]:
-            best = (c, float(x))
+    # Under a low board: with _BOARD_PLACE_MARGIN where that leaves a place, else without.
+    for margin in (0.0,) if board is None else (_BOARD_PLACE_MARGIN, 0.0):
+        for x in np.linspace(0.12 * H, 0.45 * H, 12):
+            target = np.array([x, lateral, height])
+            targets, active, _ = _hand_targets(task, target, "both" if both else (
+                "l_hand" if lateral > 0 else "r_hand"))
+            _, _, _, cost = _grid(skeleton, st, targets, active, task, None if board is None
+                                  else (x - board[0] - margin, board[1], board[2]))
+            c = float(np.min(cost))
+            if c < best[0]:
+                best = (c, float(x))
+        if best[1] is not None:
+            break
     if best[1] is None:
         raise ValueError(f"{task}: no standing place reaches a target at height {height:.3f} m")
     return best[1], lateral
