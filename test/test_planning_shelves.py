@@ -63,3 +63,52 @@ def test_grasp_palm_target_clears_a_flat_parts_support() -> None:
     assert clear > PALM_SUPPORT_GAP
     part = cell.object("gear").occupancy_at(cell.object("gear").position)
     assert float(part.signed_distance(palm[None])[0]) < radius
+
+
+def _board_clearance(world: np.ndarray, board: tuple[float, float, float]) -> float:
+    """Smallest distance (m) of the body's capsules (frames (T, J, 3)) from a board beyond
+    x = edge between heights bottom and top (``board``), the capsules sampled densely."""
+    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    edge, bottom, top = board
+    ia, ib = capsule_ends()
+    s = np.linspace(0.0, 1.0, 11)[:, None, None, None]
+    pts = world[:, ia] + s * (world[:, ib] - world[:, ia])
+    x, z = pts[..., 0], pts[..., 2]
+    dz = np.maximum(bottom - z, z - top)
+    inside = (x >= edge) & (dz <= 0.0)
+    dist = np.where(inside, -np.minimum(x - edge, -dz),
+                    np.hypot(np.maximum(edge - x, 0.0), np.maximum(dz, 0.0)))
+    return float(np.min(dist - capsule_radii(SK.stature)))
+
+
+@pytest.mark.parametrize(("height", "depth", "bottom"),
+                         [(0.08, 0.12, 0.40), (0.06, 0.10, 0.45), (0.21, 0.12, 0.54)])
+def test_reach_under_a_low_board_keeps_the_body_clear_of_it(height: float, depth: float,
+                                                            bottom: float) -> None:
+    """A part under a low board (on the floor, on a cupboard's bottom board): the worker
+    stands where a crouch reaches it, the hand goes down in front of the edge and in under
+    the board, no body part touches the board, and the motion passes the quality checks."""
+    from ltl_human_motion.planning.pipeline import get_library
+    carry = get_library(1.75).carry_standing_pose
+    top = bottom + 0.02
+    x, y = reach_placement("grasp", height, SK, board=(depth, bottom, top))
+    target = np.array([x, y, height])
+    board = (x - depth, bottom, top)
+    mp = make_goal_primitive("grasp", target, SK, rng=np.random.default_rng(1),
+                             start_pose=carry, board=board)
+    w = world_positions(mp, 0.0, 0.0, 0.0)
+    assert primitive_metrics(w, mp.fps, SK)["passed"]
+    assert np.linalg.norm(w[mp.meta["contact_frame"], J["r_hand"]] - target) < 0.01
+    assert _board_clearance(w, board) > 0.0
+    arc = make_goal_primitive("grasp", target, SK, rng=np.random.default_rng(1),
+                              start_pose=carry)
+    assert _board_clearance(world_positions(arc, 0.0, 0.0, 0.0), board) < 0.0
+
+
+@pytest.mark.parametrize("spec", ["F grasp(O1)", "F grasp(O2)"])
+def test_grasp_under_a_low_board_verifies(spec: str) -> None:
+    """The planner finds the board over the part, stands square to its edge, and the
+    plan verifies (planning:grasp:blocked in under_shelf before)."""
+    from ltl_human_motion.scenarios.run import run_pair
+    outcome = run_pair(spec, "scenarios/cells/under_shelf.yaml", 1.75, 0, timeout=30.0)
+    assert outcome.status == "verified", outcome.message[:300]

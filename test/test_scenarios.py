@@ -213,7 +213,7 @@ SUBSET: dict[str, str | None] = {
     "stations/job/big_box": None,
     "paper_cell/job/stand_up": None,
     "kitting/job/kit_three": None,
-    "under_shelf/job/low_shelf_assemble": "planning:grasp:blocked (part under a low board)",
+    "under_shelf/job/low_shelf_assemble": None,
     "bins/job/bin_to_bin": None,
     "aisle/single/walk(R2)": None,
     "aisle/single/grasp(O1)": None,

@@ -49,6 +49,7 @@ from ltl_human_motion.vocabulary import HAND_TASKS
 __all__ = [
     "GOAL_TASKS",
     "HAND_TASKS",
+    "LOW_BOARD_HEIGHT",
     "chest_height",
     "knee_height",
     "make_goal_primitive",
@@ -97,6 +98,24 @@ _LEVEL_TIME = 1.3
 #: self-penetration check of planning.biomechanics (capsule axis outside the other
 #: capsule): the seeded timing and the blend of the start pose move the arm by a few mm.
 _SELF_CLEARANCE = 0.005
+#: A board this low over a hand target (underside height above the floor, fraction of
+#: stature; 0.63 m at 1.75 m) is below the shoulders of a stoop (0.7-0.9 m at 1.75 m,
+#: measured on the under_shelf cell): the hand goes down in front of its edge and in
+#: under it, from a deep crouch (:func:`make_goal_primitive`'s ``board``).
+LOW_BOARD_HEIGHT = 0.36
+#: Clearance (m) the contact posture of a reach under a low board keeps from the board
+#: beyond the body's capsules (the seeded timing and the start pose's blend move the
+#: body by a few cm).
+_BOARD_CLEARANCE = 0.02
+#: Horizontal distance of the under path's drop point in front of the board's edge, m
+#: (the hand capsule's radius and a margin).
+_BOARD_FRONT = 0.10
+#: How much nearer the worker a low board's edge may be than where reach_placement puts
+#: it, m: the walk ends within a few cm and degrees of the standing place, and the edge
+#: across a turned worker comes nearer on one side.
+_BOARD_PLACE_MARGIN = 0.04
+#: Points sampled along every body capsule for the board check of a posture.
+_CAPSULE_SAMPLES = 5
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -337,13 +356,34 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
     return out
 
 
+def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
+                 stature: float) -> np.ndarray:
+    """How deep the body's capsules of poses (C, J, 3) go into a board beyond x = edge
+    between heights bottom and top (``board = (edge, bottom, top)``, start frame), plus
+    ``_BOARD_CLEARANCE``, metres (C,); negative: clear."""
+    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    edge, bottom, top = board
+    ia, ib = capsule_ends()
+    s = np.linspace(0.0, 1.0, _CAPSULE_SAMPLES)[:, None, None, None]
+    pts = poses[:, ia] + s * (poses[:, ib] - poses[:, ia])          # (S, C, K, 3)
+    x, z = pts[..., 0], pts[..., 2]
+    dz = np.maximum(bottom - z, z - top)
+    out_x, out_z = np.maximum(edge - x, 0.0), np.maximum(dz, 0.0)
+    dist = np.where((x >= edge) & (dz <= 0.0), -np.minimum(x - edge, -dz),
+                    np.hypot(out_x, out_z))
+    depth = capsule_radii(stature) + _BOARD_CLEARANCE - dist
+    return depth.max(axis=(0, 2))
+
+
 def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
-          task: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+          task: str | None = None, board: tuple[float, float, float] | None = None
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Costs of trunk flexion / pelvis drop candidates for hand targets.
 
     A candidate is infeasible when a hand cannot reach its target, or when its posture
     with the hands on the targets (:func:`_contact_poses`) puts a body part through
-    another (a low reach with the hand in the thigh).
+    another (a low reach with the hand in the thigh) or into the low ``board`` (edge,
+    bottom, top) over the targets.
 
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
@@ -358,9 +398,11 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         from ltl_human_motion.planning.biomechanics import self_penetration
         poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
                                task)
-        depth = self_penetration(poses, skeleton.stature)[0].max(axis=1)
+        blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
+        if board is not None:
+            blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
         feasible = feasible.copy()
-        feasible[idx[depth > -_SELF_CLEARANCE]] = False
+        feasible[idx[blocked]] = False
     cost = np.where(feasible, cost, np.inf)
     return P, D, shift, cost
 
@@ -432,8 +474,9 @@ def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray,
 
 
 def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
-                 task: str, target: np.ndarray) -> tuple[float, float, float]:
-    P, D, S, cost = _grid(skeleton, st, targets, active, task)
+                 task: str, target: np.ndarray,
+                 board: tuple[float, float, float] | None = None) -> tuple[float, float, float]:
+    P, D, S, cost = _grid(skeleton, st, targets, active, task, board)
     i = int(np.argmin(cost))
     if not np.isfinite(cost[i]):
         raise ValueError(
@@ -544,11 +587,16 @@ def _frames(skeleton: Skeleton, st: _Start, t: np.ndarray, pelvis: np.ndarray,
 
 def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: np.ndarray,
                 rel_goal: np.ndarray, lift: float, t1: float, t2: float, total: float,
-                H: float, arm: float) -> list[tuple[float, np.ndarray]]:
+                H: float, arm: float, board: tuple[float, float, float] | None = None
+                ) -> list[tuple[float, np.ndarray]]:
     """Shoulder-to-palm keys of the level path (see :data:`HAND_PATHS`): home, the turn
     point near the body at the approach height, above the target, the target (held), and
     back the same way. Arrays (2, 3); ``sh1`` (2, 3): the shoulders in the reach posture;
-    ``arm``: the arm's length (the turn point keeps the elbow clearly bent, not folded)."""
+    ``arm``: the arm's length (the turn point keeps the elbow clearly bent, not folded);
+    ``board`` (edge, bottom, top): a low board over the targets (start frame): the turn
+    point goes out to ``_BOARD_FRONT`` before its edge (down in front of the edge, then
+    in under the board, and out and up the same way)."""
+    front = None if board is None else board[0] - _BOARD_FRONT
     rel_above, rel_near = rel_goal.copy(), rel_goal.copy()
     for k in active:
         above = targets[k] + np.array([0.0, 0.0, lift])
@@ -557,6 +605,8 @@ def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: n
         dh = float(np.linalg.norm(flat))
         unfolded = np.sqrt(max((_LEVEL_MIN_EXTENSION * arm) ** 2 - rel_above[k, 2] ** 2, 0.0))
         near = min(dh, max(_LEVEL_NEAR * H, unfolded))
+        if front is not None and flat[0] > 1e-9:
+            near = min(dh, max(near, dh * (front - sh1[k, 0]) / flat[0]))
         rel_near[k, :2] = flat * (near / dh) if dh > 1e-9 else flat
         rel_near[k, 2] = rel_above[k, 2]
     r = total - t2
@@ -572,12 +622,9 @@ def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.linalg.norm(a + s * d))
 
 
-def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
-               rng: np.random.Generator, duration: float | None, hand: str,
-               fps: float, path: str = "arc", travel: float | None = None) -> MotionPrimitive:
-    H = skeleton.stature
-    travel = _INSERT_TRAVEL if travel is None else float(travel)
-    level = path == "level" and task in LEVEL_PATH_TASKS
+def _checked_target(task: str, target: np.ndarray | None, skeleton: Skeleton) -> np.ndarray:
+    """``target`` (3,) of a hand task as floats; ValueError if missing, malformed or out of
+    the task's height range."""
     if target is None:
         raise ValueError(f"{task} needs a target position (3,) in the start frame")
     target = np.asarray(target, dtype=np.float64)
@@ -585,20 +632,17 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         raise ValueError(f"target must be a finite array of shape (3,), got {target.shape}")
     if target[2] < 0.0 or target[2] > max_reach(task, skeleton):
         raise ValueError(f"{task}: target height {target[2]:.3f} m is outside [0, "
-                         f"{max_reach(task, skeleton):.3f}] m for a {H:.2f} m worker")
-    targets, active, hand_name = _hand_targets(task, target, hand)
-    # insert pushes into the target from a point before it; extract pulls back from it
-    approach = np.zeros(3)
-    if task in ("insert", "extract"):
-        sh = st.shoulders[active[0]]
-        a = target - sh
-        a[2] = 0.0
-        n = np.linalg.norm(a)
-        approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
-    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target)
-    # timing
+                         f"{max_reach(task, skeleton):.3f}] m for a {skeleton.stature:.2f} m "
+                         f"worker")
+    return target
+
+
+def _reach_times(task: str, dist: float, pitch1: float, drop1: float, H: float, level: bool,
+                 duration: float | None, rng: np.random.Generator
+                 ) -> tuple[float, float, float]:
+    """Reach, hold and return times (s) of a hand task whose palm travels ``dist`` (m) into
+    a posture of trunk flexion ``pitch1`` and pelvis drop ``drop1``."""
     jitter = rng.uniform(0.9, 1.1)
-    dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach = float(np.clip(0.5 + 0.55 * dist + 0.35 * pitch1 + 1.2 * drop1 / H, 0.6, 2.2))
     # never faster than people reach (Fitts' law) nor than a peak palm speed of
     # HAND_GOAL_PEAK_SPEED along the arced path (motion.timing)
@@ -614,6 +658,112 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         if hold < 0.1 + (0.6 if task in ("insert", "extract") else 0.0):
             raise ValueError(f"{task}: duration {duration:.2f} s is too short; this motion "
                              f"needs at least {t_reach + t_ret + 0.1:.2f} s")
+    return t_reach, hold, t_ret
+
+
+def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
+               rel_home: np.ndarray, rel_goal: np.ndarray, rel_pre: np.ndarray,
+               times: tuple[float, float, float], level: bool,
+               board: tuple[float, float, float] | None, H: float, arm: float
+               ) -> tuple[list[tuple[float, np.ndarray]], float]:
+    """Shoulder-to-palm keys (arrays (2, 3)) of a hand task and its contact time (s);
+    ``times``: (t1 reach end, t2 hold end, total), ``rel_pre``: where insert's push starts
+    and extract's pull ends."""
+    t1, t2, total = times
+    if task == "insert":
+        push = min(0.5, 0.6 * (t2 - t1))
+        return [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
+                (total, rel_home)], t1 + push
+    if task == "extract":
+        pull = min(0.5, 0.6 * (t2 - t1))
+        return [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
+                (total, rel_home)], t2
+    keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
+    if task in ("grasp", "release", "move"):
+        # Parts rest on surfaces: come down onto a target below the shoulder from
+        # _APPROACH_LIFT above it, and lift off the same way.
+        lift = np.zeros_like(rel_goal)
+        for k in active:
+            if targets[k][2] < sh1[k][2] - 0.1:
+                lift[k, 2] = _APPROACH_LIFT
+        if level:
+            keys = _level_keys(targets, active, sh1, rel_home, rel_goal, _APPROACH_LIFT,
+                               t1, t2, total, H, arm, board)
+        elif np.any(lift):
+            rel_above = rel_goal + lift
+            keys = [(0.0, rel_home), (0.7 * t1, rel_above), (t1, rel_goal), (t2, rel_goal),
+                    (t2 + 0.3 * (total - t2), rel_above), (total, rel_home)]
+    return keys, t1
+
+
+def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
+               times: tuple[float, float, float], active: tuple, targets: np.ndarray,
+               shoulders: np.ndarray, sh1: np.ndarray, st: _Start, level: bool,
+               board: tuple[float, float, float] | None, dist: float, H: float, arm: float,
+               rng: np.random.Generator) -> np.ndarray:
+    """Shoulder-to-palm vectors (T, 2, 3) through ``keys`` at times ``t`` (T,), with a
+    small seeded bow; ``times``: (reach end, hold end, total), ``shoulders`` (T, 2, 3):
+    the moving shoulders, ``sh1`` (2, 3): at the reach's end."""
+    rel = _arc_keys(t, keys)
+    if level:
+        # Straight legs (an arc about the shoulder bulges forward, into the shelf), except
+        # a leg to or from home passing the shoulder nearer than a folded elbow allows
+        # (under a low board every leg: the arc would swing the hand into its edge).
+        straight = _interp_keys(t, keys)
+        least = _LEVEL_MIN_EXTENSION * arm
+        for (t0, v0), (t1_, v1) in itertools.pairwise(keys):
+            leg = (t >= t0) & (t <= t1_)
+            for k in active:
+                if board is not None or _segment_origin_distance(v0[k], v1[k]) >= least:
+                    rel[leg, k] = straight[leg, k]
+    # a small seeded bow of the hand path (outward and up), zero at every key pose (level
+    # path: only between home and the turn point)
+    t1, t2, total = times
+    out_end, back_start = (keys[1][0], keys[-2][0]) if level else (t1, t2)
+    s_out = _profile(t, [(0.0, 0.0), (out_end, 1.0)])
+    s_back = _profile(t, [(back_start, 0.0), (total, 1.0)])
+    bow = np.sin(np.pi * s_out) * (t <= out_end) + np.sin(np.pi * s_back) * (t >= back_start)
+    for k in active:
+        out_dir = np.array([0.0, 1.0 if k == 0 else -1.0, 0.6])
+        out_dir /= np.linalg.norm(out_dir)
+        amp = rng.uniform(0.02, 0.05) * min(1.0, dist / 0.5)
+        # a hand going down past the thigh swings wide of it (no hand through the leg)
+        amp += _LOW_REACH_WIDE * H * float(np.clip((0.6 * H - targets[k][2]) / (0.15 * H),
+                                                   0.0, 1.0))
+        rel[:, k] += amp * bow[:, None] * out_dir
+        if board is not None:
+            # Between home and the turn point the palm goes straight in the world (the
+            # body's own motion would swing a shoulder-relative path into the edge).
+            away = (t <= out_end) | (t >= back_start)
+            near = sh1[k] + keys[1][1][k]
+            line = _interp_keys(t, [(0.0, st.hands[k]), (out_end, near), (back_start, near),
+                                    (total, st.hands[k])])
+            rel[away, k] = line[away] - shoulders[away, k] + amp * bow[away, None] * out_dir
+    return rel
+
+
+def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
+               rng: np.random.Generator, duration: float | None, hand: str,
+               fps: float, path: str = "arc", travel: float | None = None,
+               board: tuple[float, float, float] | None = None) -> MotionPrimitive:
+    H = skeleton.stature
+    arm = _arm_length(skeleton)
+    travel = _INSERT_TRAVEL if travel is None else float(travel)
+    board = board if task in LEVEL_PATH_TASKS else None
+    level = (path == "level" or board is not None) and task in LEVEL_PATH_TASKS
+    target = _checked_target(task, target, skeleton)
+    targets, active, hand_name = _hand_targets(task, target, hand)
+    # insert pushes into the target from a point before it; extract pulls back from it
+    approach = np.zeros(3)
+    if task in ("insert", "extract"):
+        sh = st.shoulders[active[0]]
+        a = target - sh
+        a[2] = 0.0
+        n = np.linalg.norm(a)
+        approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
+    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board)
+    dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
+    t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
     total = t_reach + hold + t_ret
     T = _n_frames(total, fps)
     t = np.arange(T) / fps
@@ -639,58 +789,10 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     for k in active:
         rel_goal[k] = targets[k] - sh1[k]
         rel_pre[k] = targets[k] - travel * approach - sh1[k]
-    if task == "insert":
-        push = min(0.5, 0.6 * hold)
-        keys = [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
-                (total, rel_home)]
-        contact_t = t1 + push
-    elif task == "extract":
-        pull = min(0.5, 0.6 * hold)
-        keys = [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
-                (total, rel_home)]
-        contact_t = t2
-    else:
-        keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
-        contact_t = t1
-        if task in ("grasp", "release", "move"):
-            # Parts rest on surfaces: come down onto a target below the shoulder from
-            # _APPROACH_LIFT above it, and lift off the same way.
-            lift = np.zeros_like(rel_goal)
-            for k in active:
-                if targets[k][2] < sh1[k][2] - 0.1:
-                    lift[k, 2] = _APPROACH_LIFT
-            if level:
-                keys = _level_keys(targets, active, sh1, rel_home, rel_goal, _APPROACH_LIFT,
-                                   t1, t2, total, H, _arm_length(skeleton))
-            elif np.any(lift):
-                rel_above = rel_goal + lift
-                keys = [(0.0, rel_home), (0.7 * t1, rel_above), (t1, rel_goal), (t2, rel_goal),
-                        (t2 + 0.3 * (total - t2), rel_above), (total, rel_home)]
-    rel = _arc_keys(t, keys)
-    if level:
-        # Straight legs (an arc about the shoulder bulges forward, into the shelf), except
-        # a leg to or from home passing the shoulder nearer than a folded elbow allows.
-        straight = _interp_keys(t, keys)
-        least = _LEVEL_MIN_EXTENSION * _arm_length(skeleton)
-        for (t0, v0), (t1_, v1) in itertools.pairwise(keys):
-            leg = (t >= t0) & (t <= t1_)
-            for k in active:
-                if _segment_origin_distance(v0[k], v1[k]) >= least:
-                    rel[leg, k] = straight[leg, k]
-    # a small seeded bow of the hand path (outward and up), zero at every key pose (level
-    # path: only between home and the turn point)
-    out_end, back_start = (keys[1][0], keys[-2][0]) if level else (t1, t2)
-    s_out = _profile(t, [(0.0, 0.0), (out_end, 1.0)])
-    s_back = _profile(t, [(back_start, 0.0), (total, 1.0)])
-    bow = np.sin(np.pi * s_out) * (t <= out_end) + np.sin(np.pi * s_back) * (t >= back_start)
-    for k in active:
-        out_dir = np.array([0.0, 1.0 if k == 0 else -1.0, 0.6])
-        out_dir /= np.linalg.norm(out_dir)
-        amp = rng.uniform(0.02, 0.05) * min(1.0, dist / 0.5)
-        # a hand going down past the thigh swings wide of it (no hand through the leg)
-        amp += _LOW_REACH_WIDE * H * float(np.clip((0.6 * H - targets[k][2]) / (0.15 * H),
-                                                   0.0, 1.0))
-        rel[:, k] += amp * bow[:, None] * out_dir
+    keys, contact_t = _hand_keys(task, targets, active, sh1, rel_home, rel_goal, rel_pre,
+                                 (t1, t2, total), level, board, H, arm)
+    rel = _hand_path(t, keys, (t1, t2, total), active, targets, shoulders, sh1, st, level,
+                     board, dist, H, arm, rng)
     # small manipulation movements while the hands are in the region
     if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
         env = _profile(t, [(t1, 0.0), (t1 + 0.2, 1.0), (t2 - 0.2, 1.0), (t2, 0.0)])
@@ -708,7 +810,24 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         if k not in active:
             hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04]) * \
                 sb[:, None]
-    # palm direction and elbow pole blend from the start pose to the reaching posture
+    hand_dir, elbow_pole = _hand_orientation(task, active, st, t, (t1, t2, total), rel_goal)
+    world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
+    contact = min(round(contact_t * fps), T - 1)
+    meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
+            "hold_frames": [f1, f2], "trunk_flexion": pitch1, "pelvis_drop": drop1,
+            "posture": _posture_name(world[f1], skeleton)}
+    return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
+                   f"goals.make_goal_primitive({task!r}, target={_fmt(target)})", meta)
+
+
+def _hand_orientation(task: str, active: tuple, st: _Start, t: np.ndarray,
+                      times: tuple[float, float, float], rel_goal: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """Palm directions and elbow poles (T, 2, 3): blended from the start pose's to the
+    reaching posture's over the reach and back over the return (``times``: reach end,
+    hold end, total)."""
+    t1, t2, total = times
+    T = t.size
     s_hand = _interp_keys(t, [(0.0, 0.0), (t1, 1.0), (t2, 1.0), (total, 0.0)])
     hand_dir = np.broadcast_to(st.hand_dir, (T, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy()
@@ -718,13 +837,15 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         hand_dir[:, k] = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
         elbow_pole[:, k] = ((1 - s_hand)[:, None] * st.elbow_pole[k]
                             + s_hand[:, None] * _goal_elbow_pole(k))
-    world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
-    contact = min(round(contact_t * fps), T - 1)
-    meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
-            "hold_frames": [f1, f2], "trunk_flexion": pitch1, "pelvis_drop": drop1,
-            "posture": _posture_name(world[f1], skeleton)}
-    return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
-                   f"goals.make_goal_primitive({task!r}, target={_fmt(target)})", meta)
+    return hand_dir, elbow_pole
+
+
+def _check_board(board: tuple[float, float, float]) -> tuple[float, float, float]:
+    """``board`` as three floats (edge, bottom, top); ValueError if malformed."""
+    b = np.asarray(board, dtype=np.float64)
+    if b.shape != (3,) or not np.all(np.isfinite(b)) or not b[1] <= b[2]:
+        raise ValueError(f"board must be (edge, bottom, top) with bottom <= top, got {board!r}")
+    return float(b[0]), float(b[1]), float(b[2])
 
 
 def _fmt(target: np.ndarray | None) -> str:
@@ -918,7 +1039,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
                         start_pose: np.ndarray | None = None,
                         rng: np.random.Generator | None = None, duration: float | None = None,
                         hand: str = "auto", fps: float = LIBRARY_FPS,
-                        path: str = "arc", travel: float | None = None) -> MotionPrimitive:
+                        path: str = "arc", travel: float | None = None,
+                        board: tuple[float, float, float] | None = None) -> MotionPrimitive:
     """A goal primitive for one Table I task, made for the exact target.
 
     Parameters
@@ -954,6 +1076,11 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     travel : float, optional
         Length of the straight push of insert and pull of extract, metres (default
         8 cm; a part deep in a fixture needs a longer pull to come out).
+    board : (edge, bottom, top), optional
+        A low board over the target of grasp, release or move (start frame: its front
+        edge at x = edge, its underside and top at heights bottom and top, metres): the
+        posture keeps every body part clear of it and the hand takes the level path with
+        its turn point in front of the edge (down there, then in under the board).
 
     Returns
     -------
@@ -981,7 +1108,10 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     if task in HAND_TASKS:
         if travel is not None and not 0.0 < float(travel) <= _MAX_TRAVEL:
             raise ValueError(f"travel must be in (0, {_MAX_TRAVEL}] m, got {travel!r}")
-        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel)
+        if board is not None:
+            board = _check_board(board)
+        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel,
+                          board)
     if task in ("bend", "stoop", "kneel"):
         return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
     if task == "wait":
@@ -993,13 +1123,19 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         return _finish(f"sit_{_fmt(tgt)}", "sit", world, st, fps,
                        f"goals.make_goal_primitive('sit', target={_fmt(tgt)})", meta,
                        start_exact=True, end_exact=False)
-    # standUp: sitting down on a seat behind the standing pose, played backwards and
-    # re-rooted at the seated pelvis
+    return _stand_up(skeleton, st, rng, duration, fps, target)
+
+
+def _stand_up(skeleton: Skeleton, st: _Start, rng: np.random.Generator,
+              duration: float | None, fps: float, target: np.ndarray | None
+              ) -> MotionPrimitive:
+    """standUp from the seat height of ``target`` (default 0.26 H): sitting down on a seat
+    behind the standing pose, played backwards and re-rooted at the seated pelvis."""
     H = skeleton.stature
     seat_z = 0.26 * H if target is None else float(np.asarray(target, dtype=np.float64)[2])
     dist, _ = reach_placement("sit", seat_z, skeleton)
-    world, meta, tgt = _sit(skeleton, st, rng, duration, fps, np.array([dist, 0.0, seat_z]),
-                            nominal=STAND_UP_SECONDS)
+    world, _, _ = _sit(skeleton, st, rng, duration, fps, np.array([dist, 0.0, seat_z]),
+                        nominal=STAND_UP_SECONDS)
     world = world[::-1].copy()
     world[..., :2] -= world[0, 0, :2]
     # Table I's condition (head above chest height) already holds for an upright seated
@@ -1040,7 +1176,8 @@ def _wait(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: fl
 
 
 @lru_cache(maxsize=512)
-def _placement(task: str, height: float, stature: float, hand: str) -> tuple[float, float]:
+def _placement(task: str, height: float, stature: float, hand: str,
+               board: tuple[float, float, float] | None = None) -> tuple[float, float]:
     skeleton = Skeleton(stature)
     H = stature
     if task in ("sit", "standUp"):
@@ -1052,21 +1189,27 @@ def _placement(task: str, height: float, stature: float, hand: str) -> tuple[flo
                                 else -0.07 * H)
     st = _Start(skeleton, None)
     best = (np.inf, None)
-    for x in np.linspace(0.12 * H, 0.45 * H, 12):
-        target = np.array([x, lateral, height])
-        targets, active, _ = _hand_targets(task, target, "both" if both else (
-            "l_hand" if lateral > 0 else "r_hand"))
-        _, _, _, cost = _grid(skeleton, st, targets, active, task)
-        c = float(np.min(cost))
-        if c < best[0]:
-            best = (c, float(x))
+    # Under a low board: with _BOARD_PLACE_MARGIN where that leaves a place, else without.
+    for margin in (0.0,) if board is None else (_BOARD_PLACE_MARGIN, 0.0):
+        for x in np.linspace(0.12 * H, 0.45 * H, 12):
+            target = np.array([x, lateral, height])
+            targets, active, _ = _hand_targets(task, target, "both" if both else (
+                "l_hand" if lateral > 0 else "r_hand"))
+            _, _, _, cost = _grid(skeleton, st, targets, active, task, None if board is None
+                                  else (x - board[0] - margin, board[1], board[2]))
+            c = float(np.min(cost))
+            if c < best[0]:
+                best = (c, float(x))
+        if best[1] is not None:
+            break
     if best[1] is None:
         raise ValueError(f"{task}: no standing place reaches a target at height {height:.3f} m")
     return best[1], lateral
 
 
 def reach_placement(task: str, target_height: float, skeleton: Skeleton,
-                    hand: str = "auto") -> tuple[float, float]:
+                    hand: str = "auto", board: tuple[float, float, float] | None = None
+                    ) -> tuple[float, float]:
     """Where to put the target relative to the standing root for a comfortable posture.
 
     Parameters
@@ -1077,6 +1220,10 @@ def reach_placement(task: str, target_height: float, skeleton: Skeleton,
     skeleton : Skeleton
     hand : str
         ``"auto"`` uses the right hand for one-handed tasks (leftHand: left).
+    board : (depth, bottom, top), optional
+        A low board over the target of grasp, release or move: the target lies ``depth``
+        behind its front edge, under its underside at height ``bottom`` (top: ``top``).
+        The worker then stands where the crouched body stays in front of the edge.
 
     Returns
     -------
@@ -1098,5 +1245,9 @@ def reach_placement(task: str, target_height: float, skeleton: Skeleton,
     if not (lo - 1e-9 <= h <= hi + 1e-9):
         raise ValueError(f"{task}: target height {h:.3f} m is outside [{lo:.3f}, {hi:.3f}] m "
                          f"for a {skeleton.stature:.2f} m worker")
-    return _placement(task, round(h, 4), float(skeleton.stature), hand)
+    if board is not None and task in LEVEL_PATH_TASKS:
+        board = tuple(round(v, 4) for v in _check_board(board))
+    else:
+        board = None
+    return _placement(task, round(h, 4), float(skeleton.stature), hand, board)
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ltl_human_motion.errors import PlanningError
-from ltl_human_motion.motion.goals import HAND_PATHS, LEVEL_PATH_TASKS
+from ltl_human_motion.motion.goals import HAND_PATHS, LEVEL_PATH_TASKS, LOW_BOARD_HEIGHT
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import (
@@ -89,6 +89,14 @@ ALTERNATIVE_NODES = 500
 #: Node budget of the walk to the side of a seat that faces the seated work (without
 #: it the worker sits facing whichever way the walk arrives).
 FACING_NODES = 600
+
+#: Half length of a low board's front edge either side of the target that the reach
+#: under it keeps clear of, metres (about a shoulder width: the arm and the head).
+BOARD_EDGE_SPAN = 0.25
+
+#: Half width of the side a worker reaching under a low board stands on, rad: nearly
+#: square to the edge (the knees of a deep crouch come up close to it).
+BOARD_FACING = math.pi / 12
 
 #: Half width of the side of the target an alternative approach walks to, rad.
 APPROACH_HALF_WIDTH = math.pi / 6
@@ -461,13 +469,49 @@ class SequencePlanner:
         """Where the target should be in the standing root's frame: (ahead, left), metres
         (for ``hand``, if given: the left hand reaches a target on the left)."""
         from ltl_human_motion.motion import goals
+        low = self._low_board(target) if kind in LEVEL_PATH_TASKS else None
         try:
             d, lat = goals.reach_placement(kind, float(target[2]), self.library.skeleton,
-                                           hand=hand or "auto")
+                                           hand=hand or "auto",
+                                           board=None if low is None else low[:3])
             return float(d), float(lat)
         except ValueError as exc:
             raise PlanningError(f"task {task}: the target at height {target[2]:.2f} m is "
                                 f"unreachable: {exc}", task=task, reason="unreachable") from None
+
+    def _low_board(self, target: np.ndarray
+                   ) -> tuple[float, float, float, np.ndarray] | None:
+        """The lowest obstacle part over ``target`` (3,) with its underside above it and
+        below ``LOW_BOARD_HEIGHT`` of the stature: (depth of the target behind the
+        part's nearest edge, underside, top in metres, the edge's outward normal (2,));
+        None if there is none."""
+        highest = LOW_BOARD_HEIGHT * self.library.skeleton.stature
+        best = None
+        xy = np.asarray(target[:2], dtype=np.float64)
+        probe = xy + np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
+        for ob in self.cell.obstacles:
+            for part in ob.parts:
+                lo, hi = part.aabb()
+                sd = part.footprint().signed_distance(probe)
+                if float(target[2]) < float(lo[2]) <= highest and sd[0] <= 0.0 and (
+                        best is None or float(lo[2]) < best[1]):
+                    grad = sd[1:] - sd[0]
+                    normal = grad / max(float(np.linalg.norm(grad)), 1e-12)
+                    best = (-float(sd[0]), float(lo[2]), float(hi[2]), normal)
+        return best
+
+    def _board_local(self, target: np.ndarray, local: np.ndarray
+                     ) -> tuple[float, float, float] | None:
+        """The low board over ``target`` (world (3,); ``local``: it in the start frame of
+        the goal primitive) as the goal primitive takes it: (edge x, underside, top),
+        the edge's nearest x within ``BOARD_EDGE_SPAN`` either side of the target."""
+        low = self._low_board(target)
+        if low is None:
+            return None
+        c, s = math.cos(-self.pose[2]), math.sin(-self.pose[2])
+        n = np.array([c * low[3][0] - s * low[3][1], s * low[3][0] + c * low[3][1]])
+        edge = float(local[0]) + low[0] * n[0] - BOARD_EDGE_SPAN * abs(n[1])
+        return edge, low[1], low[2]
 
     def _clearance(self, xy: np.ndarray) -> np.ndarray:
         return self.clearance(xy)
@@ -1136,7 +1180,10 @@ class SequencePlanner:
             # (Seated, the hands work from the seat.)
             placement = self._placement(kind, target, text,
                                         self._acting_hand(kind, args[0] if args else None))
-            walked = self._approach_facing(target, placement, text, facing)
+            walked = self._approach_under(target, placement, text) \
+                if kind in LEVEL_PATH_TASKS and facing is None else None
+            if walked is None:
+                walked = self._approach_facing(target, placement, text, facing)
         carrying_before = bool(self.held)
         raised = kind in HAND_TASKS and not carrying_before and self.seat is None
         if raised:
@@ -1261,6 +1308,24 @@ class SequencePlanner:
             self._adjust_to(target, placement, text)
         return walked
 
+    def _approach_under(self, target: np.ndarray, placement: tuple[float, float],
+                        text: str) -> int | None:
+        """:meth:`_approach` to the standing place in front of the nearest edge of a low
+        board over ``target``, facing in across the edge (within ``BOARD_FACING``); None
+        if there is no such board or no way there."""
+        low = self._low_board(target)
+        if low is None:
+            return None
+        yaw = math.atan2(-low[3][1], -low[3][0])
+        c, s = math.cos(yaw), math.sin(yaw)
+        d, lat = placement
+        side = math.atan2(-(s * d + c * lat), -(c * d - s * lat))
+        try:
+            return self._approach(target, placement, text, sector=(side, BOARD_FACING),
+                                  budget=SearchBudget(FACING_NODES))
+        except PlanningError:
+            return None
+
     def _approach_facing(self, target: np.ndarray, placement: tuple[float, float],
                          text: str, facing: np.ndarray | None) -> int:
         """:meth:`_approach`; with ``facing`` (3,), from the side of the target that makes
@@ -1381,6 +1446,10 @@ class SequencePlanner:
             kwargs["hand"] = hand
         if kind == "extract" and part is not None and container is not None:
             kwargs["travel"] = self._pull_length(part, container)
+        board = self._board_local(target, local) if local is not None \
+            and kind in LEVEL_PATH_TASKS and not seated else None
+        if board is not None:
+            kwargs["board"] = board
         hand_fixed = "hand" in kwargs
         if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
@@ -1406,7 +1475,8 @@ class SequencePlanner:
             if clear:
                 mp = candidate
                 break
-            if attempt == 1 and kind in ("grasp", "release") and not hand_fixed:
+            if attempt == 1 and kind in ("grasp", "release") and not hand_fixed \
+                    and board is None:
                 other = OTHER_HAND.get(candidate.meta.get("hand"))
                 if other:
                     kwargs["hand"] = other
