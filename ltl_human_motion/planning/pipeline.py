@@ -337,9 +337,8 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
                     options, t_automaton, t_sequence, t_library, stature
                     ) -> SynthesizedMotion:
     t_start = time.perf_counter()
-    written = [(t.name, tuple(t.args)) for t in seq.tasks]
-    steps = [task_step(name, args, cell.shorthands, t.key)
-             for (name, args), t in zip(written, seq.tasks)]
+    written = [(t.name, tuple(t.args)) for t in seq.tasks]        # as verification reads them
+    steps = [task_step(t.name, t.args, cell.shorthands, t.key) for t in seq.tasks]
     planner = SequencePlanner(cell, library, rng, options.planner)
     start = _start_pose(cell, planner.target_of(steps[0].kind, steps[0].args), rng)
     t0 = time.perf_counter()

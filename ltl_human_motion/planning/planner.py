@@ -492,9 +492,11 @@ class SequencePlanner:
         for ob in self.cell.obstacles:
             for part in ob.parts:
                 lo, hi = part.aabb()
+                if not (float(target[2]) < float(lo[2]) <= highest
+                        and (best is None or float(lo[2]) < best[1])):
+                    continue
                 sd = part.footprint().signed_distance(probe)
-                if float(target[2]) < float(lo[2]) <= highest and sd[0] <= 0.0 and (
-                        best is None or float(lo[2]) < best[1]):
+                if sd[0] <= 0.0:
                     grad = sd[1:] - sd[0]
                     normal = grad / max(float(np.linalg.norm(grad)), 1e-12)
                     best = (-float(sd[0]), float(lo[2]), float(hi[2]), normal)

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ltl_human_motion.scenarios.corpus import DWYER_PATTERNS
+from ltl_human_motion.scene.termination import parse_task
 
 __all__ = ["GeneratedPair", "Scenario", "generate_scenario", "generate_scenarios"]
 
@@ -488,8 +489,7 @@ def _unordered_tasks(feasible: list[str], parts: set[str],
     used: set[str] = set()
     for i in rng.permutation(len(feasible)):
         task = feasible[int(i)]
-        args = {a.strip() for a in task.partition("(")[2].rstrip(")").split(",")}
-        on = args & parts
+        on = set(parse_task(task)[1]) & parts
         if on & used:
             continue
         chosen.append(task)
