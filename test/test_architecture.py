@@ -97,3 +97,38 @@ def test_ros2_run_bringup_is_the_cli_with_ros_arguments_dropped() -> None:
                            "__ns:=/probe"], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert "usage: ltl-human-motion bringup" in proc.stdout
+
+
+#: The longest function the planner's modules may hold, lines (docstring included).
+MAX_FUNCTION_LINES = 80
+
+
+def _long_functions(path: Path) -> list[str]:
+    tree = ast.parse(path.read_text(), str(path))
+    return [f"{path.name}:{n.lineno} {n.name} ({n.end_lineno - n.lineno + 1} lines)"
+            for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))
+            and n.end_lineno - n.lineno + 1 > MAX_FUNCTION_LINES]
+
+
+def test_no_planning_function_is_longer_than_80_lines() -> None:
+    long = [f for p in sorted((PACKAGE / "planning").glob("*.py")) for f in _long_functions(p)]
+    assert not long
+
+
+def test_the_planner_parts_set_attributes_only_when_made() -> None:
+    """The planner's state travels in its WorkerState, never in attributes a method sets
+    on the side (the old ``_back_limit``, ``_wait_seconds``, a temporary ``options``)."""
+    offenders = []
+    for name in ("planner", "steps", "walk_goals", "goal_steps"):
+        path = PACKAGE / "planning" / f"{name}.py"
+        for cls in ast.walk(ast.parse(path.read_text(), str(path))):
+            if not isinstance(cls, ast.ClassDef):
+                continue
+            for fn in cls.body:
+                if not isinstance(fn, ast.FunctionDef) or fn.name == "__init__":
+                    continue
+                offenders += [f"{name}.{cls.name}.{fn.name}: self.{t.attr}"
+                              for node in ast.walk(fn) if isinstance(node, ast.Assign)
+                              for t in node.targets if isinstance(t, ast.Attribute)
+                              and isinstance(t.value, ast.Name) and t.value.id == "self"]
+    assert not offenders

@@ -218,9 +218,9 @@ def test_fields_with_a_key_are_reused_between_planners(paper) -> None:
     def goal(xy: np.ndarray, clearance=None) -> np.ndarray:
         return np.hypot(xy[:, 0] - 1.0, xy[:, 1] + 1.0) < 0.6
 
-    first = a._field(goal, ("test", 1.0, -1.0, 0.6))
-    assert b._field(goal, ("test", 1.0, -1.0, 0.6)) is first
-    fresh = b._field(goal)
+    first = a.goals.field(goal, ("test", 1.0, -1.0, 0.6))
+    assert b.goals.field(goal, ("test", 1.0, -1.0, 0.6)) is first
+    fresh = b.goals.field(goal)
     assert fresh is not first
     np.testing.assert_array_equal(fresh.dist, first.dist)
     assert not first.dist.flags.writeable and not first.descent.flags.writeable

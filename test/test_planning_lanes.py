@@ -99,19 +99,21 @@ def test_walk_squeezes_through_a_narrow_corridor() -> None:
     frame clear of the walls, as the verifier checks (the aisle cell's family
     planning:*:blocked / walk:unreachable)."""
     from ltl_human_motion.planning.pipeline import get_library
-    from ltl_human_motion.planning.planner import SequencePlanner, body_clear_every_frame
+    from ltl_human_motion.planning.planner import SequencePlanner
+    from ltl_human_motion.planning.steps import body_clear_every_frame
     cell = cell_from_yaml(CORRIDOR)
     lib = get_library(1.75)
     planner = SequencePlanner(cell, lib, np.random.default_rng(0))
-    planner.pose = (0.0, 0.0, 0.0)
-    assert planner.clearance(np.array([[2.5, 0.0]]))[0] <= planner.options.body_radius
-    goal = planner._region_goal(cell.region("R_in"), "walk into R_in", "walk(R_in)")
-    assert goal.clearance is planner.stand_map
-    walked = planner._walk(goal, "walk(R_in)", 0, carry=False)
+    planner.state.pose = (0.0, 0.0, 0.0)
+    assert planner.ctx.clearance(np.array([[2.5, 0.0]]))[0] <= planner.ctx.options.body_radius
+    goal = planner.goals.region(cell.region("R_in"), "walk into R_in", "walk(R_in)")
+    assert goal.clearance is planner.ctx.stand_map
+    walked = planner.executor.walk(goal, "walk(R_in)", 0, carry=False)
     assert walked > 0
-    world = np.concatenate([s.positions for s in planner.segments])
+    world = np.concatenate([s.positions for s in planner.state.segments])
     assert body_clear_every_frame(world, cell, lib.skeleton.stature)
-    assert 1.0 < planner.pose[0] < 4.0 and abs(planner.pose[1]) < 0.4   # in the corridor
+    x, y, _ = planner.state.pose
+    assert 1.0 < x < 4.0 and abs(y) < 0.4                    # in the corridor
 
 
 def test_roomy_floor_needs_no_squeeze() -> None:
@@ -120,9 +122,9 @@ def test_roomy_floor_needs_no_squeeze() -> None:
     from ltl_human_motion.planning.planner import SequencePlanner
     cell = cell_from_yaml(CORRIDOR.replace("0.65", "0.95"))      # 1.4 m apart
     planner = SequencePlanner(cell, get_library(1.75), np.random.default_rng(0))
-    planner.pose = (0.0, 0.0, 0.0)
-    goal = planner._region_goal(cell.region("R_in"), "walk into R_in", "walk(R_in)")
-    assert goal.clearance is planner.clearance
+    planner.state.pose = (0.0, 0.0, 0.0)
+    goal = planner.goals.region(cell.region("R_in"), "walk into R_in", "walk(R_in)")
+    assert goal.clearance is planner.ctx.clearance
 
 
 def test_field_without_a_spot_leads_around_it() -> None:
@@ -152,26 +154,26 @@ def test_stalled_search_walks_around_a_gap_the_body_does_not_pass() -> None:
     from pathlib import Path
 
     from ltl_human_motion.planning.pipeline import get_library
-    from ltl_human_motion.planning.planner import (
-        STALL_NODES,
-        SequencePlanner,
-        body_clear_every_frame,
-    )
+    from ltl_human_motion.planning.planner import SequencePlanner
+    from ltl_human_motion.planning.standing import standing_offset
+    from ltl_human_motion.planning.steps import STALL_NODES, body_clear_every_frame
     from ltl_human_motion.scene.cell_yaml import resolve_cell
     root = Path(__file__).resolve().parents[1]
     cell = resolve_cell(root / "scenarios" / "cells" / "cluttered.yaml")
     lib = get_library(1.75)
     planner = SequencePlanner(cell, lib, np.random.default_rng(0))
-    planner.pose = (-1.39, 1.26, 2.39)
+    planner.state.pose = (-1.39, 1.26, 2.39)
     target = planner.target_of("grasp", ("O1",))
-    goal = planner._reach_goal(target, planner._placement("grasp", target, "grasp(O1)"),
-                               "reach grasp(O1)", "grasp(O1)")
+    goal, _ = planner.goals.reach(target, standing_offset(planner.ctx, "grasp", target,
+                                                          "grasp(O1)"),
+                                  "reach grasp(O1)", "grasp(O1)")
     assert goal.reroute is not None
-    walked = planner._walk(goal, "grasp(O1)", -1, carry=False)
-    assert walked > 0 and STALL_NODES < planner.expanded < planner.options.budget.max_nodes
-    world = np.concatenate([s.positions for s in planner.segments])
+    walked = planner.executor.walk(goal, "grasp(O1)", -1, carry=False)
+    budget = planner.ctx.options.budget.max_nodes
+    assert walked > 0 and STALL_NODES < planner.state.expanded < budget
+    world = np.concatenate([s.positions for s in planner.state.segments])
     assert body_clear_every_frame(world, cell, lib.skeleton.stature)
-    assert np.hypot(planner.pose[0] - target[0], planner.pose[1] - target[1]) < 0.8
+    assert np.hypot(planner.state.pose[0] - target[0], planner.state.pose[1] - target[1]) < 0.8
 
 
 def test_a_colliding_stop_forbids_the_stops_around_it() -> None:
@@ -184,16 +186,16 @@ def test_a_colliding_stop_forbids_the_stops_around_it() -> None:
     from ltl_human_motion.planning.planner import SequencePlanner
     planner = SequencePlanner(cell_from_yaml(CELL), get_library(1.75),
                               np.random.default_rng(0))
-    index = planner.index
+    index = planner.ctx.index
     stop = int(np.flatnonzero(index.stops & ~index.standing)[0])
     walk = int(np.flatnonzero(~index.stops & ~index.carry)[0])
     turn = int(np.flatnonzero(index.standing)[0])
     poses = [(0.0, 0.0, 0.0), (0.5, 0.1, 0.2)]
-    wide = planner._forbid([walk, stop], poses, 1)
+    wide = planner.executor.forbid([walk, stop], poses, 1)
     n_stops = int(np.sum(index.stops & ~index.standing))
     assert len(wide) == 9 * n_stops and (stop, *placement_key(*poses[1])) in wide
-    assert planner._forbid([stop], poses[:1], 0) == {(stop, *placement_key(*poses[0]))}
-    assert len(planner._forbid([walk, turn], poses, 1)) == 1
+    assert planner.executor.forbid([stop], poses[:1], 0) == {(stop, *placement_key(*poses[0]))}
+    assert len(planner.executor.forbid([walk, turn], poses, 1)) == 1
 
 
 def test_arms_come_up_after_a_step_aside_from_a_board_at_elbow_height() -> None:
@@ -203,15 +205,16 @@ def test_arms_come_up_after_a_step_aside_from_a_board_at_elbow_height() -> None:
     from pathlib import Path
 
     from ltl_human_motion.planning.pipeline import get_library
-    from ltl_human_motion.planning.planner import SequencePlanner, body_clear_every_frame
+    from ltl_human_motion.planning.planner import SequencePlanner
+    from ltl_human_motion.planning.steps import body_clear_every_frame
     from ltl_human_motion.scene.cell_yaml import resolve_cell
     cell = resolve_cell(Path(__file__).resolve().parents[1] / "scenarios" / "cells"
                         / "aisle.yaml")
     lib = get_library(1.75)
     planner = SequencePlanner(cell, lib, np.random.default_rng(0))
-    planner.pose = (1.2, -0.1, 0.0)
-    planner._stand_still(-1, 0.3)
-    planner._arm_transition(False, -1)
-    assert abs(planner.pose[1] + 0.1) > 0.05                 # stepped aside
-    world = np.concatenate([s.positions for s in planner.segments])
+    planner.state.pose = (1.2, -0.1, 0.0)
+    planner.executor.stand_still(-1, 0.3)
+    planner.executor.arm_transition(False, -1)
+    assert abs(planner.state.pose[1] + 0.1) > 0.05                 # stepped aside
+    world = np.concatenate([s.positions for s in planner.state.segments])
     assert body_clear_every_frame(world, cell, lib.skeleton.stature)

@@ -84,7 +84,7 @@ def test_sit_on_the_seat_already_sat_on_stays_seated(stature: float) -> None:
     assert np.abs(held - sat).max() < 1e-6
     from ltl_human_motion.scene.termination import termination_series
     holds = termination_series("sit", ("stool",), plan.segments[second.goal_segment].positions,
-                               cell, {}, eps=0.05, stature=stature, fps=planner.library.fps)
+                               cell, {}, eps=0.05, stature=stature, fps=planner.ctx.library.fps)
     assert np.all(holds)
     names = [s.name for s in plan.segments[second.last_segment + 1:walk.last_segment + 1]]
     assert names[0].startswith("standUp_"), names

@@ -51,7 +51,8 @@ def test_grasp_palm_target_clears_a_flat_parts_support() -> None:
     """A 4 cm disc on a board: the palm target rises until the palm clears the board,
     and the palm there still enters the part (grasp holds)."""
     from ltl_human_motion.planning.pipeline import get_library, resolve_cell
-    from ltl_human_motion.planning.planner import PALM_SUPPORT_GAP, SequencePlanner
+    from ltl_human_motion.planning.planner import SequencePlanner
+    from ltl_human_motion.planning.standing import PALM_SUPPORT_GAP
     from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_radii
     cell = resolve_cell("scenarios/cells/kitting.yaml")
     planner = SequencePlanner(cell, get_library(1.75), np.random.default_rng(0))

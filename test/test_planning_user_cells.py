@@ -187,8 +187,8 @@ def test_arm_transitions_are_checked_as_played():
     from ltl_human_motion.planning.planner import SequencePlanner
     lib = get_library(1.75)
     planner = SequencePlanner(resolve_cell("demo_cell"), lib, np.random.default_rng(0))
-    planner._arm_transition(False, -1)
-    seg = planner.segments[-1].positions
+    planner.executor.arm_transition(False, -1)
+    seg = planner.state.segments[-1].positions
     assert np.allclose(enforce_bone_lengths(seg, lib.skeleton), seg, atol=1e-9)
 
 

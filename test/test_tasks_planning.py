@@ -286,7 +286,7 @@ def test_inserts_into_the_kit_tray_verify_and_a_flush_tray_is_refused_early(monk
     (a placed part would hold enclose only to rounding, as the 10-part run showed): it is
     refused before any search, naming the axis and the clearance."""
     from ltl_human_motion.errors import PlanningError
-    from ltl_human_motion.planning import planner as planner_mod
+    from ltl_human_motion.planning import steps as steps_mod
     from ltl_human_motion.planning.pipeline import synthesize
     spec = kitting_spec("response", 4)
     motion = synthesize(spec, kitting_cell_yaml(4), variants=1)[0]
@@ -300,7 +300,7 @@ def test_inserts_into_the_kit_tray_verify_and_a_flush_tray_is_refused_early(monk
 
     def no_search(*_a, **_k):
         raise AssertionError("searched")
-    monkeypatch.setattr(planner_mod, "astar", no_search)      # the planner's A*
+    monkeypatch.setattr(steps_mod, "astar", no_search)      # the planner's A*
     with pytest.raises(PlanningError, match=r"container kit leaves P\d 0.000 m of room "
                        r"along z \(at least 0.002 m, FIT_CLEARANCE") as info:
         synthesize(spec, flush, variants=1)

@@ -239,12 +239,13 @@ def _heuristic(goal: Goal, options: SearchOptions, x: np.ndarray, y: np.ndarray,
 
 
 def _over_budget(budget: SearchBudget, t0: float, expanded: int, stall_nodes: int | None,
-                 since_progress: int, closest: float) -> str:
+                 near: _Closest) -> str:
     """``"budget"`` or ``"stalled"`` when the search must end, else ``""``."""
     if expanded > budget.max_nodes or (budget.max_seconds is not None
                                        and time.perf_counter() - t0 > budget.max_seconds):
         return "budget"
-    if stall_nodes is not None and since_progress > stall_nodes and closest > STALL_FAR:
+    if stall_nodes is not None and expanded - near.progress_at > stall_nodes \
+            and near.distance > STALL_FAR:
         return "stalled"
     return ""
 
@@ -307,6 +308,83 @@ def _stop_after(index: GaitIndex, prim: int, at: Pose, goal: Goal, allowed: np.n
     return int(stop_ids[k]), stop_ends[k]
 
 
+def _step_costs(index: GaitIndex, options: SearchOptions, carry: bool,
+                rng: np.random.Generator | None) -> tuple[np.ndarray, np.ndarray]:
+    """The primitives a search may take (carry or walk ones; all if the library has none
+    of that kind), bool (P,), and their costs with the seeded noise, (P,)."""
+    allowed = index.carry == carry
+    if not allowed.any():
+        allowed = np.ones_like(allowed)
+    noise = (1.0 + options.cost_noise * rng.random(len(index.cost))
+             if (rng is not None and options.cost_noise) else np.ones(len(index.cost)))
+    return allowed, index.cost * noise
+
+
+class _Tree:
+    """The search tree and its open list: per node the parent, the primitive that led
+    there, the pose it ends at (where the next primitive starts) and the cost so far."""
+
+    def __init__(self, start: Pose, start_primitive: int, h0: float) -> None:
+        self.parents: list[int] = [-1]
+        self.prims: list[int] = [start_primitive]
+        self.poses: list[Pose] = [start]
+        self.g_cost: list[float] = [0.0]
+        self.heap: list[tuple[float, int]] = [(h0, 0)]
+        self.closed: set[tuple[int, int, int, int]] = set()
+
+    def close(self, node: int, options: SearchOptions) -> bool:
+        """Add ``node`` to the closed set (its pose on the ``options.grid`` /
+        ``options.yaw_bins`` lattice and its primitive); False if it was closed."""
+        px, py, pyaw = self.poses[node]
+        key = (round(px / options.grid), round(py / options.grid),
+               round(pyaw * (options.yaw_bins / (2.0 * np.pi))) % options.yaw_bins,
+               self.prims[node])
+        if key in self.closed:
+            return False
+        self.closed.add(key)
+        return True
+
+    def push(self, node: int, succ: np.ndarray, ends: np.ndarray, g: np.ndarray,
+             f: np.ndarray) -> None:
+        """Add the successors ``succ`` (M,) of ``node`` ending at ``ends`` (M, 3), with
+        costs ``g`` and priorities ``f`` (M,)."""
+        for prim, end, g_k, f_k in zip(succ.tolist(), ends.tolist(), g.tolist(), f.tolist()):
+            self.parents.append(node)
+            self.prims.append(prim)
+            self.poses.append((end[0], end[1], end[2]))
+            self.g_cost.append(g_k)
+            heapq.heappush(self.heap, (f_k, len(self.prims) - 1))
+
+    def chain(self, node: int, last: int, tail: list[tuple[int, Pose]]
+              ) -> tuple[list[int], list[Pose]]:
+        """The primitives from the start to ``node``, then ``last`` and ``tail``, with the
+        pose each starts from (:func:`_chain`)."""
+        return _chain(node, last, self.parents, self.prims, self.poses, tail)
+
+
+class _Closest:
+    """The search's closest approach to the goal (field distance, metres), where it was,
+    and when it last came ``STALL_PROGRESS`` nearer (for the stall test)."""
+
+    def __init__(self, distance: float, at: tuple[float, float]) -> None:
+        self.distance, self.at = distance, at
+        self.progress, self.progress_at = distance, 0
+
+    def update(self, left: np.ndarray, ends: np.ndarray, expanded: int) -> None:
+        """Take the successors' distances to the goal ``left`` (M,) at ``ends`` (M, 3)."""
+        m = int(np.argmin(left))
+        if left[m] < self.distance:
+            self.distance, self.at = float(left[m]), (float(ends[m, 0]), float(ends[m, 1]))
+            if self.distance < self.progress - STALL_PROGRESS:
+                self.progress, self.progress_at = self.distance, expanded
+
+    def failure(self, reason: str, expanded: int, t0: float) -> SearchFailure:
+        """The search's end for ``reason``, started at ``t0`` (``time.perf_counter``)."""
+        return SearchFailure(reason, expanded, time.perf_counter() - t0, self.distance,
+                             self.at)
+
+
+
 def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | None = None,
           clearance: Callable[[np.ndarray], np.ndarray],
           options: SearchOptions = SearchOptions(), carry: bool = False,
@@ -315,7 +393,8 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
           forbidden: frozenset[tuple[int, int, int, int]] = frozenset(),
           stall_nodes: int | None = None
           ) -> SearchResult | SearchFailure:
-    """Search a sequence of gait primitives from ``start`` until ``goal.reached``.
+    """Search a sequence of gait primitives from ``start`` until ``goal.reached``; returns
+    a :class:`SearchResult`, or a :class:`SearchFailure` that says why it ended.
 
     Parameters
     ----------
@@ -334,8 +413,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         Use carry primitives (arms holding an object) instead of walk primitives.
     budget : SearchBudget
     rng : numpy.random.Generator, optional
-        Draws the seeded multiplicative noise on primitive costs (``options.cost_noise``),
-        for varied but valid paths.
+        Draws the seeded cost noise (``options.cost_noise``): varied but valid paths.
     body_clear : callable, optional
         ``body_clear(poses (M, S, J, 3), standing (M,)) -> bool (M,)``: whole-body obstacle
         test (``standing``: the primitive starts where the last one ended), run on
@@ -345,85 +423,45 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         Primitives never taken from a pose, keyed by :func:`placement_key` of that pose
         (the caller found them colliding on a closer look).
     stall_nodes : int or None
-        End with ``"stalled"`` once this many nodes were expanded without bringing the
-        closest approach ``STALL_PROGRESS`` nearer, while further than ``STALL_FAR``
-        from the goal (the heuristic leads into a gap the body does not pass, and the
-        search floods the floor before it).
-
-    Returns
-    -------
-    SearchResult or SearchFailure
+        End with ``"stalled"`` after this many nodes without coming ``STALL_PROGRESS``
+        nearer, further than ``STALL_FAR`` from the goal (the heuristic leads into a gap
+        the body does not pass, and the search floods the floor before it).
     """
     t0 = time.perf_counter()
-    cost_noise, grid, yaw_bins = options.cost_noise, options.grid, options.yaw_bins
     sx, sy, syaw = start
     if bool(goal.reached(np.array([sx]), np.array([sy]), np.array([syaw]))[0]):
         return SearchResult([], [], start, 0, time.perf_counter() - t0)
-    allowed = index.carry == carry
-    if not allowed.any():
-        allowed = np.ones_like(allowed)
-    noise = (1.0 + cost_noise * rng.random(len(index.cost)) if (rng is not None and cost_noise)
-             else np.ones(len(index.cost)))
-    step_cost = index.cost * noise
-    yaw_scale = yaw_bins / (2.0 * np.pi)
-
-    # Node arrays: parent, primitive, pose, g.
-    parents: list[int] = [-1]
-    prims: list[int] = [-1 if start_primitive is None else start_primitive]
-    poses: list[Pose] = [start]
-    g_cost: list[float] = [0.0]
+    allowed, step_cost = _step_costs(index, options, carry, rng)
     h0 = float(_heuristic(goal, options, np.array([sx]), np.array([sy]), np.array([syaw]))[0])
-    open_heap: list[tuple[float, int]] = [(h0, 0)]
-    closed: set[tuple[int, int, int]] = set()
+    tree = _Tree(start, -1 if start_primitive is None else start_primitive, h0)
     expanded = 0
-    closest = float(goal.distance(np.array([sx]), np.array([sy]))[0])
-    closest_at, progress, progress_at = (sx, sy), closest, 0
-    while open_heap:
+    near = _Closest(float(goal.distance(np.array([sx]), np.array([sy]))[0]), (sx, sy))
+    while tree.heap:
         checkpoint("planning")
-        _, node = heapq.heappop(open_heap)
-        px, py, pyaw = poses[node]
-        key = (round(px / grid), round(py / grid),
-               round(pyaw * yaw_scale) % yaw_bins, prims[node])
-        if key in closed:
+        _, node = heapq.heappop(tree.heap)
+        if not tree.close(node, options):
             continue
-        closed.add(key)
         expanded += 1
-        over = _over_budget(budget, t0, expanded, stall_nodes, expanded - progress_at,
-                            closest)
+        over = _over_budget(budget, t0, expanded, stall_nodes, near)
         if over:
-            return SearchFailure(over, expanded, time.perf_counter() - t0, closest,
-                                 closest_at)
-        found = _clear_successors(index, prims[node], poses[node], allowed, clearance,
-                                  body_clear, forbidden, options)
+            return near.failure(over, expanded, t0)
+        found = _clear_successors(index, tree.prims[node], tree.poses[node], allowed,
+                                  clearance, body_clear, forbidden, options)
         if found is None:
             continue
         succ, ends = found
         done, tail = _arrivals(index, succ, ends, goal, allowed, clearance, body_clear,
                                forbidden, options)
-        g_new = g_cost[node] + step_cost[succ]
+        g_new = tree.g_cost[node] + step_cost[succ]
         if done.any():
             best = int(np.argmin(np.where(done, g_new, np.inf)))
-            chain, chain_poses = _chain(node, int(succ[best]), parents, prims, poses, tail)
-            end = tuple(float(v) for v in ends[best])
-            return SearchResult(chain, chain_poses, end, expanded, time.perf_counter() - t0)
+            chain, chain_poses = tree.chain(node, int(succ[best]), tail)
+            return SearchResult(chain, chain_poses, tuple(float(v) for v in ends[best]),
+                                expanded, time.perf_counter() - t0)
         h_new = _heuristic(goal, options, ends[:, 0], ends[:, 1], ends[:, 2])
         keep = np.isfinite(h_new)
         if not keep.any():
             continue
-        left = goal.distance(ends[keep, 0], ends[keep, 1])
-        m = int(np.argmin(left))
-        if left[m] < closest:
-            closest, closest_at = float(left[m]), (float(ends[keep][m, 0]),
-                                                   float(ends[keep][m, 1]))
-            if closest < progress - STALL_PROGRESS:
-                progress, progress_at = closest, expanded
-        succ, ends, g_new = succ[keep], ends[keep], g_new[keep]
-        f_new = g_new + h_new[keep]
-        for prim, end, g, f in zip(succ.tolist(), ends.tolist(), g_new.tolist(),
-                                   f_new.tolist()):
-            parents.append(node)
-            prims.append(prim)
-            poses.append((end[0], end[1], end[2]))
-            g_cost.append(g)
-            heapq.heappush(open_heap, (f, len(prims) - 1))
-    return SearchFailure("blocked", expanded, time.perf_counter() - t0, closest, closest_at)
+        near.update(goal.distance(ends[keep, 0], ends[keep, 1]), ends[keep], expanded)
+        tree.push(node, succ[keep], ends[keep], g_new[keep], g_new[keep] + h_new[keep])
+    return near.failure("blocked", expanded, t0)

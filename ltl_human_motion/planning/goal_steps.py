@@ -1,0 +1,375 @@
+"""Goal steps: make, check and place the goal primitive of a task, with the walk to it.
+
+:class:`GoalSteps` walks the worker to where a goal primitive reaches its target
+(:mod:`.walk_goals`, :mod:`.standing`), makes the primitive for the exact target with
+the motion library's goal models (:mod:`ltl_human_motion.motion.goals`), checks it as
+the verifier does (body, parts in hand, the part being lifted; an extract must bring
+its part out) and places it. When every seeded primitive runs into an obstacle it
+tries the alternatives in order: other places to let a part go, a roomier spot, other
+sides of the target and a step further back.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.motion.goals import HAND_PATHS, LEVEL_PATH_TASKS
+from ltl_human_motion.motion.skeleton import JOINT_INDEX
+from ltl_human_motion.motion.types import MotionPrimitive, world_positions
+from ltl_human_motion.planning.astar import SearchBudget
+from ltl_human_motion.planning.plan_state import (
+    OTHER_HAND,
+    PlanContext,
+    WorkerState,
+    acting_hand,
+    grip_frame,
+    lift_frame,
+    object_position,
+)
+from ltl_human_motion.planning.standing import (
+    board_local,
+    low_board,
+    pull_length,
+    release_targets,
+)
+from ltl_human_motion.planning.steps import StepExecutor
+from ltl_human_motion.planning.walk_goals import WalkGoals
+
+#: Frames a wait lasts beyond the blends at both ends (2 x overlap), so that the
+#: stillness the verifier checks lasts as long as asked.
+WAIT_EXTRA_FRAMES = 6
+#: How long a seated wait without a duration lasts, seconds (the wait model's default).
+SEATED_WAIT_SECONDS = 2.0
+
+#: Seeded primitives tried at each alternative (release place, approach) after the first
+#: (the first gets ``PlannerOptions.goal_attempts``).
+ALTERNATIVE_ATTEMPTS = 2
+
+#: Other ways to stand for a reach whose motions all hit an obstacle, in order: (turn of
+#: the approach direction about the target, rad; extra distance from the target, m).
+#: First a step further back (a knee or thigh at a desk or low shelf front), then the
+#: target's other sides (an arm hitting a crate beside it).
+ALTERNATE_APPROACHES: tuple[tuple[float, float], ...] = (
+    (0.0, 0.08), (math.pi / 3, 0.0), (-math.pi / 3, 0.0))
+
+#: Node budget of the walk to an alternative approach (most are a few steps round the
+#: target; a side that needs a long way round is not worth the search).
+ALTERNATIVE_NODES = 500
+
+#: Node budget of the walk to the side of a seat that faces the seated work (without
+#: it the worker sits facing whichever way the walk arrives).
+FACING_NODES = 600
+
+#: Half width of the side a worker reaching under a low board stands on, rad: nearly
+#: square to the edge (the knees of a deep crouch come up close to it).
+BOARD_FACING = math.pi / 12
+
+#: Half width of the side of the target an alternative approach walks to, rad.
+APPROACH_HALF_WIDTH = math.pi / 6
+
+#: Step left to the standing adjustment when the first one from where a walk ended was
+#: not clear: the walk goes on to a spot that needs almost none, metres.
+FINAL_ADJUST_RADIUS = 0.05
+
+#: Tasks done where the worker stands (no target); when furniture there blocks them,
+#: the worker first walks to a spot with ``IN_PLACE_ROOM`` of floor clearance.
+IN_PLACE_TASKS = ("bend", "stoop", "kneel", "wait")
+
+#: Floor clearance around the root a kneel or stoop needs, metres (the knee goes about
+#: 0.5 m ahead of the root and the head as far when stooping, plus a hand's width).
+IN_PLACE_ROOM = 0.6
+
+#: Stride of the frames on which the planner checks that an extract takes its part out.
+EXTRACT_CHECK_STRIDE = 4
+
+
+class GoalSteps:
+    """Makes the goal segments of one plan.
+
+    Parameters
+    ----------
+    ctx : PlanContext
+    state : WorkerState
+    executor : StepExecutor
+        Places the walks, steps and primitives.
+    goals : WalkGoals
+        Makes the walks' goals.
+    """
+
+    def __init__(self, ctx: PlanContext, state: WorkerState, executor: StepExecutor,
+                 goals: WalkGoals) -> None:
+        self.ctx = ctx
+        self.state = state
+        self.executor = executor
+        self.goals = goals
+
+    def where(self, name: str) -> np.ndarray:
+        """Where part ``name`` rests now (3,) (:func:`.plan_state.object_position`)."""
+        return object_position(self.ctx.cell, self.state, name)
+
+    def segment(self, kind: str, target: np.ndarray | None, label: int,
+                text: str, *, carry_stance: bool = False, seconds: float | None = None,
+                grasped: str | None = None, attempts: int | None = None,
+                part: str | None = None, container: str | None = None
+                ) -> tuple[int, MotionPrimitive]:
+        """Make, check and place the goal primitive of ``kind`` for ``target``.
+
+        ``carry_stance``: the arms are already in the carry stance; ``seconds``: how long
+        a wait lasts; ``grasped``: the part a grasp picks up (checked from contact on);
+        ``attempts``: seeded primitives tried (default ``options.goal_attempts``);
+        ``part``: the part a move, insert or release puts down (done by the hand holding
+        it; for extract, the part taken out of ``container``). A grasp or extract while
+        one hand holds a part is done by the other hand.
+        """
+        x, y, yaw = self.state.pose
+        local = None
+        if target is not None:
+            c, s = math.cos(-yaw), math.sin(-yaw)
+            dx, dy = target[0] - x, target[1] - y
+            local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
+        seated = self.state.seat is not None and kind != "standUp"
+        kwargs = {"rng": self.ctx.rng,
+                  "start_pose": self.executor.seated_pose() if seated
+                  else self.ctx.stance(bool(self.state.held) or carry_stance)}
+        hand = acting_hand(self.state, kind, part if kind != "grasp" else grasped)
+        if hand is not None:
+            kwargs["hand"] = hand
+        if kind == "extract" and part is not None and container is not None:
+            kwargs["travel"] = self.pull_length(part, container)
+        board = board_local(self.ctx.cell, target, local, yaw,
+                            self.ctx.stature) if local is not None \
+            and kind in LEVEL_PATH_TASKS and not seated else None
+        if board is not None:
+            kwargs["board"] = board
+        hand_fixed = "hand" in kwargs
+        if kind == "wait" and target is None and seconds is not None:
+            # Longer than asked by the blends at both ends, so the stillness lasts.
+            kwargs["duration"] = (seconds + (2 * self.ctx.overlap + WAIT_EXTRA_FRAMES)
+                                  / self.ctx.library.fps)
+        mp = None
+        kept_in = 0
+        attempts = self.ctx.options.goal_attempts if attempts is None else attempts
+        for attempt in range(attempts):
+            if kind in LEVEL_PATH_TASKS:
+                # Every other try comes in level (over a shelf board, under the one above).
+                kwargs["path"] = HAND_PATHS[attempt % len(HAND_PATHS)]
+            try:
+                candidate = self.executor.sit_still(kwargs.get("duration", SEATED_WAIT_SECONDS)) \
+                    if seated and kind == "wait" else self.ctx.library.goal(kind, local, **kwargs)
+            except ValueError as exc:
+                raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
+                                    f"target: {exc}", task=text, reason="unreachable") from None
+            clear = self.goal_clear(candidate, grasped)
+            if clear and kind == "extract" and part is not None and container is not None \
+                    and not self.pulls_out(candidate, part, container):
+                kept_in += 1
+                clear = False
+            if clear:
+                mp = candidate
+                break
+            if attempt == 1 and kind in ("grasp", "release") and not hand_fixed \
+                    and board is None:
+                other = OTHER_HAND.get(candidate.meta.get("hand"))
+                if other:
+                    kwargs["hand"] = other
+        if mp is None and kept_in:
+            raise PlanningError(f"task {text}: {kept_in} of the {attempts} {kind} motions "
+                                f"tried keep {part} in {container} (the hand does not take "
+                                "it out far enough from where the worker stands), the others "
+                                "run into an obstacle", task=text, reason="blocked")
+        if mp is None:
+            raise PlanningError(f"task {text}: every {kind} motion tried "
+                                f"({attempts}) runs into an obstacle; "
+                                "an obstacle blocks the reach", task=text, reason="blocked")
+        seg = self.executor.add(mp, self.state.pose, label, self.ctx.overlap)
+        self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
+        self.state.gait_state = None
+        return seg, mp
+
+    def first_clear_try(self, i: int, text: str, kind: str, args: tuple[str, ...],
+                        tries: list, carrying_before: bool
+                        ) -> tuple[int, MotionPrimitive, np.ndarray | None, int]:
+        """Make the goal primitive of step ``i`` from the first of ``tries`` (see
+        :meth:`alternatives`) that works; returns (segment, primitive, the target it
+        reached, gait primitives its preparation walked). Raises the first failure, with
+        how many other placements were tried."""
+        failure = None
+        for k, (target, prepare) in enumerate(tries):
+            mark = (len(self.state.segments), self.state.pose, self.state.gait_state)
+            try:
+                walked = prepare() if prepare is not None else 0
+                seg, mp = self.segment(
+                    kind, target, i, text, carry_stance=carrying_before,
+                    seconds=float(args[0]) if kind == "wait" and args else None,
+                    grasped=args[0] if kind == "grasp" else None,
+                    part=args[0] if kind in ("move", "insert", "release", "extract") and args
+                    else None, container=args[1] if kind == "extract" else None,
+                    attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
+                return seg, mp, target, walked
+            except PlanningError as exc:
+                # Blocked, or out of reach from where the walk ended (it came from the
+                # side of a machine): the other placements may do; an alternative may
+                # fail in any way.
+                if k == 0 and exc.reason not in ("blocked", "unreachable"):
+                    raise
+                failure = failure or exc
+                # What a failed try placed (a walk, an arm transition) is taken back.
+                del self.state.segments[mark[0]:]
+                self.state.pose, self.state.gait_state = mark[1], mark[2]
+        if len(tries) == 1:
+            raise failure
+        raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements tried",
+                            task=text, reason=failure.reason)
+
+    def alternatives(self, kind: str, args: tuple[str, ...], target: np.ndarray | None,
+                     placement: tuple[float, float] | None, text: str, raised: bool
+                     ) -> list[tuple[np.ndarray | None, Callable[[], int] | None]]:
+        """What to try when the goal primitive is blocked, in order: (target, prepare),
+        where ``prepare()`` moves the worker first and returns the primitives walked.
+
+        release: other places to let go; bend/stoop/kneel/wait: a roomier spot; tasks
+        with a target: the other ``ALTERNATE_APPROACHES`` (further back, other sides).
+        """
+        if kind == "release":
+            return [(t, None) for t in self.release_targets(args[0])]
+        if target is None:
+            return [(None, None)] + ([(None, lambda: self.walk_to_room(text))]
+                                     if kind in IN_PLACE_TASKS else [])
+        if placement is None:
+            return [(target, None)]
+        first = math.atan2(self.state.pose[1] - target[1], self.state.pose[0] - target[0])
+
+        def approach(turn: float, back: float) -> int:
+            lowered = raised and not self.state.held
+            if lowered:
+                self.executor.arm_transition(True, -1)
+            self.executor.step_out()            # the first try may have left the worker at a rack
+            walked = self.approach(target, (placement[0] + back, placement[1]), text,
+                                    sector=(first + turn, APPROACH_HALF_WIDTH),
+                                    budget=SearchBudget(ALTERNATIVE_NODES))
+            if lowered:
+                self.executor.arm_transition(False, -1)
+            return walked
+
+        return [(target, None)] + [
+            (target, functools.partial(approach, turn, back))
+            for turn, back in ALTERNATE_APPROACHES]
+
+    def approach(self, target: np.ndarray, placement: tuple[float, float], text: str,
+                 sector: tuple[float, float] | None = None,
+                 budget: SearchBudget | None = None) -> int:
+        """Walk to where the goal primitive reaches ``target`` (from ``sector``, see
+        :meth:`.walk_goals.WalkGoals.reach`; within ``budget``) and take the standing step
+        there; returns the gait primitives walked."""
+        desc = f"reach {text} at ({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})"
+        goal, back = self.goals.reach(target, placement, desc, text, sector=sector)
+        walked = self.executor.walk(goal, text, -1, carry=self.state.carrying, budget=budget)
+        if not self.executor.adjust_to(target, placement, text, back):
+            # No clear step from where the walk ended: walk on to a spot that needs
+            # (almost) none.
+            goal, back = self.goals.reach(target, placement, desc, text,
+                                          adjust=FINAL_ADJUST_RADIUS, sector=sector)
+            walked += self.executor.walk(goal, text, -1, carry=self.state.carrying,
+                                         budget=budget)
+            self.executor.adjust_to(target, placement, text, back)
+        return walked
+
+    def approach_under(self, target: np.ndarray, placement: tuple[float, float],
+                       text: str) -> int | None:
+        """:meth:`approach` to the standing place in front of the nearest edge of a low
+        board over ``target``, facing in across the edge (within ``BOARD_FACING``); None
+        if there is no such board or no way there."""
+        low = low_board(self.ctx.cell, target, self.ctx.stature)
+        if low is None:
+            return None
+        yaw = math.atan2(-low[3][1], -low[3][0])
+        c, s = math.cos(yaw), math.sin(yaw)
+        d, lat = placement
+        side = math.atan2(-(s * d + c * lat), -(c * d - s * lat))
+        try:
+            return self.approach(target, placement, text, sector=(side, BOARD_FACING),
+                                  budget=SearchBudget(FACING_NODES))
+        except PlanningError:
+            return None
+
+    def approach_facing(self, target: np.ndarray, placement: tuple[float, float],
+                        text: str, facing: np.ndarray | None) -> int:
+        """:meth:`approach`; with ``facing`` (3,), from the side of the target that makes
+        the worker face it (a seat: sit facing the desk), else from any side."""
+        if facing is not None:
+            ahead = math.atan2(facing[1] - target[1], facing[0] - target[0])
+            # The worker stands ``placement`` from the target: with the target behind
+            # (a seat), the standing spot lies towards what the worker will face.
+            side = ahead if placement[0] < 0 else ahead + math.pi
+            try:
+                return self.approach(target, placement, text,
+                                      sector=(side, APPROACH_HALF_WIDTH),
+                                      budget=SearchBudget(FACING_NODES))
+            except PlanningError:
+                pass
+        return self.approach(target, placement, text)
+
+    def walk_to_room(self, text: str) -> int:
+        """Walk to the nearest spot with ``IN_PLACE_ROOM`` of floor clearance (a task done
+        where the worker stands hit the furniture there); returns the primitives walked."""
+        room = IN_PLACE_ROOM
+
+        def roomy(x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None = None) -> np.ndarray:
+            return self.ctx.clearance(np.stack([x, y], axis=-1)) > room
+
+        field = self.goals.field(lambda xy, clearance: roomy(xy[:, 0], xy[:, 1]), ("room", room))
+        goal = self.goals.from_field(field, roomy, f"find room for {text}", text)
+        return self.executor.walk(goal, text, -1, carry=bool(self.state.held))
+
+    def release_targets(self, obj: str) -> list[np.ndarray]:
+        """Where the hand holding ``obj`` may let it go, palm positions (3,), in order
+        (:func:`.standing.release_targets`)."""
+        height = float(np.ptp(self.ctx.cell.object(obj).occupancy.aabb(), axis=0)[2])
+        return release_targets(self.ctx.cell, self.state.pose, self.ctx.stature, height,
+                               self.state.held_offset(obj))
+
+    def pull_length(self, part: str, container: str) -> float:
+        """How far an extract pulls ``part`` out of ``container``, metres
+        (:func:`.standing.pull_length`)."""
+        cell = self.ctx.cell
+        return pull_length(cell.object(container).occupancy_at(self.where(container)).aabb(),
+                           cell.object(part).occupancy_at(self.where(part)).aabb())
+
+    def pulls_out(self, mp: MotionPrimitive, part: str, container: str) -> bool:
+        """Whether the hand of an extract primitive brings ``part`` (carried from the
+        contact frame on) out of ``container`` on some frame: Table I's condition, which
+        the verifier checks (a worker standing close keeps the part in a deep fixture)."""
+        from ltl_human_motion.scene.predicates import enter_object
+        joint = {"l_hand": "l_hand"}.get(mp.meta.get("hand"), "r_hand")
+        hand = world_positions(mp, *self.state.pose)[:, JOINT_INDEX[joint]]
+        contact = min(grip_frame(mp), len(hand) - 1)
+        obj, box = self.ctx.cell.object(part), self.ctx.cell.object(container)
+        around = box.occupancy_at(self.where(container))
+        offset = self.where(part) - hand[contact]
+        return any(not enter_object(obj.occupancy_at(p + offset), around)
+                   for p in hand[contact::EXTRACT_CHECK_STRIDE])
+
+    def goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
+        """Whether the body, the objects already in the hands and the part being grasped
+        (``grasped``, from the frame the hand lifts it, :func:`lift_frame`) keep clear of
+        obstacles."""
+        world = world_positions(mp, *self.state.pose)
+        if not self.executor.placed_clear(mp, self.state.pose, samples=None, world=world):
+            return False
+        if grasped is None:
+            return True
+        from ltl_human_motion.scene.predicates import object_clearance
+        joint = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(mp.meta.get("hand"), "r_hand")
+        hand = world[:, JOINT_INDEX[joint]]
+        contact = int(mp.meta.get("contact_frame", 0))
+        lift = lift_frame(mp, hand)
+        if lift >= len(hand):
+            return True
+        # The part rests on its support until the hand lifts it; carried from then on.
+        centre = hand[lift:] + (self.where(grasped) - hand[contact])
+        return not np.any(object_clearance(self.ctx.cell, grasped, centre) <= 0.0)

@@ -1,0 +1,255 @@
+"""What a plan works in and what its steps change: the planning context, the worker's
+state, and the book-keeping of the parts (which hand holds what, where parts rest).
+
+:class:`PlanContext` holds what one plan does not change (the cell, the motion library,
+the gait index, the clearance maps, the seeded generator). :class:`WorkerState` holds
+what the steps change: the segments placed so far, the root pose, the seat, the parts
+in hand. The planner's parts (:mod:`.steps`, :mod:`.walk_goals`, :mod:`.goal_steps`)
+share one of each.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ltl_human_motion.motion.skeleton import JOINT_INDEX
+from ltl_human_motion.motion.types import MotionPrimitive
+from ltl_human_motion.planning.blend import PlacedSegment
+from ltl_human_motion.planning.gait_index import GaitIndex, gait_index
+from ltl_human_motion.planning.navigation import (
+    ClearanceMap,
+    ObstacleField,
+    clearance_maps,
+    stand_clearance_map,
+)
+
+Pose = tuple[float, float, float]
+
+#: How far the gripping hand rises before a grasped part counts as lifted off its
+#: support (a part resting on a table touches it until then), metres.
+LIFT_RISE = 0.001
+
+#: The other hand of each hand joint.
+OTHER_HAND = {"l_hand": "r_hand", "r_hand": "l_hand"}
+
+#: The joint that holds a part for a goal primitive's ``meta["hand"]`` (both hands and an
+#: unnamed hand: the right hand, the planner's convention since the first grasp).
+HOLDING_JOINT = {"l_hand": "l_hand", "r_hand": "r_hand", "both": "r_hand", None: "r_hand"}
+
+
+@dataclass(frozen=True)
+class PlanContext:
+    """What one plan does not change.
+
+    Attributes
+    ----------
+    cell : Cell
+    library : MotionLibrary
+    index : GaitIndex
+        The library's gait primitives as arrays for the search.
+    rng : numpy.random.Generator
+        The plan's seeded generator (cost noise, goal primitives).
+    options : PlannerOptions
+    clearance : ClearanceMap
+        Floor clearance of the walking map, ``(N, 2) -> (N,)`` metres.
+    obstacle_field : ObstacleField
+        Distance grid for the search's sampled body checks.
+    stand_map : ClearanceMap
+        Floor clearance of the obstacles' footprints (no allowance for the arms).
+    """
+
+    cell: object
+    library: object
+    index: GaitIndex
+    rng: np.random.Generator
+    options: object
+    clearance: ClearanceMap
+    obstacle_field: ObstacleField
+    stand_map: ClearanceMap
+
+    @classmethod
+    def build(cls, cell, library, rng: np.random.Generator, options) -> PlanContext:
+        """The context of a plan in ``cell`` with ``library`` (the maps are cached per cell)."""
+        clearance, obstacle_field = clearance_maps(cell)
+        return cls(cell, library, gait_index(library), rng, options, clearance,
+                   obstacle_field, stand_clearance_map(cell))
+
+    @property
+    def overlap(self) -> int:
+        """Frames two placed segments blend over."""
+        return int(self.library.overlap)
+
+    @property
+    def stature(self) -> float:
+        """The worker's stature, metres."""
+        return float(self.library.skeleton.stature)
+
+    def stance(self, carrying: bool) -> np.ndarray:
+        """The standing pose (J, 3), root-relative: arms down, or in the carry stance."""
+        lib = self.library
+        return np.asarray(lib.carry_standing_pose if carrying else lib.standing_pose)
+
+
+@dataclass
+class WorkerState:
+    """What the steps of a plan change.
+
+    Attributes
+    ----------
+    segments : list of PlacedSegment
+        The motion placed so far.
+    pose : (x, y, yaw)
+        Where the next segment starts (the hand-over pose of the last one).
+    gait_state : int or None
+        The gait primitive the worker is in; None when standing.
+    seat : ndarray, shape (3,), or None
+        The seat point sat on; None when standing.
+    held : dict
+        Part name -> the hand joint holding it.
+    held_offsets : dict
+        Part name -> its centre's world offset from the holding hand, (3,).
+    object_at : dict
+        Part name -> where a step put it down, (3,).
+    consumed : set
+        Parts assembled (a new one comes from the supply when grasped again).
+    expanded : int
+        A* nodes expanded so far.
+    """
+
+    segments: list[PlacedSegment] = field(default_factory=list)
+    pose: Pose = (0.0, 0.0, 0.0)
+    gait_state: int | None = None
+    seat: np.ndarray | None = None
+    held: dict[str, str] = field(default_factory=dict)
+    held_offsets: dict[str, np.ndarray] = field(default_factory=dict)
+    object_at: dict[str, np.ndarray] = field(default_factory=dict)
+    consumed: set[str] = field(default_factory=set)
+    expanded: int = 0
+
+    @property
+    def carrying(self) -> bool:
+        """Whether a hand holds a part (the arms are in the carry stance)."""
+        return bool(self.held)
+
+    def held_offset(self, name: str) -> np.ndarray:
+        """The held part's offset from its hand (3,); zero for a part not held."""
+        return self.held_offsets.get(name, np.zeros(3))
+
+
+def object_position(cell, state: WorkerState, name: str) -> np.ndarray:
+    """Where object ``name`` rests now (3,): where the last step put it down, else its
+    supply position in the cell."""
+    at = state.object_at.get(name)
+    return np.asarray(cell.object(name).position if at is None else at, dtype=np.float64)
+
+
+def acting_hand(state: WorkerState, kind: str, part: str | None) -> str | None:
+    """The hand a goal task must use, or None (either): a move, insert or release of a
+    held ``part`` uses the hand holding it; a grasp or extract while one hand holds a
+    part uses the other hand."""
+    if part is not None and part in state.held and kind in ("move", "insert", "release"):
+        return state.held[part]
+    busy = set(state.held.values())
+    if kind in ("grasp", "extract") and len(busy) == 1:
+        return OTHER_HAND[next(iter(busy))]
+    return None
+
+
+def lift_frame(mp: MotionPrimitive, hand: np.ndarray) -> int:
+    """The frame of a grasp primitive from which the part is carried: the first frame
+    after the hold where the hand has risen ``LIFT_RISE`` above its contact height (the
+    part rests on its support until then). The contact frame if the hand never rises.
+
+    Parameters
+    ----------
+    mp : MotionPrimitive
+        With ``meta["contact_frame"]`` and ``meta["hold_frames"]``.
+    hand : ndarray, shape (T, 3)
+        The gripping hand joint over the primitive's frames.
+    """
+    contact = int(mp.meta.get("contact_frame", 0))
+    if contact >= len(hand):
+        return contact
+    hold_end = max(int(mp.meta.get("hold_frames", [contact, contact])[1]), contact)
+    rose = np.flatnonzero(hand[hold_end:, 2] >= hand[contact, 2] + LIFT_RISE)
+    return hold_end + int(rose[0]) if rose.size else contact
+
+
+def grip_frame(mp: MotionPrimitive) -> int:
+    """The frame of a goal primitive from which the hand holds the part it acts on: the
+    contact frame, except for extract, where the hand takes the part when it reaches it
+    (the start of the hold) and then pulls it out (its contact frame, where the part is
+    out, is the end of the pull)."""
+    if mp.task == "extract" and "hold_frames" in mp.meta:
+        return int(mp.meta["hold_frames"][0])
+    return int(mp.meta.get("contact_frame", mp.n_frames - 1))
+
+
+def apply_effects(state: WorkerState, kind: str, args: tuple[str, ...], hand: str | None,
+                  keep_hold: bool = False) -> dict:
+    """Update which parts ``state`` holds after a goal task; returns the effect for the
+    object tracks (``attach``, ``detach``, ``consume``). ``keep_hold``: a held part that
+    a move puts into its region stays in hand (carry)."""
+    hand_joint = HOLDING_JOINT.get(hand, "r_hand")
+    if kind == "grasp":
+        state.held[args[0]] = hand_joint
+        return {"attach": {args[0]: hand_joint}}
+    if kind == "release":
+        state.held.pop(args[0], None)
+        return {"detach": [args[0]]}
+    if kind in ("move", "insert", "extract"):
+        if args[0] not in state.held:
+            # extract takes the part out of its container and keeps it in hand (move
+            # and insert fetch the part first).
+            state.held[args[0]] = hand_joint
+            return {"attach": {args[0]: hand_joint}}
+        if kind == "extract" or keep_hold:
+            return {}
+        state.held.pop(args[0], None)
+        return {"detach": [args[0]]}
+    if kind == "assemble":
+        parts = list(state.held)
+        state.consumed.update(parts)
+        state.held.clear()
+        return {"detach": parts, "consume": parts}
+    return {}
+
+
+def track_objects(cell, state: WorkerState, effect: dict, joints: dict[str, str],
+                  positions: np.ndarray, mp: MotionPrimitive, overlap: int) -> None:
+    """Follow a step's effect on the parts as the object tracks will: a part keeps its
+    world offset from the hand from the grip frame on, and rests where the hand let it
+    go.
+
+    Parameters
+    ----------
+    joints : dict
+        The hands holding parts before the step (updated).
+    positions : ndarray, shape (T, J, 3)
+        The placed goal segment.
+    mp : MotionPrimitive
+        Its primitive (grip frame, length).
+    overlap : int
+        Blend frames (a ``detach_after`` part rests where the segment hands over).
+    """
+    contact = min(grip_frame(mp), mp.n_frames - 1)
+    for name, joint in effect.get("attach", {}).items():
+        joints[name] = joint
+        state.held_offsets[name] = (object_position(cell, state, name)
+                                    - positions[contact, JOINT_INDEX[joint]])
+    for names, frame in ((effect.get("detach", ()), contact),
+                         (effect.get("detach_after", ()),
+                          min(max(mp.n_frames - overlap, 0), mp.n_frames - 1))):
+        for name in names:
+            offset = state.held_offsets.pop(name, np.zeros(3))
+            if name in joints:
+                state.object_at[name] = positions[frame, JOINT_INDEX[joints[name]]] + offset
+    for name in effect.get("consume", ()):
+        state.object_at.pop(name, None)
+
+
+__all__ = ["LIFT_RISE", "OTHER_HAND", "PlanContext", "Pose",
+           "WorkerState", "acting_hand", "apply_effects", "grip_frame", "lift_frame",
+           "object_position", "track_objects"]

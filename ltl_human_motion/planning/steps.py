@@ -1,0 +1,467 @@
+"""The step executor: places motion segments and keeps the worker's state.
+
+:class:`StepExecutor` appends placed segments to the shared
+:class:`~.plan_state.WorkerState` and returns what it made (segment indices, gait
+primitives walked, whether a step was clear): walks found by A* (:mod:`.astar`) and
+checked on every frame, standing steps and turns (:mod:`.turns`), arm transitions,
+stand-stills and seated waits. Its collision checks are the verifier's (exact capsule
+distances on every frame, parts in hand included), so a plan it accepts does not fail
+collision afterwards.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.motion.skeleton import JOINT_INDEX
+from ltl_human_motion.motion.types import MotionPrimitive, world_positions
+from ltl_human_motion.planning.astar import (
+    Goal,
+    SearchBudget,
+    SearchFailure,
+    astar,
+    placement_key,
+)
+from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
+from ltl_human_motion.planning.navigation import floor_grid
+from ltl_human_motion.planning.plan_state import PlanContext, Pose, WorkerState
+from ltl_human_motion.planning.standing import ideal_placement
+from ltl_human_motion.planning.walk_goals import PASSAGE_RADIUS
+
+#: Clearance (m) the planner keeps between the body and obstacles on the frames it
+#: checks exactly: the verifier allows none below 0; blends between segments move
+#: joints by a few millimetres.
+PLACED_MARGIN = 0.003
+
+#: Stride of the measured frames of an every-frame check, and the clearance below which
+#: those measurements are exact, metres (:func:`body_clear_every_frame`).
+CLEAR_STRIDE = 4
+
+CLEAR_EXACT = 0.1
+#: The clearance below which the planner's other checks measure exactly, metres (only
+#: clearances near ``PLACED_MARGIN`` decide a check; farther ones may be bounds).
+EXACT_BELOW = 0.01
+
+#: Searches run again after the path found collided on a frame the search did not
+#: sample (each forbids the colliding primitive at its pose).
+WALK_REPAIRS = 4
+
+#: Backward steps tried (m) to leave a spot closer to an obstacle than walking allows,
+#: and the clearance beyond ``PlannerOptions.body_radius`` the step must reach (m).
+STEP_OUT_DISTANCES: tuple[float, ...] = (0.1, 0.2, 0.3)
+
+STEP_OUT_MARGIN = 0.02
+
+#: Steps aside (m, left positive) tried when no backward step clears what follows.
+SIDE_STEPS: tuple[float, ...] = (0.1, -0.1, 0.2, -0.2)
+
+#: Node budget of a squeezing walk: along a gap the body barely fits the search gets
+#: through at once or not at all (the aisle's walks take under 20 nodes; a goal the
+#: body cannot stand at took the whole 8000 and the pair's time limit).
+SQUEEZE_NODES = 1000
+
+#: A walk's search that expands this many nodes without getting nearer the goal stalls
+#: (in front of a gap the walking body does not pass: the cell with crates floods 7000
+#: nodes there; searches that get through a tight spot went up to about 2500 nodes
+#: without progress there); its goal then reroutes around a disc of
+#: ``STALL_BLOCK_RADIUS`` (m) at the closest approach, up to ``MAX_REROUTES`` times.
+STALL_NODES = 3500
+
+MAX_REROUTES = 2
+
+#: Arm transitions by (stances, stature, rate, blend, carrying before) (see
+#: :meth:`StepExecutor.arm_poses`).
+_ARM_POSES: dict[tuple, np.ndarray] = {}
+
+#: How much further back than the ideal spot a standing adjustment may stand when the
+#: step there would touch an obstacle, metres, tried in order (up to a short step).
+ADJUST_BACKS: tuple[float, ...] = (0.0, 0.05, 0.1, 0.15)
+#: A standing adjustment shorter than this (metres, radians) is not made: the worker
+#: already stands where the goal primitive reaches from.
+ADJUST_STILL = (0.02, 0.05)
+#: The gait index's step straight back (metres ahead, left), the first step tried to
+#: get room in front (:meth:`StepExecutor.step_back`).
+GAIT_STEP_BACK = [-0.3, 0.0]
+
+
+def body_clear_every_frame(world: np.ndarray, cell, stature: float) -> bool:
+    """Whether every frame of ``world`` (T, J, 3) keeps ``PLACED_MARGIN`` from the
+    obstacles, with exact capsule distances: every ``CLEAR_STRIDE``-th frame is measured
+    (exact up to ``CLEAR_EXACT``); the frames between two measured ones are measured too
+    unless the joints' travel between them proves them clear (a capsule's distance to an
+    obstacle changes by at most the largest joint displacement)."""
+    from ltl_human_motion.scene.predicates import body_clearance
+    T = len(world)
+    idx = np.unique(np.r_[np.arange(0, T, CLEAR_STRIDE), T - 1])
+    d = body_clearance(world[idx], cell, stature=stature, exact_below=CLEAR_EXACT)
+    if np.min(d) <= PLACED_MARGIN:
+        return False
+    step = np.sqrt(np.max(np.sum(np.diff(world, axis=0) ** 2, axis=-1), axis=-1))   # (T-1,)
+    travel = np.add.reduceat(step, idx[:-1]) if len(idx) > 1 else np.zeros(0)
+    # Within a gap, every frame is within the gap's travel of both ends.
+    safe = 0.5 * (d[:-1] + d[1:] - travel) > PLACED_MARGIN
+    todo = [np.arange(idx[k] + 1, idx[k + 1]) for k in np.flatnonzero(~safe)]
+    todo = np.concatenate(todo) if todo else np.zeros(0, dtype=int)
+    if not todo.size:
+        return True
+    return bool(np.min(body_clearance(world[todo], cell, stature=stature,
+                                      exact_below=EXACT_BELOW)) > PLACED_MARGIN)
+
+
+class StepExecutor:
+    """Places the segments of one plan.
+
+    Parameters
+    ----------
+    ctx : PlanContext
+    state : WorkerState
+        Changed by every method that places a segment.
+    """
+
+    def __init__(self, ctx: PlanContext, state: WorkerState) -> None:
+        self.ctx = ctx
+        self.state = state
+
+    def add(self, mp: MotionPrimitive, pose: Pose, label: int, blend: int) -> int:
+        """Place ``mp`` at ``pose`` as the next segment (task label ``label``, blended over
+        ``blend`` frames with the one before); returns its index."""
+        pos = world_positions(mp, *pose)
+        yaw = pose[2] + mp.root[:, 3]
+        segments = self.state.segments
+        segments.append(PlacedSegment(pos, yaw, label, blend if segments else 0, mp.name))
+        return len(self.state.segments) - 1
+
+    def hand_over_pose(self, mp: MotionPrimitive, pose: Pose) -> Pose:
+        """The floor pose where ``mp`` placed at ``pose`` hands over to the next segment
+        (its root ``overlap`` frames before its end)."""
+        k = max(mp.n_frames - self.ctx.overlap, 0)
+        r = mp.root[k]
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        return (pose[0] + c * r[0] - s * r[1], pose[1] + s * r[0] + c * r[1], pose[2] + r[3])
+
+    def stand_still(self, label: int, seconds: float) -> None:
+        """A short standing segment (start of the motion, end of a walk task)."""
+        n = max(round(seconds * self.ctx.library.fps), self.ctx.overlap + 2)
+        rel = np.repeat(self.ctx.stance(bool(self.state.held))[None], n, axis=0)
+        root = np.zeros((n, 4))
+        root[:, 2] = self.ctx.library.standing_height
+        mp = MotionPrimitive("stand", "wait", rel, root, self.ctx.library.fps, "planner: stand")
+        self.add(mp, self.state.pose, label, self.ctx.overlap)
+
+    def body_clear(self, poses: np.ndarray, standing: np.ndarray) -> np.ndarray:
+        """Whether sampled poses (M, S, J, 3) keep 1 cm from every obstacle, shape (M,);
+        standing primitives (``standing`` (M,)) need only not come closer."""
+        out = np.ones(len(poses), dtype=bool)
+        stature = self.ctx.library.skeleton.stature
+        for rel in (False, True):
+            sel = standing == rel
+            if sel.any():
+                out[sel] = self.ctx.obstacle_field.clear(poses[sel], stature, relative=rel)
+        return out
+
+    def sit_still(self, seconds: float) -> MotionPrimitive:
+        """A wait on the seat: the seated pose held (the standing wait model would rebuild
+        the legs for standing)."""
+        pose = self.seated_pose()
+        n = max(round(seconds * self.ctx.library.fps), self.ctx.overlap + 2)
+        root = np.zeros((n, 4))
+        root[:, :3] = pose[0]
+        rel = np.repeat((pose - pose[0])[None], n, axis=0)
+        return MotionPrimitive(f"sit_still_{seconds:.2f}s", "wait", rel, root,
+                               self.ctx.library.fps, "planner: seated wait",
+                               meta={"contact_frame": n - 1, "hand": "none"})
+
+    def seated_pose(self) -> np.ndarray:
+        """The last frame placed (the worker seated), in the start frame of the current
+        pose (root floor point at the origin, facing +x; heights above the floor), (J, 3)."""
+        x, y, yaw = self.state.pose
+        last = self.state.segments[-1].positions[-1]
+        c, s = math.cos(-yaw), math.sin(-yaw)
+        dx, dy = last[:, 0] - x, last[:, 1] - y
+        return np.stack([c * dx - s * dy, s * dx + c * dy, last[:, 2]], axis=-1)
+
+    def arm_transition(self, carrying_before: bool, label: int) -> None:
+        """Bring the arms from the walk stance to the carry stance or back.
+
+        The palms move beside the body on a smooth curve, timed by Fitts' law with a
+        bounded peak speed (:func:`~ltl_human_motion.motion.arm_transition.
+        arm_transition_poses`).
+        """
+        rel = self.arm_poses(carrying_before)
+        root = np.zeros((len(rel), 4))
+        root[:, 2] = self.ctx.library.standing_height
+        mp = MotionPrimitive("arms_to_carry" if not carrying_before else "arms_to_walk", "wait",
+                             rel, root, self.ctx.library.fps, "planner: arm transition")
+        if not self.placed_clear(mp, self.state.pose) and not self.step_back(carrying_before,
+                                                                           label, mp):
+            raise PlanningError(f"bringing the arms {'down' if carrying_before else 'up'} at "
+                                f"({self.state.pose[0]:.2f}, {self.state.pose[1]:.2f}) hits an "
+                                "obstacle, "
+                                "also after a step back", reason="blocked")
+        self.add(mp, self.state.pose, label, self.ctx.overlap)
+
+    def arm_poses(self, carrying_before: bool) -> np.ndarray:
+        """Root-relative poses (T, J, 3) of the arm transition (made once per library and
+        direction: it depends on nothing else)."""
+        from ltl_human_motion.motion.arm_transition import arm_transition_poses
+        from ltl_human_motion.motion.retarget import enforce_bone_lengths
+        key = (self.ctx.stance(False).tobytes(), self.ctx.stance(True).tobytes(),
+               self.ctx.library.skeleton.stature, self.ctx.library.fps, self.ctx.overlap,
+               bool(carrying_before))
+        hit = _ARM_POSES.get(key)
+        if hit is not None:
+            return hit
+        a, b = self.ctx.stance(carrying_before), self.ctx.stance(not carrying_before)
+        rel = arm_transition_poses(a, b, self.ctx.library.skeleton, self.ctx.library.fps)
+        if len(rel) < self.ctx.overlap + 2:
+            rel = np.concatenate([rel, np.repeat(rel[-1:], self.ctx.overlap + 2 - len(rel), 0)])
+        # The pipeline restores bone lengths after blending, so the transition is checked
+        # as it will be played.
+        rel = enforce_bone_lengths(rel, self.ctx.library.skeleton)
+        rel.flags.writeable = False
+        if len(_ARM_POSES) >= 32:
+            _ARM_POSES.clear()
+        _ARM_POSES[key] = rel
+        return rel
+
+    def placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = None,
+                     world: np.ndarray | None = None) -> bool:
+        """Whether ``mp`` placed at ``pose`` keeps the body and the objects held (at their
+        hand offsets) clear of every obstacle, checked with the exact distances on
+        ``samples`` frames (None: every frame, as the verifier checks). ``world``:
+        ``world_positions(mp, *pose)`` if already made."""
+        from ltl_human_motion.scene.predicates import body_clearance, object_clearance
+        if not self.ctx.cell.obstacles:
+            return True
+        stature = self.ctx.library.skeleton.stature
+        if samples is None:
+            world = world_positions(mp, *pose) if world is None else world
+            if not body_clear_every_frame(world, self.ctx.cell, stature):
+                return False
+        else:
+            frames = np.linspace(0, mp.n_frames - 1, samples).round().astype(int)
+            if world is None and self.state.held:
+                world = world_positions(mp, *pose)
+            body = world_positions(mp, *pose, frames=frames) if world is None else world[frames]
+            # Only clearances up to the PLACED_MARGIN limit matter: those are exact.
+            d = body_clearance(body, self.ctx.cell, stature=stature, exact_below=EXACT_BELOW)
+            if np.min(d) <= PLACED_MARGIN:
+                return False
+        for name, joint in self.state.held.items():
+            step = 1 if samples is None else 2
+            centre = world[::step, JOINT_INDEX[joint]] + self.state.held_offset(name)
+            if np.any(object_clearance(self.ctx.cell, name, centre) <= 0.0):
+                return False
+        return True
+
+    def step_out(self) -> None:
+        """Step back onto walkable floor if the worker stands closer to an obstacle than a
+        walk may start (at a rack, where reaching allowed it): the search could not
+        leave the spot otherwise."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        x, y, yaw = self.state.pose
+        if self.walkable(x, y):
+            return
+        carrying = bool(self.state.held)
+        lib = self.ctx.library
+        c, s = math.cos(yaw), math.sin(yaw)
+        for back in STEP_OUT_DISTANCES:
+            if not self.walkable(x - back * c, y - back * s):
+                continue
+            mp = make_step_primitive(self.ctx.stance(carrying), lib.standing_height, -back, 0.0,
+                                     0.0, lib.skeleton, lib.fps,
+                                     "carry" if carrying else "walk")
+            if self.placed_clear(mp, self.state.pose, samples=None):
+                self.add(mp, self.state.pose, -1, self.ctx.overlap)
+                self.state.pose = self.hand_over_pose(mp, self.state.pose)
+                return
+
+    def walkable(self, x: float, y: float) -> bool:
+        """Whether a walk may start at (x, y): ``STEP_OUT_MARGIN`` more floor clearance
+        than ``options.body_radius``, and the navigation grid's cell there is free (the
+        searches start from that cell)."""
+        if float(self.ctx.clearance(np.array([[x, y]]))[0]) <= (self.ctx.options.body_radius
+                                                               + STEP_OUT_MARGIN):
+            return False
+        grid = floor_grid(self.ctx.clearance, self.ctx.cell.workspace_lo[:2],
+                          self.ctx.cell.workspace_hi[:2], self.ctx.options.body_radius,
+                          self.ctx.options.grid_resolution, passage=PASSAGE_RADIUS)
+        i = int(np.clip(np.rint((x - grid.lo[0]) / grid.res), 0, grid.shape[0] - 1))
+        j = int(np.clip(np.rint((y - grid.lo[1]) / grid.res), 0, grid.shape[1] - 1))
+        return bool(grid.free[i, j])
+
+    def first_collision(self, primitives: list[int], poses: list[Pose]) -> int | None:
+        """Index of the first gait primitive of a path that comes within the planner's
+        margin of an obstacle on any frame (body or held parts), or None; what
+        :meth:`placed_clear` checks on every frame, in one pass over the whole path."""
+        from ltl_human_motion.scene.predicates import body_clearance, object_clearance
+        if not self.ctx.cell.obstacles or not primitives:
+            return None
+        worlds = [world_positions(self.ctx.index.primitives[p], *pose)
+                  for p, pose in zip(primitives, poses)]
+        ends = np.cumsum([len(w) for w in worlds])
+        world = np.concatenate(worlds)
+        bad = body_clearance(world, self.ctx.cell, stature=self.ctx.library.skeleton.stature,
+                             exact_below=EXACT_BELOW) <= PLACED_MARGIN
+        for name, joint in self.state.held.items():
+            centre = world[:, JOINT_INDEX[joint]] + self.state.held_offset(name)
+            bad |= object_clearance(self.ctx.cell, name, centre) <= 0.0
+        if not bad.any():
+            return None
+        return int(np.searchsorted(ends, int(np.argmax(bad)), side="right"))
+
+    def step_back(self, carrying: bool, label: int, then: MotionPrimitive) -> bool:
+        """Step back from an obstacle in front so that ``then`` is clear afterwards: the
+        gait index's 0.3 m step back, else a model-made step of ``STEP_OUT_DISTANCES``,
+        else a step aside of ``SIDE_STEPS`` (a board at elbow height beside the worker,
+        in an aisle). Returns False (nothing added) when no step and ``then`` are both
+        clear."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        task = "carry" if carrying else "walk"
+        lib = self.ctx.library
+
+        def steps():
+            yield from [mp for mp in self.ctx.index.primitives
+                        if mp.task == task and mp.meta.get("step") == GAIT_STEP_BACK
+                        and not mp.meta.get("turn")][:1]
+            moves = [(-back, 0.0) for back in STEP_OUT_DISTANCES] + [(0.0, side)
+                                                                     for side in SIDE_STEPS]
+            for dx, dy in moves:                       # made when tried
+                yield make_step_primitive(self.ctx.stance(carrying), lib.standing_height, dx, dy,
+                                          0.0, lib.skeleton, lib.fps, task)
+
+        for mp in steps():
+            pose = self.hand_over_pose(mp, self.state.pose)
+            if self.placed_clear(mp, self.state.pose) and self.placed_clear(then, pose):
+                self.add(mp, self.state.pose, label, self.ctx.overlap)
+                self.state.pose = pose
+                return True
+        return False
+
+    def walk(self, goal: Goal, task: str, label: int, carry: bool,
+             budget: SearchBudget | None = None) -> int:
+        """A* from the current pose; appends the gait segments; returns their count.
+
+        The search checks the body on sampled frames of a distance grid; every frame of
+        the path it returns is then checked as the verifier does (exact capsules, held
+        parts). A primitive that collides is forbidden from its pose and the search runs
+        again (at most ``WALK_REPAIRS`` times)."""
+        forbidden: set[tuple[int, int, int, int]] = set()
+        noise_state = self.ctx.rng.bit_generator.state
+        budget = budget or self.ctx.options.budget
+        if goal.clearance is self.ctx.stand_map:
+            budget = replace(budget, max_nodes=min(budget.max_nodes, SQUEEZE_NODES))
+        used, repairs, reroutes = 0, 0, 0
+        while True:
+            self.ctx.rng.bit_generator.state = noise_state      # the same costs every time
+            stall = STALL_NODES if goal.reroute is not None and reroutes < MAX_REROUTES \
+                else None
+            res = astar(self.ctx.index, self.state.pose, goal,
+                        start_primitive=self.state.gait_state,
+                        clearance=goal.clearance or self.ctx.clearance,
+                        options=self.ctx.options.search, carry=carry,
+                        budget=replace(budget, max_nodes=budget.max_nodes - used),
+                        rng=self.ctx.rng, body_clear=self.body_clear,
+                        forbidden=frozenset(forbidden), stall_nodes=stall)
+            self.state.expanded += res.expanded
+            used += res.expanded
+            if isinstance(res, SearchFailure) and res.reason == "stalled":
+                # Walk around the spot the search could not get past, or search on.
+                reroutes += 1
+                goal = goal.reroute(res.closest_at) or replace(goal, reroute=None)
+                continue
+            if isinstance(res, SearchFailure):
+                break
+            bad = self.first_collision(res.primitives, res.poses)
+            if bad is None:
+                break
+            forbidden |= self.forbid(res.primitives, res.poses, bad)
+            repairs += 1
+            if repairs > WALK_REPAIRS:
+                raise PlanningError(f"task {task}: {goal.description}: every path found "
+                                    f"({WALK_REPAIRS + 1}) collides on a frame the search "
+                                    "did not sample", task=task, reason="blocked")
+        if isinstance(res, SearchFailure):
+            if res.reason == "budget":
+                why = (f"the search budget ran out ({used} nodes; closest approach "
+                       f"{res.closest:.2f} m)")
+            else:
+                why = (f"obstacles block every way to the target (searched {res.expanded} "
+                       f"placements; closest approach {res.closest:.2f} m)")
+            raise PlanningError(f"task {task}: {goal.description}: {why}", task=task,
+                                reason=res.reason)
+        for prim_id, pose in zip(res.primitives, res.poses):
+            self.add(self.ctx.index.primitives[prim_id], pose, label, self.ctx.overlap)
+        if res.primitives:
+            self.state.pose = res.end_pose
+            self.state.gait_state = None  # every walk ends with a stop primitive
+        return len(res.primitives)
+
+    def forbid(self, primitives: list[int], poses: list[Pose], bad: int
+               ) -> set[tuple[int, int, int, int]]:
+        """What a search must not take again after primitive ``bad`` of its path collided:
+        that primitive from its pose, and where it is a stop (the arms swing forward as
+        the worker stops at furniture) that ends a walk, every gait stop from there and
+        from the neighbouring closed-set cells: the stops from one spot sweep nearly the
+        same space, and forbidding them one at a time, one cell at a time, used up the
+        ``WALK_REPAIRS``."""
+        i, j, k = placement_key(*poses[bad])
+        prim = primitives[bad]
+        if bad == 0 or not self.ctx.index.stops[prim] or self.ctx.index.standing[prim]:
+            return {(prim, i, j, k)}               # the first move, a turn on the spot
+        stops = np.flatnonzero(self.ctx.index.stops & ~self.ctx.index.standing).tolist()
+        return {(int(p), i + di, j + dj, k) for p in stops
+                for di in (-1, 0, 1) for dj in (-1, 0, 1)}
+
+    def adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str,
+                  back_limit: float) -> bool:
+        """Step and turn on the spot to the ideal placement for ``target`` (if needed).
+
+        If that step would touch an obstacle, stand a little further back (up to 15 cm).
+        Returns False if no adjustment is clear (the worker stays where the walk ended).
+        """
+        from ltl_human_motion.planning.turns import make_step_primitive
+        x, y, yaw = self.state.pose
+        px, py, pyaw, _ = (float(v[0]) for v in ideal_placement(
+            self.ctx, target, placement, np.array([x]), np.array([y]), back_limit))
+        carrying = bool(self.state.held)
+        back_dir = np.array([math.cos(pyaw), math.sin(pyaw)])
+        c, s = math.cos(yaw), math.sin(yaw)
+        stance = self.ctx.stance(carrying)
+        task_name = "carry" if carrying else "walk"
+        lib = self.ctx.library
+
+        def step(dx: float, dy: float, dyaw: float) -> MotionPrimitive:
+            return make_step_primitive(stance, lib.standing_height, dx, dy, dyaw, lib.skeleton,
+                                       lib.fps, task_name)
+
+        for back in ADJUST_BACKS:
+            qx, qy = px - back * back_dir[0], py - back * back_dir[1]
+            dx, dy = c * (qx - x) + s * (qy - y), -s * (qx - x) + c * (qy - y)
+            dyaw = float(wrap_angle(pyaw - yaw))
+            if math.hypot(dx, dy) < ADJUST_STILL[0] and abs(dyaw) < ADJUST_STILL[1]:
+                return True
+            # Step and turn at once; or turn where the walk ended, then step in. The
+            # primitives are made when tried (the first plan is usually clear).
+            cp, sp = math.cos(dyaw), math.sin(dyaw)
+            plans = [((dx, dy, dyaw),),
+                     ((0.0, 0.0, dyaw), (cp * dx + sp * dy, -sp * dx + cp * dy, 0.0))]
+            for moves in plans:
+                pose = self.state.pose
+                plan = []
+                for move in moves:
+                    mp = step(*move)
+                    if not self.placed_clear(mp, pose):
+                        break
+                    plan.append(mp)
+                    pose = self.hand_over_pose(mp, pose)
+                if len(plan) == len(moves):
+                    for mp in plan:
+                        self.add(mp, self.state.pose, -1, self.ctx.overlap)
+                        self.state.pose = self.hand_over_pose(mp, self.state.pose)
+                    return True
+        return False

@@ -1,0 +1,246 @@
+"""Walk goals: where a walk may end and the navigation field that leads there.
+
+A walk goal (:class:`~ltl_human_motion.planning.astar.Goal`) tests floor poses of the
+root and carries the heuristic's distance and heading. :class:`WalkGoals` makes them for
+the three kinds of walk: into a region (the verifier's own ``enter`` predicate,
+:class:`~.placement.RegionEntry`), to a reach placement for a goal task (a ring around
+the target, :func:`.standing.ideal_placement`), and to any spot with some floor
+clearance. Fields are solved on the walking map, or where it leaves no way through, on
+the footprint map (the squeeze through a narrow aisle).
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+
+import numpy as np
+
+from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.planning.astar import Goal
+from ltl_human_motion.planning.blend import wrap_angle
+from ltl_human_motion.planning.navigation import TALL_EXTRA, NavigationField, floor_grid
+from ltl_human_motion.planning.placement import RegionEntry
+from ltl_human_motion.planning.plan_state import PlanContext, WorkerState
+from ltl_human_motion.planning.standing import ideal_placement
+
+#: Floor clearance below which the navigation field counts the floor longer, metres:
+#: about half the hip and shoulder width of a 1.75 m worker (0.2 m) plus the gait's
+#: sway, more than ``PlannerOptions.body_radius`` (the least a walk needs).
+PASSAGE_RADIUS = 0.25
+
+#: The same on the footprint map of a squeeze (:meth:`WalkGoals.field`): half
+#: the 0.8 m aisle of the corpus, whose walls the walking map counts ``TALL_EXTRA``
+#: closer; the field leads along the middle of such a gap.
+SQUEEZE_PASSAGE = PASSAGE_RADIUS + TALL_EXTRA
+
+#: Radius of the floor blocked around a stalled search's closest approach when its goal
+#: reroutes, metres (:data:`.steps.STALL_NODES` says when a search stalls).
+STALL_BLOCK_RADIUS = 0.3
+
+#: Navigation fields by floor grid and goal (see :meth:`WalkGoals.field`).
+_FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
+
+
+class WalkGoals:
+    """Makes the walk goals of one plan.
+
+    Parameters
+    ----------
+    ctx : PlanContext
+    state : WorkerState
+        Read for where the worker stands now and whether it carries a part.
+    """
+
+    def __init__(self, ctx: PlanContext, state: WorkerState) -> None:
+        self.ctx = ctx
+        self.state = state
+
+    def field(self, goal_cells, key: tuple | None = None, squeeze: bool = False
+              ) -> NavigationField:
+        """The navigation field of ``goal_cells`` on the floor grid. ``goal_cells(xy (N, 2),
+        clearance) -> bool (N,)`` gets the clearance map of the grid it is solved on.
+        ``key``: numbers that determine the goal cells on this floor; fields with a key
+        are kept (a target that does not move between items, e.g. an assembly region,
+        reuses its field).
+
+        The field keeps to lanes with ``PASSAGE_RADIUS`` of clearance where they lead from
+        the worker to a goal; else it uses all floor the walk may take, counting floor
+        with less clearance longer. Either way the search does not squeeze the gait
+        through a gap the body barely fits (and exhaust its budget there) where a roomier
+        way exists. With ``squeeze`` (where the walking map leaves no way at all: a
+        narrow aisle between racks, see :meth:`led`) the field is solved on the
+        footprint map (:attr:`stand_map`, no allowance for the arms at tall parts),
+        whose walks the search keeps clear with the whole-body check. The walk keeps its
+        clearance on ``field.grid.clearance``."""
+        if squeeze:
+            return self.field_with(self.ctx.stand_map, self.ctx.options.body_radius,
+                                   goal_cells, key)
+        roomy = self.field_with(self.ctx.clearance, PASSAGE_RADIUS, goal_cells, key)
+        if self.leads(roomy):
+            return roomy
+        return self.field_with(self.ctx.clearance, self.ctx.options.body_radius, goal_cells, key)
+
+    def leads(self, field: NavigationField) -> bool:
+        """Whether ``field`` leads from the worker's spot to a goal cell."""
+        return field.has_goal and field.reachable_from(*self.state.pose[:2])
+
+    def led(self, solve: Callable[[bool], tuple]) -> tuple:
+        """``solve(False)`` (a field on the walking map, and what made it), or where that
+        field leads nowhere and ``solve(True)``'s (the squeeze, see :meth:`field`) does,
+        the latter."""
+        plain = solve(False)
+        if self.leads(plain[0]):
+            return plain
+        squeezed = solve(True)
+        return squeezed if self.leads(squeezed[0]) else plain
+
+    def field_with(self, clearance, radius: float, goal_cells, key: tuple | None
+                   ) -> NavigationField:
+        """:meth:`field` on the floor grid of map ``clearance`` whose free cells keep
+        ``radius``."""
+        passage = SQUEEZE_PASSAGE if clearance is self.ctx.stand_map else PASSAGE_RADIUS
+        grid = floor_grid(clearance, self.ctx.cell.workspace_lo[:2],
+                          self.ctx.cell.workspace_hi[:2], radius, self.ctx.options.grid_resolution,
+                          passage=passage if radius < passage else None)
+        cells = functools.partial(goal_cells, clearance=clearance)
+        if key is None:
+            return NavigationField.on_grid(grid, cells)
+        full = (id(grid), *key)
+        hit = _FIELD_CACHE.get(full)
+        if hit is not None and hit[0] is grid:         # the grid is held, its id unique
+            return hit[1]
+        field = NavigationField.on_grid(grid, cells)
+        if len(_FIELD_CACHE) >= 16:
+            _FIELD_CACHE.pop(next(iter(_FIELD_CACHE)))
+        _FIELD_CACHE[full] = (grid, field)
+        return field
+
+    def from_field(self, field: NavigationField, reached, desc: str, task: str,
+                   heading: Callable[[NavigationField], Callable] | None = None
+                   ) -> Goal:
+        """The walk's :class:`Goal` led by ``field``; ``heading(field)``: the heuristic's
+        direction (default the field's). A search that stalls (in front of a gap the body
+        does not pass) may reroute: the same goal on the field with the floor around the
+        stall blocked (``STALL_BLOCK_RADIUS``), while it still leads to the goal."""
+        if not field.has_goal:
+            raise PlanningError(f"task {task}: {desc}: every place to stand there is blocked "
+                                "by obstacles; the region is unreachable", task=task,
+                                reason="unreachable")
+        if not field.reachable_from(*self.state.pose[:2]):
+            raise PlanningError(f"task {task}: {desc}: obstacles block every way from "
+                                f"({self.state.pose[0]:.2f}, {self.state.pose[1]:.2f})", task=task,
+                                reason="blocked")
+        slack = 0.5 * self.ctx.options.grid_resolution
+
+        def distance(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+            return np.maximum(field.distance(x, y) - slack, 0.0)
+
+        def reroute(at: tuple[float, float]) -> Goal | None:
+            around = field.without(at, STALL_BLOCK_RADIUS)
+            if not (around.has_goal and around.reachable_from(*self.state.pose[:2])):
+                return None
+            return self.from_field(around, reached, desc, task, heading)
+
+        return Goal(reached, distance, field.heading if heading is None else heading(field),
+                    desc, clearance=field.grid.clearance, reroute=reroute)
+
+    def reach(self, target: np.ndarray, placement: tuple[float, float], desc: str,
+              task: str, adjust: float | None = None,
+              sector: tuple[float, float] | None = None) -> tuple[Goal, float]:
+        """Walk until a standing adjustment (a step of at most ``adjust``, default
+        ``options.adjust_radius``, and a turn) puts the worker where the goal primitive
+        reaches ``target`` (3,) from ``placement`` (:func:`.standing.standing_offset`);
+        with ``sector`` (direction from the target, half width, rad) only from that side.
+
+        Returns the goal and how much further back than the ideal spot it lets the worker
+        stand (the reach tolerance, or ``max_step_back`` where an obstacle leaves no
+        closer place); :meth:`.steps.StepExecutor.adjust_to` takes the same."""
+        tx, ty = float(target[0]), float(target[1])
+
+        def side(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+            if sector is None:
+                return np.ones(np.shape(x), dtype=bool)
+            return np.abs(wrap_angle(np.arctan2(y - ty, x - tx) - sector[0])) <= sector[1]
+
+        tol = self.ctx.options.reach_tolerance
+        dist = float(np.hypot(*placement))
+        offset = float(np.arctan2(placement[1], placement[0]))
+        adjust = self.ctx.options.adjust_radius if adjust is None else float(adjust)
+
+        def ring(xy: np.ndarray, clearance=None) -> np.ndarray:
+            r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
+            out = (r >= dist - tol) & (r <= dist + limit[0]) & side(xy[:, 0], xy[:, 1])
+            # The floor clearance only where the distance fits (few of the cells).
+            out[out] = self.ctx.stand_map(xy[out]) > self.ctx.options.stand_clearance
+            return out
+
+        def near_ring(xy: np.ndarray, clearance=None) -> np.ndarray:
+            # Where a walk may end to step in (a rack: the walking map keeps tall
+            # parts further off than a worker standing at them needs).
+            r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
+            return ((r >= dist - tol) & (r <= dist + limit[0] + adjust)
+                    & side(xy[:, 0], xy[:, 1]))
+
+        # Stand within the reach tolerance where possible; only where an obstacle leaves
+        # no such place (a tall worker at a bench) stand up to max_step_back further.
+        def ring_key() -> tuple:
+            return ("ring", tx, ty, dist, tol, float(limit[0]),
+                    float(self.ctx.options.stand_clearance), sector)
+
+        limit = [tol]                    # how much further back than ideal, per field
+
+        def solve(squeeze: bool) -> tuple[NavigationField, float]:
+            limit[0] = tol
+            field = self.field(ring, ring_key(), squeeze)
+            if not field.has_goal:
+                limit[0] = self.ctx.options.max_step_back
+                field = self.field(ring, ring_key(), squeeze)
+            if not field.has_goal:
+                field = self.field(near_ring, ("near", *ring_key(), adjust), squeeze)
+            return field, limit[0]
+
+        field, back = self.led(solve)
+        walk_map = field.grid.clearance
+
+        def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+            px, py, pyaw, free, here = ideal_placement(self.ctx, target, placement, x, y, back,
+                                                         room=True, walk_map=walk_map)
+            # Turning on the spot needs room for the hips; facing nearly right needs none.
+            room = here > self.ctx.options.turn_clearance
+            facing = np.abs(wrap_angle(pyaw - yaw)) <= self.ctx.options.heading_tolerance
+            return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing) & side(x, y)
+
+
+        def heading(led: NavigationField) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+            def towards(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+                near = np.hypot(tx - x, ty - y) <= dist + 2 * tol
+                return np.where(near, np.arctan2(ty - y, tx - x) - offset, led.heading(x, y))
+            return towards
+
+        return self.from_field(field, reached, desc, task, heading), back
+
+    def region(self, region, desc: str, task: str) -> Goal:
+        """Walk until the standing body enters ``region`` (the verifier's predicate).
+
+        The goal cells of the heuristic are the spots with room to turn
+        (``turn_clearance``) from which the standing body enters the region facing some
+        heading; none (a region above a bench, beside a wall) makes the region
+        unreachable on foot (the caller reaches into it by hand).
+        """
+        from ltl_human_motion.scene.occupancy import capsule_radii
+        stature = self.ctx.library.skeleton.stature
+        carrying = bool(self.state.held)
+        entry = RegionEntry(region, self.ctx.stance(carrying), self.ctx.library.standing_height,
+                            stature, float(capsule_radii(stature).max()))
+        room = self.ctx.options.turn_clearance
+
+        def cells(xy: np.ndarray, clearance: Callable[[np.ndarray], np.ndarray]
+                  ) -> np.ndarray:
+            out = entry.cells(xy)
+            out[out] = clearance(xy[out]) > room
+            return out
+
+        key = ("region", *entry.lo.tolist(), *entry.hi.tolist(), stature, carrying, room)
+        field, = self.led(lambda squeeze: (self.field(cells, key, squeeze),))
+        return self.from_field(field, entry.enters, desc, task)
