@@ -1177,7 +1177,9 @@ def _wait(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: fl
 
 @lru_cache(maxsize=512)
 def _placement(task: str, height: float, stature: float, hand: str,
-               board: tuple[float, float, float] | None = None) -> tuple[float, float]:
+               board: tuple[float, float, float] | None = None,
+               start: bytes | None = None) -> tuple[float, float]:
+    """:func:`reach_placement` (``start``: the start pose's float64 bytes, or None)."""
     skeleton = Skeleton(stature)
     H = stature
     if task in ("sit", "standUp"):
@@ -1187,7 +1189,8 @@ def _placement(task: str, height: float, stature: float, hand: str,
     both = task == "assemble" or hand == "both"
     lateral = 0.0 if both else (0.07 * H if (task == "leftHand" or hand in ("l_hand", "left"))
                                 else -0.07 * H)
-    st = _Start(skeleton, None)
+    st = _Start(skeleton, None if start is None
+                else np.frombuffer(start, dtype=np.float64).reshape(-1, 3))
     best = (np.inf, None)
     # Under a low board: with _BOARD_PLACE_MARGIN where that leaves a place, else without.
     for margin in (0.0,) if board is None else (_BOARD_PLACE_MARGIN, 0.0):
@@ -1208,8 +1211,8 @@ def _placement(task: str, height: float, stature: float, hand: str,
 
 
 def reach_placement(task: str, target_height: float, skeleton: Skeleton,
-                    hand: str = "auto", board: tuple[float, float, float] | None = None
-                    ) -> tuple[float, float]:
+                    hand: str = "auto", board: tuple[float, float, float] | None = None,
+                    start_pose: np.ndarray | None = None) -> tuple[float, float]:
     """Where to put the target relative to the standing root for a comfortable posture.
 
     Parameters
@@ -1224,6 +1227,10 @@ def reach_placement(task: str, target_height: float, skeleton: Skeleton,
         A low board over the target of grasp, release or move: the target lies ``depth``
         behind its front edge, under its underside at height ``bottom`` (top: ``top``).
         The worker then stands where the crouched body stays in front of the edge.
+    start_pose : ndarray, shape (J, 3), optional
+        The pose the goal primitive will start from (as :func:`make_goal_primitive`
+        takes it); default the skeleton's rest pose. A reach under a low board is tight
+        enough that the start's feet and arms decide whether a place reaches.
 
     Returns
     -------
@@ -1249,5 +1256,7 @@ def reach_placement(task: str, target_height: float, skeleton: Skeleton,
         board = tuple(round(v, 4) for v in _check_board(board))
     else:
         board = None
-    return _placement(task, round(h, 4), float(skeleton.stature), hand, board)
+    start = None if start_pose is None else \
+        np.ascontiguousarray(start_pose, dtype=np.float64).tobytes()
+    return _placement(task, round(h, 4), float(skeleton.stature), hand, board, start)
 

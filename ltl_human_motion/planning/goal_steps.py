@@ -200,7 +200,7 @@ class GoalSteps:
         how many other placements were tried."""
         failure = None
         for k, (target, prepare) in enumerate(tries):
-            mark = (len(self.state.segments), self.state.pose, self.state.gait_state)
+            mark = self.state.mark()
             try:
                 walked = prepare() if prepare is not None else 0
                 seg, mp = self.segment(
@@ -219,8 +219,7 @@ class GoalSteps:
                     raise
                 failure = failure or exc
                 # What a failed try placed (a walk, an arm transition) is taken back.
-                del self.state.segments[mark[0]:]
-                self.state.pose, self.state.gait_state = mark[1], mark[2]
+                self.state.restore(mark)
         if len(tries) == 1:
             raise failure
         raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements tried",
@@ -262,28 +261,32 @@ class GoalSteps:
 
     def approach(self, target: np.ndarray, placement: tuple[float, float], text: str,
                  sector: tuple[float, float] | None = None,
-                 budget: SearchBudget | None = None) -> int:
-        """Walk to where the goal primitive reaches ``target`` (from ``sector``, see
-        :meth:`.walk_goals.WalkGoals.reach`; within ``budget``) and take the standing step
-        there; returns the gait primitives walked."""
+                 budget: SearchBudget | None = None, stand_yaw: float | None = None) -> int:
+        """Walk to where the goal primitive reaches ``target`` (from ``sector``, facing
+        ``stand_yaw`` if given, see :meth:`.walk_goals.WalkGoals.reach`; within
+        ``budget``) and take the standing step there; returns the gait primitives walked."""
         desc = f"reach {text} at ({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})"
-        goal, back = self.goals.reach(target, placement, desc, text, sector=sector)
+        goal, back = self.goals.reach(target, placement, desc, text, sector=sector,
+                                      stand_yaw=stand_yaw)
         walked = self.executor.walk(goal, text, -1, carry=self.state.carrying, budget=budget)
-        if not self.executor.adjust_to(target, placement, text, back):
+        if not self.executor.adjust_to(target, placement, text, back, stand_yaw):
             # No clear step from where the walk ended: walk on to a spot that needs
             # (almost) none.
             goal, back = self.goals.reach(target, placement, desc, text,
-                                          adjust=FINAL_ADJUST_RADIUS, sector=sector)
+                                          adjust=FINAL_ADJUST_RADIUS, sector=sector,
+                                          stand_yaw=stand_yaw)
             walked += self.executor.walk(goal, text, -1, carry=self.state.carrying,
                                          budget=budget)
-            self.executor.adjust_to(target, placement, text, back)
+            self.executor.adjust_to(target, placement, text, back, stand_yaw)
         return walked
 
     def approach_under(self, target: np.ndarray, placement: tuple[float, float],
                        text: str) -> int | None:
         """:meth:`approach` to the standing place in front of the nearest edge of a low
-        board over ``target``, facing in across the edge (within ``BOARD_FACING``); None
-        if there is no such board or no way there."""
+        board over ``target``, square to the edge (the walk ends within ``BOARD_FACING``
+        of it and the standing step squares up: the reach under the board is planned
+        square, :func:`.standing.standing_offset`); None if there is no such board or no
+        way there."""
         low = low_board(self.ctx.cell, target, self.ctx.stature)
         if low is None:
             return None
@@ -291,10 +294,12 @@ class GoalSteps:
         c, s = math.cos(yaw), math.sin(yaw)
         d, lat = placement
         side = math.atan2(-(s * d + c * lat), -(c * d - s * lat))
+        mark = self.state.mark()
         try:
             return self.approach(target, placement, text, sector=(side, BOARD_FACING),
-                                  budget=SearchBudget(FACING_NODES))
+                                 budget=SearchBudget(FACING_NODES), stand_yaw=yaw)
         except PlanningError:
+            self.state.restore(mark)                 # what the walk placed is taken back
             return None
 
     def approach_facing(self, target: np.ndarray, placement: tuple[float, float],
@@ -306,12 +311,13 @@ class GoalSteps:
             # The worker stands ``placement`` from the target: with the target behind
             # (a seat), the standing spot lies towards what the worker will face.
             side = ahead if placement[0] < 0 else ahead + math.pi
+            mark = self.state.mark()
             try:
                 return self.approach(target, placement, text,
-                                      sector=(side, APPROACH_HALF_WIDTH),
-                                      budget=SearchBudget(FACING_NODES))
+                                     sector=(side, APPROACH_HALF_WIDTH),
+                                     budget=SearchBudget(FACING_NODES))
             except PlanningError:
-                pass
+                self.state.restore(mark)
         return self.approach(target, placement, text)
 
     def walk_to_room(self, text: str) -> int:

@@ -133,6 +133,16 @@ class WorkerState:
         """Whether a hand holds a part (the arms are in the carry stance)."""
         return bool(self.held)
 
+    def mark(self) -> tuple[int, Pose, int | None]:
+        """Where the plan stands now, for :meth:`restore`: (segments, pose, gait state)."""
+        return len(self.segments), self.pose, self.gait_state
+
+    def restore(self, mark: tuple[int, Pose, int | None]) -> None:
+        """Take back every segment placed since ``mark`` (a try that failed); the parts
+        in hand are not changed by walks, steps and arm transitions."""
+        del self.segments[mark[0]:]
+        self.pose, self.gait_state = mark[1], mark[2]
+
     def held_offset(self, name: str) -> np.ndarray:
         """The held part's offset from its hand (3,); zero for a part not held."""
         return self.held_offsets.get(name, np.zeros(3))

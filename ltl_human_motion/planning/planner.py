@@ -47,7 +47,11 @@ from ltl_human_motion.planning.plan_state import (
     lift_frame,
     track_objects,
 )
-from ltl_human_motion.planning.standing import palm_clear_of_support, standing_offset
+from ltl_human_motion.planning.standing import (
+    low_board,
+    palm_clear_of_support,
+    standing_offset,
+)
 from ltl_human_motion.planning.steps import StepExecutor
 from ltl_human_motion.planning.walk_goals import WalkGoals
 from ltl_human_motion.vocabulary import HAND_TASKS, TaskStep
@@ -342,17 +346,17 @@ class SequencePlanner:
             # The hand puts the part's centre (held at its offset) on the target.
             target = target - self.state.held_offsets[args[0]]
         walked = 0
-        placement = None
+        placement, arms_up = None, True
         if target is not None and kind not in ("release", "standUp") and self.state.seat is None:
             # (Seated, the hands work from the seat.)
-            placement = standing_offset(self.ctx, kind, target, text,
-                                        acting_hand(self.state, kind, args[0] if args else None))
+            placement, arms_up = self._placement(kind, target, text, args)
             walked = self.goal_steps.approach_under(target, placement, text) \
                 if kind in LEVEL_PATH_TASKS and facing is None else None
             if walked is None:
                 walked = self.goal_steps.approach_facing(target, placement, text, facing)
         carrying_before = bool(self.state.held)
-        raised = kind in HAND_TASKS and not carrying_before and self.state.seat is None
+        raised = kind in HAND_TASKS and not carrying_before and self.state.seat is None \
+            and arms_up
         if raised:
             # Raise the arms to the carry stance first: hands then reach from the chest
             # (and a grasped part comes up to it) instead of swinging up from the thighs
@@ -383,6 +387,23 @@ class SequencePlanner:
                         lift_frame=lift, hand=hand, expanded=self.state.expanded - expanded0,
                         primitive=mp.name,
                         objects_effect=effect, sub_steps=subs)
+
+    def _placement(self, kind: str, target: np.ndarray, text: str, args: tuple[str, ...]
+                   ) -> tuple[tuple[float, float], bool]:
+        """Where the target should be in the standing root's frame
+        (:func:`.standing.standing_offset`), and whether the arms come up to the carry
+        stance before the goal primitive. They do, except under a low board that no
+        place reaches from the carry stance while the hands are free (a short worker's
+        floor grasp under a board at knee height reaches from the arms down)."""
+        hand = acting_hand(self.state, kind, args[0] if args else None)
+        try:
+            return standing_offset(self.ctx, kind, target, text, hand), True
+        except PlanningError:
+            if self.state.carrying or kind not in LEVEL_PATH_TASKS \
+                    or low_board(self.ctx.cell, target, self.ctx.stature) is None:
+                raise
+            return standing_offset(self.ctx, kind, target, text, hand,
+                                   carry_stance=False), False
 
     def _fetch(self, i: int, obj: str) -> StepPlan:
         """Grasp ``obj`` as part of step ``i`` (which needs it in hand)."""

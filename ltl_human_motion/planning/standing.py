@@ -101,17 +101,21 @@ def board_local(cell, target: np.ndarray, local: np.ndarray, yaw: float, stature
 
 
 def standing_offset(ctx: PlanContext, kind: str, target: np.ndarray, task: str,
-                    hand: str | None = None) -> tuple[float, float]:
+                    hand: str | None = None, carry_stance: bool = True
+                    ) -> tuple[float, float]:
     """Where ``target`` (3,) should be in the standing root's frame for goal task
     ``kind``: (ahead, left), metres (for ``hand``, if given: the left hand reaches a
     target on the left). Raises PlanningError (``unreachable``) for a height no goal
-    model reaches."""
+    model reaches. Under a low board the reach is planned from the stance the goal
+    primitive starts from: the carry stance (``carry_stance``: the planner raises the
+    arms first, or they hold a part), else arms down."""
     from ltl_human_motion.motion import goals
     low = low_board(ctx.cell, target, ctx.stature) if kind in LEVEL_PATH_TASKS else None
     try:
         d, lat = goals.reach_placement(kind, float(target[2]), ctx.library.skeleton,
                                        hand=hand or "auto",
-                                       board=None if low is None else low[:3])
+                                       board=None if low is None else low[:3],
+                                       start_pose=None if low is None else ctx.stance(carry_stance))
         return float(d), float(lat)
     except ValueError as exc:
         raise PlanningError(f"task {task}: the target at height {target[2]:.2f} m is "
@@ -128,10 +132,11 @@ def _back_steps(limit: float) -> np.ndarray:
 
 def ideal_placement(ctx: PlanContext, target: np.ndarray, placement: tuple[float, float],
                     x: np.ndarray, y: np.ndarray, back_limit: float, room: bool = False,
-                    walk_map: Callable[[np.ndarray], np.ndarray] | None = None
-                    ) -> tuple[np.ndarray, ...]:
+                    walk_map: Callable[[np.ndarray], np.ndarray] | None = None,
+                    stand_yaw: float | None = None) -> tuple[np.ndarray, ...]:
     """Root pose (x*, y*, yaw*) from which the goal primitive reaches ``target``, facing
-    it from the side of (x, y), and whether that spot is free.
+    it from the side of (x, y) (with ``stand_yaw``: facing that way, rad, wherever (x, y)
+    is; square to a low board's edge), and whether that spot is free.
 
     ``placement``: the target in the standing root's frame (:func:`standing_offset`).
     Where the ideal spot is too close to an obstacle (a bench in front), the worker
@@ -139,7 +144,10 @@ def ideal_placement(ctx: PlanContext, target: np.ndarray, placement: tuple[float
     also the floor clearance at (x, y) itself on ``walk_map`` (default the walking map).
     """
     d, lat = placement
-    yaw = np.arctan2(target[1] - y, target[0] - x) - np.arctan2(lat, d)
+    if stand_yaw is None:
+        yaw = np.arctan2(target[1] - y, target[0] - x) - np.arctan2(lat, d)
+    else:
+        yaw = np.full(np.shape(x), float(stand_yaw))
     c, s = np.cos(yaw), np.sin(yaw)
     back = _back_steps(float(back_limit))
     px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)

@@ -418,8 +418,9 @@ class StepExecutor:
                 for di in (-1, 0, 1) for dj in (-1, 0, 1)}
 
     def adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str,
-                  back_limit: float) -> bool:
-        """Step and turn on the spot to the ideal placement for ``target`` (if needed).
+                  back_limit: float, stand_yaw: float | None = None) -> bool:
+        """Step and turn on the spot to the ideal placement for ``target`` (if needed;
+        :func:`.standing.ideal_placement`, facing ``stand_yaw`` if given).
 
         If that step would touch an obstacle, stand a little further back (up to 15 cm).
         Returns False if no adjustment is clear (the worker stays where the walk ended).
@@ -427,7 +428,8 @@ class StepExecutor:
         from ltl_human_motion.planning.turns import make_step_primitive
         x, y, yaw = self.state.pose
         px, py, pyaw, _ = (float(v[0]) for v in ideal_placement(
-            self.ctx, target, placement, np.array([x]), np.array([y]), back_limit))
+            self.ctx, target, placement, np.array([x]), np.array([y]), back_limit,
+            stand_yaw=stand_yaw))
         carrying = bool(self.state.held)
         back_dir = np.array([math.cos(pyaw), math.sin(pyaw)])
         c, s = math.cos(yaw), math.sin(yaw)

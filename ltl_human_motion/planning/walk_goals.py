@@ -42,6 +42,28 @@ STALL_BLOCK_RADIUS = 0.3
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
 
 
+def _in_sector(x: np.ndarray, y: np.ndarray, target: tuple[float, float],
+               sector: tuple[float, float] | None) -> np.ndarray:
+    """Whether floor points (x, y) lie within ``sector`` (direction from ``target``, half
+    width, rad) of the target (all of them without a sector); bool, shaped like x."""
+    if sector is None:
+        return np.ones(np.shape(x), dtype=bool)
+    tx, ty = target
+    return np.abs(wrap_angle(np.arctan2(y - ty, x - tx) - sector[0])) <= sector[1]
+
+
+def _towards(led: NavigationField, target: tuple[float, float], near: float, offset: float
+             ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """The heuristic's heading for a reach: the field's way, and within ``near`` of the
+    target, straight at it less ``offset`` (the target is off the root's axis)."""
+    tx, ty = target
+
+    def towards(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        close = np.hypot(tx - x, ty - y) <= near
+        return np.where(close, np.arctan2(ty - y, tx - x) - offset, led.heading(x, y))
+    return towards
+
+
 class WalkGoals:
     """Makes the walk goals of one plan.
 
@@ -147,22 +169,19 @@ class WalkGoals:
 
     def reach(self, target: np.ndarray, placement: tuple[float, float], desc: str,
               task: str, adjust: float | None = None,
-              sector: tuple[float, float] | None = None) -> tuple[Goal, float]:
+              sector: tuple[float, float] | None = None,
+              stand_yaw: float | None = None) -> tuple[Goal, float]:
         """Walk until a standing adjustment (a step of at most ``adjust``, default
         ``options.adjust_radius``, and a turn) puts the worker where the goal primitive
         reaches ``target`` (3,) from ``placement`` (:func:`.standing.standing_offset`);
-        with ``sector`` (direction from the target, half width, rad) only from that side.
+        with ``sector`` (direction from the target, half width, rad) only from that side;
+        with ``stand_yaw`` (rad), standing facing that way (:func:`.standing.ideal_placement`).
 
         Returns the goal and how much further back than the ideal spot it lets the worker
         stand (the reach tolerance, or ``max_step_back`` where an obstacle leaves no
         closer place); :meth:`.steps.StepExecutor.adjust_to` takes the same."""
         tx, ty = float(target[0]), float(target[1])
-
-        def side(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-            if sector is None:
-                return np.ones(np.shape(x), dtype=bool)
-            return np.abs(wrap_angle(np.arctan2(y - ty, x - tx) - sector[0])) <= sector[1]
-
+        side = functools.partial(_in_sector, target=(tx, ty), sector=sector)
         tol = self.ctx.options.reach_tolerance
         dist = float(np.hypot(*placement))
         offset = float(np.arctan2(placement[1], placement[0]))
@@ -205,19 +224,20 @@ class WalkGoals:
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             px, py, pyaw, free, here = ideal_placement(self.ctx, target, placement, x, y, back,
-                                                         room=True, walk_map=walk_map)
+                                                         room=True, walk_map=walk_map,
+                                                         stand_yaw=stand_yaw)
             # Turning on the spot needs room for the hips; facing nearly right needs none.
             room = here > self.ctx.options.turn_clearance
             facing = np.abs(wrap_angle(pyaw - yaw)) <= self.ctx.options.heading_tolerance
-            return free & (np.hypot(px - x, py - y) <= adjust) & (room | facing) & side(x, y)
+            out = free & (np.hypot(px - x, py - y) <= adjust) & (room | facing) & side(x, y)
+            if stand_yaw is not None:
+                # The spot is fixed: a walk must still end on the ring, not nearer (under
+                # the board the standing step would have to back out of).
+                out &= np.hypot(tx - x, ty - y) >= dist - tol
+            return out
 
-
-        def heading(led: NavigationField) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-            def towards(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-                near = np.hypot(tx - x, ty - y) <= dist + 2 * tol
-                return np.where(near, np.arctan2(ty - y, tx - x) - offset, led.heading(x, y))
-            return towards
-
+        heading = functools.partial(_towards, target=(tx, ty), near=dist + 2 * tol,
+                                    offset=offset)
         return self.from_field(field, reached, desc, task, heading), back
 
     def region(self, region, desc: str, task: str) -> Goal:
