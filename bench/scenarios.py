@@ -142,6 +142,10 @@ def summarize(results: list[dict]) -> dict:
             "median_time_s": statistics.median(times) if times else None,
             "max_time_s": max(times) if times else None,
             "over_2s": sum(t > 2.0 for t in times),
+            "slowest": [{"id": r["id"], "stature": r["stature"], "seed": r["seed"],
+                         "seconds": round(r["outcome"]["seconds"], 3), "ok": r["ok"]}
+                        for r in sorted(rows, key=lambda r: -r["outcome"]["seconds"])
+                        if r["outcome"]["seconds"] > 2.0],
             "failures_by_family": dict(sorted(fam.items(), key=lambda kv: -kv[1]["count"])),
         }
 
@@ -178,6 +182,9 @@ def _print(summary: dict, wall: float) -> None:
               f"({_pct(b['refusal_rate'])}); time per pair median "
               f"{b['median_time_s']:.2f} s, max {b['max_time_s']:.2f} s, "
               f"{b['over_2s']} over 2 s")
+        if b["slowest"]:
+            print("  slowest (over 2 s): " + ", ".join(
+                f"{r['id']} {r['stature']} m {r['seconds']:.1f} s" for r in b["slowest"][:8]))
         if b["failures_by_family"]:
             print("  failures by family:")
             for fam, f in b["failures_by_family"].items():
