@@ -59,9 +59,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ltl_human_motion.kernel.segments import joint_segment_distances
 from ltl_human_motion.motion.ik import center_of_mass
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, JOINT_NAMES
-from ltl_human_motion.scene.geometry import segment_segment_distance
 from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 __all__ = [
@@ -247,6 +247,10 @@ def _penetration_pairs() -> list[tuple[int, int]]:
 
 
 _PAIRS = _penetration_pairs()
+#: Capsule indices (2, P) of the pairs, and the joints (2, P, 2) ending their capsules.
+_PAIR_CAPSULES = np.array(_PAIRS, dtype=np.intp).T
+_PAIR_ENDS = np.array([[_J[c[1]], _J[c[2]]] for c in BODY_CAPSULES],
+                      dtype=np.intp)[_PAIR_CAPSULES]
 
 
 def self_penetration(positions: np.ndarray, stature: float = DEFAULT_STATURE
@@ -266,11 +270,8 @@ def self_penetration(positions: np.ndarray, stature: float = DEFAULT_STATURE
     """
     p = np.asarray(positions, dtype=np.float64)
     r = capsule_radii(stature)
-    ia = np.array([_J[c[1]] for c in BODY_CAPSULES])
-    ib = np.array([_J[c[2]] for c in BODY_CAPSULES])
-    a = np.array([i for i, _ in _PAIRS])
-    b = np.array([j for _, j in _PAIRS])
-    d = segment_segment_distance(p[:, ia[a]], p[:, ib[a]], p[:, ia[b]], p[:, ib[b]])
+    a, b = _PAIR_CAPSULES
+    d = joint_segment_distances(p, _PAIR_ENDS[0], _PAIR_ENDS[1])
     depth = np.maximum(r[a], r[b])[None] - d
     names = [(BODY_CAPSULES[i][0], BODY_CAPSULES[j][0]) for i, j in _PAIRS]
     return depth, names
