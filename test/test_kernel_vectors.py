@@ -23,3 +23,16 @@ def test_products_are_numpys_bit_for_bit(shape):
     up = np.array([0.0, 0.0, 1.0])
     assert np.array_equal(cross3(a, up), np.cross(a, up))
     assert np.array_equal(dot3(a, up), np.sum(a * up, -1))
+
+
+def test_signed_zeros_are_numpys():
+    import itertools
+
+    vals = [0.0, -0.0, 1e-300, -1e-300, 2.0]
+    a = np.array(list(itertools.product(vals, repeat=3)))
+    b = a[::-1].copy()
+    bits = lambda x: np.ascontiguousarray(x).view(np.int64)   # noqa: E731
+    assert np.array_equal(bits(dot3(a, b)), bits(np.sum(a * b, -1)))
+    assert np.array_equal(bits(dot3(a, -b)), bits(np.sum(a * -b, -1)))
+    assert np.array_equal(bits(norm3(a)), bits(np.linalg.norm(a, axis=-1)))
+    assert np.array_equal(bits(cross3(a, b)), bits(np.cross(a, b)))

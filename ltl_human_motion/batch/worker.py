@@ -178,6 +178,11 @@ def pool_initializer(job: BatchJob, period: float = 1.0) -> None:
 
 def _plain(value: Any) -> Any:
     """JSON-ready plain Python; non-finite floats become None."""
+    kind = type(value)                  # the common leaves first, by exact type
+    if kind is float:
+        return value if math.isfinite(value) else None
+    if kind is int or kind is str or value is None:
+        return value
     if isinstance(value, dict):
         return {str(k): _plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

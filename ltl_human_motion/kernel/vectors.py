@@ -17,7 +17,8 @@ __all__ = ["cross3", "dot3", "norm3"]
 
 def dot3(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
     """``np.sum(a * b, -1)`` of vectors a, b (..., 3) (broadcast), shape (...)."""
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+    # numpy's sum starts from +0.0: it decides the sign of a zero result.
+    return 0.0 + a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
 def norm3(v: NDArray[np.float64]) -> NDArray[np.float64]:
