@@ -288,6 +288,12 @@ def _trilinear(grid: np.ndarray, u: np.ndarray) -> np.ndarray:
     -------
     values : ndarray, shape (N,)
     """
+    nb = _compiled_loops()
+    if nb is not None and np.isfinite(u).all():
+        out = np.empty(len(u))
+        nb.trilinear(np.ascontiguousarray(grid, dtype=np.float64),
+                     np.ascontiguousarray(u, dtype=np.float64), out)
+        return out
     flat = np.ascontiguousarray(grid, dtype=np.float64).ravel()
     step = (grid.shape[1] * grid.shape[2], grid.shape[2], 1)       # elements per axis step
     offsets, weights = [], []
