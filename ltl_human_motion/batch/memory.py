@@ -15,7 +15,7 @@ import sys
 __all__ = ["KEEP_FREED_BYTES", "MMAP_THRESHOLD_BYTES", "keep_freed_memory"]
 
 #: Freed heap at the top a worker keeps for reuse (glibc ``M_TRIM_THRESHOLD``), bytes.
-KEEP_FREED_BYTES = 512 * 2**20
+KEEP_FREED_BYTES = 256 * 2**20
 #: Allocations from this size on are mapped on their own (glibc ``M_MMAP_THRESHOLD``; the
 #: largest value it accepts on 64-bit systems). Smaller arrays come from the kept heap.
 MMAP_THRESHOLD_BYTES = 32 * 2**20
