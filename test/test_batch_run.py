@@ -305,3 +305,16 @@ def test_an_item_is_reproducible_from_its_manifest_record(reference: Path) -> No
     assert synth.sequence == r["sequence"]
     np.testing.assert_array_equal(synth.positions.astype(np.float32), item.positions)
     np.testing.assert_array_equal(synth.task_index, item.task_index)
+
+
+def test_workers_keep_freed_memory() -> None:
+    """glibc on Linux takes the heap settings (in a fresh process: they are global)."""
+    import platform
+
+    if not sys.platform.startswith("linux") or platform.libc_ver()[0] != "glibc":
+        pytest.skip("glibc only")
+    code = ("from ltl_human_motion.batch.memory import keep_freed_memory\n"
+            "assert keep_freed_memory() and keep_freed_memory()\n"
+            "import numpy as np\n"
+            "for _ in range(3): np.ones((3000, 23, 3)).sum()\n")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)

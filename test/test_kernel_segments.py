@@ -159,3 +159,26 @@ def test_read_only_inputs_use_the_compiled_signature() -> None:
         pytest.approx(0.8)
     after = {name: len(getattr(segments._compiled(), name).signatures) for name in before}
     assert after == before, "a read-only input compiled a new specialization"
+
+
+def test_joint_segment_distances_are_the_pair_kernels() -> None:
+    rng = np.random.default_rng(11)
+    X = rng.normal(size=(30, 9, 3))
+    X[:10, 3] = X[:10, 2]                                # point segments
+    X[10:20, 5] = X[10:20, 4] + 0.5 * (X[10:20, 1] - X[10:20, 0])   # parallel pairs
+    ends_a = np.array([[0, 1], [2, 3], [4, 5], [2, 3], [7, 8]])
+    ends_b = np.array([[4, 5], [6, 7], [0, 1], [2, 3], [8, 7]])
+    want = segment_segment_distance(X[:, ends_a[:, 0]], X[:, ends_a[:, 1]],
+                                    X[:, ends_b[:, 0]], X[:, ends_b[:, 1]])
+    fast, slow = both(segments.joint_segment_distances, X, ends_a, ends_b)
+    assert fast.shape == (30, 5)
+    # The same pair kernel on the same end points: bit for bit on each path.
+    assert np.array_equal(fast, want)
+    with numpy_path():
+        assert np.array_equal(slow, segment_segment_distance(
+            X[:, ends_a[:, 0]], X[:, ends_a[:, 1]], X[:, ends_b[:, 0]], X[:, ends_b[:, 1]]))
+    assert np.allclose(fast, slow, atol=1e-12, rtol=0)
+    with pytest.raises(ValueError, match="joint segments"):
+        segments.joint_segment_distances(X[0], ends_a, ends_b)
+    with pytest.raises(ValueError, match="beyond"):
+        segments.joint_segment_distances(X, ends_a, ends_b + 9)

@@ -29,29 +29,49 @@ def paper():
     return cell_by_name("paper_cell")
 
 
-def test_clearance_map_interpolates_as_scipy_does(paper) -> None:
+@pytest.mark.parametrize("compiled", [True, False])
+def test_clearance_map_interpolates_as_scipy_does(paper, compiled, monkeypatch) -> None:
     from scipy.interpolate import RegularGridInterpolator
+
+    from ltl_human_motion.planning import navigation
+    if not compiled:
+        monkeypatch.setattr(navigation, "_compiled_loops", lambda: None)
+    elif navigation._compiled_loops() is None:
+        pytest.skip("numba is not in use")
     cm = ClearanceMap(paper, resolution=0.07)
     ref = RegularGridInterpolator((cm._xs, cm._ys), cm._values.copy(), bounds_error=False,
                                   fill_value=-1.0)
     rng = np.random.default_rng(0)
     pts = np.concatenate([rng.uniform(-3.3, 3.3, (20000, 2)),
                           np.stack(np.meshgrid(cm._xs, cm._ys), -1).reshape(-1, 2),
-                          [[3.0, 3.0], [-3.0, -3.0], [3.0 + 1e-12, 0.0], [np.nan, 0.0]]])
+                          [[3.0, 3.0], [-3.0, -3.0], [3.0 + 1e-12, 0.0], [np.nan, 0.0],
+                           [0.0, np.inf], [-np.inf, 0.0]]])
     inside = np.all((pts >= cm.lo) & (pts <= cm.hi), axis=-1)
-    np.testing.assert_array_equal(cm(pts), np.where(inside, ref(pts), -1.0))
+    got = cm(pts)
+    np.testing.assert_array_equal(got, np.where(inside, ref(pts), -1.0))
+    # Bit for bit (signed zeros too), and in the shape of the points.
+    assert got.tobytes() == np.where(inside, ref(pts), -1.0).tobytes()
+    assert cm(pts[:6].reshape(2, 3, 2)).shape == (2, 3)
+    assert cm(np.zeros((0, 2))).shape == (0,)
 
 
+@pytest.mark.parametrize("compiled", [True, False])
 @pytest.mark.parametrize("shape", [(2, 2, 2), (3, 5, 4), (17, 9, 6)])
-def test_trilinear_matches_map_coordinates(shape) -> None:
+def test_trilinear_matches_map_coordinates(shape, compiled, monkeypatch) -> None:
     from scipy.ndimage import map_coordinates
+
+    from ltl_human_motion.planning import navigation
+    if not compiled:
+        monkeypatch.setattr(navigation, "_compiled_loops", lambda: None)
+    elif navigation._compiled_loops() is None:
+        pytest.skip("numba is not in use")
     rng = np.random.default_rng(1)
     grid = rng.uniform(0.0, 2.0, shape)
     n = np.array(shape)
     u = np.concatenate([rng.uniform(-5, n + 5, (20000, 3)),
                         np.round(rng.uniform(-2, n + 2, (5000, 3)) * 2) / 2])
-    np.testing.assert_array_equal(_trilinear(grid, u),
-                                  map_coordinates(grid, u.T, order=1, mode="nearest"))
+    got = _trilinear(grid, u)
+    assert got.tobytes() == map_coordinates(grid, u.T, order=1, mode="nearest").tobytes()
 
 
 def test_obstacle_field_clear_matches_reading_every_capsule(paper) -> None:

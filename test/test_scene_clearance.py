@@ -123,3 +123,26 @@ def test_helpers_match_their_references() -> None:
     per = segment_aabb_distance(a, b, lo_a[:30], hi_a[:30])
     one = [segment_aabb_distance(a[i:i + 1], b[i:i + 1], lo_a[i], hi_a[i])[0] for i in range(30)]
     np.testing.assert_array_equal(per, one)
+
+
+@pytest.mark.parametrize("exact_below", [float(np.nextafter(0.0, 1.0)), 0.05, 0.4, np.inf])
+def test_body_clearance_compiled_bounds_equal_the_numpy_ones(exact_below, monkeypatch) -> None:
+    from ltl_human_motion.scene import clearance
+
+    if clearance._compiled_bounds() is None:
+        pytest.skip("numba is not in use")
+    rng = np.random.default_rng(4)
+    rest = Skeleton().rest_positions()
+    where = rng.uniform([-0.5, -2.0, 0.0], [2.0, 2.0, 0.0], (300, 1, 3))
+    poses = rest[None] + where + rng.normal(scale=0.05, size=(300, *rest.shape))
+    seg, rad = capsules_from_positions(poses, 1.75)
+    ps = PartSet(PARTS)
+    fast = ps.body_clearance(seg, rad, exact_below)
+    fast_bounded = ps.body_clearance(seg, rad, exact_below, bounds=point_bounds(poses))
+    monkeypatch.setattr(clearance, "_compiled_bounds", lambda: None)
+    slow = ps.body_clearance(seg, rad, exact_below)
+    # Bit for bit: the same bounds, the same exact values of the same pairs.
+    assert fast.tobytes() == slow.tobytes()
+    assert fast_bounded.tobytes() == ps.body_clearance(seg, rad, exact_below,
+                                                      bounds=point_bounds(poses)).tobytes()
+    assert np.any(slow < min(exact_below, 0.4)) and np.any(slow >= 0.05)

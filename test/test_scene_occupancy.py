@@ -69,3 +69,19 @@ def test_parts_and_aliases():
         capsules_from_positions(np.zeros((10, 3)))
     with pytest.raises(ValueError, match="stature must be positive"):
         capsule_radii(0.0)
+
+
+def test_body_boxes_are_the_capsule_boxes():
+    from ltl_human_motion.scene.occupancy import body_boxes, capsules_from_positions
+
+    rng = np.random.default_rng(7)
+    rest = Skeleton(stature=1.75).rest_positions()
+    pos = rest[None] + rng.normal(scale=0.2, size=(40, len(JOINT_NAMES), 3))
+    for stature in (1.6, 1.9):
+        seg, rad = capsules_from_positions(pos, stature)
+        lo, hi = body_boxes(pos, stature)
+        # The same numbers, bit for bit, as the boxes of the capsules' end points +- radii.
+        assert np.array_equal(lo, (seg.min(axis=2) - rad[:, None]).min(axis=1))
+        assert np.array_equal(hi, (seg.max(axis=2) + rad[:, None]).max(axis=1))
+    with pytest.raises(ValueError, match="shape"):
+        body_boxes(pos[0], 1.75)

@@ -156,9 +156,63 @@ def test_offline_makes_the_live_controllers_decisions(s1, robot, horizon):
     assert m["frames_below_sp"] and max(m["frames_below_sp"]) < s1.n_frames
 
 
+@pytest.fixture
+def numpy_steps(monkeypatch):
+    """Run the offline SSM's numpy step loop instead of the compiled one."""
+    from ltl_human_motion.robot import offline_ssm
+
+    monkeypatch.setattr(offline_ssm, "_compiled_steps", lambda: None)
+
+
+@pytest.mark.parametrize("horizon, start", [(0.0, 0.0), (0.5, 0.0), (0.3, 2.9)])
+def test_compiled_and_numpy_step_loops_agree(s1, robot, horizon, start, request):
+    from ltl_human_motion.robot import offline_ssm
+
+    if offline_ssm._compiled_steps() is None:
+        pytest.skip("numba is not in use")
+    traj, model, base = robot
+    args = (s1.positions, s1.fps, traj, model, base)
+    kw = {"prediction_horizon": horizon, "trajectory_start": start}
+    fast = run_offline_ssm(*args, **kw)
+    request.getfixturevalue("numpy_steps")
+    slow = run_offline_ssm(*args, **kw)
+    # The same decisions and skipped steps; the numbers apart by rounding only (the
+    # compiled DH chain sums its products in another order than BLAS).
+    assert list(fast.mode) == list(slow.mode)
+    assert np.array_equal(np.isnan(fast.separation), np.isnan(slow.separation))
+    known = np.isfinite(slow.separation)
+    assert np.allclose(fast.separation[known], slow.separation[known], atol=1e-9, rtol=0)
+    assert np.allclose(fast.slider, slow.slider, atol=1e-9, rtol=0)
+    assert np.allclose(fast.trajectory_time, slow.trajectory_time, atol=1e-9, rtol=0)
+    for key in ("min_separation", "time_min_speed", "time_reduced_speed", "time_below_sp",
+                "throughput_ratio"):
+        assert fast.metrics[key] == pytest.approx(slow.metrics[key], abs=1e-9)
+    assert fast.metrics["frames_below_sp"] == slow.metrics["frames_below_sp"]
+    assert len(fast.metrics["violations"]) == len(slow.metrics["violations"])
+
+
+def test_compiled_slider_is_the_python_one():
+    from ltl_human_motion.robot import offline_ssm
+    from ltl_human_motion.robot.ssm import slider_from_separation
+
+    nb = offline_ssm._compiled_steps()
+    if nb is None:
+        pytest.skip("numba is not in use")
+    params = SSMParameters(min_slider=0.05, max_slider=0.9)
+    sp, margin = params.protective_distance, params.margin
+    rng = np.random.default_rng(5)
+    values = [sp, sp + margin, np.nextafter(sp, 0), np.nextafter(sp + margin, 9), -1.0,
+              np.nan, np.inf, -np.inf, *rng.uniform(sp - 0.2, sp + margin + 0.2, 500)]
+    for v in values:
+        assert nb.slider(float(v), sp, margin, params.min_slider, params.max_slider) \
+            == slider_from_separation(float(v), params)
+
+
 def test_offline_input_errors(robot):
     traj, model, base = robot
     with pytest.raises(ValueError, match="shape"):
         run_offline_ssm(np.zeros((10, 22, 3)), 120.0, traj, model, base)
     with pytest.raises(ValueError, match="fps"):
         run_offline_ssm(np.zeros((10, 23, 3)), 0.0, traj, model, base)
+    with pytest.raises(ValueError, match="base"):
+        run_offline_ssm(np.zeros((10, 23, 3)), 120.0, traj, model, np.full((4, 4), np.nan))

@@ -23,6 +23,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ltl_human_motion.kernel.vectors import cross3, norm3
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, N_JOINTS, Skeleton
 
 __all__ = ["BodyAngles", "body_angles"]
@@ -102,8 +103,7 @@ class BodyAngles:
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
-    return v / np.maximum(n, 1e-12)
+    return v / np.maximum(norm3(v)[..., None], 1e-12)
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -121,11 +121,11 @@ def _raw(p: np.ndarray) -> dict[str, np.ndarray]:
     hip = p[:, _J["l_hip"]] - p[:, _J["r_hip"]]
     hip[:, 2] = 0.0
     lat = _unit(hip)
-    fwd = np.cross(lat, up)
+    fwd = cross3(lat, up)
     trunk = p[:, _J["neck"]] - p[:, _J["pelvis"]]
     u = _unit(trunk)
     f = _unit(fwd - _dot(fwd, u)[:, None] * u)
-    lt = np.cross(u, f)
+    lt = cross3(u, f)
     out: dict[str, np.ndarray] = {
         "trunk_flexion": np.degrees(np.arctan2(_dot(trunk, fwd), _dot(trunk, up))),
         "trunk_side_bend": np.abs(np.degrees(np.arctan2(_dot(trunk, lat), _dot(trunk, up)))),
@@ -151,7 +151,7 @@ def _raw(p: np.ndarray) -> dict[str, np.ndarray]:
         behind = (ahead < 0) & (-ahead > np.abs(sideways))
         cols["upper_arm_flexion"].append(np.where(behind, -elevation, elevation))
         cols["upper_arm_abduction"].append(np.degrees(np.arcsin(np.clip(
-            sideways / np.maximum(np.linalg.norm(a, axis=-1), 1e-12), -1.0, 1.0))))
+            sideways / np.maximum(norm3(a), 1e-12), -1.0, 1.0))))
         c = shoulder - clav
         cols["shoulder_raise"].append(np.degrees(np.arctan2(_dot(c, u),
                                                             np.abs(_dot(c, lt)) + 1e-12)))

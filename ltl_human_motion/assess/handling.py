@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ltl_human_motion.kernel.vectors import norm3
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 
 __all__ = ["HOLD_RADIUS", "Lift", "held_masks", "lifts", "load_in_hand"]
@@ -40,12 +41,12 @@ def _hand_holds(obj: np.ndarray, hand: np.ndarray) -> np.ndarray:
     off = obj - hand
     still = np.zeros(len(obj), dtype=bool)
     if len(obj) > 1:
-        step = np.linalg.norm(np.diff(off, axis=0), axis=1) < _RIGID
-        moved = np.linalg.norm(np.diff(obj, axis=0), axis=1) > _RIGID
+        step = norm3(np.diff(off, axis=0)) < _RIGID
+        moved = norm3(np.diff(obj, axis=0)) > _RIGID
         rigid = step & moved
         still[1:] |= rigid
         still[:-1] |= rigid
-    return still & (np.linalg.norm(off, axis=1) < HOLD_RADIUS)
+    return still & (norm3(off) < HOLD_RADIUS)
 
 
 def _fill_pauses(mask: np.ndarray, obj: np.ndarray) -> np.ndarray:

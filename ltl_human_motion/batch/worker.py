@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ltl_human_motion.batch.items import ItemParams, cell_for_item
+from ltl_human_motion.batch.memory import keep_freed_memory
 
 __all__ = ["ARRAY_NAMES", "BatchJob", "ItemResult", "motion_sha256", "pool_initializer",
            "prepare_worker", "run_item"]
@@ -149,9 +150,11 @@ def prepare_worker(job: BatchJob) -> None:
     """Parse the cell and load the libraries of a small stature grid in this process.
 
     Called once per worker process (pool initializer, Dask worker plugin); items also
-    call it implicitly, so it is an optimization, not a requirement.
+    call it implicitly, so it is an optimization, not a requirement. The process keeps
+    freed heap memory for reuse (:func:`~ltl_human_motion.batch.memory.keep_freed_memory`).
     """
     from ltl_human_motion.planning.pipeline import get_library
+    keep_freed_memory()
     _, options = _cell_and_options(job)
     if len(job.statures) <= PRELOAD_LIMIT:
         for stature in job.statures:
@@ -178,6 +181,11 @@ def pool_initializer(job: BatchJob, period: float = 1.0) -> None:
 
 def _plain(value: Any) -> Any:
     """JSON-ready plain Python; non-finite floats become None."""
+    kind = type(value)                  # the common leaves first, by exact type
+    if kind is float:
+        return value if math.isfinite(value) else None
+    if kind is int or kind is str or value is None:
+        return value
     if isinstance(value, dict):
         return {str(k): _plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

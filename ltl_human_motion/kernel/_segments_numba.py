@@ -132,3 +132,18 @@ def bounded(seg, rad, max_coordinate, max_radius) -> bool:
         if not (r >= 0.0 and r <= max_radius):
             return False
     return True
+
+
+@_jit
+def indexed(X, ends_a, ends_b, out) -> None:
+    """out[t, p] = distance of segments X[t, ends_a[p, 0]] - X[t, ends_a[p, 1]] and
+    X[t, ends_b[p, 0]] - X[t, ends_b[p, 1]] (X (T, J, 3), ends (P, 2), out (T, P))."""
+    for t in range(X.shape[0]):
+        x = X[t]
+        for p in range(ends_a.shape[0]):
+            i, j = ends_a[p, 0], ends_a[p, 1]
+            k, m = ends_b[p, 0], ends_b[p, 1]
+            out[t, p] = _pair(x[i, 0], x[i, 1], x[i, 2],
+                              x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2],
+                              x[k, 0], x[k, 1], x[k, 2],
+                              x[m, 0] - x[k, 0], x[m, 1] - x[k, 1], x[m, 2] - x[k, 2])

@@ -31,6 +31,7 @@ __all__ = [
     "check_capsules",
     "compiled",
     "group_min_signed_distances",
+    "joint_segment_distances",
     "min_signed_distance",
     "segment_distances",
     "segment_segment_distance",
@@ -73,6 +74,8 @@ def compiled() -> bool:
     nb.group_min_signed(seg, rad, seg, rad, np.zeros(1, dtype=np.intp), np.empty(1))
     nb.pairwise(seg, seg, np.empty((1, 1)))
     nb.elementwise(seg, seg, np.empty(1))
+    nb.indexed(seg, np.zeros((1, 2), dtype=np.intp), np.zeros((1, 2), dtype=np.intp),
+               np.empty((1, 1)))
     nb.bounded(seg, rad, 1.0, 1.0)
     return True
 
@@ -285,6 +288,45 @@ def segment_segment_distance(p0: ArrayLike, p1: ArrayLike, q0: ArrayLike,
     else:
         out = _numpy_elementwise(a[:, 0], a[:, 1] - a[:, 0], b[:, 0], b[:, 1] - b[:, 0])
     return out.reshape(shape)
+
+
+def joint_segment_distances(X: ArrayLike, ends_a: ArrayLike, ends_b: ArrayLike
+                            ) -> NDArray[np.float64]:
+    """Exact distances between segments joining points of ``X``, pair by pair.
+
+    The numbers of :func:`segment_segment_distance` (the same pair kernel) for segments
+    given by the indices of their end points, without gathering the end points first.
+
+    Parameters
+    ----------
+    X : array-like, shape (T, J, 3)
+        Points (e.g. joint positions of T poses).
+    ends_a, ends_b : array-like of int, shape (P, 2)
+        Pair ``p`` joins ``X[:, ends_a[p, 0]]`` to ``X[:, ends_a[p, 1]]`` and
+        ``X[:, ends_b[p, 0]]`` to ``X[:, ends_b[p, 1]]``.
+
+    Returns
+    -------
+    d : ndarray, shape (T, P)
+    """
+    (x,) = _contiguous(X)
+    ia = np.ascontiguousarray(ends_a, dtype=np.intp)
+    ib = np.ascontiguousarray(ends_b, dtype=np.intp)
+    if x.ndim != 3 or x.shape[-1] != 3 or ia.ndim != 2 or ia.shape[1:] != (2,) \
+            or ia.shape != ib.shape:
+        raise ValueError(f"joint segments: expected points (T, J, 3) and two (P, 2) index "
+                         f"arrays, got {x.shape}, {ia.shape} and {ib.shape}")
+    if ia.size and not (0 <= min(ia.min(), ib.min()) and max(ia.max(), ib.max()) < x.shape[1]):
+        raise ValueError(f"joint segments: indices beyond the {x.shape[1]} points")
+    nb = _compiled()
+    if nb is not None:
+        out = np.empty((len(x), len(ia)))
+        nb.indexed(x, ia, ib, out)
+        return out
+    a = x[:, ia.ravel()].reshape(-1, 2, 3)
+    b = x[:, ib.ravel()].reshape(-1, 2, 3)
+    d = _numpy_elementwise(a[:, 0], a[:, 1] - a[:, 0], b[:, 0], b[:, 1] - b[:, 0])
+    return d.reshape(len(x), len(ia))
 
 
 def segment_distances(P: ArrayLike, Q: ArrayLike) -> NDArray[np.float64]:

@@ -58,15 +58,12 @@ def _strikes(p: np.ndarray, fps: float, stature: float, floor_z: float) -> list[
     for k, s in enumerate("lr"):
         idx = [_J[f"{s}_ankle"], _J[f"{s}_toe"]]
         h = (p[:, idx, 2] - floor_z - np.asarray(CONTACT_REST_HEIGHTS) * stature).min(axis=1)
-        down = h <= 0.02
         lifted = h >= 0.04
-        armed = False
-        for t in range(len(h)):
-            if lifted[t]:
-                armed = True
-            elif down[t] and armed:
-                out.append((t, k))
-                armed = False
+        # A strike is a foot-down frame whose last lifted-or-down frame before it was
+        # lifted (the foot re-arms when lifted and strikes once when it comes down).
+        events = np.flatnonzero(lifted | (h <= 0.02))
+        up = lifted[events]
+        out += [(int(t), k) for t in events[1:][up[:-1] & ~up[1:]]]
     return sorted(out)
 
 
@@ -134,9 +131,9 @@ def summary(samples: np.ndarray) -> dict:
     x = np.asarray(samples, dtype=np.float64)
     if x.size == 0:
         return {"n": 0, "mean": None, "p5": None, "median": None, "p95": None, "max": None}
-    return {"n": int(x.size), "mean": float(x.mean()), "p5": float(np.percentile(x, 5)),
-            "median": float(np.median(x)), "p95": float(np.percentile(x, 95)),
-            "max": float(x.max())}
+    p5, p95 = np.percentile(x, [5, 95])
+    return {"n": int(x.size), "mean": float(x.mean()), "p5": float(p5),
+            "median": float(np.median(x)), "p95": float(p95), "max": float(x.max())}
 
 
 def compare(ours: Iterable[dict[str, np.ndarray]], real: Iterable[dict[str, np.ndarray]]

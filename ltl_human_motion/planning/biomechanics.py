@@ -59,9 +59,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ltl_human_motion.kernel.segments import joint_segment_distances
+from ltl_human_motion.kernel.vectors import cross3, dot3, norm3
 from ltl_human_motion.motion.ik import center_of_mass
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, JOINT_NAMES
-from ltl_human_motion.scene.geometry import segment_segment_distance
 from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 __all__ = [
@@ -140,7 +141,7 @@ def joint_speeds(positions: np.ndarray, fps: float, window: float = SPEED_WINDOW
     w = max(1, round(window * float(fps)))
     if len(p) <= w:
         return np.zeros((0, p.shape[1]))
-    return np.linalg.norm(p[w:] - p[:-w], axis=-1) * (float(fps) / w)
+    return norm3(p[w:] - p[:-w]) * (float(fps) / w)
 
 
 def _kind(label: str) -> str:
@@ -166,14 +167,15 @@ def _speed_limits(n: int, labels: Sequence[str], lim: BiomechanicsLimits,
 
 # ---------------------------------------------------------------------- angles
 def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+    n = norm3(v)[..., None] if v.shape[-1] == 3 else np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.maximum(n, 1e-12)
 
 
 def _frame(lateral: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Orthonormal (forward, left, up) axes (T, 3) each from a lateral and an up vector."""
     left = _unit(lateral)
-    u = _unit(up - np.sum(up * left, -1, keepdims=True) * left)
-    return np.cross(left, u), left, u
+    u = _unit(up - dot3(up, left)[..., None] * left)
+    return cross3(left, u), left, u
 
 
 def joint_angles(positions: np.ndarray) -> dict[str, np.ndarray]:
@@ -200,22 +202,22 @@ def joint_angles(positions: np.ndarray) -> dict[str, np.ndarray]:
     for s, side in (("l", 1.0), ("r", -1.0)):
         hip, knee, ank, toe = (p[:, _J[f"{s}_{n}"]] for n in ("hip", "knee", "ankle", "toe"))
         thigh, shank, foot = knee - hip, ank - knee, toe - ank
-        axis = _unit(-np.cross(shank, foot))
-        cr = np.sum(np.cross(thigh, shank) * axis, -1)
-        out[f"{s}_knee_flexion"] = deg(np.arctan2(cr, np.sum(thigh * shank, -1)))
+        axis = _unit(-cross3(shank, foot))
+        cr = dot3(cross3(thigh, shank), axis)
+        out[f"{s}_knee_flexion"] = deg(np.arctan2(cr, dot3(thigh, shank)))
         t = _unit(thigh)
-        out[f"{s}_hip_flexion"] = deg(np.arctan2(np.sum(t * fwd, -1), -np.sum(t * up, -1)))
-        out[f"{s}_hip_abduction"] = deg(np.arcsin(np.clip(side * np.sum(t * left, -1), -1, 1)))
+        out[f"{s}_hip_flexion"] = deg(np.arctan2(dot3(t, fwd), -dot3(t, up)))
+        out[f"{s}_hip_abduction"] = deg(np.arcsin(np.clip(side * dot3(t, left), -1, 1)))
         sh, el, wr = (p[:, _J[f"{s}_{n}"]] for n in ("shoulder", "elbow", "wrist"))
         ua, fa = _unit(el - sh), _unit(wr - el)
-        out[f"{s}_elbow_flexion"] = deg(np.arccos(np.clip(np.sum(ua * fa, -1), -1, 1)))
-        out[f"{s}_shoulder_extension"] = deg(np.arcsin(np.clip(-np.sum(ua * cf, -1), -1, 1)))
-    out["trunk_flexion"] = deg(np.arctan2(np.sum(cu * fwd, -1), np.sum(cu * up, -1)))
-    out["trunk_lateral"] = deg(np.arcsin(np.clip(np.sum(cu * left, -1), -1, 1)))
-    out["trunk_rotation"] = deg(np.arctan2(np.sum(cl * -fwd, -1), np.sum(cl * left, -1)))
+        out[f"{s}_elbow_flexion"] = deg(np.arccos(np.clip(dot3(ua, fa), -1, 1)))
+        out[f"{s}_shoulder_extension"] = deg(np.arcsin(np.clip(-dot3(ua, cf), -1, 1)))
+    out["trunk_flexion"] = deg(np.arctan2(dot3(cu, fwd), dot3(cu, up)))
+    out["trunk_lateral"] = deg(np.arcsin(np.clip(dot3(cu, left), -1, 1)))
+    out["trunk_rotation"] = deg(np.arctan2(dot3(cl, -fwd), dot3(cl, left)))
     h = _unit(p[:, _J["head"]] - p[:, _J["neck"]])
-    out["neck_flexion"] = deg(np.arctan2(np.sum(h * cf, -1), np.sum(h * cu, -1)))
-    out["neck_lateral"] = deg(np.arcsin(np.clip(np.sum(h * cl, -1), -1, 1)))
+    out["neck_flexion"] = deg(np.arctan2(dot3(h, cf), dot3(h, cu)))
+    out["neck_lateral"] = deg(np.arcsin(np.clip(dot3(h, cl), -1, 1)))
     return out
 
 
@@ -247,6 +249,10 @@ def _penetration_pairs() -> list[tuple[int, int]]:
 
 
 _PAIRS = _penetration_pairs()
+#: Capsule indices (2, P) of the pairs, and the joints (2, P, 2) ending their capsules.
+_PAIR_CAPSULES = np.array(_PAIRS, dtype=np.intp).T
+_PAIR_ENDS = np.array([[_J[c[1]], _J[c[2]]] for c in BODY_CAPSULES],
+                      dtype=np.intp)[_PAIR_CAPSULES]
 
 
 def self_penetration(positions: np.ndarray, stature: float = DEFAULT_STATURE
@@ -266,11 +272,8 @@ def self_penetration(positions: np.ndarray, stature: float = DEFAULT_STATURE
     """
     p = np.asarray(positions, dtype=np.float64)
     r = capsule_radii(stature)
-    ia = np.array([_J[c[1]] for c in BODY_CAPSULES])
-    ib = np.array([_J[c[2]] for c in BODY_CAPSULES])
-    a = np.array([i for i, _ in _PAIRS])
-    b = np.array([j for _, j in _PAIRS])
-    d = segment_segment_distance(p[:, ia[a]], p[:, ib[a]], p[:, ia[b]], p[:, ib[b]])
+    a, b = _PAIR_CAPSULES
+    d = joint_segment_distances(p, _PAIR_ENDS[0], _PAIR_ENDS[1])
     depth = np.maximum(r[a], r[b])[None] - d
     names = [(BODY_CAPSULES[i][0], BODY_CAPSULES[j][0]) for i, j in _PAIRS]
     return depth, names
@@ -329,7 +332,7 @@ def balance_margins(positions: np.ndarray, fps: float, stature: float = DEFAULT_
     rest_h = np.tile(CONTACT_REST_HEIGHTS, 2) * stature
     low = np.all(p[:, feet, 2] - floor_z - rest_h <= limits.contact_height, axis=1)
     slow = np.all(v <= limits.planted_speed * stature / limits.reference_stature, axis=1)
-    pv = np.linalg.norm(np.diff(p[:, 0], axis=0), axis=-1) * fps
+    pv = norm3(np.diff(p[:, 0], axis=0)) * fps
     pv = np.concatenate([pv[:1], pv])
     static = low & slow & (pv <= limits.static_pelvis_speed)
     if skip is not None:

@@ -10,8 +10,9 @@ unreachable goal is known before any primitive is expanded.
 from __future__ import annotations
 
 from collections.abc import Callable
-from functools import lru_cache
+from functools import cache, lru_cache
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -178,6 +179,19 @@ class NavigationField:
         return bool(np.isfinite(self.distance(np.array([x]), np.array([y]))[0]))
 
 
+@cache
+def _compiled_loops() -> ModuleType | None:
+    """The compiled loops (:mod:`._navigation_numba`), where the compiled kernel is in use."""
+    from ltl_human_motion.kernel.segments import compiled
+    if not compiled():
+        return None
+    try:
+        from ltl_human_motion.planning import _navigation_numba
+    except ImportError:
+        return None
+    return _navigation_numba
+
+
 #: How much closer than its footprint a tall part counts for walking (the swinging arms
 #: pass it at shoulder width), metres.
 TALL_EXTRA = 0.25
@@ -231,6 +245,12 @@ class ClearanceMap:
     def __call__(self, xy: np.ndarray) -> np.ndarray:
         """Clearance of floor points, shape (N,) for ``xy`` of shape (N, 2)."""
         xy = np.asarray(xy, dtype=np.float64)
+        nb = _compiled_loops()
+        if nb is not None:
+            flat = np.ascontiguousarray(xy).reshape(-1, 2)
+            out = np.empty(len(flat))
+            nb.bilinear(self._xs, self._ys, self._values, self._in_lo, self._in_hi, flat, out)
+            return out.reshape(xy.shape[:-1])
         x, y = xy[..., 0], xy[..., 1]
         xs, ys = self._xs, self._ys
         flat, ny = self._values.ravel(), self._values.shape[1]
@@ -268,6 +288,12 @@ def _trilinear(grid: np.ndarray, u: np.ndarray) -> np.ndarray:
     -------
     values : ndarray, shape (N,)
     """
+    nb = _compiled_loops()
+    if nb is not None and np.isfinite(u).all():
+        out = np.empty(len(u))
+        nb.trilinear(np.ascontiguousarray(grid, dtype=np.float64),
+                     np.ascontiguousarray(u, dtype=np.float64), out)
+        return out
     flat = np.ascontiguousarray(grid, dtype=np.float64).ravel()
     step = (grid.shape[1] * grid.shape[2], grid.shape[2], 1)       # elements per axis step
     offsets, weights = [], []

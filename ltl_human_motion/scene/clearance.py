@@ -16,7 +16,9 @@ capsule, and gets that (smaller, still at least ``exact_below``) bound instead.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
+from types import ModuleType
 
 import numpy as np
 
@@ -164,6 +166,10 @@ class PartSet:
             lo, hi = point_bounds(seg.reshape(-1, 2 * K, 3))
         else:
             lo, hi = (np.asarray(b, dtype=np.float64).reshape(-1, 3) for b in bounds)
+        nb = _compiled_bounds()
+        if nb is not None:
+            return self._body_clearance_compiled(nb, seg.reshape(-1, K, 2, 3), rad, lo, hi,
+                                                 exact_below).reshape(lead)
         body = box_gap(lo[:, None], hi[:, None], self.lo, self.hi) - rad.max()     # (F, P)
         f_idx, p_idx = np.nonzero(body < exact_below)
         if f_idx.size:
@@ -175,6 +181,39 @@ class PartSet:
             body[f_idx, p_idx] = vals.reshape(-1, K).min(axis=1)
         out = body.min(axis=1)
         return out.reshape(lead)
+
+
+    def _body_clearance_compiled(self, nb: ModuleType, seg: np.ndarray, rad: np.ndarray,
+                                 lo: np.ndarray, hi: np.ndarray, exact_below: float
+                                 ) -> np.ndarray:
+        """:meth:`body_clearance` of bodies (F, K, 2, 3) with their boxes lo, hi (F, 3),
+        the bounds compiled (:mod:`._clearance_numba`), the exact values as in numpy."""
+        seg = np.ascontiguousarray(seg, dtype=np.float64)
+        body, f_idx, p_idx, caps = nb.body_bounds(
+            seg, np.ascontiguousarray(rad, dtype=np.float64), np.ascontiguousarray(lo),
+            np.ascontiguousarray(hi), self.lo, self.hi, float(exact_below))
+        if f_idx.size:
+            K = seg.shape[1]
+            near = np.flatnonzero(caps.ravel() < exact_below)
+            if near.size:
+                m, k = np.divmod(near, K)
+                ends = seg[f_idx[m], k]                                          # (N, 2, 3)
+                caps.ravel()[near] = self._exact(ends[:, 0], ends[:, 1], rad[k], p_idx[m])
+            body[f_idx, p_idx] = caps.min(axis=1)
+        return body.min(axis=1)
+
+
+@functools.cache
+def _compiled_bounds() -> ModuleType | None:
+    """The compiled bounds (:mod:`._clearance_numba`), where the compiled kernel is in use."""
+    from ltl_human_motion.kernel.segments import compiled
+    if not compiled():
+        return None
+    try:
+        from ltl_human_motion.scene import _clearance_numba
+    except ImportError:
+        return None
+    return _clearance_numba
 
 
 _PART_SETS: BoundedCache[PartSet] = BoundedCache(64)

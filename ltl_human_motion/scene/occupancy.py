@@ -22,6 +22,7 @@ __all__ = [
     "BODY_CAPSULES",
     "BODY_PARTS",
     "PART_ALIASES",
+    "body_boxes",
     "body_radius_xy",
     "capsule_ends",
     "capsule_radii",
@@ -139,6 +140,41 @@ def capsules_from_positions(positions: np.ndarray, stature: float = DEFAULT_STAT
     # One gather of both end points of every capsule: (..., 2K, 3) -> (..., K, 2, 3).
     segments = np.take(pos, ends, axis=-2).reshape(*pos.shape[:-2], -1, 2, 3)
     return segments, radii
+
+
+_BOX_JOINTS = np.unique(_IAB)                        # joints that end a capsule
+
+
+def body_boxes(positions: np.ndarray, stature: float = DEFAULT_STATURE
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned box of the whole occ(x), per frame.
+
+    The same numbers as the least and greatest capsule end point coordinate less and plus
+    its capsule's radius (:func:`capsules_from_positions`), taken per joint with the
+    largest radius of the capsules the joint ends.
+
+    Parameters
+    ----------
+    positions : array-like, shape (T, J, 3)
+        Joint positions of the canonical skeleton.
+    stature : float
+
+    Returns
+    -------
+    lo, hi : ndarray, shape (T, 3)
+    """
+    pos = np.asarray(positions, dtype=np.float64)
+    if pos.ndim != 3 or pos.shape[1:] != (N_JOINTS, 3):
+        raise ValueError(f"positions must have shape (T, {N_JOINTS}, 3), got {pos.shape}")
+    radius = np.full(N_JOINTS, -np.inf)
+    np.maximum.at(radius, _IAB, np.repeat(capsule_radii(stature), 2))
+    first, *rest = _BOX_JOINTS.tolist()
+    lo = pos[:, first] - radius[first]
+    hi = pos[:, first] + radius[first]
+    for j in rest:                  # elementwise over (T, 3), one joint at a time: fast
+        np.minimum(lo, pos[:, j] - radius[j], out=lo)
+        np.maximum(hi, pos[:, j] + radius[j], out=hi)
+    return lo, hi
 
 
 def occ(positions: np.ndarray, parts: str | Iterable[str] | None = None,

@@ -95,6 +95,12 @@ class JointTrajectory:
         """Joint position (6,) at trajectory time ``t``."""
         return self.sample(t)[0]
 
+    def segment_arrays(self) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                      NDArray[np.float64], NDArray[np.float64]]:
+        """The segments as arrays: start times (W,), move times (W,), and the joints each
+        one moves from and to (W, 6); segment ``k`` starts at ``start[k]`` (s of the cycle)."""
+        return self._start, self._move, self._from, self._q
+
     def positions(self, times: Sequence[float]) -> NDArray[np.float64]:
         """Joint positions (T, 6) at many trajectory times (vectorized :meth:`position`)."""
         t = np.asarray(times, dtype=np.float64).reshape(-1)
