@@ -158,15 +158,22 @@ def _place(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float) ->
                      yaw + d[:, 2]], axis=-1)
 
 
-def _path_clearance(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float,
-                    clearance: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-    """Smallest obstacle clearance along the root path of primitives ``ids``, shape (M,)."""
+def _path_points(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float
+                 ) -> np.ndarray:
+    """World floor points of the root paths of primitives ``ids`` started at (x, y, yaw),
+    shape (M, S, 2)."""
     c, s = np.cos(yaw), np.sin(yaw)
     p = index.path[ids]                                    # (M, S, 2)
     wx = x + c * p[..., 0] - s * p[..., 1]
     wy = y + s * p[..., 0] + c * p[..., 1]
-    pts = np.stack([wx, wy], axis=-1).reshape(-1, 2)
-    return clearance(pts).reshape(p.shape[:2]).min(axis=1)
+    return np.stack([wx, wy], axis=-1)
+
+
+def _path_clearance(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float,
+                    clearance: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """Smallest obstacle clearance along the root path of primitives ``ids``, shape (M,)."""
+    pts = _path_points(index, ids, x, y, yaw)
+    return clearance(pts.reshape(-1, 2)).reshape(pts.shape[:2]).min(axis=1)
 
 
 def _clear_successors(index: GaitIndex, prim: int, pose: Pose, allowed: np.ndarray,
@@ -214,17 +221,57 @@ def _arrivals(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, goal: Goal,
     done = near & index.stops[succ]
     tail: list[tuple[int, Pose]] = []
     if not done.any() and near.any():
-        for m in np.flatnonzero(near):
-            at = (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2]))
-            stop = _stop_after(index, int(succ[m]), at, goal, allowed, clearance,
-                               options.body_radius, body_clear, forbidden, options.grid,
-                               options.yaw_bins)
-            if stop is not None:
-                tail = [(stop[0], at)]
-                done[m] = True
-                ends[m] = stop[1]
-                break
+        found = _first_stop(index, succ, ends, np.flatnonzero(near), goal, allowed,
+                            clearance, body_clear, forbidden, options)
+        if found is not None:
+            m, stop, end = found
+            tail = [(stop, (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2])))]
+            done[m] = True
+            ends[m] = end
     return done, tail
+
+
+def _first_stop(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, near: np.ndarray,
+                goal: Goal, allowed: np.ndarray,
+                clearance: Callable[[np.ndarray], np.ndarray],
+                body_clear: Callable[[np.ndarray, np.ndarray], np.ndarray] | None,
+                forbidden: frozenset[tuple[int, int, int, int]], options: SearchOptions
+                ) -> tuple[int, int, np.ndarray] | None:
+    """The first successor ``m`` of ``near`` (indices into ``succ`` (M,) and ``ends``
+    (M, 3), in order) after which a stop primitive may follow, is not ``forbidden``
+    there, keeps clear and ends in the goal, with the first such stop: (m, the stop, its
+    end pose (3,)); None if there is none. The goal, floor and body tests of all the
+    candidates run in one call each."""
+    owners, ids, stop_ends, paths, bodies = [], [], [], [], []
+    for m in near.tolist():
+        at = (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2]))
+        stop_ids = _stop_candidates(index, int(succ[m]), at, allowed, forbidden, options)
+        if stop_ids.size:
+            owners.append(np.full(stop_ids.size, m))
+            ids.append(stop_ids)
+            stop_ends.append(_place(index, stop_ids, *at))
+            paths.append(_path_points(index, stop_ids, *at))
+    if not ids:
+        return None
+    owner, cand, cand_ends = np.concatenate(owners), np.concatenate(ids), np.concatenate(stop_ends)
+    path = np.concatenate(paths)                                     # (K, S, 2)
+    ok = goal.reached(cand_ends[:, 0], cand_ends[:, 1], cand_ends[:, 2])
+    ok &= clearance(path.reshape(-1, 2)).reshape(path.shape[:2]).min(axis=1) \
+        > options.body_radius
+    if ok.any() and body_clear is not None and index.body.size:
+        # The arms swing as the worker stops: check the whole body, as for every move.
+        for k in np.flatnonzero(ok).tolist():
+            if not bodies or bodies[-1][0] != owner[k]:
+                bodies.append((owner[k], []))
+            bodies[-1][1].append(k)
+        sel = np.concatenate([np.asarray(ks) for _, ks in bodies])
+        body = np.concatenate([_body_at(index, cand[ks], *(float(v) for v in ends[m]))
+                               for m, ks in bodies])
+        ok[sel] = body_clear(body, index.standing[cand[sel]])
+    if not ok.any():
+        return None
+    k = int(np.flatnonzero(ok)[0])
+    return int(owner[k]), int(cand[k]), cand_ends[k]
 
 
 def _heuristic(goal: Goal, options: SearchOptions, x: np.ndarray, y: np.ndarray,
@@ -279,33 +326,17 @@ def _body_at(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float
     return body
 
 
-def _stop_after(index: GaitIndex, prim: int, at: Pose, goal: Goal, allowed: np.ndarray,
-                clearance: Callable[[np.ndarray], np.ndarray], body_radius: float,
-                body_clear: Callable[[np.ndarray, np.ndarray], np.ndarray] | None,
-                forbidden: frozenset[tuple[int, int, int, int]], grid: float, yaw_bins: int
-                ) -> tuple[int, np.ndarray] | None:
-    """A stop primitive that may follow ``prim`` at pose ``at``, is not ``forbidden``
-    there, keeps clear and ends in the goal: (its index, its end pose (3,)), or None."""
+def _stop_candidates(index: GaitIndex, prim: int, at: Pose, allowed: np.ndarray,
+                     forbidden: frozenset[tuple[int, int, int, int]], options: SearchOptions
+                     ) -> np.ndarray:
+    """The stop primitives that may follow ``prim`` at pose ``at`` and are not
+    ``forbidden`` there, (K,)."""
     stop_ids = index.successors(prim)
     stop_ids = stop_ids[index.stops[stop_ids] & allowed[stop_ids]]
     if forbidden and stop_ids.size:
-        there = placement_key(*at, grid, yaw_bins)
+        there = placement_key(*at, options.grid, options.yaw_bins)
         stop_ids = stop_ids[[(int(p), *there) not in forbidden for p in stop_ids.tolist()]]
-    if stop_ids.size == 0:
-        return None
-    mx, my, myaw = at
-    stop_ends = _place(index, stop_ids, mx, my, myaw)
-    stop_ok = goal.reached(stop_ends[:, 0], stop_ends[:, 1], stop_ends[:, 2])
-    stop_ok &= _path_clearance(index, stop_ids, mx, my, myaw, clearance) > body_radius
-    if stop_ok.any() and body_clear is not None and index.body.size:
-        # The arms swing as the worker stops: check the whole body, as for every move.
-        cand = stop_ids[stop_ok]
-        stop_ok[stop_ok] = body_clear(_body_at(index, cand, mx, my, myaw),
-                                      index.standing[cand])
-    if not stop_ok.any():
-        return None
-    k = int(np.flatnonzero(stop_ok)[0])
-    return int(stop_ids[k]), stop_ends[k]
+    return stop_ids
 
 
 def _step_costs(index: GaitIndex, options: SearchOptions, carry: bool,
