@@ -74,7 +74,16 @@ def test_trilinear_matches_map_coordinates(shape, compiled, monkeypatch) -> None
     assert got.tobytes() == map_coordinates(grid, u.T, order=1, mode="nearest").tobytes()
 
 
-def test_obstacle_field_clear_matches_reading_every_capsule(paper) -> None:
+@pytest.mark.parametrize("compiled", [False, True])
+def test_obstacle_field_clear_matches_reading_every_capsule(paper, compiled, monkeypatch
+                                                            ) -> None:
+    """Both paths (the compiled loop stops at a capsule's first failing gap) give what
+    reading every capsule's ends and middle gives."""
+    from ltl_human_motion.planning import navigation
+    if not compiled:
+        monkeypatch.setattr(navigation, "_compiled_loops", lambda: None)
+    elif navigation._compiled_loops() is None:
+        pytest.skip("numba is not in use")
     field = ObstacleField(paper)
     rng = np.random.default_rng(2)
     rest = Skeleton().rest_positions()

@@ -74,3 +74,73 @@ def trilinear(grid, u, out) -> None:
                     k = lo[2] if f2 == 0 else hi[2]
                     v = v + grid[i, j, k] * w[0, f0] * w[1, f1] * w[2, f2]
         out[n] = v
+
+
+@_jit
+def _field_distance(grid, lo, res, far, p0, p1, p2):
+    """The obstacle field's distance at one point (``ObstacleField.distance``): the
+    trilinear value at index coordinates ``(p - lo) / res``, at least ``far`` off the
+    grid; the arithmetic of :func:`trilinear`."""
+    nx, ny, nz = grid.shape
+    u0, u1, u2 = (p0 - lo[0]) / res, (p1 - lo[1]) / res, (p2 - lo[2]) / res
+    outside = (u0 < 0 or u0 > nx - 1 or u1 < 0 or u1 > ny - 1 or u2 < 0 or u2 > nz - 1)
+    b0, b1, b2 = math.floor(u0), math.floor(u1), math.floor(u2)
+    w00 = 1.0 - (u0 - b0)
+    w10 = 1.0 - (u1 - b1)
+    w20 = 1.0 - (u2 - b2)
+    w01, w11, w21 = 1.0 - w00, 1.0 - w10, 1.0 - w20
+    i0, i1 = int(min(max(b0, 0.0), nx - 1)), int(min(max(b0 + 1, 0.0), nx - 1))
+    j0, j1 = int(min(max(b1, 0.0), ny - 1)), int(min(max(b1 + 1, 0.0), ny - 1))
+    k0, k1 = int(min(max(b2, 0.0), nz - 1)), int(min(max(b2 + 1, 0.0), nz - 1))
+    v = 0.0
+    v = v + grid[i0, j0, k0] * w00 * w10 * w20
+    v = v + grid[i0, j0, k1] * w00 * w10 * w21
+    v = v + grid[i0, j1, k0] * w00 * w11 * w20
+    v = v + grid[i0, j1, k1] * w00 * w11 * w21
+    v = v + grid[i1, j0, k0] * w01 * w10 * w20
+    v = v + grid[i1, j0, k1] * w01 * w10 * w21
+    v = v + grid[i1, j1, k0] * w01 * w11 * w20
+    v = v + grid[i1, j1, k1] * w01 * w11 * w21
+    return max(v, far) if outside else v
+
+
+@_jit
+def _capsule_gap(grid, lo, res, far, pos, m, s, a, b, long, need):
+    """Gap of one capsule (joints a, b of sample s of candidate m) by the field: the
+    nearer of its ends' distances (and of its middle's, for a long capsule) less
+    ``need``."""
+    da = _field_distance(grid, lo, res, far, pos[m, s, a, 0], pos[m, s, a, 1], pos[m, s, a, 2])
+    db = _field_distance(grid, lo, res, far, pos[m, s, b, 0], pos[m, s, b, 1], pos[m, s, b, 2])
+    d = min(da, db)
+    if long:
+        mid = _field_distance(grid, lo, res, far, (pos[m, s, a, 0] + pos[m, s, b, 0]) / 2.0,
+                              (pos[m, s, a, 1] + pos[m, s, b, 1]) / 2.0,
+                              (pos[m, s, a, 2] + pos[m, s, b, 2]) / 2.0)
+        d = min(d, mid)
+    return d - need
+
+
+@_jit
+def body_field_clear(grid, lo, res, far, pos, ia, ib, long, need, relative, out) -> None:
+    """out[m] = whether every capsule of every sample of candidate m (pos (M, S, J, 3);
+    capsule k from joint ia[k] to ib[k]) keeps its field gap >= 0, or with ``relative``
+    >= min(its gap at the first sample, 0) - 0.005 (``ObstacleField.clear``; ``need``
+    (K,): radius, margin and interpolation allowance). Stops at the first failing gap."""
+    K = ia.shape[0]
+    first = np.empty(K)
+    for m in range(pos.shape[0]):
+        ok = True
+        if relative:
+            for k in range(K):
+                first[k] = min(_capsule_gap(grid, lo, res, far, pos, m, 0, ia[k], ib[k],
+                                            long[k], need[k]), 0.0) - 0.005
+        for s in range(pos.shape[1]):
+            for k in range(K):
+                gap = _capsule_gap(grid, lo, res, far, pos, m, s, ia[k], ib[k], long[k],
+                                   need[k])
+                if not gap >= (first[k] if relative else 0.0):
+                    ok = False
+                    break
+            if not ok:
+                break
+        out[m] = ok

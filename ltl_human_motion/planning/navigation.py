@@ -419,6 +419,15 @@ class ObstacleField:
         if not check.any():
             return ok
         pos = pos[check]
+        nb = _compiled_loops()
+        if nb is not None and np.isfinite(pos).all():
+            out = np.empty(pos.shape[0], dtype=np.bool_)
+            nb.body_field_clear(np.ascontiguousarray(self.dist, dtype=np.float64),
+                                np.asarray(self.lo, dtype=np.float64), float(self.res),
+                                float(self.far), np.ascontiguousarray(pos), ia, ib, long,
+                                radii + margin + self.res * 0.4, bool(relative), out)
+            ok[check] = out
+            return ok
         d_joint = self.distance(pos)                                        # (m, S, J)
         d_mid = self.distance((pos[..., ia[long], :] + pos[..., ib[long], :]) / 2.0)
         closest = np.minimum(d_joint[..., ia], d_joint[..., ib])            # (m, S, K)
