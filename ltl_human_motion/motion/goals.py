@@ -865,12 +865,121 @@ def _posture_name(pose: np.ndarray, skeleton: Skeleton) -> str:
     return "upright"
 
 
+def _bend_path(skeleton: Skeleton, st: _Start, rng: np.random.Generator, s: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Pelvis (T, 3) and trunk pitch (T,) of bend at progress ``s`` (T,): head to 0.60 H
+    (below chest height 0.72 H), knees nearly straight."""
+    H = skeleton.stature
+    pelvis = np.tile(st.pelvis, (s.shape[0], 1))
+    head_off = skeleton.rest_positions()[_J["head"]] - skeleton.rest_positions()[0]
+    want = 0.60 * H + rng.uniform(-0.02, 0.02) * H
+    drop = 0.01 * H
+    c = np.clip((want - (st.pelvis[2] - drop)) / np.linalg.norm(head_off), -1, 1)
+    pitch1 = float(np.arccos(c))
+    pitch = pitch1 * s
+    pelvis[:, 2] -= drop * s
+    p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
+    shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
+    pelvis[:, 0] += shift * s
+    return pelvis, pitch
+
+
+def _stoop_path(skeleton: Skeleton, st: _Start, rng: np.random.Generator, s: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Pelvis (T, 3) and trunk pitch (T,) of stoop at progress ``s`` (T,): buttocks (hips)
+    below knee height, trunk flexed forward."""
+    H = skeleton.stature
+    pelvis = np.tile(st.pelvis, (s.shape[0], 1))
+    hip_h = 0.20 * H + rng.uniform(-0.01, 0.01) * H
+    rest = skeleton.rest_positions()
+    drop = st.pelvis[2] - (hip_h + (rest[0, 2] - rest[_J["l_hip"], 2]))
+    pitch1 = float(0.85 + rng.uniform(-0.05, 0.05))
+    p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
+    shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
+    pelvis[:, 2] -= drop * s
+    pelvis[:, 0] += shift * s
+    pitch = pitch1 * s
+    return pelvis, pitch
+
+
+def _kneel_path(skeleton: Skeleton, st: _Start, hand: str, t: np.ndarray, s: np.ndarray,
+                times: tuple[float, float, float, float], ankles: np.ndarray,
+                toes: np.ndarray, knee_pole: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pelvis (T, 3) and trunk pitch (T,) of kneeling on one knee (right by default,
+    ``hand="l_hand"`` kneels on the left) at times ``t`` and progress ``s`` (T,);
+    ``times`` = (t1, t2, t_up, total). Moves the kneeling leg's ankle, toe and knee pole
+    (each (T, 2, 3)) in place."""
+    H = skeleton.stature
+    b = _bones(skeleton)
+    t1, t2, t_up, total = times
+    k = 0 if hand in ("l_hand", "left", "l") else 1
+    rest = skeleton.rest_positions()
+    thigh, shank, foot = b[_J["l_knee"]], b[_J["l_ankle"]], b[_J["l_toe"]]
+    knee_z = 0.026 * H
+    hip_above = 0.97 * thigh
+    hip_x = -0.6 * thigh
+    knee = np.array([hip_x + 0.24 * thigh, st.ankles[k, 1], knee_z])
+    hip = np.array([knee[0] - np.sqrt(thigh ** 2 - hip_above ** 2), knee[1],
+                    knee_z + hip_above])
+    ankle_z = 0.075 * H
+    ankle = np.array([knee[0] - np.sqrt(shank ** 2 - (ankle_z - knee_z) ** 2), knee[1],
+                      ankle_z])
+    toe_z = rest[_J["l_toe"], 2]
+    toe = ankle + np.array([np.sqrt(foot ** 2 - (ankle_z - toe_z) ** 2), 0.0,
+                            toe_z - ankle_z])
+    pel1 = hip - (rest[_J[f"{_SIDES[k]}_hip"]] - rest[0])
+    # the moving foot lifts while it steps back
+    # it moves only once lifted and lands before it stops, so it never slides over
+    # the floor (the first and last 15 % of each step are rise and set-down)
+    w0, w1 = 0.55 * t1, total - (t2 + 0.45 * t_up)
+    s_foot = _profile(t, [(0.15 * w0, 0.0), (0.85 * w0, 1.0),
+                          (t2 + 0.45 * t_up + 0.15 * w1, 1.0), (total - 0.15 * w1, 0.0)])
+    tau = np.where(t < w0, t / w0, np.where(t > total - w1, (t - (total - w1)) / w1, 0.0))
+    lift = 0.05 * H * np.sin(np.pi * tau) ** 2
+    ankles[:, k] = st.ankles[k] + s_foot[:, None] * (ankle - st.ankles[k])
+    ankles[:, k, 2] += lift
+    toes[:, k] = st.toes[k] + s_foot[:, None] * (toe - st.toes[k])
+    toes[:, k, 2] += lift
+    knee_pole[:, k] = np.array([0.35, 0.0, -1.0])
+    pelvis = st.pelvis + s[:, None] * (pel1 - st.pelvis)
+    pitch = 0.15 * s
+    return pelvis, pitch
+
+
+def _low_reach(task: str, skeleton: Skeleton, st: _Start, t: np.ndarray,
+               shoulders: np.ndarray, target: np.ndarray | None, hand: str,
+               times: tuple[float, float, float], fps: float
+               ) -> tuple[np.ndarray, np.ndarray | None, str]:
+    """Hands (T, 2, 3) of a down-up task: resting relative to the shoulders (T, 2, 3),
+    or reaching ``target`` (3,) in the low posture; also the checked target and the
+    acting hand's name. ``times`` = (t1, t2, total)."""
+    hands = shoulders + st.hand_rel
+    if target is None:
+        return hands, None, "none"
+    t1, t2, total = times
+    T = t.shape[0]
+    target = np.asarray(target, dtype=np.float64)
+    if target.shape != (3,):
+        raise ValueError(f"target must have shape (3,), got {target.shape}")
+    targets, active, hand_name = _hand_targets("grasp", target, hand if hand != "auto"
+                                               else "auto")
+    f1 = min(round(t1 * fps), T - 1)
+    arm = _arm_length(skeleton)
+    rel = np.broadcast_to(st.hand_rel, (T, 2, 3)).copy()
+    for k in active:
+        goal = targets[k] - shoulders[f1, k]
+        if np.linalg.norm(goal) > _REACH_FRACTION * arm:
+            raise ValueError(f"{task}: target {np.round(target, 3).tolist()} is out of reach "
+                             f"from the {task} posture")
+        rel[:, k] = _arc_keys(t, [(0.0, st.hand_rel[k]), (t1, goal), (t2, goal),
+                                  (total, st.hand_rel[k])])
+    return shoulders + rel, target, hand_name
+
+
 def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator,
              duration: float | None, fps: float, target: np.ndarray | None,
              hand: str) -> MotionPrimitive:
     """bend, stoop and kneel: go down, stay, come back up."""
-    H = skeleton.stature
-    b = _bones(skeleton)
     jitter = rng.uniform(0.9, 1.1)
     t_down = {"bend": 1.1, "stoop": 1.3, "kneel": 1.7}[task] * jitter
     t_up = t_down * rng.uniform(1.0, 1.15)
@@ -886,85 +995,19 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
     ankles = np.broadcast_to(st.ankles, (T, 2, 3)).copy()
     toes = np.broadcast_to(st.toes, (T, 2, 3)).copy()
     knee_pole = np.broadcast_to(st.knee_pole, (T, 2, 3)).copy()
-    pelvis = np.tile(st.pelvis, (T, 1))
     if task == "bend":
-        # head to 0.62 H (below chest height 0.72 H), knees nearly straight
-        head_off = skeleton.rest_positions()[_J["head"]] - skeleton.rest_positions()[0]
-        want = 0.60 * H + rng.uniform(-0.02, 0.02) * H
-        drop = 0.01 * H
-        c = np.clip((want - (st.pelvis[2] - drop)) / np.linalg.norm(head_off), -1, 1)
-        pitch1 = float(np.arccos(c))
-        pitch = pitch1 * s
-        pelvis[:, 2] -= drop * s
-        p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
-        shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
-        pelvis[:, 0] += shift * s
+        pelvis, pitch = _bend_path(skeleton, st, rng, s)
     elif task == "stoop":
-        # buttocks (hips) below knee height, trunk flexed forward
-        hip_h = 0.20 * H + rng.uniform(-0.01, 0.01) * H
-        rest = skeleton.rest_positions()
-        drop = st.pelvis[2] - (hip_h + (rest[0, 2] - rest[_J["l_hip"], 2]))
-        pitch1 = float(0.85 + rng.uniform(-0.05, 0.05))
-        p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
-        shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
-        pelvis[:, 2] -= drop * s
-        pelvis[:, 0] += shift * s
-        pitch = pitch1 * s
-    else:  # kneel on one knee (right by default, hand="l_hand" kneels on the left)
-        k = 0 if hand in ("l_hand", "left", "l") else 1
-        rest = skeleton.rest_positions()
-        thigh, shank, foot = b[_J["l_knee"]], b[_J["l_ankle"]], b[_J["l_toe"]]
-        knee_z = 0.026 * H
-        hip_above = 0.97 * thigh
-        hip_x = -0.6 * thigh
-        knee = np.array([hip_x + 0.24 * thigh, st.ankles[k, 1], knee_z])
-        hip = np.array([knee[0] - np.sqrt(thigh ** 2 - hip_above ** 2), knee[1],
-                        knee_z + hip_above])
-        ankle_z = 0.075 * H
-        ankle = np.array([knee[0] - np.sqrt(shank ** 2 - (ankle_z - knee_z) ** 2), knee[1],
-                          ankle_z])
-        toe_z = rest[_J["l_toe"], 2]
-        toe = ankle + np.array([np.sqrt(foot ** 2 - (ankle_z - toe_z) ** 2), 0.0,
-                                toe_z - ankle_z])
-        pel1 = hip - (rest[_J[f"{_SIDES[k]}_hip"]] - rest[0])
-        # the moving foot lifts while it steps back
-        # it moves only once lifted and lands before it stops, so it never slides over
-        # the floor (the first and last 15 % of each step are rise and set-down)
-        w0, w1 = 0.55 * t1, total - (t2 + 0.45 * t_up)
-        s_foot = _profile(t, [(0.15 * w0, 0.0), (0.85 * w0, 1.0),
-                              (t2 + 0.45 * t_up + 0.15 * w1, 1.0), (total - 0.15 * w1, 0.0)])
-        tau = np.where(t < w0, t / w0, np.where(t > total - w1, (t - (total - w1)) / w1, 0.0))
-        lift = 0.05 * H * np.sin(np.pi * tau) ** 2
-        ankles[:, k] = st.ankles[k] + s_foot[:, None] * (ankle - st.ankles[k])
-        ankles[:, k, 2] += lift
-        toes[:, k] = st.toes[k] + s_foot[:, None] * (toe - st.toes[k])
-        toes[:, k, 2] += lift
-        knee_pole[:, k] = np.array([0.35, 0.0, -1.0])
-        pelvis = st.pelvis + s[:, None] * (pel1 - st.pelvis)
-        pitch = 0.15 * s
+        pelvis, pitch = _stoop_path(skeleton, st, rng, s)
+    else:
+        pelvis, pitch = _kneel_path(skeleton, st, hand, t, s, (t1, t2, t_up, total),
+                                    ankles, toes, knee_pole)
     tr = _trunk(skeleton, pelvis, pitch)
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
-    hands = shoulders + st.hand_rel
     hand_dir = np.broadcast_to(st.hand_dir, (T, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy()
-    hand_name = "none"
-    if target is not None:
-        target = np.asarray(target, dtype=np.float64)
-        if target.shape != (3,):
-            raise ValueError(f"target must have shape (3,), got {target.shape}")
-        targets, active, hand_name = _hand_targets("grasp", target, hand if hand != "auto"
-                                                   else "auto")
-        f1 = min(round(t1 * fps), T - 1)
-        arm = _arm_length(skeleton)
-        rel = np.broadcast_to(st.hand_rel, (T, 2, 3)).copy()
-        for k in active:
-            goal = targets[k] - shoulders[f1, k]
-            if np.linalg.norm(goal) > _REACH_FRACTION * arm:
-                raise ValueError(f"{task}: target {np.round(target, 3).tolist()} is out of reach "
-                                 f"from the {task} posture")
-            rel[:, k] = _arc_keys(t, [(0.0, st.hand_rel[k]), (t1, goal), (t2, goal),
-                                      (total, st.hand_rel[k])])
-        hands = shoulders + rel
+    hands, target, hand_name = _low_reach(task, skeleton, st, t, shoulders, target, hand,
+                                          (t1, t2, total), fps)
     world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, ankles, toes,
                     knee_pole)
     f1 = min(round(t1 * fps), T - 1)
@@ -1094,15 +1137,7 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     ValueError
         Unknown task, malformed or unreachable target, too short duration.
     """
-    _check_task(task)
-    if not isinstance(skeleton, Skeleton):
-        raise ValueError(f"skeleton must be a Skeleton, got {type(skeleton).__name__}")
-    if not fps > 0:
-        raise ValueError(f"fps must be positive, got {fps!r}")
-    if duration is not None and not duration > 0:
-        raise ValueError(f"duration must be positive, got {duration!r}")
-    if path not in HAND_PATHS:
-        raise ValueError(f"path must be one of {', '.join(HAND_PATHS)}, got {path!r}")
+    _check_options(task, skeleton, fps, duration, path)
     rng = np.random.default_rng(0) if rng is None else rng
     st = _Start(skeleton, start_pose)
     if task in HAND_TASKS:
@@ -1117,13 +1152,34 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     if task == "wait":
         return _wait(skeleton, st, rng, duration, fps)
     if task == "sit":
-        world, meta, tgt = _sit(skeleton, st, rng, duration, fps, target)
-        meta.update({"contact_frame": world.shape[0] - 1, "hand": "none",
-                     "posture": "seated", "hold_frames": [world.shape[0] - 1] * 2})
-        return _finish(f"sit_{_fmt(tgt)}", "sit", world, st, fps,
-                       f"goals.make_goal_primitive('sit', target={_fmt(tgt)})", meta,
-                       start_exact=True, end_exact=False)
+        return _sit_primitive(skeleton, st, rng, duration, fps, target)
     return _stand_up(skeleton, st, rng, duration, fps, target)
+
+
+def _check_options(task: str, skeleton: Skeleton, fps: float, duration: float | None,
+                   path: str) -> None:
+    """ValueError unless the arguments of :func:`make_goal_primitive` are well formed."""
+    _check_task(task)
+    if not isinstance(skeleton, Skeleton):
+        raise ValueError(f"skeleton must be a Skeleton, got {type(skeleton).__name__}")
+    if not fps > 0:
+        raise ValueError(f"fps must be positive, got {fps!r}")
+    if duration is not None and not duration > 0:
+        raise ValueError(f"duration must be positive, got {duration!r}")
+    if path not in HAND_PATHS:
+        raise ValueError(f"path must be one of {', '.join(HAND_PATHS)}, got {path!r}")
+
+
+def _sit_primitive(skeleton: Skeleton, st: _Start, rng: np.random.Generator,
+                   duration: float | None, fps: float, target: np.ndarray | None
+                   ) -> MotionPrimitive:
+    """sit onto the seat point ``target`` (3,) (see :func:`_sit`)."""
+    world, meta, tgt = _sit(skeleton, st, rng, duration, fps, target)
+    meta.update({"contact_frame": world.shape[0] - 1, "hand": "none",
+                 "posture": "seated", "hold_frames": [world.shape[0] - 1] * 2})
+    return _finish(f"sit_{_fmt(tgt)}", "sit", world, st, fps,
+                   f"goals.make_goal_primitive('sit', target={_fmt(tgt)})", meta,
+                   start_exact=True, end_exact=False)
 
 
 def _stand_up(skeleton: Skeleton, st: _Start, rng: np.random.Generator,
