@@ -254,6 +254,26 @@ def test_subset_pair(pair_id: str) -> None:
     assert ok, f"{pair.id}: {family}: {outcome.message[:300]}"
 
 
+#: Corpus pairs of a failure family of the biomechanical checks that is fixed: each must
+#: verify with the checks on (``VerificationOptions(biomechanics=True)``).
+BIOMECHANICS_PAIRS = {
+    # floor grasps whose stoop folded the hip past 125 degrees (range_of_motion)
+    "floor_parts/single/grasp(O1)": "range_of_motion:hip_flexion",
+    "floor_parts/single/grasp(O3)": "range_of_motion:hip_flexion",
+    "floor_parts/single/carry(O3, R1)": "range_of_motion:hip_flexion",
+    "floor_parts/dwyer/absence_after/0": "range_of_motion:hip_flexion",
+}
+
+
+@pytest.mark.parametrize("stature", (1.55, 1.75))
+@pytest.mark.parametrize("pair_id", list(BIOMECHANICS_PAIRS))
+def test_pair_verifies_with_the_biomechanical_checks(pair_id: str, stature: float) -> None:
+    pair = BY_ID[pair_id]
+    outcome = run_pair(pair.spec, pair.cell_file, stature, 0, timeout=10.0, biomechanics=True)
+    ok, family = judge(pair.expect, pair.reason, outcome)
+    assert ok, f"{pair.id} ({BIOMECHANICS_PAIRS[pair_id]}): {family}: {outcome.message[:300]}"
+
+
 def test_generator_frame_and_floor_variants_keep_the_layout() -> None:
     import yaml
 

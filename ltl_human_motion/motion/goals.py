@@ -116,6 +116,9 @@ _BOARD_FRONT = 0.10
 _BOARD_PLACE_MARGIN = 0.04
 #: Points sampled along every body capsule for the board check of a posture.
 _CAPSULE_SAMPLES = 5
+#: Degrees the posture search keeps inside the hip and knee ranges of motion of
+#: planning.biomechanics (blending and foot locking move the legs by a degree or two).
+_ROM_MARGIN = 3.0
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -188,6 +191,17 @@ def _rot_y(angle: np.ndarray) -> np.ndarray:
     return out
 
 
+#: Largest forward tilt of the pelvis in a crouch's trunk flexion, rad (20 degrees): past
+#: it the lumbar spine bends alone. In a crouch the thighs already flex the hips; without
+#: the cap a crouch with the trunk flexed to reach the floor folds them past their 125
+#: degree range of motion (planning.biomechanics). The trunk's own flexion stays within
+#: its 80 degrees (at most 63 at the posture search's largest pitch).
+PELVIS_TILT_MAX = 0.35
+#: Pelvis drops below standing, fractions of stature, between which the cap fades in: a
+#: bend or a shallow crouch tilts the pelvis with the trunk; the hips pass 120 degrees
+#: only from a drop of about 0.22 H (the posture grid at 1.55 and 1.75 m).
+_CROUCH_DROP = (0.12, 0.22)
+
 _TRUNK = (("spine", "pelvis", 0.5), ("chest", "spine", 0.85), ("neck", "chest", 1.0),
           ("head", "neck", 1.0), ("l_clavicle", "chest", 1.0), ("l_shoulder", "l_clavicle", 1.0),
           ("r_clavicle", "chest", 1.0), ("r_shoulder", "r_clavicle", 1.0))
@@ -203,7 +217,13 @@ def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray) -> np.ndar
     for name, parent, frac in _TRUNK:
         j, p = _J[name], _J[parent]
         if frac not in rot:
-            rot[frac] = _rot_y(frac * pitch)
+            angle = frac * pitch
+            if name == "spine":            # the pelvis's own tilt (the hips' flexion)
+                drop = (rest[0, 2] - pelvis[:, 2]) / skeleton.stature
+                crouch = np.clip((drop - _CROUCH_DROP[0]) / (_CROUCH_DROP[1] - _CROUCH_DROP[0]),
+                                 0.0, 1.0)
+                angle = angle - crouch * np.maximum(angle - PELVIS_TILT_MAX, 0.0)
+            rot[frac] = _rot_y(angle)
         out[:, j] = out[:, p] + rot[frac] @ (rest[j] - rest[p])
     for name in ("l_hip", "r_hip"):
         out[:, _J[name]] = pelvis + (rest[_J[name]] - rest[0])
@@ -347,6 +367,7 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
     # the head must not go below the hands' height band (no diving into the floor)
     feasible &= tr[:, _J["head"], 2] > 0.12 * H
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
+    feasible &= _legs_in_range(skeleton, st, pelvis, P, tr, shoulders)
     out = (P, D, shift, cost, shoulders, feasible)
     for arr in out:
         arr.flags.writeable = False
@@ -354,6 +375,29 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
         _GRID_CACHE.clear()
     _GRID_CACHE[key] = out
     return out
+
+
+def _legs_in_range(skeleton: Skeleton, st: _Start, pelvis: np.ndarray, pitch: np.ndarray,
+                   trunk: np.ndarray, shoulders: np.ndarray) -> np.ndarray:
+    """Whether the hips and knees of postures (C,) (pelvis (C, 3), pitch (C,), their
+    trunk (C, J, 3) and shoulders (C, 2, 3)) stay within the biomechanical range of motion
+    less :data:`_ROM_MARGIN` (a deep crouch with a flexed trunk folds the hip past
+    125 degrees), shape (C,) of bool."""
+    from ltl_human_motion.planning.biomechanics import BiomechanicsLimits, joint_angles
+    C = pitch.size
+    poses = _body(skeleton, pelvis, pitch, np.broadcast_to(st.ankles, (C, 2, 3)),
+                  np.broadcast_to(st.toes, (C, 2, 3)), np.broadcast_to(st.knee_pole, (C, 2, 3)),
+                  shoulders + st.hand_rel, np.broadcast_to(st.hand_dir, (C, 2, 3)),
+                  np.broadcast_to(st.elbow_pole, (C, 2, 3)), trunk)
+    angles = joint_angles(poses)
+    rom = BiomechanicsLimits().rom
+    ok = np.ones(C, bool)
+    for s in _SIDES:
+        for name in ("hip_flexion", "knee_flexion"):
+            lo, hi = rom[name]
+            a = angles[f"{s}_{name}"]
+            ok &= (a >= lo + _ROM_MARGIN) & (a <= hi - _ROM_MARGIN)
+    return ok
 
 
 def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
