@@ -262,6 +262,10 @@ BIOMECHANICS_PAIRS = {
     "floor_parts/single/grasp(O3)": "range_of_motion:hip_flexion",
     "floor_parts/single/carry(O3, R1)": "range_of_motion:hip_flexion",
     "floor_parts/dwyer/absence_after/0": "range_of_motion:hip_flexion",
+    # a step back of a 1.55 m worker: foot locking turned the thigh into the hanging hand
+    "bins/dwyer/absence_after/0": "self_penetration:hand_thigh",
+    "floor_parts/single/assemble(R2)": "self_penetration:hand_thigh",
+    "seats/single/sit(stool)": "self_penetration:hand_thigh",
 }
 
 

@@ -56,8 +56,10 @@ def _progress(t: np.ndarray, a: float, b: float) -> np.ndarray:
 
 
 #: Clearance (m) the hanging arms keep from the thighs of the stepping legs, over the
-#: self-penetration check of planning.biomechanics.
-ARM_CLEARANCE = 0.01
+#: self-penetration check of planning.biomechanics. 2 cm: foot locking (planning.footlock)
+#: turns a thigh of a step by up to 1 cm towards its hand (1 cm left the hand 2 mm inside
+#: the thigh in the steps back of a 1.55 m worker).
+ARM_CLEARANCE = 0.02
 #: Time (s) over which the arms swing out of the legs' way and back (half-width).
 ARM_RAMP = 0.15
 
