@@ -266,6 +266,12 @@ BIOMECHANICS_PAIRS = {
     "bins/dwyer/absence_after/0": "self_penetration:hand_thigh",
     "floor_parts/single/assemble(R2)": "self_penetration:hand_thigh",
     "seats/single/sit(stool)": "self_penetration:hand_thigh",
+    # foot locking swung the knee of a straight leg sideways (knee 3-13 m/s, flexion -16)
+    "floor_parts/job/carry_two": "joint_speed:knee_flip",
+    "stations/single/grasp(O3)": "joint_speed:knee_flip",
+    "stations/dwyer/existence_after/0": "joint_speed:knee_flip",
+    # the walk after a kneel (l_knee 4.42 m/s, flexion -16): verifies since the crouch fix
+    "floor_parts/job/kneel_pick": "joint_speed:kneel_walk",
 }
 
 
