@@ -259,7 +259,7 @@ def test_subset_pair(pair_id: str) -> None:
 BIOMECHANICS_PAIRS = {
     # floor grasps whose stoop folded the hip past 125 degrees (range_of_motion)
     "floor_parts/single/grasp(O1)": "range_of_motion:hip_flexion",
-    "floor_parts/single/grasp(O3)": "range_of_motion:hip_flexion",
+    "floor_parts/single/move(O1, R1)": "range_of_motion:hip_flexion",
     "floor_parts/single/carry(O3, R1)": "range_of_motion:hip_flexion",
     "floor_parts/dwyer/absence_after/0": "range_of_motion:hip_flexion",
     # a step back of a 1.55 m worker: foot locking turned the thigh into the hanging hand
@@ -267,9 +267,11 @@ BIOMECHANICS_PAIRS = {
     "floor_parts/single/assemble(R2)": "self_penetration:hand_thigh",
     "seats/single/sit(stool)": "self_penetration:hand_thigh",
     # foot locking swung the knee of a straight leg sideways (knee 3-13 m/s, flexion -16)
-    "floor_parts/job/carry_two": "joint_speed:knee_flip",
     "stations/single/grasp(O3)": "joint_speed:knee_flip",
-    "stations/dwyer/existence_after/0": "joint_speed:knee_flip",
+    # a swing foot 5-15 cm off at a junction of gait primitives (ankle over 4.1 m/s)
+    "bins/job/insert_extract_assemble": "joint_speed:ankle_junction",
+    "floor_parts/job/stoop_pick": "joint_speed:ankle_junction",
+    "aisle/single/grasp(O1)": "joint_speed:ankle_junction",
     # the walk after a kneel (l_knee 4.42 m/s, flexion -16): verifies since the crouch fix
     "floor_parts/job/kneel_pick": "joint_speed:kneel_walk",
 }
