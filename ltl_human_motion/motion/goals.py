@@ -207,8 +207,11 @@ _TRUNK = (("spine", "pelvis", 0.5), ("chest", "spine", 0.85), ("neck", "chest", 
           ("r_clavicle", "chest", 1.0), ("r_shoulder", "r_clavicle", 1.0))
 
 
-def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray) -> np.ndarray:
-    """Pelvis, spine, head, clavicles, shoulders and hips of frames (T,) -> (T, J, 3)."""
+def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, cap: bool = True
+           ) -> np.ndarray:
+    """Pelvis, spine, head, clavicles, shoulders and hips of frames (T,) -> (T, J, 3);
+    ``cap``: a crouch's pelvis tilts at most :data:`PELVIS_TILT_MAX` (not under a low
+    board, where the reach needs the pelvis's full tilt)."""
     rest = skeleton.rest_positions()
     T = pelvis.shape[0]
     out = np.zeros((T, len(rest), 3))
@@ -218,7 +221,7 @@ def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray) -> np.ndar
         j, p = _J[name], _J[parent]
         if frac not in rot:
             angle = frac * pitch
-            if name == "spine":            # the pelvis's own tilt (the hips' flexion)
+            if name == "spine" and cap:    # the pelvis's own tilt (the hips' flexion)
                 drop = (rest[0, 2] - pelvis[:, 2]) / skeleton.stature
                 crouch = np.clip((drop - _CROUCH_DROP[0]) / (_CROUCH_DROP[1] - _CROUCH_DROP[0]),
                                  0.0, 1.0)
@@ -302,7 +305,8 @@ def _support_x(ankles: np.ndarray, toes: np.ndarray, stature: float) -> tuple[fl
 
 
 def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
-                   st: _Start, hands: np.ndarray | None = None) -> np.ndarray:
+                   st: _Start, hands: np.ndarray | None = None, cap: bool = True
+                   ) -> np.ndarray:
     """Pelvis x shift (T,) that keeps the centre of mass over the feet (2 iterations)."""
     T = pelvis.shape[0]
     shift = np.zeros(T)
@@ -310,7 +314,7 @@ def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
     for _ in range(3):
         pel = pelvis.copy()
         pel[:, 0] += shift
-        tr = _trunk(skeleton, pel, pitch)
+        tr = _trunk(skeleton, pel, pitch, cap)
         sh = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
         hnd = sh + st.hand_rel if hands is None else hands
         pose = _body(skeleton, pel, pitch, np.broadcast_to(st.ankles, (T, 2, 3)),
@@ -328,12 +332,15 @@ def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
 _GRID_CACHE: dict[tuple, tuple[np.ndarray, ...]] = {}
 
 
-def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
+def _grid_base(skeleton: Skeleton, st: _Start, low_board: bool = False
+               ) -> tuple[np.ndarray, ...]:
     """The candidate postures of :func:`_grid`, which do not depend on the targets.
 
     Balance shifts, trunk poses, the posture cost and the leg/head feasibility depend only
     on the skeleton and the start pose, of which a worker has a few (walking and carrying
-    stance), so they are computed once per pair and kept (read-only arrays).
+    stance), so they are computed once per pair and kept (read-only arrays). Under a low
+    board (``low_board``) the pelvis tilt is not capped and the hip and knee ranges of
+    motion are not asked for: the reach in under the board needs the deepest postures.
 
     Returns
     -------
@@ -342,7 +349,7 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
         Left and right shoulder of each candidate.
     feasible : ndarray of bool, shape (C,)
     """
-    key = (skeleton, st.pose.tobytes())
+    key = (skeleton, st.pose.tobytes(), low_board)
     hit = _GRID_CACHE.get(key)
     if hit is not None:
         return hit
@@ -355,9 +362,9 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
     P, D = P.ravel(), D.ravel()
     pelvis = np.tile(st.pelvis, (P.size, 1))
     pelvis[:, 2] -= D
-    shift = _balance_shift(skeleton, pelvis, P, st)
+    shift = _balance_shift(skeleton, pelvis, P, st, cap=not low_board)
     pelvis[:, 0] += shift
-    tr = _trunk(skeleton, pelvis, P)
+    tr = _trunk(skeleton, pelvis, P, not low_board)
     cost = P ** 2 + (D / (0.14 * H)) ** 2
     feasible = np.ones(P.size, bool)
     for k, s in enumerate(_SIDES):
@@ -367,7 +374,8 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
     # the head must not go below the hands' height band (no diving into the floor)
     feasible &= tr[:, _J["head"], 2] > 0.12 * H
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
-    feasible &= _legs_in_range(skeleton, st, pelvis, P, tr, shoulders)
+    if not low_board:
+        feasible &= _legs_in_range(skeleton, st, pelvis, P, tr, shoulders)
     out = (P, D, shift, cost, shoulders, feasible)
     for arr in out:
         arr.flags.writeable = False
@@ -432,7 +440,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
     arm = _arm_length(skeleton)
-    P, D, shift, cost, shoulders, feasible = _grid_base(skeleton, st)
+    P, D, shift, cost, shoulders, feasible = _grid_base(skeleton, st, board is not None)
     for k in active:
         d = np.linalg.norm(targets[k] - shoulders[:, k], axis=-1)
         feasible = feasible & (d <= _REACH_FRACTION * arm)
@@ -441,7 +449,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     if idx.size:
         from ltl_human_motion.planning.biomechanics import self_penetration
         poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
-                               task)
+                               task, cap=board is None)
         blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
         if board is not None:
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
@@ -471,14 +479,14 @@ def _goal_elbow_pole(k: int) -> np.ndarray:
 
 def _contact_poses(skeleton: Skeleton, st: _Start, pitch: np.ndarray, drop: np.ndarray,
                    shift: np.ndarray, targets: np.ndarray, active: tuple[int, ...],
-                   task: str | None) -> np.ndarray:
+                   task: str | None, cap: bool = True) -> np.ndarray:
     """Poses (C, J, 3) of posture candidates (C,) with the active hands on ``targets``
     (2, 3) and a free hand by the hip, as :func:`_hand_task` holds them at contact."""
     C = pitch.size
     pelvis = np.tile(st.pelvis, (C, 1))
     pelvis[:, 2] -= drop
     pelvis[:, 0] += shift
-    tr = _trunk(skeleton, pelvis, pitch)
+    tr = _trunk(skeleton, pelvis, pitch, cap)
     hands = np.empty((C, 2, 3))
     hand_dir = np.broadcast_to(st.hand_dir, (C, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (C, 2, 3)).copy()
@@ -821,7 +829,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     pelvis[:, 2] -= drop1 * sb
     pelvis[:, 0] += shift1 * sb
     pitch = pitch1 * sb
-    tr = _trunk(skeleton, pelvis, pitch)
+    tr = _trunk(skeleton, pelvis, pitch, board is None)
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)   # (T,2,3)
     f1 = min(round(t1 * fps), T - 1)
     f2 = min(round(t2 * fps), T - 1)
