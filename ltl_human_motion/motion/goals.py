@@ -222,7 +222,7 @@ def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, cap: bool 
         if frac not in rot:
             angle = frac * pitch
             if name == "spine" and cap:    # the pelvis's own tilt (the hips' flexion)
-                drop = (rest[0, 2] - pelvis[:, 2]) / skeleton.stature
+                drop = (rest[0, 2] - pelvis[..., 2]) / skeleton.stature
                 crouch = np.clip((drop - _CROUCH_DROP[0]) / (_CROUCH_DROP[1] - _CROUCH_DROP[0]),
                                  0.0, 1.0)
                 angle = angle - crouch * np.maximum(angle - PELVIS_TILT_MAX, 0.0)
