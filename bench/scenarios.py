@@ -47,7 +47,8 @@ DEFAULT_TIMEOUT = 10.0
 def _job(item: dict) -> dict:
     """Run one (pair, stature, seed) in a worker; returns the item with its outcome."""
     cell = item["cell_yaml"] if item.get("cell_yaml") else item["cell_file"]
-    outcome = run_pair(item["spec"], cell, item["stature"], item["seed"], item["timeout"])
+    outcome = run_pair(item["spec"], cell, item["stature"], item["seed"], item["timeout"],
+                       biomechanics=item.get("biomechanics", False))
     ok, family = judge(item["expect"], item.get("reason"), outcome)
     out = {k: v for k, v in item.items() if k != "cell_yaml"}
     out.update(outcome=outcome.as_dict(), ok=ok, family=family)
@@ -88,7 +89,8 @@ def _items(args) -> list[dict]:
                 items.append({"source": "corpus", "id": p.id, "cell": p.cell,
                               "cell_file": p.cell_file, "spec": p.spec, "expect": p.expect,
                               "reason": p.reason, "family_label": p.family,
-                              "stature": stature, "seed": seed, "timeout": args.timeout})
+                              "stature": stature, "seed": seed, "timeout": args.timeout,
+                              "biomechanics": args.biomechanics})
     if args.generated > 0:
         from ltl_human_motion.scenarios.generator import generate_scenarios
         for scen in generate_scenarios(args.generated, seed=args.generator_seed):
@@ -97,7 +99,8 @@ def _items(args) -> list[dict]:
                               "cell": scen.name, "cell_file": None, "cell_yaml": scen.yaml,
                               "spec": gp.spec, "expect": gp.expect, "reason": gp.reason,
                               "family_label": gp.family, "stature": scen.stature,
-                              "seed": 0, "timeout": args.timeout})
+                              "seed": 0, "timeout": args.timeout,
+                              "biomechanics": args.biomechanics})
     return items
 
 
@@ -216,6 +219,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT,
                         help="seconds per pair")
     parser.add_argument("--workers", type=int, default=MAX_WORKERS)
+    parser.add_argument("--biomechanics", action="store_true",
+                        help="verify with the biomechanical checks (and their motion work)")
     parser.add_argument("--quick", action="store_true",
                         help="one stature (1.75 m), one seed, 60 pairs, 3 generated cells")
     parser.add_argument("--out", type=Path,
@@ -252,6 +257,7 @@ def main(argv: list[str] | None = None) -> int:
     report = {"benchmark": "scenarios", "machine": machine(), "commit": _commit(),
               "load_average": list(os.getloadavg()), "statures": args.statures,
               "seeds": args.seeds, "timeout_s": args.timeout, "workers": workers,
+              "biomechanics": bool(args.biomechanics),
               "wall_time_s": wall, "specs": str(args.specs.relative_to(ROOT))
               if args.specs.resolve().is_relative_to(ROOT) else str(args.specs),
               "cells_selected": args.cells, "limit": args.limit,

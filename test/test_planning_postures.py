@@ -113,3 +113,29 @@ def test_biomechanics_reads_the_task_of_a_step_with_arguments() -> None:
     assert np.all(out[10:20, JOINT_INDEX["l_knee"]] == lim.knee_speed_posture)
     assert np.all(out[:10, JOINT_INDEX["l_knee"]] == lim.knee_speed)
     assert np.all(out[20:, JOINT_INDEX["r_hand"]] == lim.hand_speed_goal)
+
+
+@pytest.mark.parametrize("stature", (1.55, 1.75))
+def test_floor_reach_postures_keep_the_hips_and_knees_in_range(stature: float) -> None:
+    """The posture search of hand tasks offers no crouch that folds a hip or knee past
+    its range of motion (a floor grasp's stoop flexed the hip to 129 degrees), and a
+    part on the floor (3 cm) is still within reach from a standing place."""
+    from ltl_human_motion.motion import goals
+    from ltl_human_motion.motion.skeleton import Skeleton
+    from ltl_human_motion.planning.biomechanics import BiomechanicsLimits, joint_angles
+
+    skeleton = Skeleton(stature)
+    st = goals._Start(skeleton, None)
+    x, y = goals.reach_placement("grasp", 0.03, skeleton)
+    targets = np.array([[x, y, 0.03], [x, y, 0.03]])
+    P, D, S, cost = goals._grid(skeleton, st, targets, (1,), "grasp")
+    ok = np.isfinite(cost)
+    assert ok.any()
+    poses = goals._contact_poses(skeleton, st, P[ok], D[ok], S[ok], targets, (1,), "grasp")
+    angles = joint_angles(poses)
+    rom = BiomechanicsLimits().rom
+    for side in "lr":
+        for name in ("hip_flexion", "knee_flexion", "trunk_flexion"):
+            lo, hi = rom[name]
+            a = angles[name if name.startswith("trunk") else f"{side}_{name}"]
+            assert lo <= a.min() and a.max() <= hi, (name, a.min(), a.max())

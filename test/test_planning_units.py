@@ -55,6 +55,28 @@ def test_concatenate_overlaps_and_blends_positions_and_heading() -> None:
     assert labels[0] == 0 and labels[-1] == 1
 
 
+def test_a_foot_mismatch_at_a_junction_is_spread_to_the_speed_it_may_add() -> None:
+    """Offset blending spreads a swing foot's 10 cm jump over up to 0.5 s, so it adds at
+    most JUNCTION_ADDED_SPEED; every other joint keeps the JUNCTION_SPREAD window."""
+    from ltl_human_motion.planning.blend import JUNCTION_ADDED_SPEED, JUNCTION_SPREAD
+    fps, J = 120.0, len(JOINT_INDEX)
+    a = PlacedSegment(np.zeros((200, J, 3)), np.zeros(200))
+    jump = np.zeros((200, J, 3))
+    jump[:, JOINT_INDEX["l_ankle"], 0] = 0.10
+    jump[:, JOINT_INDEX["l_hand"], 0] = 0.10
+    b = PlacedSegment(jump, np.zeros(200), blend_in=5)
+    spread = round(JUNCTION_SPREAD * fps)
+    pos = concatenate([a, b], spread=spread, fps=fps)[0]
+    speed = np.abs(np.diff(pos[:, :, 0], axis=0)) * fps
+    assert speed[:, JOINT_INDEX["l_ankle"]].max() <= JUNCTION_ADDED_SPEED * 1.01
+    moving = np.flatnonzero(speed[:, JOINT_INDEX["l_ankle"]] > 1e-9)
+    assert moving[-1] - moving[0] > 2 * spread
+    hand = np.flatnonzero(speed[:, JOINT_INDEX["l_hand"]] > 1e-9)
+    assert hand[-1] - hand[0] <= 2 * spread
+    np.testing.assert_array_equal(concatenate([a, b], spread=spread)[0][:, JOINT_INDEX["l_hand"]],
+                                  pos[:, JOINT_INDEX["l_hand"]])
+
+
 def _wall_free(xy: np.ndarray) -> np.ndarray:
     """Free floor: everything except a wall x in [0.9, 1.1], y in [-1, 3]."""
     inside = (np.abs(xy[:, 0] - 1.0) <= 0.1) & (xy[:, 1] >= -1.0) & (xy[:, 1] <= 3.0)

@@ -254,6 +254,38 @@ def test_subset_pair(pair_id: str) -> None:
     assert ok, f"{pair.id}: {family}: {outcome.message[:300]}"
 
 
+#: Corpus pairs of a failure family of the biomechanical checks that is fixed: each must
+#: verify with the checks on (``VerificationOptions(biomechanics=True)``).
+BIOMECHANICS_PAIRS = {
+    # floor grasps whose stoop folded the hip past 125 degrees (range_of_motion)
+    "floor_parts/single/grasp(O1)": "range_of_motion:hip_flexion",
+    "floor_parts/single/move(O1, R1)": "range_of_motion:hip_flexion",
+    "floor_parts/single/carry(O3, R1)": "range_of_motion:hip_flexion",
+    "floor_parts/dwyer/absence_after/0": "range_of_motion:hip_flexion",
+    # a step back of a 1.55 m worker: foot locking turned the thigh into the hanging hand
+    "bins/dwyer/absence_after/0": "self_penetration:hand_thigh",
+    "floor_parts/single/assemble(R2)": "self_penetration:hand_thigh",
+    "seats/single/sit(stool)": "self_penetration:hand_thigh",
+    # foot locking swung the knee of a straight leg sideways (knee 3-13 m/s, flexion -16)
+    "stations/single/grasp(O3)": "joint_speed:knee_flip",
+    # a swing foot 5-15 cm off at a junction of gait primitives (ankle over 4.1 m/s)
+    "bins/job/insert_extract_assemble": "joint_speed:ankle_junction",
+    "floor_parts/job/stoop_pick": "joint_speed:ankle_junction",
+    "aisle/single/grasp(O1)": "joint_speed:ankle_junction",
+    # the walk after a kneel (l_knee 4.42 m/s, flexion -16): verifies since the crouch fix
+    "floor_parts/job/kneel_pick": "joint_speed:kneel_walk",
+}
+
+
+@pytest.mark.parametrize("stature", (1.55, 1.75))
+@pytest.mark.parametrize("pair_id", list(BIOMECHANICS_PAIRS))
+def test_pair_verifies_with_the_biomechanical_checks(pair_id: str, stature: float) -> None:
+    pair = BY_ID[pair_id]
+    outcome = run_pair(pair.spec, pair.cell_file, stature, 0, timeout=10.0, biomechanics=True)
+    ok, family = judge(pair.expect, pair.reason, outcome)
+    assert ok, f"{pair.id} ({BIOMECHANICS_PAIRS[pair_id]}): {family}: {outcome.message[:300]}"
+
+
 def test_generator_frame_and_floor_variants_keep_the_layout() -> None:
     import yaml
 

@@ -116,6 +116,9 @@ _BOARD_FRONT = 0.10
 _BOARD_PLACE_MARGIN = 0.04
 #: Points sampled along every body capsule for the board check of a posture.
 _CAPSULE_SAMPLES = 5
+#: Degrees the posture search keeps inside the hip and knee ranges of motion of
+#: planning.biomechanics (blending and foot locking move the legs by a degree or two).
+_ROM_MARGIN = 3.0
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -188,13 +191,27 @@ def _rot_y(angle: np.ndarray) -> np.ndarray:
     return out
 
 
+#: Largest forward tilt of the pelvis in a crouch's trunk flexion, rad (20 degrees): past
+#: it the lumbar spine bends alone. In a crouch the thighs already flex the hips; without
+#: the cap a crouch with the trunk flexed to reach the floor folds them past their 125
+#: degree range of motion (planning.biomechanics). The trunk's own flexion stays within
+#: its 80 degrees (at most 63 at the posture search's largest pitch).
+PELVIS_TILT_MAX = 0.35
+#: Pelvis drops below standing, fractions of stature, between which the cap fades in: a
+#: bend or a shallow crouch tilts the pelvis with the trunk; the hips pass 120 degrees
+#: only from a drop of about 0.22 H (the posture grid at 1.55 and 1.75 m).
+_CROUCH_DROP = (0.12, 0.22)
+
 _TRUNK = (("spine", "pelvis", 0.5), ("chest", "spine", 0.85), ("neck", "chest", 1.0),
           ("head", "neck", 1.0), ("l_clavicle", "chest", 1.0), ("l_shoulder", "l_clavicle", 1.0),
           ("r_clavicle", "chest", 1.0), ("r_shoulder", "r_clavicle", 1.0))
 
 
-def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray) -> np.ndarray:
-    """Pelvis, spine, head, clavicles, shoulders and hips of frames (T,) -> (T, J, 3)."""
+def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, cap: bool = True
+           ) -> np.ndarray:
+    """Pelvis, spine, head, clavicles, shoulders and hips of frames (T,) -> (T, J, 3);
+    ``cap``: a crouch's pelvis tilts at most :data:`PELVIS_TILT_MAX` (not under a low
+    board, where the reach needs the pelvis's full tilt)."""
     rest = skeleton.rest_positions()
     T = pelvis.shape[0]
     out = np.zeros((T, len(rest), 3))
@@ -203,7 +220,13 @@ def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray) -> np.ndar
     for name, parent, frac in _TRUNK:
         j, p = _J[name], _J[parent]
         if frac not in rot:
-            rot[frac] = _rot_y(frac * pitch)
+            angle = frac * pitch
+            if name == "spine" and cap:    # the pelvis's own tilt (the hips' flexion)
+                drop = (rest[0, 2] - pelvis[..., 2]) / skeleton.stature
+                crouch = np.clip((drop - _CROUCH_DROP[0]) / (_CROUCH_DROP[1] - _CROUCH_DROP[0]),
+                                 0.0, 1.0)
+                angle = angle - crouch * np.maximum(angle - PELVIS_TILT_MAX, 0.0)
+            rot[frac] = _rot_y(angle)
         out[:, j] = out[:, p] + rot[frac] @ (rest[j] - rest[p])
     for name in ("l_hip", "r_hip"):
         out[:, _J[name]] = pelvis + (rest[_J[name]] - rest[0])
@@ -282,7 +305,8 @@ def _support_x(ankles: np.ndarray, toes: np.ndarray, stature: float) -> tuple[fl
 
 
 def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
-                   st: _Start, hands: np.ndarray | None = None) -> np.ndarray:
+                   st: _Start, hands: np.ndarray | None = None, cap: bool = True
+                   ) -> np.ndarray:
     """Pelvis x shift (T,) that keeps the centre of mass over the feet (2 iterations)."""
     T = pelvis.shape[0]
     shift = np.zeros(T)
@@ -290,7 +314,7 @@ def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
     for _ in range(3):
         pel = pelvis.copy()
         pel[:, 0] += shift
-        tr = _trunk(skeleton, pel, pitch)
+        tr = _trunk(skeleton, pel, pitch, cap)
         sh = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
         hnd = sh + st.hand_rel if hands is None else hands
         pose = _body(skeleton, pel, pitch, np.broadcast_to(st.ankles, (T, 2, 3)),
@@ -308,12 +332,15 @@ def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
 _GRID_CACHE: dict[tuple, tuple[np.ndarray, ...]] = {}
 
 
-def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
+def _grid_base(skeleton: Skeleton, st: _Start, low_board: bool = False
+               ) -> tuple[np.ndarray, ...]:
     """The candidate postures of :func:`_grid`, which do not depend on the targets.
 
     Balance shifts, trunk poses, the posture cost and the leg/head feasibility depend only
     on the skeleton and the start pose, of which a worker has a few (walking and carrying
-    stance), so they are computed once per pair and kept (read-only arrays).
+    stance), so they are computed once per pair and kept (read-only arrays). Under a low
+    board (``low_board``) the pelvis tilt is not capped and the hip and knee ranges of
+    motion are not asked for: the reach in under the board needs the deepest postures.
 
     Returns
     -------
@@ -322,7 +349,7 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
         Left and right shoulder of each candidate.
     feasible : ndarray of bool, shape (C,)
     """
-    key = (skeleton, st.pose.tobytes())
+    key = (skeleton, st.pose.tobytes(), low_board)
     hit = _GRID_CACHE.get(key)
     if hit is not None:
         return hit
@@ -335,9 +362,9 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
     P, D = P.ravel(), D.ravel()
     pelvis = np.tile(st.pelvis, (P.size, 1))
     pelvis[:, 2] -= D
-    shift = _balance_shift(skeleton, pelvis, P, st)
+    shift = _balance_shift(skeleton, pelvis, P, st, cap=not low_board)
     pelvis[:, 0] += shift
-    tr = _trunk(skeleton, pelvis, P)
+    tr = _trunk(skeleton, pelvis, P, not low_board)
     cost = P ** 2 + (D / (0.14 * H)) ** 2
     feasible = np.ones(P.size, bool)
     for k, s in enumerate(_SIDES):
@@ -347,6 +374,8 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
     # the head must not go below the hands' height band (no diving into the floor)
     feasible &= tr[:, _J["head"], 2] > 0.12 * H
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
+    if not low_board:
+        feasible &= _legs_in_range(skeleton, st, pelvis, P, tr, shoulders)
     out = (P, D, shift, cost, shoulders, feasible)
     for arr in out:
         arr.flags.writeable = False
@@ -354,6 +383,29 @@ def _grid_base(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
         _GRID_CACHE.clear()
     _GRID_CACHE[key] = out
     return out
+
+
+def _legs_in_range(skeleton: Skeleton, st: _Start, pelvis: np.ndarray, pitch: np.ndarray,
+                   trunk: np.ndarray, shoulders: np.ndarray) -> np.ndarray:
+    """Whether the hips and knees of postures (C,) (pelvis (C, 3), pitch (C,), their
+    trunk (C, J, 3) and shoulders (C, 2, 3)) stay within the biomechanical range of motion
+    less :data:`_ROM_MARGIN` (a deep crouch with a flexed trunk folds the hip past
+    125 degrees), shape (C,) of bool."""
+    from ltl_human_motion.planning.biomechanics import BiomechanicsLimits, joint_angles
+    C = pitch.size
+    poses = _body(skeleton, pelvis, pitch, np.broadcast_to(st.ankles, (C, 2, 3)),
+                  np.broadcast_to(st.toes, (C, 2, 3)), np.broadcast_to(st.knee_pole, (C, 2, 3)),
+                  shoulders + st.hand_rel, np.broadcast_to(st.hand_dir, (C, 2, 3)),
+                  np.broadcast_to(st.elbow_pole, (C, 2, 3)), trunk)
+    angles = joint_angles(poses)
+    rom = BiomechanicsLimits().rom
+    ok = np.ones(C, bool)
+    for s in _SIDES:
+        for name in ("hip_flexion", "knee_flexion"):
+            lo, hi = rom[name]
+            a = angles[f"{s}_{name}"]
+            ok &= (a >= lo + _ROM_MARGIN) & (a <= hi - _ROM_MARGIN)
+    return ok
 
 
 def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
@@ -388,7 +440,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
     arm = _arm_length(skeleton)
-    P, D, shift, cost, shoulders, feasible = _grid_base(skeleton, st)
+    P, D, shift, cost, shoulders, feasible = _grid_base(skeleton, st, board is not None)
     for k in active:
         d = np.linalg.norm(targets[k] - shoulders[:, k], axis=-1)
         feasible = feasible & (d <= _REACH_FRACTION * arm)
@@ -397,7 +449,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     if idx.size:
         from ltl_human_motion.planning.biomechanics import self_penetration
         poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
-                               task)
+                               task, cap=board is None)
         blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
         if board is not None:
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
@@ -427,14 +479,14 @@ def _goal_elbow_pole(k: int) -> np.ndarray:
 
 def _contact_poses(skeleton: Skeleton, st: _Start, pitch: np.ndarray, drop: np.ndarray,
                    shift: np.ndarray, targets: np.ndarray, active: tuple[int, ...],
-                   task: str | None) -> np.ndarray:
+                   task: str | None, cap: bool = True) -> np.ndarray:
     """Poses (C, J, 3) of posture candidates (C,) with the active hands on ``targets``
     (2, 3) and a free hand by the hip, as :func:`_hand_task` holds them at contact."""
     C = pitch.size
     pelvis = np.tile(st.pelvis, (C, 1))
     pelvis[:, 2] -= drop
     pelvis[:, 0] += shift
-    tr = _trunk(skeleton, pelvis, pitch)
+    tr = _trunk(skeleton, pelvis, pitch, cap)
     hands = np.empty((C, 2, 3))
     hand_dir = np.broadcast_to(st.hand_dir, (C, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (C, 2, 3)).copy()
@@ -777,7 +829,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     pelvis[:, 2] -= drop1 * sb
     pelvis[:, 0] += shift1 * sb
     pitch = pitch1 * sb
-    tr = _trunk(skeleton, pelvis, pitch)
+    tr = _trunk(skeleton, pelvis, pitch, board is None)
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)   # (T,2,3)
     f1 = min(round(t1 * fps), T - 1)
     f2 = min(round(t2 * fps), T - 1)
@@ -865,12 +917,121 @@ def _posture_name(pose: np.ndarray, skeleton: Skeleton) -> str:
     return "upright"
 
 
+def _bend_path(skeleton: Skeleton, st: _Start, rng: np.random.Generator, s: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Pelvis (T, 3) and trunk pitch (T,) of bend at progress ``s`` (T,): head to 0.60 H
+    (below chest height 0.72 H), knees nearly straight."""
+    H = skeleton.stature
+    pelvis = np.tile(st.pelvis, (s.shape[0], 1))
+    head_off = skeleton.rest_positions()[_J["head"]] - skeleton.rest_positions()[0]
+    want = 0.60 * H + rng.uniform(-0.02, 0.02) * H
+    drop = 0.01 * H
+    c = np.clip((want - (st.pelvis[2] - drop)) / np.linalg.norm(head_off), -1, 1)
+    pitch1 = float(np.arccos(c))
+    pitch = pitch1 * s
+    pelvis[:, 2] -= drop * s
+    p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
+    shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
+    pelvis[:, 0] += shift * s
+    return pelvis, pitch
+
+
+def _stoop_path(skeleton: Skeleton, st: _Start, rng: np.random.Generator, s: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Pelvis (T, 3) and trunk pitch (T,) of stoop at progress ``s`` (T,): buttocks (hips)
+    below knee height, trunk flexed forward."""
+    H = skeleton.stature
+    pelvis = np.tile(st.pelvis, (s.shape[0], 1))
+    hip_h = 0.20 * H + rng.uniform(-0.01, 0.01) * H
+    rest = skeleton.rest_positions()
+    drop = st.pelvis[2] - (hip_h + (rest[0, 2] - rest[_J["l_hip"], 2]))
+    pitch1 = float(0.85 + rng.uniform(-0.05, 0.05))
+    p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
+    shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
+    pelvis[:, 2] -= drop * s
+    pelvis[:, 0] += shift * s
+    pitch = pitch1 * s
+    return pelvis, pitch
+
+
+def _kneel_path(skeleton: Skeleton, st: _Start, hand: str, t: np.ndarray, s: np.ndarray,
+                times: tuple[float, float, float, float], ankles: np.ndarray,
+                toes: np.ndarray, knee_pole: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pelvis (T, 3) and trunk pitch (T,) of kneeling on one knee (right by default,
+    ``hand="l_hand"`` kneels on the left) at times ``t`` and progress ``s`` (T,);
+    ``times`` = (t1, t2, t_up, total). Moves the kneeling leg's ankle, toe and knee pole
+    (each (T, 2, 3)) in place."""
+    H = skeleton.stature
+    b = _bones(skeleton)
+    t1, t2, t_up, total = times
+    k = 0 if hand in ("l_hand", "left", "l") else 1
+    rest = skeleton.rest_positions()
+    thigh, shank, foot = b[_J["l_knee"]], b[_J["l_ankle"]], b[_J["l_toe"]]
+    knee_z = 0.026 * H
+    hip_above = 0.97 * thigh
+    hip_x = -0.6 * thigh
+    knee = np.array([hip_x + 0.24 * thigh, st.ankles[k, 1], knee_z])
+    hip = np.array([knee[0] - np.sqrt(thigh ** 2 - hip_above ** 2), knee[1],
+                    knee_z + hip_above])
+    ankle_z = 0.075 * H
+    ankle = np.array([knee[0] - np.sqrt(shank ** 2 - (ankle_z - knee_z) ** 2), knee[1],
+                      ankle_z])
+    toe_z = rest[_J["l_toe"], 2]
+    toe = ankle + np.array([np.sqrt(foot ** 2 - (ankle_z - toe_z) ** 2), 0.0,
+                            toe_z - ankle_z])
+    pel1 = hip - (rest[_J[f"{_SIDES[k]}_hip"]] - rest[0])
+    # the moving foot lifts while it steps back
+    # it moves only once lifted and lands before it stops, so it never slides over
+    # the floor (the first and last 15 % of each step are rise and set-down)
+    w0, w1 = 0.55 * t1, total - (t2 + 0.45 * t_up)
+    s_foot = _profile(t, [(0.15 * w0, 0.0), (0.85 * w0, 1.0),
+                          (t2 + 0.45 * t_up + 0.15 * w1, 1.0), (total - 0.15 * w1, 0.0)])
+    tau = np.where(t < w0, t / w0, np.where(t > total - w1, (t - (total - w1)) / w1, 0.0))
+    lift = 0.05 * H * np.sin(np.pi * tau) ** 2
+    ankles[:, k] = st.ankles[k] + s_foot[:, None] * (ankle - st.ankles[k])
+    ankles[:, k, 2] += lift
+    toes[:, k] = st.toes[k] + s_foot[:, None] * (toe - st.toes[k])
+    toes[:, k, 2] += lift
+    knee_pole[:, k] = np.array([0.35, 0.0, -1.0])
+    pelvis = st.pelvis + s[:, None] * (pel1 - st.pelvis)
+    pitch = 0.15 * s
+    return pelvis, pitch
+
+
+def _low_reach(task: str, skeleton: Skeleton, st: _Start, t: np.ndarray,
+               shoulders: np.ndarray, target: np.ndarray | None, hand: str,
+               times: tuple[float, float, float], fps: float
+               ) -> tuple[np.ndarray, np.ndarray | None, str]:
+    """Hands (T, 2, 3) of a down-up task: resting relative to the shoulders (T, 2, 3),
+    or reaching ``target`` (3,) in the low posture; also the checked target and the
+    acting hand's name. ``times`` = (t1, t2, total)."""
+    hands = shoulders + st.hand_rel
+    if target is None:
+        return hands, None, "none"
+    t1, t2, total = times
+    T = t.shape[0]
+    target = np.asarray(target, dtype=np.float64)
+    if target.shape != (3,):
+        raise ValueError(f"target must have shape (3,), got {target.shape}")
+    targets, active, hand_name = _hand_targets("grasp", target, hand if hand != "auto"
+                                               else "auto")
+    f1 = min(round(t1 * fps), T - 1)
+    arm = _arm_length(skeleton)
+    rel = np.broadcast_to(st.hand_rel, (T, 2, 3)).copy()
+    for k in active:
+        goal = targets[k] - shoulders[f1, k]
+        if np.linalg.norm(goal) > _REACH_FRACTION * arm:
+            raise ValueError(f"{task}: target {np.round(target, 3).tolist()} is out of reach "
+                             f"from the {task} posture")
+        rel[:, k] = _arc_keys(t, [(0.0, st.hand_rel[k]), (t1, goal), (t2, goal),
+                                  (total, st.hand_rel[k])])
+    return shoulders + rel, target, hand_name
+
+
 def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator,
              duration: float | None, fps: float, target: np.ndarray | None,
              hand: str) -> MotionPrimitive:
     """bend, stoop and kneel: go down, stay, come back up."""
-    H = skeleton.stature
-    b = _bones(skeleton)
     jitter = rng.uniform(0.9, 1.1)
     t_down = {"bend": 1.1, "stoop": 1.3, "kneel": 1.7}[task] * jitter
     t_up = t_down * rng.uniform(1.0, 1.15)
@@ -886,85 +1047,19 @@ def _down_up(task: str, skeleton: Skeleton, st: _Start, rng: np.random.Generator
     ankles = np.broadcast_to(st.ankles, (T, 2, 3)).copy()
     toes = np.broadcast_to(st.toes, (T, 2, 3)).copy()
     knee_pole = np.broadcast_to(st.knee_pole, (T, 2, 3)).copy()
-    pelvis = np.tile(st.pelvis, (T, 1))
     if task == "bend":
-        # head to 0.62 H (below chest height 0.72 H), knees nearly straight
-        head_off = skeleton.rest_positions()[_J["head"]] - skeleton.rest_positions()[0]
-        want = 0.60 * H + rng.uniform(-0.02, 0.02) * H
-        drop = 0.01 * H
-        c = np.clip((want - (st.pelvis[2] - drop)) / np.linalg.norm(head_off), -1, 1)
-        pitch1 = float(np.arccos(c))
-        pitch = pitch1 * s
-        pelvis[:, 2] -= drop * s
-        p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
-        shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
-        pelvis[:, 0] += shift * s
+        pelvis, pitch = _bend_path(skeleton, st, rng, s)
     elif task == "stoop":
-        # buttocks (hips) below knee height, trunk flexed forward
-        hip_h = 0.20 * H + rng.uniform(-0.01, 0.01) * H
-        rest = skeleton.rest_positions()
-        drop = st.pelvis[2] - (hip_h + (rest[0, 2] - rest[_J["l_hip"], 2]))
-        pitch1 = float(0.85 + rng.uniform(-0.05, 0.05))
-        p1 = np.array([[st.pelvis[0], st.pelvis[1], st.pelvis[2] - drop]])
-        shift = _balance_shift(skeleton, p1, np.array([pitch1]), st)[0]
-        pelvis[:, 2] -= drop * s
-        pelvis[:, 0] += shift * s
-        pitch = pitch1 * s
-    else:  # kneel on one knee (right by default, hand="l_hand" kneels on the left)
-        k = 0 if hand in ("l_hand", "left", "l") else 1
-        rest = skeleton.rest_positions()
-        thigh, shank, foot = b[_J["l_knee"]], b[_J["l_ankle"]], b[_J["l_toe"]]
-        knee_z = 0.026 * H
-        hip_above = 0.97 * thigh
-        hip_x = -0.6 * thigh
-        knee = np.array([hip_x + 0.24 * thigh, st.ankles[k, 1], knee_z])
-        hip = np.array([knee[0] - np.sqrt(thigh ** 2 - hip_above ** 2), knee[1],
-                        knee_z + hip_above])
-        ankle_z = 0.075 * H
-        ankle = np.array([knee[0] - np.sqrt(shank ** 2 - (ankle_z - knee_z) ** 2), knee[1],
-                          ankle_z])
-        toe_z = rest[_J["l_toe"], 2]
-        toe = ankle + np.array([np.sqrt(foot ** 2 - (ankle_z - toe_z) ** 2), 0.0,
-                                toe_z - ankle_z])
-        pel1 = hip - (rest[_J[f"{_SIDES[k]}_hip"]] - rest[0])
-        # the moving foot lifts while it steps back
-        # it moves only once lifted and lands before it stops, so it never slides over
-        # the floor (the first and last 15 % of each step are rise and set-down)
-        w0, w1 = 0.55 * t1, total - (t2 + 0.45 * t_up)
-        s_foot = _profile(t, [(0.15 * w0, 0.0), (0.85 * w0, 1.0),
-                              (t2 + 0.45 * t_up + 0.15 * w1, 1.0), (total - 0.15 * w1, 0.0)])
-        tau = np.where(t < w0, t / w0, np.where(t > total - w1, (t - (total - w1)) / w1, 0.0))
-        lift = 0.05 * H * np.sin(np.pi * tau) ** 2
-        ankles[:, k] = st.ankles[k] + s_foot[:, None] * (ankle - st.ankles[k])
-        ankles[:, k, 2] += lift
-        toes[:, k] = st.toes[k] + s_foot[:, None] * (toe - st.toes[k])
-        toes[:, k, 2] += lift
-        knee_pole[:, k] = np.array([0.35, 0.0, -1.0])
-        pelvis = st.pelvis + s[:, None] * (pel1 - st.pelvis)
-        pitch = 0.15 * s
+        pelvis, pitch = _stoop_path(skeleton, st, rng, s)
+    else:
+        pelvis, pitch = _kneel_path(skeleton, st, hand, t, s, (t1, t2, t_up, total),
+                                    ankles, toes, knee_pole)
     tr = _trunk(skeleton, pelvis, pitch)
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
-    hands = shoulders + st.hand_rel
     hand_dir = np.broadcast_to(st.hand_dir, (T, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy()
-    hand_name = "none"
-    if target is not None:
-        target = np.asarray(target, dtype=np.float64)
-        if target.shape != (3,):
-            raise ValueError(f"target must have shape (3,), got {target.shape}")
-        targets, active, hand_name = _hand_targets("grasp", target, hand if hand != "auto"
-                                                   else "auto")
-        f1 = min(round(t1 * fps), T - 1)
-        arm = _arm_length(skeleton)
-        rel = np.broadcast_to(st.hand_rel, (T, 2, 3)).copy()
-        for k in active:
-            goal = targets[k] - shoulders[f1, k]
-            if np.linalg.norm(goal) > _REACH_FRACTION * arm:
-                raise ValueError(f"{task}: target {np.round(target, 3).tolist()} is out of reach "
-                                 f"from the {task} posture")
-            rel[:, k] = _arc_keys(t, [(0.0, st.hand_rel[k]), (t1, goal), (t2, goal),
-                                      (total, st.hand_rel[k])])
-        hands = shoulders + rel
+    hands, target, hand_name = _low_reach(task, skeleton, st, t, shoulders, target, hand,
+                                          (t1, t2, total), fps)
     world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, ankles, toes,
                     knee_pole)
     f1 = min(round(t1 * fps), T - 1)
@@ -1094,15 +1189,7 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     ValueError
         Unknown task, malformed or unreachable target, too short duration.
     """
-    _check_task(task)
-    if not isinstance(skeleton, Skeleton):
-        raise ValueError(f"skeleton must be a Skeleton, got {type(skeleton).__name__}")
-    if not fps > 0:
-        raise ValueError(f"fps must be positive, got {fps!r}")
-    if duration is not None and not duration > 0:
-        raise ValueError(f"duration must be positive, got {duration!r}")
-    if path not in HAND_PATHS:
-        raise ValueError(f"path must be one of {', '.join(HAND_PATHS)}, got {path!r}")
+    _check_options(task, skeleton, fps, duration, path)
     rng = np.random.default_rng(0) if rng is None else rng
     st = _Start(skeleton, start_pose)
     if task in HAND_TASKS:
@@ -1117,13 +1204,34 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     if task == "wait":
         return _wait(skeleton, st, rng, duration, fps)
     if task == "sit":
-        world, meta, tgt = _sit(skeleton, st, rng, duration, fps, target)
-        meta.update({"contact_frame": world.shape[0] - 1, "hand": "none",
-                     "posture": "seated", "hold_frames": [world.shape[0] - 1] * 2})
-        return _finish(f"sit_{_fmt(tgt)}", "sit", world, st, fps,
-                       f"goals.make_goal_primitive('sit', target={_fmt(tgt)})", meta,
-                       start_exact=True, end_exact=False)
+        return _sit_primitive(skeleton, st, rng, duration, fps, target)
     return _stand_up(skeleton, st, rng, duration, fps, target)
+
+
+def _check_options(task: str, skeleton: Skeleton, fps: float, duration: float | None,
+                   path: str) -> None:
+    """ValueError unless the arguments of :func:`make_goal_primitive` are well formed."""
+    _check_task(task)
+    if not isinstance(skeleton, Skeleton):
+        raise ValueError(f"skeleton must be a Skeleton, got {type(skeleton).__name__}")
+    if not fps > 0:
+        raise ValueError(f"fps must be positive, got {fps!r}")
+    if duration is not None and not duration > 0:
+        raise ValueError(f"duration must be positive, got {duration!r}")
+    if path not in HAND_PATHS:
+        raise ValueError(f"path must be one of {', '.join(HAND_PATHS)}, got {path!r}")
+
+
+def _sit_primitive(skeleton: Skeleton, st: _Start, rng: np.random.Generator,
+                   duration: float | None, fps: float, target: np.ndarray | None
+                   ) -> MotionPrimitive:
+    """sit onto the seat point ``target`` (3,) (see :func:`_sit`)."""
+    world, meta, tgt = _sit(skeleton, st, rng, duration, fps, target)
+    meta.update({"contact_frame": world.shape[0] - 1, "hand": "none",
+                 "posture": "seated", "hold_frames": [world.shape[0] - 1] * 2})
+    return _finish(f"sit_{_fmt(tgt)}", "sit", world, st, fps,
+                   f"goals.make_goal_primitive('sit', target={_fmt(tgt)})", meta,
+                   start_exact=True, end_exact=False)
 
 
 def _stand_up(skeleton: Skeleton, st: _Start, rng: np.random.Generator,

@@ -23,10 +23,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ltl_human_motion.motion.skeleton import JOINT_INDEX
+
+#: The foot joints, whose junction ramps may be longer (:func:`_add_junction`).
+_FOOT_JOINTS = tuple(JOINT_INDEX[n] for n in ("l_ankle", "l_toe", "r_ankle", "r_toe"))
+
 #: Time (s) over which synthesis spreads each junction's pose mismatch on either side of
 #: it (offset blending): long enough that a 5 cm mismatch adds under 0.25 m/s to a joint,
 #: short next to a goal primitive's reach (at least 0.6 s).
 JUNCTION_SPREAD = 0.2
+#: Speed (m/s) a junction's offset ramp may add to a foot joint (ankle, toe): a larger
+#: mismatch of the feet is spread over a longer window, up to
+#: :data:`JUNCTION_FOOT_SPREAD_MAX` (the ``JUNCTION_SPREAD`` design number: 5 cm adds
+#: 0.23 m/s). Transitions of the gait graph leave a swing foot 5-15 cm off, whose ramp
+#: at 0.2 s added 0.25-0.7 m/s near the foot's swing peak (ankle over 4.1 m/s).
+JUNCTION_ADDED_SPEED = 0.25
+#: Longest window (s) of a foot's ramp on either side of a junction, short of a goal
+#: primitive's reach (at least 0.6 s). The rest of the body keeps ``JUNCTION_SPREAD``
+#: (longer ramps of the whole leg or body turned into knee, hand and collision failures).
+JUNCTION_FOOT_SPREAD_MAX = 0.5
 
 
 def blend_weights(nf: int) -> np.ndarray:
@@ -71,12 +86,14 @@ class PlacedSegment:
     name: str = ""
 
 
-def concatenate(segments: list[PlacedSegment], spread: int = 0
+def concatenate(segments: list[PlacedSegment], spread: int = 0, fps: float | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[tuple[int, int]]]:
     """Concatenate placed segments, blending each overlap with the cubic weight.
 
     ``spread``: frames over which each overlap's pose mismatch is spread by offset
-    blending (module docstring); 0 = the cross-fade of Eq. (2).
+    blending (module docstring); 0 = the cross-fade of Eq. (2). With ``fps`` (frame
+    rate) a foot whose mismatch would add more than :data:`JUNCTION_ADDED_SPEED` over
+    ``spread`` frames gets a longer window, up to :data:`JUNCTION_FOOT_SPREAD_MAX`.
 
     Returns
     -------
@@ -120,7 +137,7 @@ def concatenate(segments: list[PlacedSegment], spread: int = 0
             c = nf // 2
             d = seg.positions[c] - positions[start + c]                  # (J, 3)
             positions[start + c:end] = seg.positions[c:nf]
-            _add_ramps(offset, start + c, d, spread)
+            _add_junction(offset, start + c, d, spread, fps)
         elif nf:
             w = blend_weights(nf)
             a_pos, b_pos = positions[start:end], seg.positions[:nf]
@@ -139,6 +156,24 @@ def concatenate(segments: list[PlacedSegment], spread: int = 0
     if offset is not None:
         positions += offset
     return positions, yaw, labels, spans
+
+
+def _add_junction(offset: np.ndarray, c: int, d: np.ndarray, spread: int,
+                  fps: float | None) -> None:
+    """Add the ramps of a junction with mismatch ``d`` (J, 3) at frame ``c`` to ``offset``
+    (T, J, 3): over ``spread`` frames, the feet's over as many as keep their added speed
+    ``1.875 |d| / 2 / (frames / fps)`` within :data:`JUNCTION_ADDED_SPEED` (at most
+    :data:`JUNCTION_FOOT_SPREAD_MAX` seconds) when ``fps`` is given."""
+    if fps is None:
+        _add_ramps(offset, c, d, spread)
+        return
+    feet = np.zeros(len(d), bool)
+    feet[list(_FOOT_JOINTS)] = True
+    d_feet = np.where(feet[:, None], d, 0.0)
+    _add_ramps(offset, c, d - d_feet, spread)
+    need = 1.875 * float(np.max(np.linalg.norm(d_feet, axis=-1))) / 2.0 / JUNCTION_ADDED_SPEED
+    frames = min(int(np.ceil(need * fps)), round(JUNCTION_FOOT_SPREAD_MAX * fps))
+    _add_ramps(offset, c, d_feet, max(spread, frames))
 
 
 def _add_ramps(offset: np.ndarray, c: int, d: np.ndarray, spread: int) -> None:

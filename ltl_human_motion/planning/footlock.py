@@ -59,6 +59,9 @@ LOCK_MISS = 0.003
 CONTACT_SWITCH = 0.003
 #: Time (s) over which the heading lock of a flat planted foot fades fully in or out.
 YAW_RAMP = 0.1
+#: Half-width (s) of the smoothing of the knee's bend direction (the IK pole) of a locked
+#: leg: without it a straight leg's knee jumped sideways at 3-4 m/s.
+POLE_SMOOTH = 0.05
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -398,7 +401,12 @@ def _solve_leg(p: np.ndarray, s: str, bones: np.ndarray, ank_all: np.ndarray,
     fwd = np.zeros_like(foot)
     fwd[:, :2] = foot[:, :2] / np.maximum(np.linalg.norm(foot[:, :2], axis=-1,
                                                          keepdims=True), 1e-9)
-    pole = p[moved, knee] - 0.5 * (p[moved, hip] + p[moved, ank]) + 0.01 * fwd
+    # (smoothed over time: a nearly straight leg's offset is a few mm in any direction,
+    # and the knee of a pin that shortens the leg swung sideways with it between frames)
+    offset = p[:, knee] - 0.5 * (p[:, hip] + p[:, ank])
+    offset = uniform_filter1d(offset, 2 * max(1, round(POLE_SMOOTH * fps)) + 1, axis=0,
+                              mode="nearest")
+    pole = offset[moved] + 0.01 * fwd
     kn, an = two_bone_ik(p[moved, hip], target, bones[knee], bones[ank], pole,
                          max_stretch=1.0)
     kn_out[moved] = kn

@@ -355,7 +355,8 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     for realism in attempts:
         t0 = time.perf_counter()
         positions, root_yaw, _labels, spans = concatenate(
-            plan.segments, spread=round(JUNCTION_SPREAD * library.fps) if realism else 0)
+            plan.segments, spread=round(JUNCTION_SPREAD * library.fps) if realism else 0,
+            fps=library.fps if realism else None)
         # Linear blends of joint positions shorten bones between unlike poses; restore them.
         positions = enforce_bone_lengths(positions, library.skeleton)
         if realism:

@@ -56,8 +56,10 @@ def _progress(t: np.ndarray, a: float, b: float) -> np.ndarray:
 
 
 #: Clearance (m) the hanging arms keep from the thighs of the stepping legs, over the
-#: self-penetration check of planning.biomechanics.
-ARM_CLEARANCE = 0.01
+#: self-penetration check of planning.biomechanics. 2 cm: foot locking (planning.footlock)
+#: turns a thigh of a step by up to 1 cm towards its hand (1 cm left the hand 2 mm inside
+#: the thigh in the steps back of a 1.55 m worker).
+ARM_CLEARANCE = 0.02
 #: Time (s) over which the arms swing out of the legs' way and back (half-width).
 ARM_RAMP = 0.15
 
@@ -70,21 +72,30 @@ def _arms_clear_of_thighs(poses: np.ndarray, skeleton: Skeleton, fps: float) -> 
 
     out = np.array(poses, dtype=np.float64, copy=True)
     width = 2 * max(1, round(ARM_RAMP * fps)) + 1
+    # the first and last frames stay the standing pose the primitive starts and ends in
+    k = np.arange(len(out))
+    half = max(1, round(ARM_RAMP * fps))
+    ends_fixed = min_jerk(np.clip(k / half, 0.0, 1.0)) * min_jerk(
+        np.clip((len(out) - 1 - k) / half, 0.0, 1.0))
     for _ in range(2):
         depth, pairs = self_penetration(out, skeleton.stature)
         done = True
         for side, sign in (("l", 1.0), ("r", -1.0)):
             cols = [i for i, (a, b) in enumerate(pairs) if b == f"{side}_thigh"
                     and a in (f"{side}_upper_arm", f"{side}_lower_arm", f"{side}_hand")]
-            need = np.maximum(depth[:, cols].max(axis=1) + ARM_CLEARANCE, 0.0)
-            if not np.any(depth[:, cols] > -ARM_CLEARANCE):
+            # never more clearance than the standing pose at either end has (it starts and
+            # ends the primitive unchanged)
+            ends = max(float(depth[0, cols].max()), float(depth[-1, cols].max()))
+            clearance = float(np.clip(-ends, 0.0, ARM_CLEARANCE))
+            need = np.maximum(depth[:, cols].max(axis=1) + clearance, 0.0)
+            if not np.any(depth[:, cols] > -clearance):
                 continue
             done = False
             sh = JOINT_INDEX[f"{side}_shoulder"]
             arm = [JOINT_INDEX[f"{side}_{x}"] for x in ("elbow", "wrist", "hand")]
             reach = np.linalg.norm(out[:, arm[-1]] - out[:, sh], axis=-1)
             ang = need / np.maximum(reach, 1e-6)
-            ang = uniform_filter1d(maximum_filter1d(ang, width), width)
+            ang = uniform_filter1d(maximum_filter1d(ang, width), width) * ends_fixed
             c, s = np.cos(sign * ang)[:, None], np.sin(sign * ang)[:, None]
             rel = out[:, arm] - out[:, sh][:, None]
             y, z = rel[..., 1].copy(), rel[..., 2].copy()

@@ -68,8 +68,8 @@ def _on_alarm(signum, frame) -> None:
     raise _PairTimeoutError(task)
 
 
-def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None = None
-             ) -> Outcome:
+def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None = None,
+             biomechanics: bool = False) -> Outcome:
     """Synthesize one motion for ``spec`` in ``cell`` and classify the result.
 
     Parameters
@@ -81,8 +81,13 @@ def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None =
     seed : int
     timeout : float, optional
         Seconds; uses SIGALRM, so only in a process's main thread.
+    biomechanics : bool
+        Verify with the biomechanical checks too (``VerificationOptions.biomechanics``).
     """
-    from ltl_human_motion.planning.pipeline import get_library, synthesize
+    from ltl_human_motion.planning.pipeline import SynthesisOptions, get_library, synthesize
+    from ltl_human_motion.planning.verify import VerificationOptions
+    options = SynthesisOptions(verification=VerificationOptions(biomechanics=True)) \
+        if biomechanics else None
     get_library(float(stature))                      # loaded before timing
     use_alarm = timeout is not None and timeout > 0
     if use_alarm:
@@ -90,7 +95,8 @@ def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None =
         signal.setitimer(signal.ITIMER_REAL, float(timeout))
     t0 = time.perf_counter()
     try:
-        motions = synthesize(spec, cell, stature=float(stature), seed=int(seed))
+        motions = synthesize(spec, cell, stature=float(stature), seed=int(seed),
+                             options=options)
         passed = bool(motions[0].verification.get("passed", False))
         out = Outcome("verified" if passed else "verification", 0.0,
                       None if passed else "unknown")
