@@ -53,10 +53,12 @@ def _submissions_while_blocked(executor_type: type) -> tuple[int, int, int]:
     executor = executor_type(num_threads=1, context=context)
     executor.add_node(node)
     submitted: dict[int, int] = {}
+    alive: list = []                  # every task seen stays alive: its id is never reused
     pool_submit = executor._executor.submit
 
     def counting_submit(fn, *args):                    # the real pool, counted
         task = args[0] if args else fn
+        alive.append(task)
         submitted[id(task)] = submitted.get(id(task), 0) + 1
         return pool_submit(fn, *args)
 
