@@ -225,6 +225,9 @@ SUBSET: dict[str, str | None] = {
     "machine_tending/single/extract(done, fixture)": None,
     "shelf_heights/single/grasp(O_shoulder)": None,
     "shelf_heights/single/grasp(O_over)": None,
+    # a knee-board part grasped with the free hand under the waist board (square to it)
+    "shelf_heights/dwyer/absence_after/0": None,
+    "shelf_heights/job/two_heights": None,
     "kitting/single/grasp(gear)": None,
     # refused before any search, one per reason
     "shelf_heights/infeasible/F grasp(O_top)": None,

@@ -32,6 +32,7 @@ from ltl_human_motion.planning.plan_state import (
     object_position,
 )
 from ltl_human_motion.planning.standing import (
+    SQUARE_BOARD_HEIGHT,
     board_local,
     low_board,
     pull_length,
@@ -282,12 +283,13 @@ class GoalSteps:
 
     def approach_under(self, target: np.ndarray, placement: tuple[float, float],
                        text: str) -> int | None:
-        """:meth:`approach` to the standing place in front of the nearest edge of a low
-        board over ``target``, square to the edge (the walk ends within ``BOARD_FACING``
-        of it and the standing step squares up: the reach under the board is planned
-        square, :func:`.standing.standing_offset`); None if there is no such board or no
-        way there."""
-        low = low_board(self.ctx.cell, target, self.ctx.stature)
+        """:meth:`approach` to the standing place in front of the nearest edge of a board
+        over ``target`` lower than ``SQUARE_BOARD_HEIGHT`` of the stature, square to the
+        edge (the walk ends within ``BOARD_FACING`` of it and the standing step squares
+        up: the reach under the board is planned square,
+        :func:`.standing.standing_offset`); None if there is no such board or no way
+        there."""
+        low = low_board(self.ctx.cell, target, self.ctx.stature, below=SQUARE_BOARD_HEIGHT)
         if low is None:
             return None
         yaw = math.atan2(-low[3][1], -low[3][0])

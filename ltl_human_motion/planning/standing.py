@@ -33,6 +33,13 @@ RELEASE_PLACES: tuple[tuple[float, float], ...] = (
     (0.45, 0.0), (0.45, math.pi / 4), (0.45, -math.pi / 4), (0.4, math.pi / 2),
     (0.4, -math.pi / 2), (0.3, 0.0))
 
+#: A board over a hand target lower than this fraction of the stature (the head of a
+#: worker stooping to the target passes under or at it: 1.05 m at 1.75 m, a rack's
+#: waist board over its knee board) is approached square to its edge, and the reach
+#: keeps every body capsule out from under it, as for a low board (:func:`low_board`
+#: with ``below``; the goal model's ``board``).
+SQUARE_BOARD_HEIGHT = 0.6
+
 #: Half length of a low board's front edge either side of the target that the reach
 #: under it keeps clear of, metres (about a shoulder width: the arm and the head).
 BOARD_EDGE_SPAN = 0.25
@@ -62,12 +69,13 @@ PULL_RANGE = (0.08, 0.3)
 
 
 
-def low_board(cell, target: np.ndarray, stature: float) -> Board | None:
+def low_board(cell, target: np.ndarray, stature: float, below: float = LOW_BOARD_HEIGHT
+              ) -> Board | None:
     """The lowest obstacle part over ``target`` (3,) with its underside above it and
-    below ``LOW_BOARD_HEIGHT`` of the stature: (depth of the target behind the part's
-    nearest edge, underside, top in metres, the edge's outward normal (2,)); None if
-    there is none."""
-    highest = LOW_BOARD_HEIGHT * stature
+    below ``below`` of the stature (default ``LOW_BOARD_HEIGHT``: a board the reach
+    crouches under): (depth of the target behind the part's nearest edge, underside,
+    top in metres, the edge's outward normal (2,)); None if there is none."""
+    highest = below * stature
     best = None
     xy = np.asarray(target[:2], dtype=np.float64)
     probe = xy + np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
@@ -91,7 +99,7 @@ def board_local(cell, target: np.ndarray, local: np.ndarray, yaw: float, stature
     goal primitive, whose heading is ``yaw``) as the goal primitive takes it: (edge x,
     underside, top), the edge's nearest x within ``BOARD_EDGE_SPAN`` either side of the
     target; None if there is no low board."""
-    low = low_board(cell, target, stature)
+    low = low_board(cell, target, stature, below=SQUARE_BOARD_HEIGHT)
     if low is None:
         return None
     c, s = math.cos(-yaw), math.sin(-yaw)
@@ -110,7 +118,8 @@ def standing_offset(ctx: PlanContext, kind: str, target: np.ndarray, task: str,
     primitive starts from: the carry stance (``carry_stance``: the planner raises the
     arms first, or they hold a part), else arms down."""
     from ltl_human_motion.motion import goals
-    low = low_board(ctx.cell, target, ctx.stature) if kind in LEVEL_PATH_TASKS else None
+    low = low_board(ctx.cell, target, ctx.stature, below=SQUARE_BOARD_HEIGHT) \
+        if kind in LEVEL_PATH_TASKS else None
     try:
         d, lat = goals.reach_placement(kind, float(target[2]), ctx.library.skeleton,
                                        hand=hand or "auto",
