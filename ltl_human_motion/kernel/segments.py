@@ -16,6 +16,7 @@ pays nothing for it.
 from __future__ import annotations
 
 import functools
+import importlib
 import os
 from types import ModuleType
 
@@ -30,6 +31,7 @@ __all__ = [
     "batched_min_signed_distances",
     "check_capsules",
     "compiled",
+    "compiled_module",
     "group_min_signed_distances",
     "joint_segment_distances",
     "min_signed_distance",
@@ -81,6 +83,20 @@ def compiled() -> bool:
 
 
 # ---------------------------------------------------------------------------- validation
+
+@functools.cache
+def compiled_module(name: str) -> ModuleType | None:
+    """The compiled-loop module ``name`` (e.g. ``"ltl_human_motion.planning.
+    _navigation_numba"``) where the compiled kernels are in use, else None (numba missing
+    or disabled, or the module fails to import): the numpy paths run instead. Decided
+    once per name."""
+    if not compiled():
+        return None
+    try:
+        return importlib.import_module(name)
+    except ImportError:
+        return None
+
 def check_capsules(segments: ArrayLike, radii: ArrayLike, what: str = "capsules",
                    max_coordinate: float = MAX_COORDINATE
                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -10,7 +10,7 @@ unreachable goal is known before any primitive is expanded.
 from __future__ import annotations
 
 from collections.abc import Callable
-from functools import cache, lru_cache
+from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
 
@@ -179,17 +179,10 @@ class NavigationField:
         return bool(np.isfinite(self.distance(np.array([x]), np.array([y]))[0]))
 
 
-@cache
 def _compiled_loops() -> ModuleType | None:
     """The compiled loops (:mod:`._navigation_numba`), where the compiled kernel is in use."""
-    from ltl_human_motion.kernel.segments import compiled
-    if not compiled():
-        return None
-    try:
-        from ltl_human_motion.planning import _navigation_numba
-    except ImportError:
-        return None
-    return _navigation_numba
+    from ltl_human_motion.kernel.segments import compiled_module
+    return compiled_module("ltl_human_motion.planning._navigation_numba")
 
 
 #: How much closer than its footprint a tall part counts for walking (the swinging arms

@@ -30,7 +30,6 @@ S_p + margin apart skip the distance (the command is full speed whatever it is).
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -40,7 +39,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ltl_human_motion.kernel.segments import batched_min_signed_distances, compiled
+from ltl_human_motion.kernel.segments import batched_min_signed_distances, compiled_module
 from ltl_human_motion.robot.coexistence import ControlDecision, ssm_command
 from ltl_human_motion.robot.kinematics import URModel, robot_capsules, ur_model
 from ltl_human_motion.robot.metrics import metrics_from_columns
@@ -193,16 +192,9 @@ class _Steps:
     arm: Callable[[np.ndarray], np.ndarray]
 
 
-@functools.cache
 def _compiled_steps() -> ModuleType | None:
     """The compiled step loop, where the compiled segment kernel is in use."""
-    if not compiled():
-        return None
-    try:
-        from ltl_human_motion.robot import _offline_numba
-    except ImportError:
-        return None
-    return _offline_numba
+    return compiled_module("ltl_human_motion.robot._offline_numba")
 
 
 def _steps_compiled(nb: ModuleType, occ: _Occupancy, trajectory: JointTrajectory,

@@ -16,7 +16,6 @@ capsule, and gets that (smaller, still at least ``exact_below``) bound instead.
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from types import ModuleType
 
@@ -203,17 +202,10 @@ class PartSet:
         return body.min(axis=1)
 
 
-@functools.cache
 def _compiled_bounds() -> ModuleType | None:
     """The compiled bounds (:mod:`._clearance_numba`), where the compiled kernel is in use."""
-    from ltl_human_motion.kernel.segments import compiled
-    if not compiled():
-        return None
-    try:
-        from ltl_human_motion.scene import _clearance_numba
-    except ImportError:
-        return None
-    return _clearance_numba
+    from ltl_human_motion.kernel.segments import compiled_module
+    return compiled_module("ltl_human_motion.scene._clearance_numba")
 
 
 _PART_SETS: BoundedCache[PartSet] = BoundedCache(64)
