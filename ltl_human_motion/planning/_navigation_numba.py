@@ -49,41 +49,11 @@ def bilinear(xs, ys, values, in_lo, in_hi, xy, out) -> None:
 
 
 @_jit
-def trilinear(grid, u, out) -> None:
-    """out[n] = trilinear interpolation of grid (nx, ny, nz) at index coordinates u[n]
-    (N, 3), finite: corners clamped to the grid, weights ``1 - f`` and ``1 - (1 - f)``,
-    the eight corners summed in C order."""
+def _trilinear_at(grid, u0, u1, u2):
+    """Trilinear interpolation of grid (nx, ny, nz) at index coordinates (u0, u1, u2),
+    finite: corners clamped to the grid, weights ``1 - f`` and ``1 - (1 - f)``, the
+    eight corners summed in C order."""
     nx, ny, nz = grid.shape
-    lo = np.empty(3, dtype=np.intp)
-    hi = np.empty(3, dtype=np.intp)
-    w = np.empty((3, 2))
-    for n in range(u.shape[0]):
-        for d in range(3):
-            top = (nx, ny, nz)[d] - 1
-            base = math.floor(u[n, d])
-            w0 = 1.0 - (u[n, d] - base)
-            w[d, 0], w[d, 1] = w0, 1.0 - w0
-            lo[d] = int(min(max(base, 0.0), top))
-            hi[d] = int(min(max(base + 1, 0.0), top))
-        v = 0.0
-        for f0 in range(2):
-            i = lo[0] if f0 == 0 else hi[0]
-            for f1 in range(2):
-                j = lo[1] if f1 == 0 else hi[1]
-                for f2 in range(2):
-                    k = lo[2] if f2 == 0 else hi[2]
-                    v = v + grid[i, j, k] * w[0, f0] * w[1, f1] * w[2, f2]
-        out[n] = v
-
-
-@_jit
-def _field_distance(grid, lo, res, far, p0, p1, p2):
-    """The obstacle field's distance at one point (``ObstacleField.distance``): the
-    trilinear value at index coordinates ``(p - lo) / res``, at least ``far`` off the
-    grid; the arithmetic of :func:`trilinear`."""
-    nx, ny, nz = grid.shape
-    u0, u1, u2 = (p0 - lo[0]) / res, (p1 - lo[1]) / res, (p2 - lo[2]) / res
-    outside = (u0 < 0 or u0 > nx - 1 or u1 < 0 or u1 > ny - 1 or u2 < 0 or u2 > nz - 1)
     b0, b1, b2 = math.floor(u0), math.floor(u1), math.floor(u2)
     w00 = 1.0 - (u0 - b0)
     w10 = 1.0 - (u1 - b1)
@@ -101,6 +71,26 @@ def _field_distance(grid, lo, res, far, p0, p1, p2):
     v = v + grid[i1, j0, k1] * w01 * w10 * w21
     v = v + grid[i1, j1, k0] * w01 * w11 * w20
     v = v + grid[i1, j1, k1] * w01 * w11 * w21
+    return v
+
+
+@_jit
+def trilinear(grid, u, out) -> None:
+    """out[n] = trilinear interpolation of grid (nx, ny, nz) at index coordinates u[n]
+    (N, 3), finite (:func:`_trilinear_at`)."""
+    for n in range(u.shape[0]):
+        out[n] = _trilinear_at(grid, u[n, 0], u[n, 1], u[n, 2])
+
+
+@_jit
+def _field_distance(grid, lo, res, far, p0, p1, p2):
+    """The obstacle field's distance at one point (``ObstacleField.distance``): the
+    trilinear value at index coordinates ``(p - lo) / res``, at least ``far`` off the
+    grid."""
+    nx, ny, nz = grid.shape
+    u0, u1, u2 = (p0 - lo[0]) / res, (p1 - lo[1]) / res, (p2 - lo[2]) / res
+    outside = (u0 < 0 or u0 > nx - 1 or u1 < 0 or u1 > ny - 1 or u2 < 0 or u2 > nz - 1)
+    v = _trilinear_at(grid, u0, u1, u2)
     return max(v, far) if outside else v
 
 

@@ -242,7 +242,7 @@ def _first_stop(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, near: np.n
     there, keeps clear and ends in the goal, with the first such stop: (m, the stop, its
     end pose (3,)); None if there is none. The goal, floor and body tests of all the
     candidates run in one call each."""
-    owners, ids, stop_ends, paths, bodies = [], [], [], [], []
+    owners, ids, stop_ends, paths = [], [], [], []
     for m in near.tolist():
         at = (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2]))
         stop_ids = _stop_candidates(index, int(succ[m]), at, allowed, forbidden, options)
@@ -260,13 +260,10 @@ def _first_stop(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, near: np.n
         > options.body_radius
     if ok.any() and body_clear is not None and index.body.size:
         # The arms swing as the worker stops: check the whole body, as for every move.
-        for k in np.flatnonzero(ok).tolist():
-            if not bodies or bodies[-1][0] != owner[k]:
-                bodies.append((owner[k], []))
-            bodies[-1][1].append(k)
-        sel = np.concatenate([np.asarray(ks) for _, ks in bodies])
-        body = np.concatenate([_body_at(index, cand[ks], *(float(v) for v in ends[m]))
-                               for m, ks in bodies])
+        sel = np.flatnonzero(ok)
+        groups = np.split(sel, np.flatnonzero(np.diff(owner[sel])) + 1)   # per successor
+        body = np.concatenate([_body_at(index, cand[g], *(float(v) for v in ends[owner[g[0]]]))
+                               for g in groups])
         ok[sel] = body_clear(body, index.standing[cand[sel]])
     if not ok.any():
         return None

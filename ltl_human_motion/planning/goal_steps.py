@@ -28,6 +28,7 @@ from ltl_human_motion.planning.plan_state import (
     WorkerState,
     acting_hand,
     grip_frame,
+    holding_joint,
     lift_frame,
     object_position,
 )
@@ -136,7 +137,7 @@ class GoalSteps:
         seated = self.state.seat is not None and kind != "standUp"
         kwargs = {"rng": self.ctx.rng,
                   "start_pose": self.executor.seated_pose() if seated
-                  else self.ctx.stance(bool(self.state.held) or carry_stance)}
+                  else self.ctx.stance(self.state.carrying or carry_stance)}
         hand = acting_hand(self.state, kind, part if kind != "grasp" else grasped)
         if hand is not None:
             kwargs["hand"] = hand
@@ -332,7 +333,7 @@ class GoalSteps:
 
         field = self.goals.field(lambda xy, clearance: roomy(xy[:, 0], xy[:, 1]), ("room", room))
         goal = self.goals.from_field(field, roomy, f"find room for {text}", text)
-        return self.executor.walk(goal, text, -1, carry=bool(self.state.held))
+        return self.executor.walk(goal, text, -1, carry=self.state.carrying)
 
     def release_targets(self, obj: str) -> list[np.ndarray]:
         """Where the hand holding ``obj`` may let it go, palm positions (3,), in order
@@ -353,7 +354,7 @@ class GoalSteps:
         contact frame on) out of ``container`` on some frame: Table I's condition, which
         the verifier checks (a worker standing close keeps the part in a deep fixture)."""
         from ltl_human_motion.scene.predicates import enter_object
-        joint = {"l_hand": "l_hand"}.get(mp.meta.get("hand"), "r_hand")
+        joint = holding_joint(mp.meta.get("hand"))
         hand = world_positions(mp, *self.state.pose)[:, JOINT_INDEX[joint]]
         contact = min(grip_frame(mp), len(hand) - 1)
         obj, box = self.ctx.cell.object(part), self.ctx.cell.object(container)
@@ -372,7 +373,7 @@ class GoalSteps:
         if grasped is None:
             return True
         from ltl_human_motion.scene.predicates import object_clearance
-        joint = {"l_hand": "l_hand", "r_hand": "r_hand"}.get(mp.meta.get("hand"), "r_hand")
+        joint = holding_joint(mp.meta.get("hand"))
         hand = world[:, JOINT_INDEX[joint]]
         contact = int(mp.meta.get("contact_frame", 0))
         lift = lift_frame(mp, hand)

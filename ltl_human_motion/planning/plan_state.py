@@ -148,6 +148,12 @@ class WorkerState:
         return self.held_offsets.get(name, np.zeros(3))
 
 
+def holding_joint(hand: str | None) -> str:
+    """The joint that holds a part for a goal primitive's ``meta["hand"]``
+    (``HOLDING_JOINT``; any other value: the right hand)."""
+    return HOLDING_JOINT.get(hand, "r_hand")
+
+
 def object_position(cell, state: WorkerState, name: str) -> np.ndarray:
     """Where object ``name`` rests now (3,): where the last step put it down, else its
     supply position in the cell."""
@@ -202,7 +208,7 @@ def apply_effects(state: WorkerState, kind: str, args: tuple[str, ...], hand: st
     """Update which parts ``state`` holds after a goal task; returns the effect for the
     object tracks (``attach``, ``detach``, ``consume``). ``keep_hold``: a held part that
     a move puts into its region stays in hand (carry)."""
-    hand_joint = HOLDING_JOINT.get(hand, "r_hand")
+    hand_joint = holding_joint(hand)
     if kind == "grasp":
         state.held[args[0]] = hand_joint
         return {"attach": {args[0]: hand_joint}}
@@ -261,5 +267,6 @@ def track_objects(cell, state: WorkerState, effect: dict, joints: dict[str, str]
 
 
 __all__ = ["LIFT_RISE", "OTHER_HAND", "PlanContext", "Pose",
-           "WorkerState", "acting_hand", "apply_effects", "grip_frame", "lift_frame",
+           "WorkerState", "acting_hand", "apply_effects", "grip_frame", "holding_joint",
+           "lift_frame",
            "object_position", "track_objects"]

@@ -323,7 +323,7 @@ class SequencePlanner:
         target = self.target_of(kind, args)
         if target is None or self.state.seat is None:
             return False
-        envelope = reach_envelope(self.ctx.library.skeleton.stature)
+        envelope = reach_envelope(self.ctx.stature)
         away = float(np.hypot(*(np.asarray(target[:2]) - np.asarray(self.state.seat[:2]))))
         return away > envelope.horizontal(float(target[2]), float(target[2]))
 
@@ -354,7 +354,7 @@ class SequencePlanner:
                 if kind in LEVEL_PATH_TASKS and facing is None else None
             if walked is None:
                 walked = self.goal_steps.approach_facing(target, placement, text, facing)
-        carrying_before = bool(self.state.held)
+        carrying_before = self.state.carrying
         raised = kind in HAND_TASKS and not carrying_before and self.state.seat is None \
             and arms_up
         if raised:
@@ -374,7 +374,7 @@ class SequencePlanner:
             effect["respawn"] = [args[0]]
         track_objects(self.ctx.cell, self.state, effect, joints,
                       self.state.segments[seg].positions, mp, self.ctx.overlap)
-        if bool(self.state.held) != carrying_before and self.state.seat is None:
+        if self.state.carrying != carrying_before and self.state.seat is None:
             self.executor.arm_transition(carrying_before, i)
         if kind in ("sit", "standUp"):
             self.state.seat = target if kind == "sit" else None

@@ -146,7 +146,7 @@ class StepExecutor:
     def stand_still(self, label: int, seconds: float) -> None:
         """A short standing segment (start of the motion, end of a walk task)."""
         n = max(round(seconds * self.ctx.library.fps), self.ctx.overlap + 2)
-        rel = np.repeat(self.ctx.stance(bool(self.state.held))[None], n, axis=0)
+        rel = np.repeat(self.ctx.stance(self.state.carrying)[None], n, axis=0)
         root = np.zeros((n, 4))
         root[:, 2] = self.ctx.library.standing_height
         mp = MotionPrimitive("stand", "wait", rel, root, self.ctx.library.fps, "planner: stand")
@@ -156,7 +156,7 @@ class StepExecutor:
         """Whether sampled poses (M, S, J, 3) keep 1 cm from every obstacle, shape (M,);
         standing primitives (``standing`` (M,)) need only not come closer."""
         out = np.ones(len(poses), dtype=bool)
-        stature = self.ctx.library.skeleton.stature
+        stature = self.ctx.stature
         for rel in (False, True):
             sel = standing == rel
             if sel.any():
@@ -210,7 +210,7 @@ class StepExecutor:
         from ltl_human_motion.motion.arm_transition import arm_transition_poses
         from ltl_human_motion.motion.retarget import enforce_bone_lengths
         key = (self.ctx.stance(False).tobytes(), self.ctx.stance(True).tobytes(),
-               self.ctx.library.skeleton.stature, self.ctx.library.fps, self.ctx.overlap,
+               self.ctx.stature, self.ctx.library.fps, self.ctx.overlap,
                bool(carrying_before))
         hit = _ARM_POSES.get(key)
         if hit is not None:
@@ -237,7 +237,7 @@ class StepExecutor:
         from ltl_human_motion.scene.predicates import body_clearance, object_clearance
         if not self.ctx.cell.obstacles:
             return True
-        stature = self.ctx.library.skeleton.stature
+        stature = self.ctx.stature
         if samples is None:
             world = world_positions(mp, *pose) if world is None else world
             if not body_clear_every_frame(world, self.ctx.cell, stature):
@@ -266,7 +266,7 @@ class StepExecutor:
         x, y, yaw = self.state.pose
         if self.walkable(x, y):
             return
-        carrying = bool(self.state.held)
+        carrying = self.state.carrying
         lib = self.ctx.library
         c, s = math.cos(yaw), math.sin(yaw)
         for back in STEP_OUT_DISTANCES:
@@ -305,7 +305,7 @@ class StepExecutor:
                   for p, pose in zip(primitives, poses)]
         ends = np.cumsum([len(w) for w in worlds])
         world = np.concatenate(worlds)
-        bad = body_clearance(world, self.ctx.cell, stature=self.ctx.library.skeleton.stature,
+        bad = body_clearance(world, self.ctx.cell, stature=self.ctx.stature,
                              exact_below=EXACT_BELOW) <= PLACED_MARGIN
         for name, joint in self.state.held.items():
             centre = world[:, JOINT_INDEX[joint]] + self.state.held_offset(name)
@@ -430,7 +430,7 @@ class StepExecutor:
         px, py, pyaw, _ = (float(v[0]) for v in ideal_placement(
             self.ctx, target, placement, np.array([x]), np.array([y]), back_limit,
             stand_yaw=stand_yaw))
-        carrying = bool(self.state.held)
+        carrying = self.state.carrying
         back_dir = np.array([math.cos(pyaw), math.sin(pyaw)])
         c, s = math.cos(yaw), math.sin(yaw)
         stance = self.ctx.stance(carrying)

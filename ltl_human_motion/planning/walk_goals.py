@@ -249,8 +249,8 @@ class WalkGoals:
         unreachable on foot (the caller reaches into it by hand).
         """
         from ltl_human_motion.scene.occupancy import capsule_radii
-        stature = self.ctx.library.skeleton.stature
-        carrying = bool(self.state.held)
+        stature = self.ctx.stature
+        carrying = self.state.carrying
         entry = RegionEntry(region, self.ctx.stance(carrying), self.ctx.library.standing_height,
                             stature, float(capsule_radii(stature).max()))
         room = self.ctx.options.turn_clearance
