@@ -155,6 +155,7 @@ class GoalSteps:
                                   / self.ctx.library.fps)
         mp = None
         kept_in = 0
+        blocked: list[MotionPrimitive] = []
         attempts = self.ctx.options.goal_attempts if attempts is None else attempts
         for attempt in range(attempts):
             if kind in LEVEL_PATH_TASKS:
@@ -174,20 +175,15 @@ class GoalSteps:
             if clear:
                 mp = candidate
                 break
+            blocked.append(candidate)
             if attempt == 1 and kind in ("grasp", "release") and not hand_fixed \
                     and board is None:
                 other = OTHER_HAND.get(candidate.meta.get("hand"))
                 if other:
                     kwargs["hand"] = other
-        if mp is None and kept_in:
-            raise PlanningError(f"task {text}: {kept_in} of the {attempts} {kind} motions "
-                                f"tried keep {part} in {container} (the hand does not take "
-                                "it out far enough from where the worker stands), the others "
-                                "run into an obstacle", task=text, reason="blocked")
         if mp is None:
-            raise PlanningError(f"task {text}: every {kind} motion tried "
-                                f"({attempts}) runs into an obstacle; "
-                                "an obstacle blocks the reach", task=text, reason="blocked")
+            raise self.refusal(text, kind, attempts, blocked, grasped, kept_in,
+                               part, container)
         seg = self.executor.add(mp, self.state.pose, label, self.ctx.overlap)
         self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
         self.state.gait_state = None
@@ -362,6 +358,34 @@ class GoalSteps:
         offset = self.where(part) - hand[contact]
         return any(not enter_object(obj.occupancy_at(p + offset), around)
                    for p in hand[contact::EXTRACT_CHECK_STRIDE])
+
+    def refusal(self, text: str, kind: str, attempts: int, blocked: list[MotionPrimitive],
+                grasped: str | None, kept_in: int, part: str | None,
+                container: str | None) -> PlanningError:
+        """The error of a goal primitive none of whose ``attempts`` tries was clear."""
+        if kept_in:
+            return PlanningError(f"task {text}: {kept_in} of the {attempts} {kind} motions "
+                                 f"tried keep {part} in {container} (the hand does not take "
+                                 "it out far enough from where the worker stands), the "
+                                 "others run into an obstacle", task=text, reason="blocked")
+        return PlanningError(f"task {text}: every {kind} motion tried ({attempts}) runs "
+                             f"into an obstacle; {self.what_blocks(blocked, grasped)}",
+                             task=text, reason="blocked")
+
+    def what_blocks(self, blocked: list[MotionPrimitive], grasped: str | None) -> str:
+        """In words, what blocks the least blocked of ``blocked`` (goal primitives at the
+        current pose that :meth:`goal_clear` refused): the body part, the obstacle, how
+        deep and when, or the part in hand or being grasped that meets an obstacle."""
+        from ltl_human_motion.scene.contacts import deepest_contact
+        contacts = [deepest_contact(world_positions(mp, *self.state.pose), self.ctx.cell,
+                                    stature=self.ctx.stature) for mp in blocked]
+        found = [c for c in contacts if c is not None]
+        if len(found) < len(contacts):
+            held = ", ".join(sorted({*self.state.held, *([grasped] if grasped else [])}))
+            return f"the part in hand ({held}) meets an obstacle" if held \
+                else "an obstacle blocks the reach"
+        least = min(found, key=lambda c: c.depth)
+        return f"closest try: {least.describe(self.ctx.library.fps)}"
 
     def goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
         """Whether the body, the objects already in the hands and the part being grasped

@@ -212,6 +212,7 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
 def _collision_check(synth, cell, held: dict[str, np.ndarray] | None,
                      stature: float) -> dict:
     """The ``collision`` entry of :func:`verify_motion`: exact on every frame."""
+    from ltl_human_motion.scene.contacts import deepest_contact
     from ltl_human_motion.scene.predicates import collision
 
     pos = synth.motion.positions
@@ -223,9 +224,14 @@ def _collision_check(synth, cell, held: dict[str, np.ndarray] | None,
         # bounding boxes are apart.
         hits = collision(pos, cell, stature=stature, carried=carried)
     n_hit = int(np.sum(hits))
-    return _check(n_hit == 0, "no frame collides" if n_hit == 0 else
-                  f"{n_hit} frames collide, first at t = "
-                  f"{int(np.argmax(hits)) / synth.motion.fps:.2f} s", frames=n_hit)
+    if n_hit == 0:
+        return _check(True, "no frame collides", frames=0)
+    fps = synth.motion.fps
+    contact = deepest_contact(pos, cell, stature=stature)
+    deepest = f"; deepest: {contact.describe(fps)}" if contact is not None \
+        else "; a carried part meets an obstacle"
+    return _check(False, f"{n_hit} frames collide, first at t = "
+                  f"{int(np.argmax(hits)) / fps:.2f} s{deepest}", frames=n_hit)
 
 
 def _termination_check(synth, cell, steps: list[tuple[str, tuple[str, ...]]],
