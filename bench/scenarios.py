@@ -81,7 +81,7 @@ def _spread(pairs: list, limit: int) -> list:
 
 
 def _items(args) -> list[dict]:
-    pairs = _spread(load_corpus(args.specs, args.cells), args.limit)
+    pairs = [] if args.no_corpus else _spread(load_corpus(args.specs, args.cells), args.limit)
     items = []
     for p in pairs:
         for stature in args.statures:
@@ -209,6 +209,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--specs", type=Path, default=default_specs_path())
     parser.add_argument("--cells", nargs="+", default=None, help="only these corpus cells")
+    parser.add_argument("--no-corpus", action="store_true",
+                        help="only the generated cells (see --generated)")
     parser.add_argument("--limit", type=int, default=0,
                         help="at most this many corpus pairs, spread over the families")
     parser.add_argument("--statures", type=float, nargs="+", default=[1.55, 1.75, 1.95])
@@ -231,7 +233,10 @@ def main(argv: list[str] | None = None) -> int:
         args.limit = args.limit or 60
         args.generated = min(args.generated, 3)
     workers = max(1, min(args.workers, MAX_WORKERS))
-    items = _items(args)
+    try:
+        items = _items(args)
+    except (OSError, ValueError) as exc:      # unknown cell, unreadable or broken specs
+        parser.error(str(exc))
     print(f"{len(items)} runs on {workers} worker(s), {args.timeout:.0f} s limit per pair")
     t0 = time.perf_counter()
     results: list[dict] = []

@@ -333,14 +333,56 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     return results
 
 
+def _blended(plan: Plan, floor_cell, floor_z: float, library, realism: bool,
+             spec_text: str, sequence: list[str], seed: int, variant: int
+             ) -> tuple[SynthesizedMotion, dict[str, np.ndarray], list[tuple[int, int]]]:
+    """The plan's segments blended into one motion (with offset blending of junctions and
+    foot locking when ``realism``), its part tracks and task timeline, lifted from the
+    planner's floor at z = 0 (``floor_cell``) by ``floor_z``; the held masks (T,) and
+    the frame span of each segment."""
+    positions, root_yaw, _labels, spans = concatenate(
+        plan.segments, spread=round(JUNCTION_SPREAD * library.fps) if realism else 0,
+        fps=library.fps if realism else None)
+    # Linear blends of joint positions shorten bones between unlike poses; restore them.
+    positions = enforce_bone_lengths(positions, library.skeleton)
+    if realism:
+        positions = lock_feet(positions, library.fps, library.skeleton, 0.0)
+    tracks, held = _object_tracks(floor_cell, plan, spans, positions, library.overlap)
+    targets = [step.target for step in plan.steps]
+    if floor_z:
+        lift = np.array([0.0, 0.0, float(floor_z)])
+        positions = positions + lift
+        tracks = {name: track + lift for name, track in tracks.items()}
+        targets = [None if t is None else np.asarray(t) + lift for t in targets]
+    timeline = []
+    for step, target in zip(plan.steps, targets):
+        if step.goal_segment is not None:
+            a, b = spans[step.goal_segment]
+        else:
+            a = spans[step.first_segment][0]
+            b = spans[step.last_segment][1]
+        timeline.append(TaskSegment(step.task, a, b, step.primitive, target))
+    task_index = np.full(positions.shape[0], -1, dtype=np.int64)
+    for i, seg in enumerate(timeline):
+        task_index[seg.start_frame:seg.end_frame] = i
+    motion = Motion(positions, library.fps, library.skeleton,
+                    name=f"{floor_cell.name}-seed{seed}-v{variant}")
+    return SynthesizedMotion(motion=motion, root_yaw=root_yaw, task_index=task_index,
+                             timeline=timeline, objects=tracks, spec=spec_text,
+                             sequence=sequence, seed=int(seed)), held, spans
+
+
 def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, variant,
                     options, t_automaton, t_sequence, t_library, stature
                     ) -> SynthesizedMotion:
     t_start = time.perf_counter()
     written = [(t.name, tuple(t.args)) for t in seq.tasks]        # as verification reads them
     steps = [task_step(t.name, t.args, cell.shorthands, t.key) for t in seq.tasks]
-    planner = SequencePlanner(cell, library, rng, options.planner)
-    start = _start_pose(cell, planner.target_of(steps[0].kind, steps[0].args), rng)
+    # Planned on a floor at z = 0; the motion, the parts and the targets are lifted back
+    # (_blended) and verified in the user's own cell.
+    floor_cell = cell.floor_at_zero()
+    planner = SequencePlanner(floor_cell, library, rng, options.planner)
+    start = _start_pose(floor_cell, planner.target_of(steps[0].kind, steps[0].args), rng)
     t0 = time.perf_counter()
     plan = planner.plan(steps, start)
     t_planning = time.perf_counter() - t0
@@ -354,32 +396,10 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     t_blending = t_verify = 0.0
     for realism in attempts:
         t0 = time.perf_counter()
-        positions, root_yaw, _labels, spans = concatenate(
-            plan.segments, spread=round(JUNCTION_SPREAD * library.fps) if realism else 0,
-            fps=library.fps if realism else None)
-        # Linear blends of joint positions shorten bones between unlike poses; restore them.
-        positions = enforce_bone_lengths(positions, library.skeleton)
-        if realism:
-            positions = lock_feet(positions, library.fps, library.skeleton, cell.floor_z)
-        tracks, held = _object_tracks(cell, plan, spans, positions, library.overlap)
-        timeline = []
-        for step in plan.steps:
-            if step.goal_segment is not None:
-                a, b = spans[step.goal_segment]
-            else:
-                a = spans[step.first_segment][0]
-                b = spans[step.last_segment][1]
-            timeline.append(TaskSegment(step.task, a, b, step.primitive, step.target))
-        task_index = np.full(positions.shape[0], -1, dtype=np.int64)
-        for i, seg in enumerate(timeline):
-            task_index[seg.start_frame:seg.end_frame] = i
-        motion = Motion(positions, library.fps, library.skeleton,
-                        name=f"{cell.name}-seed{seed}-v{variant}")
+        synth, held, spans = _blended(plan, floor_cell, cell.floor_z, library, realism,
+                                      spec_text, [s.text for s in steps], seed, variant)
         t_blending += time.perf_counter() - t0
         checkpoint("blending")
-        synth = SynthesizedMotion(motion=motion, root_yaw=root_yaw, task_index=task_index,
-                                  timeline=timeline, objects=tracks, spec=spec_text,
-                                  sequence=[s.text for s in steps], seed=int(seed))
 
         t0 = time.perf_counter()
         report = verify_motion(synth, cell, specification, seq, written,
@@ -392,6 +412,7 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     if not report["passed"] and options.verify:
         raise failure_error(report)
     compute = time.perf_counter() - t_start + t_automaton + t_sequence
+    motion, timeline = synth.motion, synth.timeline
     synth.verification = report
     synth.stats = {
         "automaton_time": t_automaton, "sequence_time": t_sequence,
@@ -401,13 +422,14 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
         "real_time_factor": motion.duration / compute if compute > 0 else float("inf"),
         "variant": variant, "lasso": str(seq),
         "goal_primitives": [{"task": s.task, "primitive": s.primitive,
-                             "target": None if s.target is None else [float(x) for x in s.target],
+                             "target": None if timeline[i].target is None
+                             else [float(x) for x in timeline[i].target],
                              "frames": [timeline[i].start_frame, timeline[i].end_frame],
                              "walk_primitives": s.walk_segments, "expanded": s.expanded}
                             for i, s in enumerate(plan.steps)],
         "start_pose": list(plan.start_pose),
         "segments": [[seg.name, int(a), int(b)] for seg, (a, b) in zip(plan.segments, spans)],
-        "realism": realism_summary(positions, library.fps, stature, cell.floor_z),
+        "realism": realism_summary(motion.positions, library.fps, stature, cell.floor_z),
         "foot_locking": bool(realism),
     }
     return synth

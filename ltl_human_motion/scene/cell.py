@@ -48,7 +48,7 @@ from here.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -314,6 +314,28 @@ class Cell:
     def workspace(self) -> tuple[np.ndarray, np.ndarray]:
         """Workspace bounds ``(lo (3,), hi (3,))``."""
         return self.workspace_lo, self.workspace_hi
+
+    def floor_at_zero(self) -> Cell:
+        """This cell moved down by ``floor_z``, so that its floor is at z = 0.
+
+        The planner and the motion model work on a floor at z = 0; a cell on a platform
+        or in a pit is planned in this frame and its motion lifted back by ``floor_z``
+        (one conversion, at the edge). Returns the cell itself when ``floor_z`` is 0.
+        """
+        if self.floor_z == 0.0:
+            return self
+        down = np.array([0.0, 0.0, -float(self.floor_z)])
+        regions = {n: replace(r, shape=r.shape.translated(down))
+                   for n, r in self.regions.items()}
+        objects = {n: replace(o, position=o.position + down, shape=o.shape.translated(down))
+                   for n, o in self.objects.items()}
+        obstacles = tuple(replace(ob, parts=tuple(p.translated(down) for p in ob.parts))
+                          for ob in self.obstacles)
+        final = None if self.final_region is None else regions[self.final_region.name]
+        return replace(self, objects=objects, regions=regions, obstacles=obstacles,
+                       start_region=regions[self.start_region.name], final_region=final,
+                       floor_z=0.0, workspace_lo=self.workspace_lo + down,
+                       workspace_hi=self.workspace_hi + down)
 
     # ---------------------------------------------------------------- planner helpers
     def footprints(self) -> tuple[Footprint, ...]:
