@@ -289,6 +289,27 @@ def test_pair_verifies_with_the_biomechanical_checks(pair_id: str, stature: floa
     assert ok, f"{pair.id} ({BIOMECHANICS_PAIRS[pair_id]}): {family}: {outcome.message[:300]}"
 
 
+#: The same at one stature each: (pair, stature) -> family.
+BIOMECHANICS_RUNS = {
+    # foot locking re-solved a nearly straight (slightly hyperextended) stance knee with
+    # its bend direction near the hip-ankle line: the knee flipped backwards (flexion -12
+    # deg, knee 3.5-3.9 m/s); fixed by footlock.POLE_FORWARD
+    ("stations/single/walk(R1)", 1.95): "joint_speed:knee_backwards",
+    ("stations/job/patrol", 1.95): "joint_speed:knee_backwards",
+    ("stations/dwyer/existence_after/0", 1.55): "joint_speed:knee_backwards",
+    ("floor_parts/job/carry_two", 1.75): "joint_speed:knee_backwards",
+}
+
+
+@pytest.mark.parametrize(("pair_id", "stature"), list(BIOMECHANICS_RUNS))
+def test_run_verifies_with_the_biomechanical_checks(pair_id: str, stature: float) -> None:
+    pair = BY_ID[pair_id]
+    outcome = run_pair(pair.spec, pair.cell_file, stature, 0, timeout=10.0, biomechanics=True)
+    ok, family = judge(pair.expect, pair.reason, outcome)
+    assert ok, (f"{pair.id} at {stature} m ({BIOMECHANICS_RUNS[pair_id, stature]}): "
+                f"{family}: {outcome.message[:300]}")
+
+
 def test_generator_frame_and_floor_variants_keep_the_layout() -> None:
     import yaml
 

@@ -62,6 +62,13 @@ YAW_RAMP = 0.1
 #: Half-width (s) of the smoothing of the knee's bend direction (the IK pole) of a locked
 #: leg: without it a straight leg's knee jumped sideways at 3-4 m/s.
 POLE_SMOOTH = 0.05
+#: Least forward lean (m) of the knee's bend direction (the IK pole) of a locked leg in
+#: front of the hip-ankle line, along the pelvis's facing (a knee bends forward; the
+#: foot's own heading turns with a swinging foot). The gait clips
+#: straighten the stance leg to a few degrees of hyperextension (the knee 1-2 cm behind
+#: that line), where the smoothed pole lay near the line and flipped between frames:
+#: the re-solved knee then bent backwards (-12 deg) and back at 3-4 m/s.
+POLE_FORWARD = 0.03
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -407,6 +414,11 @@ def _solve_leg(p: np.ndarray, s: str, bones: np.ndarray, ank_all: np.ndarray,
     offset = uniform_filter1d(offset, 2 * max(1, round(POLE_SMOOTH * fps)) + 1, axis=0,
                               mode="nearest")
     pole = offset[moved] + 0.01 * fwd
+    facing = np.zeros_like(foot)
+    facing[:, :2] = (p[moved, _J["l_hip"]] - p[moved, _J["r_hip"]])[:, 1::-1] * [1.0, -1.0]
+    facing /= np.maximum(np.linalg.norm(facing, axis=-1, keepdims=True), 1e-9)
+    lean = np.sum(pole * facing, axis=-1, keepdims=True)
+    pole = pole + np.maximum(POLE_FORWARD - lean, 0.0) * facing
     kn, an = two_bone_ik(p[moved, hip], target, bones[knee], bones[ank], pole,
                          max_stretch=1.0)
     kn_out[moved] = kn
