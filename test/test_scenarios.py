@@ -298,6 +298,14 @@ BIOMECHANICS_RUNS = {
     ("stations/job/patrol", 1.95): "joint_speed:knee_backwards",
     ("stations/dwyer/existence_after/0", 1.55): "joint_speed:knee_backwards",
     ("floor_parts/job/carry_two", 1.75): "joint_speed:knee_backwards",
+    # narrow steps and turns (and their blended junctions) took the swinging foot
+    # through the standing leg's shank (0.1-4.4 cm); fixed by footlock._pass_clear
+    ("stations/single/grasp(O1)", 1.75): "self_penetration:foot_shank",
+    ("stations/single/grasp(O1)", 1.95): "self_penetration:foot_shank",
+    ("stations/single/move(O1, R2)", 1.55): "self_penetration:foot_shank",
+    ("shelf_heights/job/shelf_to_table", 1.75): "self_penetration:foot_shank",
+    ("seats/single/leftHand(R2)", 1.55): "self_penetration:foot_shank",
+    ("demo_cell/dwyer/absence_before/0", 1.55): "self_penetration:foot_shank",
 }
 
 

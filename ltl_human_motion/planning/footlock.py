@@ -27,6 +27,7 @@ from scipy.ndimage import maximum_filter1d, uniform_filter1d
 
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
+from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 __all__ = ["lock_feet"]
 
@@ -69,6 +70,15 @@ POLE_SMOOTH = 0.05
 #: that line), where the smoothed pole lay near the line and flipped between frames:
 #: the re-solved knee then bent backwards (-12 deg) and back at 3-4 m/s.
 POLE_FORWARD = 0.03
+
+#: Room (m) a swinging foot's bone axis keeps beyond the other leg's shank capsule as it
+#: passes it (the self-penetration check of planning.biomechanics wants the axis outside
+#: the capsule; blending and foot locking move the feet by millimetres afterwards).
+FOOT_PASS_MARGIN = 0.005
+#: Order of the feet moved clear of the other leg's shank (:func:`_pass_clear`), twice
+#: round: a sideways shift gains less than its length where the gap is partly vertical,
+#: and moving one leg can bring its shank nearer the other foot.
+PASS_ORDER = (("l", "r"), ("r", "l")) * 2
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -354,7 +364,65 @@ def lock_feet(positions: np.ndarray, fps: float, skeleton: Skeleton,
                                                    floor_z, free)
             leg = _solve_leg(p, s, bones, ank_all, toe_all, fps)
         p[:, _J[f"{s}_knee"]], p[:, ank], p[:, toe] = leg
+    for s, o in PASS_ORDER:
+        ank_t, toe_t = _pass_clear(p, s, o, fps, skeleton.stature)
+        if ank_t is not None:
+            p[:, _J[f"{s}_knee"]], p[:, _J[f"{s}_ankle"]], p[:, _J[f"{s}_toe"]] = \
+                _solve_leg(p, s, bones, ank_t, toe_t, fps)
     return p
+
+
+def _segment_gaps(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Closest points of segments [p0, p1] and [q0, q1] (each (T, 3)): the vector (T, 3)
+    from the second's closest point to the first's, and its length (T,)."""
+    u, v, w = p1 - p0, q1 - q0, p0 - q0
+    a, b, c = np.sum(u * u, -1), np.sum(u * v, -1), np.sum(v * v, -1)
+    d, e = np.sum(u * w, -1), np.sum(v * w, -1)
+    den = a * c - b * b
+    sp = np.where(den > 1e-12, np.clip((b * e - c * d) / np.maximum(den, 1e-12), 0, 1), 0.0)
+    t = (b * sp + e) / np.maximum(c, 1e-12)
+    sp = np.where(t < 0, np.clip(-d / np.maximum(a, 1e-12), 0, 1),
+                  np.where(t > 1, np.clip((b - d) / np.maximum(a, 1e-12), 0, 1), sp))
+    t = np.clip(t, 0, 1)
+    gap = (p0 + sp[:, None] * u) - (q0 + t[:, None] * v)
+    return gap, np.linalg.norm(gap, axis=-1)
+
+
+def _pass_clear(p: np.ndarray, s: str, o: str, fps: float, stature: float
+                ) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Ankle and toe targets (T, 3) each that keep foot ``s`` ("l"/"r") of ``p`` (T, J, 3)
+    clear of the other leg's (``o``) shank while the foot swings past it, or (None, None)
+    where it already is.
+
+    The gait clips' narrow steps and turns, and the blends of their junctions, take a
+    swinging foot through the standing leg's shank (self-penetration, issue 13): where
+    the foot's bone axis comes within the shank's capsule radius plus
+    ``FOOT_PASS_MARGIN`` of the shank's axis while the foot moves faster than
+    ``STANCE_SPEED``, the foot is moved sideways away from the shank by what it lacks,
+    the shift grown and smoothed over ``LIFT_RAMP`` (in and out while it swings).
+    """
+    names = [c[0] for c in BODY_CAPSULES]
+    need = float(capsule_radii(stature)[names.index(f"{o}_shank")]) + FOOT_PASS_MARGIN
+    ank, toe = p[:, _J[f"{s}_ankle"]], p[:, _J[f"{s}_toe"]]
+    gap, dist = _segment_gaps(ank, toe, p[:, _J[f"{o}_knee"]], p[:, _J[f"{o}_ankle"]])
+    speed = np.zeros(len(p))
+    speed[1:] = np.linalg.norm(np.diff(ank[:, :2], axis=0), axis=-1) * fps
+    lack = np.where((dist < need) & (speed > STANCE_SPEED), need - dist, 0.0)
+    if not np.any(lack > 0):
+        return None, None
+    # the sideways direction of each pass: away from the shank, horizontally, held over
+    # the whole (widened) pass so the shift does not turn
+    width = max(1, round(LIFT_RAMP * fps))
+    span = maximum_filter1d(lack, 2 * width + 1) > 0
+    away = np.zeros((len(p), 3))
+    for a, b in _runs(span):
+        hit = np.flatnonzero(lack[a:b] > 0) + a
+        g = np.sum(gap[hit, :2] * lack[hit, None], axis=0)
+        away[a:b, :2] = g / max(float(np.linalg.norm(g)), 1e-9)
+    size = uniform_filter1d(maximum_filter1d(lack, 2 * width + 1), 2 * width + 1)
+    shift = away * np.maximum(size, lack)[:, None]
+    return ank + shift, toe + shift
 
 
 def _solve_leg(p: np.ndarray, s: str, bones: np.ndarray, ank_all: np.ndarray,
