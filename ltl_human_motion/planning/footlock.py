@@ -46,6 +46,12 @@ MAX_TWIST = np.radians(25.0)
 #: Largest correction of a stance, m: a foot that would have to be held back further is
 #: stepping, not planted (a slow, low final step of a stop), so its stance ends there.
 MAX_LOCK = 0.05
+#: Speed (m/s) under which a planted foot's contact point stands still, and the least
+#: time (s) it must do so to anchor its stance there (:func:`_anchor`): the stand
+#: primitives hold the feet exactly still (under 1 mm/s); a stance of a step is shorter
+#: or slides throughout.
+STILL_SPEED = 0.005
+STILL_TIME = 0.25
 #: Time the foot takes to return to its own path after a stance, s.
 RELEASE = 0.15
 #: Height above its rest height a moving, unplanted foot is lifted to, m: just above the
@@ -175,6 +181,24 @@ def _roll_weight(h: np.ndarray) -> np.ndarray:
     return np.clip(0.5 + (h[:, 0] - h[:, 1]) / (2.0 * CONTACT_SWITCH), 0.0, 1.0)
 
 
+def _anchor(cp: np.ndarray, fps: float) -> int:
+    """Anchor frame of a stance from its contact point's positions (n, 2): the middle of
+    its longest still part, at least ``STILL_TIME`` long (the standing part of a stop or
+    a start, the pose the planner placed and checked: in a region, clear of obstacles);
+    else the frame where the contact point is nearest its median position over the
+    stance (the mid-stance of a step: a slide within it is split, not all undone one
+    way)."""
+    speed = np.zeros(len(cp))
+    speed[1:] = np.linalg.norm(np.diff(cp, axis=0), axis=-1) * fps
+    speed[0] = speed[min(1, len(cp) - 1)]
+    still = _runs(speed <= STILL_SPEED)
+    if still:
+        a, b = max(still, key=lambda r: r[1] - r[0])
+        if b - a >= STILL_TIME * fps:
+            return (a + b) // 2
+    return int(np.argmin(np.linalg.norm(cp - np.median(cp, axis=0), axis=-1)))
+
+
 def _pin_offsets(joints: np.ndarray, h: np.ndarray, a: int, b: int, k: int) -> np.ndarray:
     """Horizontal offsets (b - a, 2) that hold the foot's pinned point still over frames
     ``a..b-1``, zero at frame ``k``: the lower of heel and ball, a blend of the two while
@@ -247,8 +271,7 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     heading, and a foot that moves fast while low (a swing foot that would slide over the
     floor) lifted to ``SWING_CLEARANCE`` above its rest height.
 
-    Each stance is anchored where its contact point is nearest its median position (the
-    mid-stance of a step, the standing part of a stop or a start); the correction ramps
+    Each stance is anchored where the foot stands (:func:`_anchor`); the correction ramps
     in before the stance and out after it over ``RELEASE`` while the foot is in the air.
     Frames in ``free`` (T,) of bool are never stance frames (the leg cannot hold the pin
     there): a low foot is lifted clear instead.
@@ -279,10 +302,7 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     n_rel = max(1, round(RELEASE * fps))
     ramp = min_jerk(np.arange(1, n_rel + 1) / (n_rel + 1))
     for a, b in _runs(stance):
-        # the anchor frame: where the contact point is nearest its median position over
-        # the stance (a slide within the stance is split, not all undone one way)
-        cp = held[np.arange(a, b), contact[a:b], :2]
-        k = a + int(np.argmin(np.linalg.norm(cp - np.median(cp, axis=0), axis=-1)))
+        k = a + _anchor(held[np.arange(a, b), contact[a:b], :2], fps)
         run_off = _pin_offsets(held, h, a, b, k)
         run_off, a, b = _trim_to_anchor(run_off, stance, a, b, k)
         # continuous where the contact passes from heel to ball (the pin continues, the
