@@ -46,6 +46,12 @@ MAX_TWIST = np.radians(25.0)
 #: Largest correction of a stance, m: a foot that would have to be held back further is
 #: stepping, not planted (a slow, low final step of a stop), so its stance ends there.
 MAX_LOCK = 0.05
+#: The same while the ball is the contact point and the heel is up (push-off), m: a ball
+#: the motion slides forward as the foot leaves is held back this far at most, then
+#: the foot leaves the floor (lifted clear). Holding it the full ``MAX_LOCK`` grew the
+#: leg's correction at the slide's 0.3-0.5 m/s just as the knee flexes fastest in the
+#: swing's start: the knee 5-10 % over its speed limit (issue 13).
+MAX_LOCK_BALL = 0.02
 #: Speed (m/s) under which a planted foot's contact point stands still, and the least
 #: time (s) it must do so to anchor its stance there (:func:`_anchor`): the stand
 #: primitives hold the feet exactly still (under 1 mm/s); a stance of a step is shorter
@@ -216,12 +222,14 @@ def _pin_offsets(joints: np.ndarray, h: np.ndarray, a: int, b: int, k: int) -> n
     return off
 
 
-def _trim_to_anchor(run_off: np.ndarray, stance: np.ndarray, a: int, b: int, k: int
+def _trim_to_anchor(run_off: np.ndarray, stance: np.ndarray, a: int, b: int, k: int,
+                    limit: np.ndarray | float = MAX_LOCK
                     ) -> tuple[np.ndarray, int, int]:
     """Keep only the frames around the anchor ``k`` of the stance [a, b) whose pin
-    offsets ``run_off`` (b - a, 2) stay within ``MAX_LOCK``; the others leave ``stance``
-    (T,) of bool, which is changed in place. Returns the kept offsets and their [a, b)."""
-    big = np.linalg.norm(run_off, axis=-1) > MAX_LOCK
+    offsets ``run_off`` (b - a, 2) stay within ``limit`` (m, per frame (b - a,) or one
+    for all); the others leave ``stance`` (T,) of bool, which is changed in place.
+    Returns the kept offsets and their [a, b)."""
+    big = np.linalg.norm(run_off, axis=-1) > limit
     if np.any(big):                     # keep the frames around the anchor only
         ok = ~big
         lo = k - a
@@ -304,7 +312,9 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     for a, b in _runs(stance):
         k = a + _anchor(held[np.arange(a, b), contact[a:b], :2], fps)
         run_off = _pin_offsets(held, h, a, b, k)
-        run_off, a, b = _trim_to_anchor(run_off, stance, a, b, k)
+        ball = _roll_weight(h[a:b]) >= 1.0
+        run_off, a, b = _trim_to_anchor(run_off, stance, a, b, k,
+                                        np.where(ball, MAX_LOCK_BALL, MAX_LOCK))
         # continuous where the contact passes from heel to ball (the pin continues, the
         # heading's pivot slides), and not smoothed: it cancels the motion's slide exactly
         disp[a:b] = held[a:b, :, :2] - joints[a:b, :, :2] + run_off[:, None]
