@@ -306,6 +306,8 @@ BIOMECHANICS_RUNS = {
     ("shelf_heights/job/shelf_to_table", 1.75): "self_penetration:foot_shank",
     ("seats/single/leftHand(R2)", 1.55): "self_penetration:foot_shank",
     ("demo_cell/dwyer/absence_before/0", 1.55): "self_penetration:foot_shank",
+    # (the shift of a foot lifting off: only once it is off the floor, no slide)
+    ("shelf_heights/single/leftHand(R2)", 1.95): "self_penetration:foot_shank",
     # foot locking anchored a stop's stance mid-slide, 5-30 mm from where the planner
     # stood the foot: the walk's region was no longer entered (termination of walk(R));
     # fixed by footlock._anchor (the standing part of a stance)

@@ -21,6 +21,7 @@ leg cannot hold a grounded pin, the foot is lifted clear of the floor instead.
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 from scipy.ndimage import maximum_filter1d, uniform_filter1d
@@ -341,17 +342,19 @@ def _unit3(v: np.ndarray) -> np.ndarray:
 
 
 def _rate_limited(x: np.ndarray, step: float) -> np.ndarray:
-    """``x`` (T, D) with every frame-to-frame change at most ``step`` (forward and backward
+    """``x`` (T, 3) with every frame-to-frame change at most ``step`` (forward and backward
     passes, so the result stays within ``x``'s envelope towards zero)."""
-    out = x.copy()
-    for order in (range(1, len(x)), range(len(x) - 2, -1, -1)):
+    rows = x.tolist()                   # plain floats: this loop is sequential
+    for order, back in ((range(1, len(rows)), 1), (range(len(rows) - 2, -1, -1), -1)):
         for t in order:
-            prev = out[t - 1] if order.step == 1 else out[t + 1]
-            d = out[t] - prev
-            n = float(np.linalg.norm(d))
+            px, py, pz = rows[t - back]
+            cx, cy, cz = rows[t]
+            dx, dy, dz = cx - px, cy - py, cz - pz
+            n = math.sqrt(dx * dx + dy * dy + dz * dz)
             if n > step:
-                out[t] = prev + d * (step / n)
-    return out
+                k = step / n
+                rows[t] = [px + dx * k, py + dy * k, pz + dz * k]
+    return np.array(rows, dtype=np.float64).reshape(x.shape)
 
 
 def lock_feet(positions: np.ndarray, fps: float, skeleton: Skeleton,
@@ -395,7 +398,8 @@ def lock_feet(positions: np.ndarray, fps: float, skeleton: Skeleton,
             leg = _solve_leg(p, s, bones, ank_all, toe_all, fps)
         p[:, _J[f"{s}_knee"]], p[:, ank], p[:, toe] = leg
     for s, o in PASS_ORDER:
-        ank_t, toe_t = _pass_clear(p, s, o, fps, skeleton.stature)
+        rest_h = rest[[_J[f"{s}_ankle"], _J[f"{s}_toe"]], 2] + floor_z
+        ank_t, toe_t = _pass_clear(p, s, o, fps, skeleton.stature, rest_h)
         if ank_t is not None:
             p[:, _J[f"{s}_knee"]], p[:, _J[f"{s}_ankle"]], p[:, _J[f"{s}_toe"]] = \
                 _solve_leg(p, s, bones, ank_t, toe_t, fps)
@@ -419,8 +423,8 @@ def _segment_gaps(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
     return gap, np.linalg.norm(gap, axis=-1)
 
 
-def _pass_clear(p: np.ndarray, s: str, o: str, fps: float, stature: float
-                ) -> tuple[np.ndarray | None, np.ndarray | None]:
+def _pass_clear(p: np.ndarray, s: str, o: str, fps: float, stature: float,
+                rest_h: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
     """Ankle and toe targets (T, 3) each that keep foot ``s`` ("l"/"r") of ``p`` (T, J, 3)
     clear of the other leg's (``o``) shank while the foot swings past it, or (None, None)
     where it already is.
@@ -428,30 +432,37 @@ def _pass_clear(p: np.ndarray, s: str, o: str, fps: float, stature: float
     The gait clips' narrow steps and turns, and the blends of their junctions, take a
     swinging foot through the standing leg's shank (self-penetration, issue 13): where
     the foot's bone axis comes within the shank's capsule radius plus
-    ``FOOT_PASS_MARGIN`` of the shank's axis while the foot moves faster than
+    ``FOOT_PASS_MARGIN`` of the shank's axis while heel and ball both move faster than
     ``STANCE_SPEED``, the foot is moved sideways away from the shank by what it lacks,
-    the shift grown and smoothed over ``LIFT_RAMP`` (in and out while it swings).
+    the shift grown and smoothed over ``LIFT_RAMP`` (in and out while it swings), and
+    applied in full once the foot is ``CONTACT_HEIGHT`` above the floor (none within half
+    that: a foot on the floor does not slide). ``rest_h`` (2,) are the heights of the
+    foot's ankle and toe standing on the floor.
     """
     names = [c[0] for c in BODY_CAPSULES]
     need = float(capsule_radii(stature)[names.index(f"{o}_shank")]) + FOOT_PASS_MARGIN
     ank, toe = p[:, _J[f"{s}_ankle"]], p[:, _J[f"{s}_toe"]]
     gap, dist = _segment_gaps(ank, toe, p[:, _J[f"{o}_knee"]], p[:, _J[f"{o}_ankle"]])
+    # swinging: heel and ball both move (a push-off's ankle moves about a planted ball)
     speed = np.zeros(len(p))
-    speed[1:] = np.linalg.norm(np.diff(ank[:, :2], axis=0), axis=-1) * fps
+    speed[1:] = np.min(np.linalg.norm(np.diff(np.stack([ank, toe], 1)[:, :, :2], axis=0),
+                                      axis=-1), axis=1) * fps
     lack = np.where((dist < need) & (speed > STANCE_SPEED), need - dist, 0.0)
     if not np.any(lack > 0):
         return None, None
     # the sideways direction of each pass: away from the shank, horizontally, held over
     # the whole (widened) pass so the shift does not turn
     width = max(1, round(LIFT_RAMP * fps))
-    span = maximum_filter1d(lack, 2 * width + 1) > 0
+    span = maximum_filter1d(lack, 4 * width + 1) > 0
     away = np.zeros((len(p), 3))
     for a, b in _runs(span):
         hit = np.flatnonzero(lack[a:b] > 0) + a
         g = np.sum(gap[hit, :2] * lack[hit, None], axis=0)
         away[a:b, :2] = g / max(float(np.linalg.norm(g)), 1e-9)
     size = uniform_filter1d(maximum_filter1d(lack, 2 * width + 1), 2 * width + 1)
-    shift = away * np.maximum(size, lack)[:, None]
+    up = np.min(np.stack([ank[:, 2], toe[:, 2]], 1) - rest_h, axis=1)
+    air = np.clip(2.0 * up / CONTACT_HEIGHT - 1.0, 0.0, 1.0)
+    shift = away * (np.maximum(size, lack) * air)[:, None]
     return ank + shift, toe + shift
 
 
