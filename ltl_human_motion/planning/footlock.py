@@ -104,13 +104,13 @@ def _contact_joint(h: np.ndarray) -> np.ndarray:
     """Contact joint of every frame (T,) (0 = ankle, 1 = toe) from their heights over their
     rest heights (T, 2): the lower one, kept until the other is ``CONTACT_SWITCH`` lower
     (a flat foot's pin and pivot do not flicker between heel and ball)."""
-    contact = np.empty(len(h), dtype=np.int64)
+    contact = [0] * len(h)
     c = int(np.argmin(h[0])) if len(h) else 0
-    for t in range(len(h)):
-        if h[t, 1 - c] < h[t, c] - CONTACT_SWITCH:
+    for t, ht in enumerate(h.tolist()):             # plain floats: a sequential loop
+        if ht[1 - c] < ht[c] - CONTACT_SWITCH:
             c = 1 - c
         contact[t] = c
-    return contact
+    return np.array(contact, dtype=np.int64)
 
 
 def _stance(hc: np.ndarray, vc: np.ndarray) -> np.ndarray:
@@ -118,13 +118,13 @@ def _stance(hc: np.ndarray, vc: np.ndarray) -> np.ndarray:
     horizontal speed (T,): low and slower than ``STANCE_SPEED`` to enter, slower than twice
     that to stay (no flicker)."""
     low = hc <= CONTACT_HEIGHT
-    stance = low & (vc <= STANCE_SPEED)
-    keep = low & (vc <= 2.0 * STANCE_SPEED)
+    stance = (low & (vc <= STANCE_SPEED)).tolist()  # plain bools: sequential loops
+    keep = (low & (vc <= 2.0 * STANCE_SPEED)).tolist()
     for t in range(1, len(hc)):
-        stance[t] |= stance[t - 1] & keep[t]
+        stance[t] = stance[t] or (stance[t - 1] and keep[t])
     for t in range(len(hc) - 2, -1, -1):
-        stance[t] |= stance[t + 1] & keep[t]
-    return stance
+        stance[t] = stance[t] or (stance[t + 1] and keep[t])
+    return np.array(stance, dtype=bool)
 
 
 def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: float
@@ -154,11 +154,12 @@ def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: fl
     # the lock is in full by the time the foot is flat: it fades in over YAW_RAMP before
     # (while the heel is down and the ball comes down) and out over YAW_RAMP after
     step = 1.0 / max(1.0, YAW_RAMP * fps)
+    wl = w.tolist()                                 # plain floats: sequential loops
     for t in range(T - 2, -1, -1):
-        w[t] = max(w[t], w[t + 1] - step)
+        wl[t] = max(wl[t], wl[t + 1] - step)
     for t in range(1, T):
-        w[t] = max(w[t], w[t - 1] - step)
-    w = np.minimum(w, stance.astype(float))
+        wl[t] = max(wl[t], wl[t - 1] - step)
+    w = np.minimum(np.array(wl), stance.astype(float))
     out = joints.copy()
     idx = np.flatnonzero((w > 0) & stance)
     if not idx.size:
@@ -212,15 +213,13 @@ def _pin_offsets(joints: np.ndarray, h: np.ndarray, a: int, b: int, k: int) -> n
     their heights are within ``CONTACT_SWITCH`` (:func:`_roll_weight`). Each frame's
     offset cancels the pinned point's step from the frame before, so the pin passes from
     heel to ball without a jump."""
-    beta = _roll_weight(h[a:b])[:, None]
+    beta = _roll_weight(h[a + 1:b])[:, None]
     step = np.diff(joints[a:b, :, :2], axis=0)                         # (n-1, 2, 2)
-    off = np.zeros((b - a, 2))
-    i = k - a
-    for t in range(i + 1, b - a):
-        off[t] = off[t - 1] - ((1.0 - beta[t]) * step[t - 1, 0] + beta[t] * step[t - 1, 1])
-    for t in range(i - 1, -1, -1):
-        off[t] = off[t + 1] + ((1.0 - beta[t + 1]) * step[t, 0] + beta[t + 1] * step[t, 1])
-    return off
+    # the pinned point's step into each frame; the offsets undo their sum from frame k
+    pin_step = (1.0 - beta) * step[:, 0] + beta * step[:, 1]            # (n-1, 2)
+    travelled = np.zeros((b - a, 2))
+    np.cumsum(pin_step, axis=0, out=travelled[1:])
+    return travelled[k - a] - travelled
 
 
 def _trim_to_anchor(run_off: np.ndarray, stance: np.ndarray, a: int, b: int, k: int,
