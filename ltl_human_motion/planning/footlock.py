@@ -104,13 +104,15 @@ def _contact_joint(h: np.ndarray) -> np.ndarray:
     """Contact joint of every frame (T,) (0 = ankle, 1 = toe) from their heights over their
     rest heights (T, 2): the lower one, kept until the other is ``CONTACT_SWITCH`` lower
     (a flat foot's pin and pivot do not flicker between heel and ball)."""
-    contact = [0] * len(h)
-    c = int(np.argmin(h[0])) if len(h) else 0
-    for t, ht in enumerate(h.tolist()):             # plain floats: a sequential loop
-        if ht[1 - c] < ht[c] - CONTACT_SWITCH:
-            c = 1 - c
-        contact[t] = c
-    return np.array(contact, dtype=np.int64)
+    if not len(h):
+        return np.zeros(0, dtype=np.int64)
+    # the ball takes over where it is CONTACT_SWITCH lower, the heel where it is; in
+    # between the contact stays (the last decided one, at first the lower joint)
+    d = h[:, 0] - h[:, 1]
+    decided = np.where(d > CONTACT_SWITCH, 1, np.where(-d > CONTACT_SWITCH, 0, -1))
+    last = np.maximum.accumulate(np.where(decided >= 0, np.arange(len(h)), -1))
+    first = int(np.argmin(h[0]))
+    return np.where(last >= 0, decided[np.maximum(last, 0)], first).astype(np.int64)
 
 
 def _stance(hc: np.ndarray, vc: np.ndarray) -> np.ndarray:
@@ -118,13 +120,13 @@ def _stance(hc: np.ndarray, vc: np.ndarray) -> np.ndarray:
     horizontal speed (T,): low and slower than ``STANCE_SPEED`` to enter, slower than twice
     that to stay (no flicker)."""
     low = hc <= CONTACT_HEIGHT
-    stance = (low & (vc <= STANCE_SPEED)).tolist()  # plain bools: sequential loops
-    keep = (low & (vc <= 2.0 * STANCE_SPEED)).tolist()
-    for t in range(1, len(hc)):
-        stance[t] = stance[t] or (stance[t - 1] and keep[t])
-    for t in range(len(hc) - 2, -1, -1):
-        stance[t] = stance[t] or (stance[t + 1] and keep[t])
-    return np.array(stance, dtype=bool)
+    enter = low & (vc <= STANCE_SPEED)
+    keep = low & (vc <= 2.0 * STANCE_SPEED)          # holds every entering frame
+    # the runs of keep frames that hold an entering frame
+    run = np.cumsum(np.diff(np.concatenate([[False], keep]).astype(np.int8)) > 0)
+    entered = np.zeros(int(run[-1]) + 1 if len(run) else 1, dtype=bool)
+    entered[run[enter]] = True
+    return keep & entered[run]
 
 
 def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: float
@@ -343,6 +345,8 @@ def _unit3(v: np.ndarray) -> np.ndarray:
 def _rate_limited(x: np.ndarray, step: float) -> np.ndarray:
     """``x`` (T, 3) with every frame-to-frame change at most ``step`` (forward and backward
     passes, so the result stays within ``x``'s envelope towards zero)."""
+    if not len(x) or np.max(np.linalg.norm(np.diff(x, axis=0), axis=-1), initial=0.0) <= step:
+        return x.copy()                 # no change is too fast
     rows = x.tolist()                   # plain floats: this loop is sequential
     for order, back in ((range(1, len(rows)), 1), (range(len(rows) - 2, -1, -1), -1)):
         for t in order:
