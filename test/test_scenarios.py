@@ -314,6 +314,7 @@ BIOMECHANICS_RUNS = {
     ("bins/single/walk(R1)", 1.95): "termination:walk_region",
     ("bins/single/insert(O1, bin_a)", 1.55): "termination:walk_region",
     ("stations/single/walk(R2)", 1.55): "termination:walk_region",
+    ("bins/single/stoop", 1.95): "termination:walk_region",
     # a push-off's ball pinned against the motion's 0.3-0.5 m/s slide up to 5 cm: the
     # leg's correction grew as the knee flexed fastest (knee 5-10 % over its limit);
     # fixed by footlock.MAX_LOCK_BALL

@@ -193,17 +193,17 @@ def _roll_weight(h: np.ndarray) -> np.ndarray:
 
 def _anchor(cp: np.ndarray, fps: float) -> int:
     """Anchor frame of a stance from its contact point's positions (n, 2): the middle of
-    its longest still part, at least ``STILL_TIME`` long (the standing part of a stop or
-    a start, the pose the planner placed and checked: in a region, clear of obstacles);
+    its first still part at least ``STILL_TIME`` long (the standing part of a stop or a
+    start, the pose the planner placed and checked: in a region, clear of obstacles; a
+    task done standing there afterwards, such as a stoop, may shift the feet by
+    millimetres);
     else the frame where the contact point is nearest its median position over the
     stance (the mid-stance of a step: a slide within it is split, not all undone one
     way)."""
     speed = np.zeros(len(cp))
     speed[1:] = np.linalg.norm(np.diff(cp, axis=0), axis=-1) * fps
     speed[0] = speed[min(1, len(cp) - 1)]
-    still = _runs(speed <= STILL_SPEED)
-    if still:
-        a, b = max(still, key=lambda r: r[1] - r[0])
+    for a, b in _runs(speed <= STILL_SPEED):
         if b - a >= STILL_TIME * fps:
             return (a + b) // 2
     return int(np.argmin(np.linalg.norm(cp - np.median(cp, axis=0), axis=-1)))
