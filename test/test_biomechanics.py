@@ -157,3 +157,23 @@ def test_s1_verifies_with_the_biomechanical_checks() -> None:
         assert rep[key]["passed"], rep[key]["detail"]
     assert rep["foot_skate"]["mean"] <= 0.03
     assert rep["balance"]["static_frames"] > 100
+
+
+def test_hull_distance_matches_qhull_facets() -> None:
+    """The all-frames support-polygon distance equals max(n . p + c) over Qhull's facets."""
+    from scipy.spatial import ConvexHull
+
+    from ltl_human_motion.planning.biomechanics import _foot_outline, _hull_distance
+    rng = np.random.default_rng(1)
+    n = 400
+    zeros = np.zeros((n, 1))
+    feet = []
+    for _ in range(2):
+        ankle = rng.normal(size=(n, 2)) * 0.2
+        toe = ankle + rng.normal(size=(n, 2)) * 0.1
+        feet.append(_foot_outline(np.hstack([ankle, zeros]), np.hstack([toe, zeros]), 1.75))
+    poly = np.concatenate(feet, 1)                                   # (n, 8, 2)
+    com = rng.normal(size=(n, 2)) * 0.2
+    ref = [float(np.max(h.equations[:, :2] @ c + h.equations[:, 2]))
+           for h, c in ((ConvexHull(q), c) for q, c in zip(poly, com))]
+    np.testing.assert_allclose(_hull_distance(poly, com), ref, rtol=0, atol=1e-12)

@@ -289,6 +289,53 @@ def test_pair_verifies_with_the_biomechanical_checks(pair_id: str, stature: floa
     assert ok, f"{pair.id} ({BIOMECHANICS_PAIRS[pair_id]}): {family}: {outcome.message[:300]}"
 
 
+#: The same at one stature each: (pair, stature) -> family.
+BIOMECHANICS_RUNS = {
+    # foot locking re-solved a nearly straight (slightly hyperextended) stance knee with
+    # its bend direction near the hip-ankle line: the knee flipped backwards (flexion -12
+    # deg, knee 3.5-3.9 m/s); fixed by footlock.POLE_FORWARD
+    ("stations/single/walk(R1)", 1.95): "joint_speed:knee_backwards",
+    ("stations/job/patrol", 1.95): "joint_speed:knee_backwards",
+    ("stations/dwyer/existence_after/0", 1.55): "joint_speed:knee_backwards",
+    ("floor_parts/job/carry_two", 1.75): "joint_speed:knee_backwards",
+    # narrow steps and turns (and their blended junctions) took the swinging foot
+    # through the standing leg's shank (0.1-4.4 cm); fixed by footlock._pass_clear
+    ("stations/single/grasp(O1)", 1.75): "self_penetration:foot_shank",
+    ("stations/single/grasp(O1)", 1.95): "self_penetration:foot_shank",
+    ("stations/single/move(O1, R2)", 1.55): "self_penetration:foot_shank",
+    ("shelf_heights/job/shelf_to_table", 1.75): "self_penetration:foot_shank",
+    ("seats/single/leftHand(R2)", 1.55): "self_penetration:foot_shank",
+    ("demo_cell/dwyer/absence_before/0", 1.55): "self_penetration:foot_shank",
+    # (the shift of a foot lifting off: only once it is off the floor, no slide)
+    ("shelf_heights/single/leftHand(R2)", 1.95): "self_penetration:foot_shank",
+    # foot locking anchored a stop's stance mid-slide, 5-30 mm from where the planner
+    # stood the foot: the walk's region was no longer entered (termination of walk(R));
+    # fixed by footlock._anchor (the standing part of a stance)
+    ("bins/single/walk(R1)", 1.95): "termination:walk_region",
+    ("bins/single/insert(O1, bin_a)", 1.55): "termination:walk_region",
+    ("stations/single/walk(R2)", 1.55): "termination:walk_region",
+    ("bins/single/stoop", 1.95): "termination:walk_region",
+    # a push-off's ball pinned against the motion's 0.3-0.5 m/s slide up to 5 cm: the
+    # leg's correction grew as the knee flexed fastest (knee 5-10 % over its limit);
+    # fixed by footlock.MAX_LOCK_BALL
+    ("demo_cell/dwyer/precedence_after/0", 1.55): "joint_speed:knee_push_off",
+    ("demo_cell/dwyer/precedence_before/0", 1.55): "joint_speed:knee_push_off",
+    ("paper_cell/dwyer/absence_before/0", 1.75): "joint_speed:knee_push_off",
+    ("shelf_heights/dwyer/existence_between/0", 1.75): "joint_speed:knee_push_off",
+    ("seats/single/assemble(R2)", 1.55): "joint_speed:knee_push_off",
+    ("stations/job/station_tour", 1.95): "joint_speed:knee_push_off",
+}
+
+
+@pytest.mark.parametrize(("pair_id", "stature"), list(BIOMECHANICS_RUNS))
+def test_run_verifies_with_the_biomechanical_checks(pair_id: str, stature: float) -> None:
+    pair = BY_ID[pair_id]
+    outcome = run_pair(pair.spec, pair.cell_file, stature, 0, timeout=10.0, biomechanics=True)
+    ok, family = judge(pair.expect, pair.reason, outcome)
+    assert ok, (f"{pair.id} at {stature} m ({BIOMECHANICS_RUNS[pair_id, stature]}): "
+                f"{family}: {outcome.message[:300]}")
+
+
 def test_generator_frame_and_floor_variants_keep_the_layout() -> None:
     import yaml
 

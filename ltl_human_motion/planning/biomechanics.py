@@ -292,13 +292,28 @@ def _foot_outline(ankle: np.ndarray, toe: np.ndarray, stature: float) -> np.ndar
 
 
 def _hull_distance(points: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Signed distance (T,) of ``p`` (T, 2) to the convex hull of ``points`` (T, V, 2)."""
-    from scipy.spatial import ConvexHull
-    out = np.empty(len(p))
-    for i in range(len(p)):
-        eq = ConvexHull(points[i]).equations          # (F, 3): n . x + c <= 0 inside
-        out[i] = float(np.max(eq[:, :2] @ p[i] + eq[:, 2]))
-    return out
+    """Signed distance (T,) of ``p`` (T, 2) to the convex hull of ``points`` (T, V, 2).
+
+    The largest signed distance of ``p`` to the lines of the hull's edges (negative
+    inside), as ``max(n . p + c)`` over the facet equations of a per-frame Qhull
+    ``ConvexHull``, for all frames at once: an edge of two points belongs to the hull
+    when no other point lies beyond it (to within ``1e-12`` of the points' extent).
+    """
+    P = np.asarray(points, dtype=np.float64)
+    q = np.asarray(p, dtype=np.float64)
+    i, j = np.nonzero(~np.eye(P.shape[1], dtype=bool))        # every ordered pair
+    x, y = P[..., 0], P[..., 1]
+    xi, yi = x[:, i], y[:, i]                                  # (T, E)
+    ex, ey = x[:, j] - xi, y[:, j] - yi
+    length = np.hypot(ex, ey)
+    # |e| times the distance of every point beyond the edge's line (outward normal
+    # (ey, -ex) / |e|), shape (T, E, V)
+    beyond = ey[..., None] * (x[:, None, :] - xi[..., None]) \
+        - ex[..., None] * (y[:, None, :] - yi[..., None])
+    tol = 1e-12 * np.max(np.abs(P), axis=(1, 2))[:, None]
+    edge = (length > tol) & np.all(beyond <= (length * tol)[..., None], axis=2)
+    dist = (ey * (q[:, :1] - xi) - ex * (q[:, 1:] - yi)) / np.maximum(length, 1e-300)
+    return np.max(np.where(edge, dist, -np.inf), axis=1)
 
 
 def balance_margins(positions: np.ndarray, fps: float, stature: float = DEFAULT_STATURE,

@@ -21,12 +21,14 @@ leg cannot hold a grounded pin, the foot is lifted clear of the floor instead.
 from __future__ import annotations
 
 import itertools
+import math
 
 import numpy as np
 from scipy.ndimage import maximum_filter1d, uniform_filter1d
 
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
+from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 __all__ = ["lock_feet"]
 
@@ -45,6 +47,18 @@ MAX_TWIST = np.radians(25.0)
 #: Largest correction of a stance, m: a foot that would have to be held back further is
 #: stepping, not planted (a slow, low final step of a stop), so its stance ends there.
 MAX_LOCK = 0.05
+#: The same while the ball is the contact point and the heel is up (push-off), m: a ball
+#: the motion slides forward as the foot leaves is held back this far at most, then
+#: the foot leaves the floor (lifted clear). Holding it the full ``MAX_LOCK`` grew the
+#: leg's correction at the slide's 0.3-0.5 m/s just as the knee flexes fastest in the
+#: swing's start: the knee 5-10 % over its speed limit (issue 13).
+MAX_LOCK_BALL = 0.02
+#: Speed (m/s) under which a planted foot's contact point stands still, and the least
+#: time (s) it must do so to anchor its stance there (:func:`_anchor`): the stand
+#: primitives hold the feet exactly still (under 1 mm/s); a stance of a step is shorter
+#: or slides throughout.
+STILL_SPEED = 0.005
+STILL_TIME = 0.25
 #: Time the foot takes to return to its own path after a stance, s.
 RELEASE = 0.15
 #: Height above its rest height a moving, unplanted foot is lifted to, m: just above the
@@ -62,6 +76,22 @@ YAW_RAMP = 0.1
 #: Half-width (s) of the smoothing of the knee's bend direction (the IK pole) of a locked
 #: leg: without it a straight leg's knee jumped sideways at 3-4 m/s.
 POLE_SMOOTH = 0.05
+#: Least forward lean (m) of the knee's bend direction (the IK pole) of a locked leg in
+#: front of the hip-ankle line, along the pelvis's facing (a knee bends forward; the
+#: foot's own heading turns with a swinging foot). The gait clips
+#: straighten the stance leg to a few degrees of hyperextension (the knee 1-2 cm behind
+#: that line), where the smoothed pole lay near the line and flipped between frames:
+#: the re-solved knee then bent backwards (-12 deg) and back at 3-4 m/s.
+POLE_FORWARD = 0.03
+
+#: Room (m) a swinging foot's bone axis keeps beyond the other leg's shank capsule as it
+#: passes it (the self-penetration check of planning.biomechanics wants the axis outside
+#: the capsule; blending and foot locking move the feet by millimetres afterwards).
+FOOT_PASS_MARGIN = 0.005
+#: Order of the feet moved clear of the other leg's shank (:func:`_pass_clear`), twice
+#: round: a sideways shift gains less than its length where the gap is partly vertical,
+#: and moving one leg can bring its shank nearer the other foot.
+PASS_ORDER = (("l", "r"), ("r", "l")) * 2
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -74,13 +104,15 @@ def _contact_joint(h: np.ndarray) -> np.ndarray:
     """Contact joint of every frame (T,) (0 = ankle, 1 = toe) from their heights over their
     rest heights (T, 2): the lower one, kept until the other is ``CONTACT_SWITCH`` lower
     (a flat foot's pin and pivot do not flicker between heel and ball)."""
-    contact = np.empty(len(h), dtype=np.int64)
-    c = int(np.argmin(h[0])) if len(h) else 0
-    for t in range(len(h)):
-        if h[t, 1 - c] < h[t, c] - CONTACT_SWITCH:
-            c = 1 - c
-        contact[t] = c
-    return contact
+    if not len(h):
+        return np.zeros(0, dtype=np.int64)
+    # the ball takes over where it is CONTACT_SWITCH lower, the heel where it is; in
+    # between the contact stays (the last decided one, at first the lower joint)
+    d = h[:, 0] - h[:, 1]
+    decided = np.where(d > CONTACT_SWITCH, 1, np.where(-d > CONTACT_SWITCH, 0, -1))
+    last = np.maximum.accumulate(np.where(decided >= 0, np.arange(len(h)), -1))
+    first = int(np.argmin(h[0]))
+    return np.where(last >= 0, decided[np.maximum(last, 0)], first).astype(np.int64)
 
 
 def _stance(hc: np.ndarray, vc: np.ndarray) -> np.ndarray:
@@ -88,13 +120,13 @@ def _stance(hc: np.ndarray, vc: np.ndarray) -> np.ndarray:
     horizontal speed (T,): low and slower than ``STANCE_SPEED`` to enter, slower than twice
     that to stay (no flicker)."""
     low = hc <= CONTACT_HEIGHT
-    stance = low & (vc <= STANCE_SPEED)
-    keep = low & (vc <= 2.0 * STANCE_SPEED)
-    for t in range(1, len(hc)):
-        stance[t] |= stance[t - 1] & keep[t]
-    for t in range(len(hc) - 2, -1, -1):
-        stance[t] |= stance[t + 1] & keep[t]
-    return stance
+    enter = low & (vc <= STANCE_SPEED)
+    keep = low & (vc <= 2.0 * STANCE_SPEED)          # holds every entering frame
+    # the runs of keep frames that hold an entering frame
+    run = np.cumsum(np.diff(np.concatenate([[False], keep]).astype(np.int8)) > 0)
+    entered = np.zeros(int(run[-1]) + 1 if len(run) else 1, dtype=bool)
+    entered[run[enter]] = True
+    return keep & entered[run]
 
 
 def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: float
@@ -124,11 +156,12 @@ def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: fl
     # the lock is in full by the time the foot is flat: it fades in over YAW_RAMP before
     # (while the heel is down and the ball comes down) and out over YAW_RAMP after
     step = 1.0 / max(1.0, YAW_RAMP * fps)
+    wl = w.tolist()                                 # plain floats: sequential loops
     for t in range(T - 2, -1, -1):
-        w[t] = max(w[t], w[t + 1] - step)
+        wl[t] = max(wl[t], wl[t + 1] - step)
     for t in range(1, T):
-        w[t] = max(w[t], w[t - 1] - step)
-    w = np.minimum(w, stance.astype(float))
+        wl[t] = max(wl[t], wl[t - 1] - step)
+    w = np.minimum(np.array(wl), stance.astype(float))
     out = joints.copy()
     idx = np.flatnonzero((w > 0) & stance)
     if not idx.size:
@@ -158,29 +191,47 @@ def _roll_weight(h: np.ndarray) -> np.ndarray:
     return np.clip(0.5 + (h[:, 0] - h[:, 1]) / (2.0 * CONTACT_SWITCH), 0.0, 1.0)
 
 
+def _anchor(cp: np.ndarray, fps: float) -> int:
+    """Anchor frame of a stance from its contact point's positions (n, 2): the middle of
+    its first still part at least ``STILL_TIME`` long (the standing part of a stop or a
+    start, the pose the planner placed and checked: in a region, clear of obstacles; a
+    task done standing there afterwards, such as a stoop, may shift the feet by
+    millimetres);
+    else the frame where the contact point is nearest its median position over the
+    stance (the mid-stance of a step: a slide within it is split, not all undone one
+    way)."""
+    speed = np.zeros(len(cp))
+    speed[1:] = np.linalg.norm(np.diff(cp, axis=0), axis=-1) * fps
+    speed[0] = speed[min(1, len(cp) - 1)]
+    for a, b in _runs(speed <= STILL_SPEED):
+        if b - a >= STILL_TIME * fps:
+            return (a + b) // 2
+    return int(np.argmin(np.linalg.norm(cp - np.median(cp, axis=0), axis=-1)))
+
+
 def _pin_offsets(joints: np.ndarray, h: np.ndarray, a: int, b: int, k: int) -> np.ndarray:
     """Horizontal offsets (b - a, 2) that hold the foot's pinned point still over frames
     ``a..b-1``, zero at frame ``k``: the lower of heel and ball, a blend of the two while
     their heights are within ``CONTACT_SWITCH`` (:func:`_roll_weight`). Each frame's
     offset cancels the pinned point's step from the frame before, so the pin passes from
     heel to ball without a jump."""
-    beta = _roll_weight(h[a:b])[:, None]
+    beta = _roll_weight(h[a + 1:b])[:, None]
     step = np.diff(joints[a:b, :, :2], axis=0)                         # (n-1, 2, 2)
-    off = np.zeros((b - a, 2))
-    i = k - a
-    for t in range(i + 1, b - a):
-        off[t] = off[t - 1] - ((1.0 - beta[t]) * step[t - 1, 0] + beta[t] * step[t - 1, 1])
-    for t in range(i - 1, -1, -1):
-        off[t] = off[t + 1] + ((1.0 - beta[t + 1]) * step[t, 0] + beta[t + 1] * step[t, 1])
-    return off
+    # the pinned point's step into each frame; the offsets undo their sum from frame k
+    pin_step = (1.0 - beta) * step[:, 0] + beta * step[:, 1]            # (n-1, 2)
+    travelled = np.zeros((b - a, 2))
+    np.cumsum(pin_step, axis=0, out=travelled[1:])
+    return travelled[k - a] - travelled
 
 
-def _trim_to_anchor(run_off: np.ndarray, stance: np.ndarray, a: int, b: int, k: int
+def _trim_to_anchor(run_off: np.ndarray, stance: np.ndarray, a: int, b: int, k: int,
+                    limit: np.ndarray | float = MAX_LOCK
                     ) -> tuple[np.ndarray, int, int]:
     """Keep only the frames around the anchor ``k`` of the stance [a, b) whose pin
-    offsets ``run_off`` (b - a, 2) stay within ``MAX_LOCK``; the others leave ``stance``
-    (T,) of bool, which is changed in place. Returns the kept offsets and their [a, b)."""
-    big = np.linalg.norm(run_off, axis=-1) > MAX_LOCK
+    offsets ``run_off`` (b - a, 2) stay within ``limit`` (m, per frame (b - a,) or one
+    for all); the others leave ``stance`` (T,) of bool, which is changed in place.
+    Returns the kept offsets and their [a, b)."""
+    big = np.linalg.norm(run_off, axis=-1) > limit
     if np.any(big):                     # keep the frames around the anchor only
         ok = ~big
         lo = k - a
@@ -230,8 +281,7 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     heading, and a foot that moves fast while low (a swing foot that would slide over the
     floor) lifted to ``SWING_CLEARANCE`` above its rest height.
 
-    Each stance is anchored where its contact point is nearest its median position (the
-    mid-stance of a step, the standing part of a stop or a start); the correction ramps
+    Each stance is anchored where the foot stands (:func:`_anchor`); the correction ramps
     in before the stance and out after it over ``RELEASE`` while the foot is in the air.
     Frames in ``free`` (T,) of bool are never stance frames (the leg cannot hold the pin
     there): a low foot is lifted clear instead.
@@ -262,12 +312,11 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     n_rel = max(1, round(RELEASE * fps))
     ramp = min_jerk(np.arange(1, n_rel + 1) / (n_rel + 1))
     for a, b in _runs(stance):
-        # the anchor frame: where the contact point is nearest its median position over
-        # the stance (a slide within the stance is split, not all undone one way)
-        cp = held[np.arange(a, b), contact[a:b], :2]
-        k = a + int(np.argmin(np.linalg.norm(cp - np.median(cp, axis=0), axis=-1)))
+        k = a + _anchor(held[np.arange(a, b), contact[a:b], :2], fps)
         run_off = _pin_offsets(held, h, a, b, k)
-        run_off, a, b = _trim_to_anchor(run_off, stance, a, b, k)
+        ball = _roll_weight(h[a:b]) >= 1.0
+        run_off, a, b = _trim_to_anchor(run_off, stance, a, b, k,
+                                        np.where(ball, MAX_LOCK_BALL, MAX_LOCK))
         # continuous where the contact passes from heel to ball (the pin continues, the
         # heading's pivot slides), and not smoothed: it cancels the motion's slide exactly
         disp[a:b] = held[a:b, :, :2] - joints[a:b, :, :2] + run_off[:, None]
@@ -294,17 +343,21 @@ def _unit3(v: np.ndarray) -> np.ndarray:
 
 
 def _rate_limited(x: np.ndarray, step: float) -> np.ndarray:
-    """``x`` (T, D) with every frame-to-frame change at most ``step`` (forward and backward
+    """``x`` (T, 3) with every frame-to-frame change at most ``step`` (forward and backward
     passes, so the result stays within ``x``'s envelope towards zero)."""
-    out = x.copy()
-    for order in (range(1, len(x)), range(len(x) - 2, -1, -1)):
+    if not len(x) or np.max(np.linalg.norm(np.diff(x, axis=0), axis=-1), initial=0.0) <= step:
+        return x.copy()                 # no change is too fast
+    rows = x.tolist()                   # plain floats: this loop is sequential
+    for order, back in ((range(1, len(rows)), 1), (range(len(rows) - 2, -1, -1), -1)):
         for t in order:
-            prev = out[t - 1] if order.step == 1 else out[t + 1]
-            d = out[t] - prev
-            n = float(np.linalg.norm(d))
+            px, py, pz = rows[t - back]
+            cx, cy, cz = rows[t]
+            dx, dy, dz = cx - px, cy - py, cz - pz
+            n = math.sqrt(dx * dx + dy * dy + dz * dz)
             if n > step:
-                out[t] = prev + d * (step / n)
-    return out
+                k = step / n
+                rows[t] = [px + dx * k, py + dy * k, pz + dz * k]
+    return np.array(rows, dtype=np.float64).reshape(x.shape)
 
 
 def lock_feet(positions: np.ndarray, fps: float, skeleton: Skeleton,
@@ -347,7 +400,73 @@ def lock_feet(positions: np.ndarray, fps: float, skeleton: Skeleton,
                                                    floor_z, free)
             leg = _solve_leg(p, s, bones, ank_all, toe_all, fps)
         p[:, _J[f"{s}_knee"]], p[:, ank], p[:, toe] = leg
+    for s, o in PASS_ORDER:
+        rest_h = rest[[_J[f"{s}_ankle"], _J[f"{s}_toe"]], 2] + floor_z
+        ank_t, toe_t = _pass_clear(p, s, o, fps, skeleton.stature, rest_h)
+        if ank_t is not None:
+            p[:, _J[f"{s}_knee"]], p[:, _J[f"{s}_ankle"]], p[:, _J[f"{s}_toe"]] = \
+                _solve_leg(p, s, bones, ank_t, toe_t, fps)
     return p
+
+
+def _segment_gaps(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Closest points of segments [p0, p1] and [q0, q1] (each (T, 3)): the vector (T, 3)
+    from the second's closest point to the first's, and its length (T,)."""
+    u, v, w = p1 - p0, q1 - q0, p0 - q0
+    a, b, c = np.sum(u * u, -1), np.sum(u * v, -1), np.sum(v * v, -1)
+    d, e = np.sum(u * w, -1), np.sum(v * w, -1)
+    den = a * c - b * b
+    sp = np.where(den > 1e-12, np.clip((b * e - c * d) / np.maximum(den, 1e-12), 0, 1), 0.0)
+    t = (b * sp + e) / np.maximum(c, 1e-12)
+    sp = np.where(t < 0, np.clip(-d / np.maximum(a, 1e-12), 0, 1),
+                  np.where(t > 1, np.clip((b - d) / np.maximum(a, 1e-12), 0, 1), sp))
+    t = np.clip(t, 0, 1)
+    gap = (p0 + sp[:, None] * u) - (q0 + t[:, None] * v)
+    return gap, np.linalg.norm(gap, axis=-1)
+
+
+def _pass_clear(p: np.ndarray, s: str, o: str, fps: float, stature: float,
+                rest_h: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Ankle and toe targets (T, 3) each that keep foot ``s`` ("l"/"r") of ``p`` (T, J, 3)
+    clear of the other leg's (``o``) shank while the foot swings past it, or (None, None)
+    where it already is.
+
+    The gait clips' narrow steps and turns, and the blends of their junctions, take a
+    swinging foot through the standing leg's shank (self-penetration, issue 13): where
+    the foot's bone axis comes within the shank's capsule radius plus
+    ``FOOT_PASS_MARGIN`` of the shank's axis while heel and ball both move faster than
+    ``STANCE_SPEED``, the foot is moved sideways away from the shank by what it lacks,
+    the shift grown and smoothed over ``LIFT_RAMP`` (in and out while it swings), and
+    applied in full once the foot is ``CONTACT_HEIGHT`` above the floor (none within half
+    that: a foot on the floor does not slide). ``rest_h`` (2,) are the heights of the
+    foot's ankle and toe standing on the floor.
+    """
+    names = [c[0] for c in BODY_CAPSULES]
+    need = float(capsule_radii(stature)[names.index(f"{o}_shank")]) + FOOT_PASS_MARGIN
+    ank, toe = p[:, _J[f"{s}_ankle"]], p[:, _J[f"{s}_toe"]]
+    gap, dist = _segment_gaps(ank, toe, p[:, _J[f"{o}_knee"]], p[:, _J[f"{o}_ankle"]])
+    # swinging: heel and ball both move (a push-off's ankle moves about a planted ball)
+    speed = np.zeros(len(p))
+    speed[1:] = np.min(np.linalg.norm(np.diff(np.stack([ank, toe], 1)[:, :, :2], axis=0),
+                                      axis=-1), axis=1) * fps
+    lack = np.where((dist < need) & (speed > STANCE_SPEED), need - dist, 0.0)
+    if not np.any(lack > 0):
+        return None, None
+    # the sideways direction of each pass: away from the shank, horizontally, held over
+    # the whole (widened) pass so the shift does not turn
+    width = max(1, round(LIFT_RAMP * fps))
+    span = maximum_filter1d(lack, 4 * width + 1) > 0
+    away = np.zeros((len(p), 3))
+    for a, b in _runs(span):
+        hit = np.flatnonzero(lack[a:b] > 0) + a
+        g = np.sum(gap[hit, :2] * lack[hit, None], axis=0)
+        away[a:b, :2] = g / max(float(np.linalg.norm(g)), 1e-9)
+    size = uniform_filter1d(maximum_filter1d(lack, 2 * width + 1), 2 * width + 1)
+    up = np.min(np.stack([ank[:, 2], toe[:, 2]], 1) - rest_h, axis=1)
+    air = np.clip(2.0 * up / CONTACT_HEIGHT - 1.0, 0.0, 1.0)
+    shift = away * (np.maximum(size, lack) * air)[:, None]
+    return ank + shift, toe + shift
 
 
 def _solve_leg(p: np.ndarray, s: str, bones: np.ndarray, ank_all: np.ndarray,
@@ -407,6 +526,11 @@ def _solve_leg(p: np.ndarray, s: str, bones: np.ndarray, ank_all: np.ndarray,
     offset = uniform_filter1d(offset, 2 * max(1, round(POLE_SMOOTH * fps)) + 1, axis=0,
                               mode="nearest")
     pole = offset[moved] + 0.01 * fwd
+    facing = np.zeros_like(foot)
+    facing[:, :2] = (p[moved, _J["l_hip"]] - p[moved, _J["r_hip"]])[:, 1::-1] * [1.0, -1.0]
+    facing /= np.maximum(np.linalg.norm(facing, axis=-1, keepdims=True), 1e-9)
+    lean = np.sum(pole * facing, axis=-1, keepdims=True)
+    pole = pole + np.maximum(POLE_FORWARD - lean, 0.0) * facing
     kn, an = two_bone_ik(p[moved, hip], target, bones[knee], bones[ank], pole,
                          max_stretch=1.0)
     kn_out[moved] = kn
