@@ -36,11 +36,13 @@ from ltl_human_motion.planning.standing import (
     SQUARE_BOARD_HEIGHT,
     board_local,
     low_board,
+    posture_clearance,
     pull_length,
     release_targets,
 )
 from ltl_human_motion.planning.steps import StepExecutor
 from ltl_human_motion.planning.walk_goals import WalkGoals
+from ltl_human_motion.vocabulary import HAND_TASKS
 
 #: Frames a wait lasts beyond the blends at both ends (2 x overlap), so that the
 #: stillness the verifier checks lasts as long as asked.
@@ -148,6 +150,10 @@ class GoalSteps:
             and kind in LEVEL_PATH_TASKS and not seated else None
         if board is not None:
             kwargs["board"] = board
+        if kind in HAND_TASKS and not seated and self.ctx.cell.obstacles:
+            # The posture keeps the whole body clear of what stands around the worker.
+            kwargs["obstacles"] = posture_clearance(self.ctx.cell, self.state.pose,
+                                                    self.ctx.stature)
         hand_fixed = "hand" in kwargs
         if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
