@@ -57,6 +57,7 @@ __all__ = [
     "make_goal_primitive",
     "max_reach",
     "min_reach_height",
+    "posture_clear",
     "reach_placement",
     "seat_height_range",
 ]
@@ -450,7 +451,7 @@ def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
 
 def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
           task: str | None = None, board: tuple[float, float, float] | None = None,
-          obstacles: ObstacleClearance | None = None
+          obstacles: ObstacleClearance | None = None, strict: bool = False
           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Costs of trunk flexion / pelvis drop candidates for hand targets.
 
@@ -459,7 +460,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     another (a low reach with the hand in the thigh) or into the low ``board`` (edge,
     bottom, top) over the targets, or, with ``obstacles``, when it or the trunk and legs
     on the way to it come nearer an obstacle than ``_OBSTACLE_CLEARANCE``
-    (:func:`_obstacle_blocked`; unless every candidate does).
+    (:func:`_obstacle_blocked`; unless every candidate does and not ``strict``).
 
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
@@ -482,7 +483,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
             hit = _obstacle_blocked(skeleton, st, (P[idx[free]], D[idx[free]],
                                                    shift[idx[free]]), poses[free], active,
                                     obstacles, board is None)
-            if not np.all(hit):
+            if strict or not np.all(hit):
                 blocked[free[hit]] = True
         feasible = feasible.copy()
         feasible[idx[blocked]] = False
@@ -534,6 +535,21 @@ def _obstacle_blocked(skeleton: Skeleton, st: _Start,
                 np.broadcast_to(st.elbow_pole, (n, 2, 3)), tr)
     near = obstacles(way, _WAY_PARTS).reshape(S, C) <= _OBSTACLE_CLEARANCE
     return hit | near.any(axis=0)
+
+
+def posture_clear(task: str, target: np.ndarray, skeleton: Skeleton,
+                  obstacles: ObstacleClearance, *, start_pose: np.ndarray | None = None,
+                  hand: str = "auto", board: tuple[float, float, float] | None = None
+                  ) -> bool:
+    """Whether some posture of hand task ``task`` reaches ``target`` (3,) (start frame)
+    with the body clear of ``obstacles`` as :func:`make_goal_primitive`'s search keeps
+    it, without that search's fallback (a cheap test of a standing place before the
+    worker walks there). ``start_pose``, ``hand`` and ``board`` as there."""
+    st = _Start(skeleton, start_pose)
+    targets, active, _ = _hand_targets(task, np.asarray(target, dtype=np.float64), hand)
+    board = _check_board(board) if board is not None and task in LEVEL_PATH_TASKS else None
+    cost = _grid(skeleton, st, targets, active, task, board, obstacles, strict=True)[3]
+    return bool(np.isfinite(cost).any())
 
 
 def _goal_hand_dir(task: str | None, k: int, rel_goal: np.ndarray) -> np.ndarray:
@@ -1259,11 +1275,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         posture keeps every body part clear of it and the hand takes the level path with
         its turn point in front of the edge (down there, then in under the board).
     obstacles : ObstacleClearance, optional
-        The obstacles around the worker (:data:`ObstacleClearance`, start frame): the
-        posture of a hand task keeps the whole body (but the acting hands) clear of them
-        at contact, and the trunk and legs on the way there (a tall worker's knees at a
-        table's front, a head at the board above a low shelf); where no posture does,
-        the search goes on without them.
+        The obstacles around the worker: a hand task's posture keeps the body clear of
+        them where one does (:func:`_obstacle_blocked`).
 
     Returns
     -------

@@ -108,9 +108,9 @@ def board_local(cell, target: np.ndarray, local: np.ndarray, yaw: float, stature
     return edge, low[1], low[2]
 
 
-def posture_clearance(cell, pose: Pose, stature: float
+def posture_clearance(ctx: PlanContext, pose: Pose
                       ) -> Callable[[np.ndarray, tuple[str, ...]], np.ndarray]:
-    """The obstacles of ``cell`` around a worker standing at ``pose`` (x, y, yaw) as the
+    """The obstacles of the cell around a worker standing at ``pose`` (x, y, yaw) as the
     goal models' posture search takes them (``motion.goals.ObstacleClearance``):
     ``clearance(poses, parts)``, the smallest exact clearance (m, below
     ``EXACT_BELOW``) of the capsules ``parts`` of start-frame poses (C, J, 3) to any
@@ -118,6 +118,7 @@ def posture_clearance(cell, pose: Pose, stature: float
     from ltl_human_motion.scene.geometry import point_bounds
     from ltl_human_motion.scene.occupancy import capsules_from_positions
     from ltl_human_motion.scene.shapes import EXACT_BELOW
+    cell, stature = ctx.cell, ctx.stature
     x, y, yaw = (float(v) for v in pose)
     rot = np.array([[math.cos(yaw), -math.sin(yaw), 0.0],
                     [math.sin(yaw), math.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
