@@ -84,3 +84,35 @@ def test_reach_family_verifies_at_every_stature(cell: str, spec: str, stature: f
     from ltl_human_motion.scenarios.run import run_pair
     outcome = run_pair(spec, cell, stature, 0, timeout=30.0)
     assert outcome.status == "verified", outcome.message[:300]
+
+
+def test_posture_clear_answers_without_the_fallback() -> None:
+    """``posture_clear`` is the search's own test: a table front just clear of the
+    stooping posture leaves one; a wall through the worker leaves none (where
+    ``make_goal_primitive`` would go on without the obstacles)."""
+    from ltl_human_motion.motion.goals import posture_clear
+    target = np.array([0.5, -0.136, 0.84])
+    for parts, expect in ((_table(0.28, 0.75), True),
+                          (PartSet([Box.from_bounds(np.array([-0.3, -1.0, 0.0]),
+                                                    np.array([1.0, 1.0, 2.5]))]), False)):
+        def obstacles(poses: np.ndarray, names: tuple[str, ...], parts=parts) -> np.ndarray:
+            seg, rad = capsules_from_positions(poses, TALL.stature, names)
+            return parts.body_clearance(seg, rad)
+        assert posture_clear("grasp", target, TALL, obstacles) is expect
+
+
+#: Pairs that verify only from a spot the checked approaches find (a part on the low
+#: board of an aisle rack, a part on the floor in front of a cart), each at the stature
+#: it failed at (planning:grasp:blocked at ebe5545).
+CHECKED_PAIRS = [
+    ("scenarios/cells/aisle.yaml", "F grasp(O2)", 1.55),
+    ("scenarios/cells/cluttered.yaml",
+     "F (grasp(O2)) & F (grasp(O1)) & G((grasp(O2)) -> G !(grasp(O1)))", 1.55),
+]
+
+
+@pytest.mark.parametrize(("cell", "spec", "stature"), CHECKED_PAIRS)
+def test_a_checked_approach_finds_a_clear_reach(cell: str, spec: str, stature: float) -> None:
+    from ltl_human_motion.scenarios.run import run_pair
+    outcome = run_pair(spec, cell, stature, 0, timeout=30.0)
+    assert outcome.status == "verified", outcome.message[:300]
