@@ -293,7 +293,7 @@ class GoalSteps:
         ``target`` (3,) plus ``back`` metres where a walk from the side of it at angle
         ``side`` (rad, from the target; within ``ROOM_SIDE_SPREAD`` of the sector's half
         width) would stand (:func:`.standing.ideal_placement`, with its steps back from
-        an obstacle); either hand unless the task's hand is fixed."""
+        an obstacle), with the hand the goal primitive's first tries there use."""
         from ltl_human_motion.motion.goals import posture_clear
         ahead = placement[0] + back
         turns = side + APPROACH_HALF_WIDTH * np.asarray(ROOM_SIDE_SPREAD)
@@ -310,12 +310,9 @@ class GoalSteps:
             local = np.array([c * dx - s * dy, s * dx + c * dy, float(target[2])])
             board = board_local(self.ctx.cell, target, local, pose[2], self.ctx.stature) \
                 if kind in LEVEL_PATH_TASKS else None
-            hands = (fixed,) if fixed is not None else ("auto",) if board is not None \
-                else ("l_hand", "r_hand")
-            obstacles = posture_clearance(self.ctx, pose)
-            if any(posture_clear(kind, local, self.ctx.library.skeleton, obstacles,
-                                 start_pose=stance, hand=hand, board=board)
-                   for hand in hands):
+            if posture_clear(kind, local, self.ctx.library.skeleton,
+                             posture_clearance(self.ctx, pose), start_pose=stance,
+                             hand=fixed or "auto", board=board):
                 return True
         return False
 
