@@ -460,7 +460,8 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     another (a low reach with the hand in the thigh) or into the low ``board`` (edge,
     bottom, top) over the targets, or, with ``obstacles``, when it or the trunk and legs
     on the way to it come nearer an obstacle than ``_OBSTACLE_CLEARANCE``
-    (:func:`_obstacle_blocked`; unless every candidate does and not ``strict``).
+    (:func:`_obstacle_blocked`; unless every candidate does and not ``strict``; where
+    the cheapest candidate is clear the others are not measured).
 
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
@@ -480,11 +481,17 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
         if obstacles is not None and not np.all(blocked):
             free = np.flatnonzero(~blocked)
-            hit = _obstacle_blocked(skeleton, st, (P[idx[free]], D[idx[free]],
-                                                   shift[idx[free]]), poses[free], active,
-                                    obstacles, board is None)
-            if strict or not np.all(hit):
-                blocked[free[hit]] = True
+            # The cheapest candidate first: where it is clear it is the posture (the
+            # others are not measured); else every candidate.
+            free = np.r_[free[np.argmin(cost[idx[free]])], free]
+            for some in (free[:1], free[1:]):
+                hit = _obstacle_blocked(skeleton, st, (P[idx[some]], D[idx[some]],
+                                                       shift[idx[some]]), poses[some],
+                                        active, obstacles, board is None)
+                if not hit[0] and some.size == 1:
+                    break
+                if some.size > 1 and (strict or not np.all(hit)):
+                    blocked[some[hit]] = True
         feasible = feasible.copy()
         feasible[idx[blocked]] = False
     cost = np.where(feasible, cost, np.inf)
