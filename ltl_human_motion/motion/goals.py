@@ -34,6 +34,7 @@ origin, facing +x, left = +y, z = height above the floor. Every goal primitive s
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from functools import lru_cache
 
 import numpy as np
@@ -50,11 +51,13 @@ __all__ = [
     "GOAL_TASKS",
     "HAND_TASKS",
     "LOW_BOARD_HEIGHT",
+    "ObstacleClearance",
     "chest_height",
     "knee_height",
     "make_goal_primitive",
     "max_reach",
     "min_reach_height",
+    "posture_clear",
     "reach_placement",
     "seat_height_range",
 ]
@@ -119,6 +122,25 @@ _CAPSULE_SAMPLES = 5
 #: Degrees the posture search keeps inside the hip and knee ranges of motion of
 #: planning.biomechanics (blending and foot locking move the legs by a degree or two).
 _ROM_MARGIN = 3.0
+#: The obstacles around a worker as the posture search sees them
+#: (:func:`make_goal_primitive`'s ``obstacles``): ``clearance(poses, parts)`` is the
+#: smallest clearance (m) of the capsules ``parts`` (names of
+#: ``scene.occupancy.BODY_PARTS``) of start-frame poses (C, J, 3) to any obstacle, (C,).
+ObstacleClearance = Callable[[np.ndarray, tuple[str, ...]], np.ndarray]
+#: Clearance (m) a reaching posture keeps from the obstacles around the worker, at
+#: contact and on the trunk's and legs' way there: over the planner's 3 mm
+#: (planning.steps.PLACED_MARGIN) by the few mm the blends at the primitive's ends and
+#: the start pose's residual move the body.
+_OBSTACLE_CLEARANCE = 0.01
+#: Fractions of the way into the reaching posture at which the trunk and legs are
+#: checked against the obstacles (they move along pitch, drop and shift scaled by one
+#: profile, so these are poses of the primitive; a tall worker's head sweeps forward
+#: through the board above a low shelf before it is under it).
+_POSTURE_WAY = (0.2, 0.35, 0.5, 0.65, 0.8, 0.9)
+#: Capsules checked on the way into the posture (the arms follow the hand path, which
+#: the planner checks on every frame).
+_WAY_PARTS: tuple[str, ...] = ("head", "abdomen", "torso", "pelvis", "buttocks", "l_thigh",
+                               "r_thigh", "l_knee", "r_knee", "l_shank", "r_shank")
 
 
 def chest_height(skeleton: Skeleton) -> float:
@@ -428,14 +450,18 @@ def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
 
 
 def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
-          task: str | None = None, board: tuple[float, float, float] | None = None
+          task: str | None = None, board: tuple[float, float, float] | None = None,
+          obstacles: ObstacleClearance | None = None, strict: bool = False
           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Costs of trunk flexion / pelvis drop candidates for hand targets.
 
     A candidate is infeasible when a hand cannot reach its target, or when its posture
     with the hands on the targets (:func:`_contact_poses`) puts a body part through
     another (a low reach with the hand in the thigh) or into the low ``board`` (edge,
-    bottom, top) over the targets.
+    bottom, top) over the targets, or, with ``obstacles``, when it or the trunk and legs
+    on the way to it come nearer an obstacle than ``_OBSTACLE_CLEARANCE``
+    (:func:`_obstacle_blocked`; unless every candidate does and not ``strict``; where
+    the cheapest candidate is clear the others are not measured).
 
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
@@ -453,10 +479,84 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
         if board is not None:
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
+        if obstacles is not None and not np.all(blocked):
+            free = np.flatnonzero(~blocked)
+            # The cheapest candidate first: where it is clear it is the posture (the
+            # others are not measured); else every candidate.
+            free = np.r_[free[np.argmin(cost[idx[free]])], free]
+            for some in (free[:1], free[1:]):
+                hit = _obstacle_blocked(skeleton, st, (P[idx[some]], D[idx[some]],
+                                                       shift[idx[some]]), poses[some],
+                                        active, obstacles, board is None)
+                if not hit[0] and some.size == 1:
+                    break
+                if some.size > 1 and (strict or not np.all(hit)):
+                    blocked[some[hit]] = True
         feasible = feasible.copy()
         feasible[idx[blocked]] = False
     cost = np.where(feasible, cost, np.inf)
     return P, D, shift, cost
+
+
+def _obstacle_blocked(skeleton: Skeleton, st: _Start,
+                      posture: tuple[np.ndarray, np.ndarray, np.ndarray], contact: np.ndarray,
+                      active: tuple[int, ...], obstacles: ObstacleClearance, cap: bool
+                      ) -> np.ndarray:
+    """Whether posture candidates come nearer the obstacles than ``_OBSTACLE_CLEARANCE``.
+
+    Parameters
+    ----------
+    posture : (pitch, drop, shift), each ndarray (C,)
+    contact : ndarray, shape (C, J, 3)
+        The candidates' contact poses (:func:`_contact_poses`): checked whole but for the
+        acting hands, which are on their targets, and the feet, which stand where the
+        worker stands, whatever the posture.
+    active : tuple of int
+        The acting hands (0 left, 1 right).
+    obstacles : ObstacleClearance
+    cap : bool
+        As :func:`_trunk`'s.
+
+    Returns
+    -------
+    ndarray of bool, shape (C,)
+    """
+    from ltl_human_motion.scene.occupancy import BODY_PARTS
+    fixed = {f"{_SIDES[k]}_{n}" for k in active for n in ("hand", "palm")} | {"l_foot",
+                                                                               "r_foot"}
+    whole = tuple(p for p in BODY_PARTS if p not in fixed)
+    hit = obstacles(contact, whole) <= _OBSTACLE_CLEARANCE
+    pitch, drop, shift = posture
+    C, S = pitch.size, len(_POSTURE_WAY)
+    frac = np.repeat(np.asarray(_POSTURE_WAY), C)                    # (S C,)
+    pelvis = np.tile(st.pelvis, (S * C, 1))
+    pelvis[:, 2] -= frac * np.tile(drop, S)
+    pelvis[:, 0] += frac * np.tile(shift, S)
+    pit = frac * np.tile(pitch, S)
+    tr = _trunk(skeleton, pelvis, pit, cap)
+    shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
+    n = S * C
+    way = _body(skeleton, pelvis, pit, np.broadcast_to(st.ankles, (n, 2, 3)),
+                np.broadcast_to(st.toes, (n, 2, 3)), np.broadcast_to(st.knee_pole, (n, 2, 3)),
+                shoulders + st.hand_rel, np.broadcast_to(st.hand_dir, (n, 2, 3)),
+                np.broadcast_to(st.elbow_pole, (n, 2, 3)), tr)
+    near = obstacles(way, _WAY_PARTS).reshape(S, C) <= _OBSTACLE_CLEARANCE
+    return hit | near.any(axis=0)
+
+
+def posture_clear(task: str, target: np.ndarray, skeleton: Skeleton,
+                  obstacles: ObstacleClearance, *, start_pose: np.ndarray | None = None,
+                  hand: str = "auto", board: tuple[float, float, float] | None = None
+                  ) -> bool:
+    """Whether some posture of hand task ``task`` reaches ``target`` (3,) (start frame)
+    with the body clear of ``obstacles`` as :func:`make_goal_primitive`'s search keeps
+    it, without that search's fallback (a cheap test of a standing place before the
+    worker walks there). ``start_pose``, ``hand`` and ``board`` as there."""
+    st = _Start(skeleton, start_pose)
+    targets, active, _ = _hand_targets(task, np.asarray(target, dtype=np.float64), hand)
+    board = _check_board(board) if board is not None and task in LEVEL_PATH_TASKS else None
+    cost = _grid(skeleton, st, targets, active, task, board, obstacles, strict=True)[3]
+    return bool(np.isfinite(cost).any())
 
 
 def _goal_hand_dir(task: str | None, k: int, rel_goal: np.ndarray) -> np.ndarray:
@@ -527,8 +627,10 @@ def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray,
 
 def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
                  task: str, target: np.ndarray,
-                 board: tuple[float, float, float] | None = None) -> tuple[float, float, float]:
-    P, D, S, cost = _grid(skeleton, st, targets, active, task, board)
+                 board: tuple[float, float, float] | None = None,
+                 obstacles: ObstacleClearance | None = None) -> tuple[float, float, float]:
+    """Trunk flexion, pelvis drop and shift of the cheapest feasible posture (:func:`_grid`)."""
+    P, D, S, cost = _grid(skeleton, st, targets, active, task, board, obstacles)
     i = int(np.argmin(cost))
     if not np.isfinite(cost[i]):
         raise ValueError(
@@ -797,7 +899,8 @@ def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
                fps: float, path: str = "arc", travel: float | None = None,
-               board: tuple[float, float, float] | None = None) -> MotionPrimitive:
+               board: tuple[float, float, float] | None = None,
+               obstacles: ObstacleClearance | None = None) -> MotionPrimitive:
     H = skeleton.stature
     arm = _arm_length(skeleton)
     travel = _INSERT_TRAVEL if travel is None else float(travel)
@@ -813,7 +916,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         a[2] = 0.0
         n = np.linalg.norm(a)
         approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
-    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board)
+    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board,
+                                         obstacles)
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
     total = t_reach + hold + t_ret
@@ -1135,7 +1239,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
                         rng: np.random.Generator | None = None, duration: float | None = None,
                         hand: str = "auto", fps: float = LIBRARY_FPS,
                         path: str = "arc", travel: float | None = None,
-                        board: tuple[float, float, float] | None = None) -> MotionPrimitive:
+                        board: tuple[float, float, float] | None = None,
+                        obstacles: ObstacleClearance | None = None) -> MotionPrimitive:
     """A goal primitive for one Table I task, made for the exact target.
 
     Parameters
@@ -1176,6 +1281,9 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         edge at x = edge, its underside and top at heights bottom and top, metres): the
         posture keeps every body part clear of it and the hand takes the level path with
         its turn point in front of the edge (down there, then in under the board).
+    obstacles : ObstacleClearance, optional
+        The obstacles around the worker: a hand task's posture keeps the body clear of
+        them where one does (:func:`_obstacle_blocked`).
 
     Returns
     -------
@@ -1198,7 +1306,7 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         if board is not None:
             board = _check_board(board)
         return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel,
-                          board)
+                          board, obstacles)
     if task in ("bend", "stoop", "kneel"):
         return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
     if task == "wait":

@@ -35,12 +35,15 @@ from ltl_human_motion.planning.plan_state import (
 from ltl_human_motion.planning.standing import (
     SQUARE_BOARD_HEIGHT,
     board_local,
+    ideal_placement,
     low_board,
+    posture_clearance,
     pull_length,
     release_targets,
 )
 from ltl_human_motion.planning.steps import StepExecutor
 from ltl_human_motion.planning.walk_goals import WalkGoals
+from ltl_human_motion.vocabulary import HAND_TASKS
 
 #: Frames a wait lasts beyond the blends at both ends (2 x overlap), so that the
 #: stillness the verifier checks lasts as long as asked.
@@ -58,6 +61,19 @@ ALTERNATIVE_ATTEMPTS = 2
 #: target's other sides (an arm hitting a crate beside it).
 ALTERNATE_APPROACHES: tuple[tuple[float, float], ...] = (
     (0.0, 0.08), (math.pi / 3, 0.0), (-math.pi / 3, 0.0))
+
+#: More ways to stand, tried after ``ALTERNATE_APPROACHES`` and only where the posture
+#: search finds a reach clear of the obstacles from there (:meth:`GoalSteps.posture_room`,
+#: before any walk): two steps further back (a head under the board above a low shelf
+#: stays in front of its edge) and square to either side of the target (a side panel or
+#: a cart face in front of a part on the floor).
+CHECKED_APPROACHES: tuple[tuple[float, float], ...] = (
+    (0.0, 0.16), (0.0, 0.24), (math.pi / 2, 0.0), (-math.pi / 2, 0.0))
+
+#: Where in the side of an alternative approach :meth:`GoalSteps.posture_room` looks for
+#: a clear reach, fractions of ``APPROACH_HALF_WIDTH`` either side of its middle (the
+#: walk ends anywhere in the side).
+ROOM_SIDE_SPREAD: tuple[float, ...] = (0.0, -0.5, 0.5)
 
 #: Node budget of the walk to an alternative approach (most are a few steps round the
 #: target; a side that needs a long way round is not worth the search).
@@ -148,6 +164,8 @@ class GoalSteps:
             and kind in LEVEL_PATH_TASKS and not seated else None
         if board is not None:
             kwargs["board"] = board
+        if kind in HAND_TASKS and not seated and self.ctx.cell.obstacles:   # the body clear
+            kwargs["obstacles"] = posture_clearance(self.ctx, self.state.pose)
         hand_fixed = "hand" in kwargs
         if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
@@ -241,7 +259,11 @@ class GoalSteps:
             return [(target, None)]
         first = math.atan2(self.state.pose[1] - target[1], self.state.pose[0] - target[0])
 
-        def approach(turn: float, back: float) -> int:
+        def approach(turn: float, back: float, checked: bool = False) -> int:
+            if checked and not self.posture_room(kind, args, target, placement,
+                                                 first + turn, back, raised):
+                raise PlanningError(f"task {text}: no reach clear of the obstacles from "
+                                    "that side", task=text, reason="blocked")
             lowered = raised and not self.state.held
             if lowered:
                 self.executor.arm_transition(True, -1)
@@ -255,7 +277,40 @@ class GoalSteps:
 
         return [(target, None)] + [
             (target, functools.partial(approach, turn, back))
-            for turn, back in ALTERNATE_APPROACHES]
+            for turn, back in ALTERNATE_APPROACHES] + [
+            (target, functools.partial(approach, turn, back, True))
+            for turn, back in CHECKED_APPROACHES]
+
+    def posture_room(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                     placement: tuple[float, float], side: float, back: float,
+                     raised: bool) -> bool:
+        """Whether the goal model finds a posture clear of the obstacles
+        (:func:`.motion.goals.posture_clear`) for the worker standing ``placement`` from
+        ``target`` (3,) plus ``back`` metres where a walk from the side of it at angle
+        ``side`` (rad, from the target; within ``ROOM_SIDE_SPREAD`` of the sector's half
+        width) would stand (:func:`.standing.ideal_placement`, with its steps back from
+        an obstacle), with the hand the goal primitive's first tries there use."""
+        from ltl_human_motion.motion.goals import posture_clear
+        ahead = placement[0] + back
+        turns = side + APPROACH_HALF_WIDTH * np.asarray(ROOM_SIDE_SPREAD)
+        far = 2.0 * math.hypot(ahead, placement[1])
+        px, py, yaw, free = ideal_placement(
+            self.ctx, target, (ahead, placement[1]), target[0] + far * np.cos(turns),
+            target[1] + far * np.sin(turns), self.ctx.options.max_step_back)
+        fixed = acting_hand(self.state, kind, args[0] if args else None)
+        stance = self.ctx.stance(self.state.carrying or raised)
+        for k in np.flatnonzero(free):
+            pose = (float(px[k]), float(py[k]), float(yaw[k]))
+            c, s = math.cos(-pose[2]), math.sin(-pose[2])
+            dx, dy = target[0] - pose[0], target[1] - pose[1]
+            local = np.array([c * dx - s * dy, s * dx + c * dy, float(target[2])])
+            board = board_local(self.ctx.cell, target, local, pose[2], self.ctx.stature) \
+                if kind in LEVEL_PATH_TASKS else None
+            if posture_clear(kind, local, self.ctx.library.skeleton,
+                             posture_clearance(self.ctx, pose), start_pose=stance,
+                             hand=fixed or "auto", board=board):
+                return True
+        return False
 
     def approach(self, target: np.ndarray, placement: tuple[float, float], text: str,
                  sector: tuple[float, float] | None = None,

@@ -108,6 +108,30 @@ def board_local(cell, target: np.ndarray, local: np.ndarray, yaw: float, stature
     return edge, low[1], low[2]
 
 
+def posture_clearance(ctx: PlanContext, pose: Pose
+                      ) -> Callable[[np.ndarray, tuple[str, ...]], np.ndarray]:
+    """The obstacles of the cell around a worker standing at ``pose`` (x, y, yaw) as the
+    goal models' posture search takes them (``motion.goals.ObstacleClearance``):
+    ``clearance(poses, parts)``, the smallest exact clearance (m, below
+    ``EXACT_BELOW``) of the capsules ``parts`` of start-frame poses (C, J, 3) to any
+    obstacle part, (C,)."""
+    from ltl_human_motion.scene.geometry import point_bounds
+    from ltl_human_motion.scene.occupancy import capsules_from_positions
+    from ltl_human_motion.scene.shapes import EXACT_BELOW
+    cell, stature = ctx.cell, ctx.stature
+    x, y, yaw = (float(v) for v in pose)
+    rot = np.array([[math.cos(yaw), -math.sin(yaw), 0.0],
+                    [math.sin(yaw), math.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+    shift = np.array([x, y, 0.0])
+
+    def clearance(poses: np.ndarray, parts: tuple[str, ...]) -> np.ndarray:
+        world = np.asarray(poses, dtype=np.float64) @ rot.T + shift
+        seg, rad = capsules_from_positions(world, stature, parts)
+        return cell.part_set.body_clearance(seg, rad, EXACT_BELOW, bounds=point_bounds(world))
+
+    return clearance
+
+
 def standing_offset(ctx: PlanContext, kind: str, target: np.ndarray, task: str,
                     hand: str | None = None, carry_stance: bool = True
                     ) -> tuple[float, float]:
