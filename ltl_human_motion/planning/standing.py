@@ -162,7 +162,7 @@ def ideal_placement(ctx: PlanContext, target: np.ndarray, placement: tuple[float
     px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)
     py = target[1] - (s[..., None] * (d + back) + c[..., None] * lat)
     pts = np.stack([px, py], axis=-1).reshape(-1, 2)
-    free = ctx.stand_map(pts).reshape(px.shape) > ctx.options.stand_clearance
+    free = ctx.stand_map(pts).reshape(px.shape) > ctx.stand_room
     k = np.argmax(free, axis=-1)
     pick = np.take_along_axis
     out = (pick(px, k[..., None], -1)[..., 0], pick(py, k[..., None], -1)[..., 0], yaw,
