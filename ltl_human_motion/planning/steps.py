@@ -389,11 +389,16 @@ class StepExecutor:
             if res.reason == "budget":
                 why = (f"the search budget ran out ({used} nodes; closest approach "
                        f"{res.closest:.2f} m)")
+            elif res.reason == "no_stop":
+                why = (f"the search reached the target's neighbourhood but no place to stop "
+                       f"there keeps the body clear and ends where the reach starts "
+                       f"({used} nodes)")
             else:
                 why = (f"obstacles block every way to the target (searched {res.expanded} "
                        f"placements; closest approach {res.closest:.2f} m)")
+            # No stop at the goal is a blocked goal (the caller may try other placements).
             raise PlanningError(f"task {task}: {goal.description}: {why}", task=task,
-                                reason=res.reason)
+                                reason="blocked" if res.reason == "no_stop" else res.reason)
         for prim_id, pose in zip(res.primitives, res.poses):
             self.add(self.ctx.index.primitives[prim_id], pose, label, self.ctx.overlap)
         if res.primitives:
