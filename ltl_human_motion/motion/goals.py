@@ -116,6 +116,14 @@ _BOARD_FRONT = 0.10
 _BOARD_PLACE_MARGIN = 0.04
 #: Points sampled along every body capsule for the board check of a posture.
 _CAPSULE_SAMPLES = 5
+#: Body capsules the posture search keeps out of the furniture under a hand target
+#: (:func:`make_goal_primitive`'s ``support``): all but the arms, which reach onto it,
+#: and the feet, which stay where they stand.
+#: A 1.95 m worker's contact posture for a part on a 0.75 m table put its thigh 1-3 cm
+#: into the table's edge (the knees bend forward at table-top height).
+_SUPPORT_FREE_PARTS: tuple[str, ...] = (
+    "head", "abdomen", "torso", "pelvis", "buttocks", "l_thigh", "r_thigh", "l_knee",
+    "r_knee", "l_shank", "r_shank")
 #: Degrees the posture search keeps inside the hip and knee ranges of motion of
 #: planning.biomechanics (blending and foot locking move the legs by a degree or two).
 _ROM_MARGIN = 3.0
@@ -427,15 +435,39 @@ def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
     return depth.max(axis=(0, 2))
 
 
+def _support_depth(poses: np.ndarray, support: tuple[float, float, float, float],
+                   stature: float) -> np.ndarray:
+    """How deep the trunk and legs (``_SUPPORT_FREE_PARTS``) of poses (C, J, 3) go into
+    the furniture under a target, plus ``_BOARD_CLEARANCE``, metres (C,); negative:
+    clear. ``support = (nx, ny, offset, top)`` (start frame): the furniture is where
+    ``nx * x + ny * y >= offset`` ((nx, ny) the unit normal into it from its edge), from
+    the floor up to height ``top``."""
+    from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_ends, capsule_radii
+    keep = np.array([BODY_PARTS.index(name) for name in _SUPPORT_FREE_PARTS])
+    nx, ny, offset, top = support
+    ia, ib = capsule_ends()
+    ia, ib, radii = ia[keep], ib[keep], capsule_radii(stature)[keep]
+    s = np.linspace(0.0, 1.0, _CAPSULE_SAMPLES)[:, None, None, None]
+    pts = poses[:, ia] + s * (poses[:, ib] - poses[:, ia])          # (S, C, K, 3)
+    into = nx * pts[..., 0] + ny * pts[..., 1] - offset              # beyond the edge
+    above = pts[..., 2] - top
+    dist = np.where((into >= 0.0) & (above <= 0.0), -np.minimum(into, -above),
+                    np.hypot(np.maximum(-into, 0.0), np.maximum(above, 0.0)))
+    return (radii + _BOARD_CLEARANCE - dist).max(axis=(0, 2))
+
+
 def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
-          task: str | None = None, board: tuple[float, float, float] | None = None
+          task: str | None = None, board: tuple[float, float, float] | None = None,
+          support: tuple[float, float, float, float] | None = None
           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Costs of trunk flexion / pelvis drop candidates for hand targets.
 
     A candidate is infeasible when a hand cannot reach its target, or when its posture
     with the hands on the targets (:func:`_contact_poses`) puts a body part through
     another (a low reach with the hand in the thigh) or into the low ``board`` (edge,
-    bottom, top) over the targets.
+    bottom, top) over the targets; and, unless no candidate keeps out of it (the
+    planner's exact check decides then), when the trunk or legs go into the furniture
+    under the targets (``support``, :func:`_support_depth`).
 
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
@@ -453,6 +485,10 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
         if board is not None:
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
+        if support is not None:
+            under = _support_depth(poses, support, skeleton.stature) > 0.0
+            if not np.all(blocked | under):
+                blocked |= under
         feasible = feasible.copy()
         feasible[idx[blocked]] = False
     cost = np.where(feasible, cost, np.inf)
@@ -527,8 +563,9 @@ def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray,
 
 def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
                  task: str, target: np.ndarray,
-                 board: tuple[float, float, float] | None = None) -> tuple[float, float, float]:
-    P, D, S, cost = _grid(skeleton, st, targets, active, task, board)
+                 board: tuple[float, float, float] | None = None,
+                 support: tuple[float, float, float, float] | None = None) -> tuple[float, float, float]:
+    P, D, S, cost = _grid(skeleton, st, targets, active, task, board, support)
     i = int(np.argmin(cost))
     if not np.isfinite(cost[i]):
         raise ValueError(
@@ -797,7 +834,8 @@ def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
                fps: float, path: str = "arc", travel: float | None = None,
-               board: tuple[float, float, float] | None = None) -> MotionPrimitive:
+               board: tuple[float, float, float] | None = None,
+               support: tuple[float, float, float, float] | None = None) -> MotionPrimitive:
     H = skeleton.stature
     arm = _arm_length(skeleton)
     travel = _INSERT_TRAVEL if travel is None else float(travel)
@@ -813,7 +851,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         a[2] = 0.0
         n = np.linalg.norm(a)
         approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
-    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board)
+    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board,
+                                         support)
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
     total = t_reach + hold + t_ret
@@ -898,6 +937,15 @@ def _check_board(board: tuple[float, float, float]) -> tuple[float, float, float
     if b.shape != (3,) or not np.all(np.isfinite(b)) or not b[1] <= b[2]:
         raise ValueError(f"board must be (edge, bottom, top) with bottom <= top, got {board!r}")
     return float(b[0]), float(b[1]), float(b[2])
+
+
+def _check_support(support: tuple[float, float, float, float]
+                   ) -> tuple[float, float, float, float]:
+    """``support`` as four floats (nx, ny, offset, top); ValueError if malformed."""
+    v = np.asarray(support, dtype=np.float64)
+    if v.shape != (4,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"support must be (nx, ny, offset, top), got {support!r}")
+    return float(v[0]), float(v[1]), float(v[2]), float(v[3])
 
 
 def _fmt(target: np.ndarray | None) -> str:
@@ -1135,7 +1183,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
                         rng: np.random.Generator | None = None, duration: float | None = None,
                         hand: str = "auto", fps: float = LIBRARY_FPS,
                         path: str = "arc", travel: float | None = None,
-                        board: tuple[float, float, float] | None = None) -> MotionPrimitive:
+                        board: tuple[float, float, float] | None = None,
+                        support: tuple[float, float, float, float] | None = None) -> MotionPrimitive:
     """A goal primitive for one Table I task, made for the exact target.
 
     Parameters
@@ -1176,6 +1225,9 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         edge at x = edge, its underside and top at heights bottom and top, metres): the
         posture keeps every body part clear of it and the hand takes the level path with
         its turn point in front of the edge (down there, then in under the board).
+    support : (nx, ny, offset, top), optional
+        The furniture under the target of a hand task (:func:`_support_depth`): the
+        posture keeps the trunk and legs out of it where any posture that reaches does.
 
     Returns
     -------
@@ -1195,10 +1247,10 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     if task in HAND_TASKS:
         if travel is not None and not 0.0 < float(travel) <= _MAX_TRAVEL:
             raise ValueError(f"travel must be in (0, {_MAX_TRAVEL}] m, got {travel!r}")
-        if board is not None:
-            board = _check_board(board)
+        board = None if board is None else _check_board(board)
+        support = None if support is None else _check_support(support)
         return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel,
-                          board)
+                          board, support)
     if task in ("bend", "stoop", "kneel"):
         return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
     if task == "wait":

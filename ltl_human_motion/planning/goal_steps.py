@@ -18,7 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ltl_human_motion.errors import PlanningError
-from ltl_human_motion.motion.goals import HAND_PATHS, LEVEL_PATH_TASKS
+from ltl_human_motion.motion.goals import HAND_PATHS, HAND_TASKS, LEVEL_PATH_TASKS
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import SearchBudget
@@ -36,6 +36,7 @@ from ltl_human_motion.planning.standing import (
     SQUARE_BOARD_HEIGHT,
     board_local,
     low_board,
+    support_local,
     pull_length,
     release_targets,
 )
@@ -143,11 +144,9 @@ class GoalSteps:
             kwargs["hand"] = hand
         if kind == "extract" and part is not None and container is not None:
             kwargs["travel"] = self.pull_length(part, container)
-        board = board_local(self.ctx.cell, target, local, yaw,
-                            self.ctx.stature) if local is not None \
-            and kind in LEVEL_PATH_TASKS and not seated else None
-        if board is not None:
-            kwargs["board"] = board
+        furniture = self.furniture(kind, target, local) if not seated else {}
+        kwargs.update(furniture)
+        board = furniture.get("board")
         hand_fixed = "hand" in kwargs
         if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
@@ -192,6 +191,26 @@ class GoalSteps:
         self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
         self.state.gait_state = None
         return seg, mp
+
+    def furniture(self, kind: str, target: np.ndarray | None, local: np.ndarray | None
+                  ) -> dict:
+        """The furniture the goal primitive of ``kind`` for ``target`` (world (3,);
+        ``local``: in the start frame) keeps the body clear of, as its keyword arguments:
+        a low board over the target (``board``, :func:`.standing.board_local`) and what the
+        target rests on or in (``support``, :func:`.standing.support_local`)."""
+        out: dict = {}
+        if local is None:
+            return out
+        yaw = self.state.pose[2]
+        if kind in LEVEL_PATH_TASKS:
+            board = board_local(self.ctx.cell, target, local, yaw, self.ctx.stature)
+            if board is not None:
+                out["board"] = board
+        if kind in HAND_TASKS:
+            support = support_local(self.ctx.cell, target, local, yaw)
+            if support is not None:
+                out["support"] = support
+        return out
 
     def first_clear_try(self, i: int, text: str, kind: str, args: tuple[str, ...],
                         tries: list, carrying_before: bool
