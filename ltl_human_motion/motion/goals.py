@@ -50,6 +50,7 @@ __all__ = [
     "GOAL_TASKS",
     "HAND_TASKS",
     "LOW_BOARD_HEIGHT",
+    "PUSH_LEVEL_TASKS",
     "chest_height",
     "knee_height",
     "make_goal_primitive",
@@ -85,6 +86,14 @@ _LOW_REACH_WIDE = 0.05
 HAND_PATHS: tuple[str, ...] = ("arc", "level")
 #: Tasks whose hand may take the level path (the palm comes in over a support).
 LEVEL_PATH_TASKS: tuple[str, ...] = ("grasp", "release", "move")
+#: Tasks whose ``"level"`` path makes the straight push (insert) or pull (extract) start
+#: or end in front of the furniture under the target (a fixture in a machine's housing:
+#: the 1.55 m worker's hand, coming up from the hip, hit the base's front edge).
+PUSH_LEVEL_TASKS: tuple[str, ...] = ("insert", "extract")
+#: Fraction of the reach time at which extract's level path is at the start of its
+#: straight way in (the rest goes in straight, as the pull comes out); insert's comes
+#: back out straight in the same fraction of its return time.
+_PUSH_IN_AT = 0.6
 #: Horizontal distance from the shoulder of the level path's turn point, fraction of
 #: stature (0.12 m at 1.75 m: in front of the chest, behind the front edge of a shelf the
 #: worker stands at, also one overhead).
@@ -761,12 +770,18 @@ def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
     t1, t2, total = times
     if task == "insert":
         push = min(0.5, 0.6 * (t2 - t1))
-        return [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
-                (total, rel_home)], t1 + push
+        keys = [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
+                (total, rel_home)]
+        if level:           # out the straight way it pushed in (PUSH_LEVEL_TASKS)
+            keys.insert(-1, (t2 + (1.0 - _PUSH_IN_AT) * (total - t2), rel_pre))
+        return keys, t1 + push
     if task == "extract":
         pull = min(0.5, 0.6 * (t2 - t1))
-        return [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
-                (total, rel_home)], t2
+        keys = [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
+                (total, rel_home)]
+        if level:           # in the straight way it pulls out (PUSH_LEVEL_TASKS)
+            keys.insert(1, (_PUSH_IN_AT * t1, rel_pre))
+        return keys, t2
     keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
     if task in ("grasp", "release", "move"):
         # Parts rest on surfaces: come down onto a target below the shoulder from
@@ -831,6 +846,32 @@ def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
     return rel
 
 
+def _push_travel(task: str, target: np.ndarray, st: _Start, hand: str,
+                 travel: float | None, path: str,
+                 support: tuple[float, float, float, float] | None) -> tuple[float, bool]:
+    """Length of the straight push of insert or pull of extract, metres: ``travel``
+    (default ``_INSERT_TRAVEL``); on the ``"level"`` path (:data:`PUSH_LEVEL_TASKS`) over
+    furniture (``support``, :func:`_support_depth`), long enough (up to ``_MAX_TRAVEL``)
+    that the push starts and the pull ends ``_BOARD_FRONT`` in front of its edge, where
+    the hand comes from and goes back to the hip without passing under the edge (and
+    extract goes in the same straight way). Also whether the hand takes that level
+    path."""
+    travel = _INSERT_TRAVEL if travel is None else float(travel)
+    if support is None or path != "level" or task not in PUSH_LEVEL_TASKS:
+        return travel, False
+    t = np.asarray(target, dtype=np.float64)
+    targets, active, _ = _hand_targets(task, t, hand)
+    a = targets[active[0]] - st.shoulders[active[0]]
+    a[2] = 0.0
+    a /= max(float(np.linalg.norm(a)), 1e-9)
+    nx, ny, offset, _ = support
+    towards = nx * a[0] + ny * a[1]                   # how fast the push goes in
+    if towards <= 1e-6:
+        return travel, False
+    need = (nx * t[0] + ny * t[1] - offset + _BOARD_FRONT) / towards
+    return float(np.clip(need, travel, _MAX_TRAVEL)), True
+
+
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
                fps: float, path: str = "arc", travel: float | None = None,
@@ -838,9 +879,9 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                support: tuple[float, float, float, float] | None = None) -> MotionPrimitive:
     H = skeleton.stature
     arm = _arm_length(skeleton)
-    travel = _INSERT_TRAVEL if travel is None else float(travel)
+    travel, pushed = _push_travel(task, target, st, hand, travel, path, support)
     board = board if task in LEVEL_PATH_TASKS else None
-    level = (path == "level" or board is not None) and task in LEVEL_PATH_TASKS
+    level = pushed or (path == "level" or board is not None) and task in LEVEL_PATH_TASKS
     target = _checked_target(task, target, skeleton)
     targets, active, hand_name = _hand_targets(task, target, hand)
     # insert pushes into the target from a point before it; extract pulls back from it
@@ -1216,7 +1257,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         "l_hand" kneels on the left knee.
     fps : float
     path : {"arc", "level"}
-        Hand path of grasp, release and move (:data:`HAND_PATHS`); other tasks ignore it.
+        Hand path of grasp, release and move (:data:`HAND_PATHS`; insert and extract over
+        a ``support``: :data:`PUSH_LEVEL_TASKS`); other tasks ignore it.
     travel : float, optional
         Length of the straight push of insert and pull of extract, metres (default
         8 cm; a part deep in a fixture needs a longer pull to come out).
@@ -1226,8 +1268,7 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         posture keeps every body part clear of it and the hand takes the level path with
         its turn point in front of the edge (down there, then in under the board).
     support : (nx, ny, offset, top), optional
-        The furniture under the target of a hand task (:func:`_support_depth`): the
-        posture keeps the trunk and legs out of it where any posture that reaches does.
+        The furniture under a hand target (:func:`_support_depth`), kept out of the legs.
 
     Returns
     -------

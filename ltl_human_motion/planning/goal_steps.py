@@ -18,7 +18,12 @@ from collections.abc import Callable
 import numpy as np
 
 from ltl_human_motion.errors import PlanningError
-from ltl_human_motion.motion.goals import HAND_PATHS, HAND_TASKS, LEVEL_PATH_TASKS
+from ltl_human_motion.motion.goals import (
+    HAND_PATHS,
+    HAND_TASKS,
+    LEVEL_PATH_TASKS,
+    PUSH_LEVEL_TASKS,
+)
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import SearchBudget
@@ -156,7 +161,7 @@ class GoalSteps:
         kept_in = 0
         attempts = self.ctx.options.goal_attempts if attempts is None else attempts
         for attempt in range(attempts):
-            if kind in LEVEL_PATH_TASKS:
+            if kind in LEVEL_PATH_TASKS or (kind in PUSH_LEVEL_TASKS and "support" in kwargs):
                 # Every other try comes in level (over a shelf board, under the one above).
                 kwargs["path"] = HAND_PATHS[attempt % len(HAND_PATHS)]
             try:
