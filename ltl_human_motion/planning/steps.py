@@ -350,6 +350,10 @@ class StepExecutor:
         the path it returns is then checked as the verifier does (exact capsules, held
         parts). A primitive that collides is forbidden from its pose and the search runs
         again (at most ``WALK_REPAIRS`` times)."""
+        # A step of the same task (a grasp at a rack, then the step back its arms needed)
+        # may have left the worker where no walk may start.
+        if self.state.seat is None:
+            self.step_out()
         forbidden: set[tuple[int, int, int, int]] = set()
         noise_state = self.ctx.rng.bit_generator.state
         budget = budget or self.ctx.options.budget
@@ -390,9 +394,8 @@ class StepExecutor:
                 why = (f"the search budget ran out ({used} nodes; closest approach "
                        f"{res.closest:.2f} m)")
             elif res.reason == "no_stop":
-                why = (f"the search reached the target's neighbourhood but no place to stop "
-                       f"there keeps the body clear and ends where the reach starts "
-                       f"({used} nodes)")
+                why = (f"the search reached the goal's neighbourhood but no place to stop "
+                       f"there keeps the body clear and passes the goal test ({used} nodes)")
             else:
                 why = (f"obstacles block every way to the target (searched {res.expanded} "
                        f"placements; closest approach {res.closest:.2f} m)")
