@@ -294,8 +294,9 @@ class GoalSteps:
         desc = f"reach {text} at ({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})"
         goal, back = self.goals.reach(target, placement, desc, text, sector=sector,
                                       stand_yaw=stand_yaw)
-        if self.state.gait_state is None and self.state.seat is None:
-            self.executor.step_towards(target, placement, back, stand_yaw)
+        if sector is None and stand_yaw is None and self.state.seat is None:
+            # (From a side or facing a board, the alternatives walk round instead.)
+            self.executor.step_towards(target, placement, back)
         walked = self.executor.walk(goal, text, -1, carry=self.state.carrying, budget=budget)
         if not self.executor.adjust_to(target, placement, text, back, stand_yaw):
             # No clear step from where the walk ended: walk on to a spot that needs
