@@ -451,23 +451,35 @@ def _support_depth(poses: np.ndarray, support: tuple[float, float, float, float]
     clear. ``support = (nx, ny, offset, top)`` (start frame): the furniture is where
     ``nx * x + ny * y >= offset`` ((nx, ny) the unit normal into it from its edge), from
     the floor up to height ``top``."""
-    from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_ends, capsule_radii
+    from ltl_human_motion.scene.occupancy import BODY_PARTS
     keep = np.array([BODY_PARTS.index(name) for name in _SUPPORT_FREE_PARTS])
-    nx, ny, offset, top = support
+    return _slab_depth(poses, (*support[:3], -1.0, support[3]), stature, keep)
+
+
+def _slab_depth(poses: np.ndarray, slab: tuple[float, float, float, float, float],
+                stature: float, parts: np.ndarray | None = None) -> np.ndarray:
+    """How deep the body's capsules (``parts``: indices (K,), default all) of poses
+    (C, J, 3) go into ``slab = (nx, ny, offset, bottom, top)`` (start frame: where
+    ``nx * x + ny * y >= offset`` between heights bottom and top), plus
+    ``_BOARD_CLEARANCE``, metres (C,); negative: clear."""
+    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    nx, ny, offset, bottom, top = slab
     ia, ib = capsule_ends()
-    ia, ib, radii = ia[keep], ib[keep], capsule_radii(stature)[keep]
+    radii = capsule_radii(stature)
+    if parts is not None:
+        ia, ib, radii = ia[parts], ib[parts], radii[parts]
     s = np.linspace(0.0, 1.0, _CAPSULE_SAMPLES)[:, None, None, None]
     pts = poses[:, ia] + s * (poses[:, ib] - poses[:, ia])          # (S, C, K, 3)
     into = nx * pts[..., 0] + ny * pts[..., 1] - offset              # beyond the edge
-    above = pts[..., 2] - top
-    dist = np.where((into >= 0.0) & (above <= 0.0), -np.minimum(into, -above),
-                    np.hypot(np.maximum(-into, 0.0), np.maximum(above, 0.0)))
+    out_z = np.maximum(bottom - pts[..., 2], pts[..., 2] - top)      # above or below
+    dist = np.where((into >= 0.0) & (out_z <= 0.0), -np.minimum(into, -out_z),
+                    np.hypot(np.maximum(-into, 0.0), np.maximum(out_z, 0.0)))
     return (radii + _BOARD_CLEARANCE - dist).max(axis=(0, 2))
 
 
 def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
           task: str | None = None, board: tuple[float, float, float] | None = None,
-          support: tuple[float, float, float, float] | None = None
+          furniture: tuple[tuple[float, ...] | None, tuple[float, ...] | None] | None = None
           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Costs of trunk flexion / pelvis drop candidates for hand targets.
 
@@ -476,7 +488,8 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     another (a low reach with the hand in the thigh) or into the low ``board`` (edge,
     bottom, top) over the targets; and, unless no candidate keeps out of it (the
     planner's exact check decides then), when the trunk or legs go into the furniture
-    under the targets (``support``, :func:`_support_depth`).
+    under the targets (``furniture[0]``, :func:`_support_depth`) or the body into a board
+    over them (``furniture[1]``, (nx, ny, offset, bottom, top), :func:`_slab_depth`).
 
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
@@ -494,10 +507,12 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
         if board is not None:
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
-        if support is not None:
-            under = _support_depth(poses, support, skeleton.stature) > 0.0
-            if not np.all(blocked | under):
-                blocked |= under
+        under, over = furniture or (None, None)
+        for depth in ([] if under is None else [_support_depth(poses, under, skeleton.stature)]) \
+                + ([] if over is None else [_slab_depth(poses, over, skeleton.stature)]):
+            # The furniture under the targets, then the board over them (a shelf's).
+            if not np.all(blocked | (depth > 0.0)):
+                blocked |= depth > 0.0
         feasible = feasible.copy()
         feasible[idx[blocked]] = False
     cost = np.where(feasible, cost, np.inf)
@@ -573,8 +588,8 @@ def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray,
 def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
                  task: str, target: np.ndarray,
                  board: tuple[float, float, float] | None = None,
-                 support: tuple[float, float, float, float] | None = None) -> tuple[float, float, float]:
-    P, D, S, cost = _grid(skeleton, st, targets, active, task, board, support)
+                 furniture: tuple | None = None) -> tuple[float, float, float]:
+    P, D, S, cost = _grid(skeleton, st, targets, active, task, board, furniture)
     i = int(np.argmin(cost))
     if not np.isfinite(cost[i]):
         raise ValueError(
@@ -876,10 +891,11 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
                fps: float, path: str = "arc", travel: float | None = None,
                board: tuple[float, float, float] | None = None,
-               support: tuple[float, float, float, float] | None = None) -> MotionPrimitive:
+               furniture: tuple | None = None) -> MotionPrimitive:
     H = skeleton.stature
     arm = _arm_length(skeleton)
-    travel, pushed = _push_travel(task, target, st, hand, travel, path, support)
+    travel, pushed = _push_travel(task, target, st, hand, travel, path,
+                                  None if furniture is None else furniture[0])
     board = board if task in LEVEL_PATH_TASKS else None
     level = pushed or (path == "level" or board is not None) and task in LEVEL_PATH_TASKS
     target = _checked_target(task, target, skeleton)
@@ -893,7 +909,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         n = np.linalg.norm(a)
         approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
     pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board,
-                                         support)
+                                         furniture)
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
     total = t_reach + hold + t_ret
@@ -980,13 +996,19 @@ def _check_board(board: tuple[float, float, float]) -> tuple[float, float, float
     return float(b[0]), float(b[1]), float(b[2])
 
 
-def _check_support(support: tuple[float, float, float, float]
-                   ) -> tuple[float, float, float, float]:
-    """``support`` as four floats (nx, ny, offset, top); ValueError if malformed."""
-    v = np.asarray(support, dtype=np.float64)
-    if v.shape != (4,) or not np.all(np.isfinite(v)):
-        raise ValueError(f"support must be (nx, ny, offset, top), got {support!r}")
-    return float(v[0]), float(v[1]), float(v[2]), float(v[3])
+def _check_furniture(board: tuple | None, support: tuple | None, ceiling: tuple | None
+                     ) -> tuple[tuple[float, ...] | None, tuple | None]:
+    """``board`` (edge, bottom, top), and ``support`` (nx, ny, offset, top) and ``ceiling``
+    (nx, ny, offset, bottom, top) as one pair (None without either), as floats;
+    ValueError if malformed."""
+    board = None if board is None else _check_board(board)
+    out = []
+    for name, value, n in (("support", support, 4), ("ceiling", ceiling, 5)):
+        v = None if value is None else np.asarray(value, dtype=np.float64)
+        if v is not None and (v.shape != (n,) or not np.all(np.isfinite(v))):
+            raise ValueError(f"{name} must be {n} finite numbers, got {value!r}")
+        out.append(None if v is None else tuple(float(x) for x in v))
+    return board, (None if out == [None, None] else tuple(out))
 
 
 def _fmt(target: np.ndarray | None) -> str:
@@ -1225,7 +1247,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
                         hand: str = "auto", fps: float = LIBRARY_FPS,
                         path: str = "arc", travel: float | None = None,
                         board: tuple[float, float, float] | None = None,
-                        support: tuple[float, float, float, float] | None = None) -> MotionPrimitive:
+                        support: tuple | None = None, ceiling: tuple | None = None
+                        ) -> MotionPrimitive:
     """A goal primitive for one Table I task, made for the exact target.
 
     Parameters
@@ -1260,15 +1283,15 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         Hand path of grasp, release and move (:data:`HAND_PATHS`; insert and extract over
         a ``support``: :data:`PUSH_LEVEL_TASKS`); other tasks ignore it.
     travel : float, optional
-        Length of the straight push of insert and pull of extract, metres (default
-        8 cm; a part deep in a fixture needs a longer pull to come out).
+        Length of insert's straight push and extract's pull, metres (default 8 cm).
     board : (edge, bottom, top), optional
-        A low board over the target of grasp, release or move (start frame: its front
-        edge at x = edge, its underside and top at heights bottom and top, metres): the
-        posture keeps every body part clear of it and the hand takes the level path with
-        its turn point in front of the edge (down there, then in under the board).
+        A low board over the target of grasp, release or move (start frame: front edge
+        at x = edge, underside and top at heights bottom and top, metres): the posture
+        keeps clear of it; the hand comes in level under it from in front of its edge.
     support : (nx, ny, offset, top), optional
         The furniture under a hand target (:func:`_support_depth`), kept out of the legs.
+    ceiling : (nx, ny, offset, bottom, top), optional
+        A board over a hand target (:func:`_slab_depth`), kept out of the body.
 
     Returns
     -------
@@ -1288,10 +1311,9 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     if task in HAND_TASKS:
         if travel is not None and not 0.0 < float(travel) <= _MAX_TRAVEL:
             raise ValueError(f"travel must be in (0, {_MAX_TRAVEL}] m, got {travel!r}")
-        board = None if board is None else _check_board(board)
-        support = None if support is None else _check_support(support)
+        board, furniture = _check_furniture(board, support, ceiling)
         return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel,
-                          board, support)
+                          board, furniture)
     if task in ("bend", "stoop", "kneel"):
         return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
     if task == "wait":

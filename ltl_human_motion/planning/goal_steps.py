@@ -40,6 +40,7 @@ from ltl_human_motion.planning.plan_state import (
 from ltl_human_motion.planning.standing import (
     SQUARE_BOARD_HEIGHT,
     board_local,
+    ceiling_local,
     low_board,
     support_local,
     pull_length,
@@ -201,8 +202,9 @@ class GoalSteps:
                   ) -> dict:
         """The furniture the goal primitive of ``kind`` for ``target`` (world (3,);
         ``local``: in the start frame) keeps the body clear of, as its keyword arguments:
-        a low board over the target (``board``, :func:`.standing.board_local`) and what the
-        target rests on or in (``support``, :func:`.standing.support_local`)."""
+        a low board over the target (``board``, :func:`.standing.board_local`), else any
+        board over it (``ceiling``, :func:`.standing.ceiling_local`), and what the target
+        rests on or in (``support``, :func:`.standing.support_local`)."""
         out: dict = {}
         if local is None:
             return out
@@ -215,6 +217,10 @@ class GoalSteps:
             support = support_local(self.ctx.cell, target, local, yaw)
             if support is not None:
                 out["support"] = support
+            if "board" not in out:
+                ceiling = ceiling_local(self.ctx.cell, target, local, yaw)
+                if ceiling is not None:
+                    out["ceiling"] = ceiling
         return out
 
     def first_clear_try(self, i: int, text: str, kind: str, args: tuple[str, ...],

@@ -207,6 +207,32 @@ def support_local(cell, target: np.ndarray, local: np.ndarray, yaw: float
     return best
 
 
+def ceiling_local(cell, target: np.ndarray, local: np.ndarray, yaw: float
+                  ) -> tuple[float, float, float, float, float] | None:
+    """The board over ``target`` (world (3,); ``local``: it in the start frame of the
+    goal primitive, whose heading is ``yaw``) as the goal primitive keeps the body out of
+    it: the lowest obstacle part above the target (its footprint holds the target's
+    floor point, its underside is higher than the target) as the slab beyond its nearest
+    edge, (nx, ny, offset, bottom, top) (see
+    :func:`~ltl_human_motion.motion.goals.make_goal_primitive`); None if there is none."""
+    xy = np.asarray(target[:2], dtype=np.float64)
+    probe = xy + np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
+    c, s = math.cos(-yaw), math.sin(-yaw)
+    best = None
+    for ob in cell.obstacles:
+        for part in ob.parts:
+            lo, hi = part.aabb()
+            sd = part.footprint().signed_distance(probe)
+            if float(lo[2]) <= float(target[2]) or sd[0] > 0.0 \
+                    or (best is not None and float(lo[2]) >= best[3]):
+                continue
+            grad = (sd[1:] - sd[0]) / max(float(np.linalg.norm(sd[1:] - sd[0])), 1e-12)
+            inward = -np.array([c * grad[0] - s * grad[1], s * grad[0] + c * grad[1]])
+            offset = float(inward @ np.asarray(local[:2], dtype=np.float64)) + float(sd[0])
+            best = (float(inward[0]), float(inward[1]), offset, float(lo[2]), float(hi[2]))
+    return best
+
+
 def palm_clear_of_support(cell, stature: float, point: np.ndarray, part) -> np.ndarray:
     """The palm target (3,) for a grasp at ``point`` (3,) of ``part`` (its shape where it
     rests): the grasp point, raised by up to the palm's radius where the palm sphere
