@@ -388,6 +388,8 @@ CONTAINER_PAIRS = {
     ("machine_tending/single/extract(done, fixture)", 1.95, 1): "budget ran out",
     # a walk from where the arms' step back at a shelf ended (step out first)
     ("kitting/single/insert(bolt, kit_a)", 1.75, 1): "every start blocked",
+    # the upper arm of the reach under a shelf board at 0.69 of the stature (ceiling)
+    ("kitting/single/grasp(bolt)", 1.95, 1): "upper arm into the board above",
 }
 
 
