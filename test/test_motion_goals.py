@@ -224,3 +224,31 @@ def test_two_bone_ik_reaches_and_keeps_lengths() -> None:
     reach = np.linalg.norm(target - base, axis=1)
     ok = (reach < 0.999 * 0.55) & (reach > 0.05 + 1e-6)
     np.testing.assert_allclose(end[ok], target[ok], atol=1e-9)
+
+
+def test_reach_onto_a_table_keeps_the_knees_out_of_it() -> None:
+    # A 1.95 m worker standing obliquely at a 0.75 m table reaches a part 10 cm in from
+    # its edge: the unconstrained posture bends a knee into the table; with the table as
+    # ``support`` the trunk and legs stay out of it (2 cm clearance at contact).
+    from ltl_human_motion.motion.goals import _support_depth
+    sk = Skeleton(1.95)
+    target = np.array([0.434, -0.136, 0.85])
+    inward = np.array([np.cos(0.852), -np.sin(0.852)])         # the edge 49 deg across
+    support = (*inward, float(inward @ target[:2]) - 0.1, 0.75)
+    free = make_goal_primitive("grasp", target, sk, hand="r_hand")
+    kept = make_goal_primitive("grasp", target, sk, hand="r_hand", support=support)
+    depth = [float(_support_depth(world_positions(mp, 0.0, 0.0, 0.0), support, 1.95).max())
+             for mp in (free, kept)]
+    assert depth[0] > 0.0 >= depth[1]
+
+
+def test_extract_over_furniture_pulls_out_in_front_of_its_edge() -> None:
+    # A fixture 0.2 m behind a base's front edge (top 0.98 m): on the level path the
+    # pull ends in front of the edge and the hand comes in the same straight way.
+    target = np.array([0.6, -0.1, 1.06])
+    support = (1.0, 0.0, 0.4, 0.98)
+    mp = make_goal_primitive("extract", target, SK, hand="r_hand", path="level",
+                             support=support)
+    palm = world_positions(mp, 0.0, 0.0, 0.0)[:, J["r_hand"]]
+    beyond = palm[:, 0] > 0.4
+    assert beyond.any() and np.all(palm[beyond, 2] > 0.98)

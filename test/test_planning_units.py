@@ -154,6 +154,21 @@ def test_astar_reports_blocked_and_budget_failures() -> None:
     assert isinstance(tiny, SearchFailure) and tiny.reason == "budget"
 
 
+def test_astar_ends_early_at_a_goal_with_no_place_to_stop() -> None:
+    # The heuristic's distance is 0 around (1, 0), but no pose there passes the goal
+    # test (the 1.95 m worker's 5 cm final adjustment at a table): the search says so
+    # after ``at_goal_nodes``, not after its whole budget.
+    index = _straight_and_turning_gait()
+    near = _point_goal(1.0, 0.0, radius=0.5)
+    hopeless = Goal(lambda px, py, yaw: np.zeros(np.shape(px), dtype=bool), near.distance,
+                    near.heading, "no stop")
+    res = astar(index, (0.0, 0.0, 0.0), hopeless,
+                clearance=lambda xy: np.full(len(xy), np.inf),
+                budget=SearchBudget(max_nodes=5000, at_goal_nodes=100))
+    assert isinstance(res, SearchFailure) and res.reason == "no_stop"
+    assert res.closest == 0.0 and res.expanded < 500
+
+
 @pytest.mark.parametrize("angle", [np.pi / 2, -np.pi, np.radians(45)])
 def test_turn_primitive_turns_on_the_spot_with_feet_on_the_floor(angle: float) -> None:
     sk = Skeleton()

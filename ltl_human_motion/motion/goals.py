@@ -51,6 +51,7 @@ __all__ = [
     "GOAL_TASKS",
     "HAND_TASKS",
     "LOW_BOARD_HEIGHT",
+    "PUSH_LEVEL_TASKS",
     "ObstacleClearance",
     "chest_height",
     "knee_height",
@@ -88,6 +89,14 @@ _LOW_REACH_WIDE = 0.05
 HAND_PATHS: tuple[str, ...] = ("arc", "level")
 #: Tasks whose hand may take the level path (the palm comes in over a support).
 LEVEL_PATH_TASKS: tuple[str, ...] = ("grasp", "release", "move")
+#: Tasks whose ``"level"`` path makes the straight push (insert) or pull (extract) start
+#: or end in front of the furniture under the target (a fixture in a machine's housing:
+#: the 1.55 m worker's hand, coming up from the hip, hit the base's front edge).
+PUSH_LEVEL_TASKS: tuple[str, ...] = ("insert", "extract")
+#: Fraction of the reach time at which extract's level path is at the start of its
+#: straight way in (the rest goes in straight, as the pull comes out); insert's comes
+#: back out straight in the same fraction of its return time.
+_PUSH_IN_AT = 0.6
 #: Horizontal distance from the shoulder of the level path's turn point, fraction of
 #: stature (0.12 m at 1.75 m: in front of the chest, behind the front edge of a shelf the
 #: worker stands at, also one overhead).
@@ -119,6 +128,14 @@ _BOARD_FRONT = 0.10
 _BOARD_PLACE_MARGIN = 0.04
 #: Points sampled along every body capsule for the board check of a posture.
 _CAPSULE_SAMPLES = 5
+#: Body capsules the posture search keeps out of the furniture under a hand target
+#: (:func:`make_goal_primitive`'s ``support``): all but the arms, which reach onto it,
+#: and the feet, which stay where they stand.
+#: A 1.95 m worker's contact posture for a part on a 0.75 m table put its thigh 1-3 cm
+#: into the table's edge (the knees bend forward at table-top height).
+_SUPPORT_FREE_PARTS: tuple[str, ...] = (
+    "head", "abdomen", "torso", "pelvis", "buttocks", "l_thigh", "r_thigh", "l_knee",
+    "r_knee", "l_shank", "r_shank")
 #: Degrees the posture search keeps inside the hip and knee ranges of motion of
 #: planning.biomechanics (blending and foot locking move the legs by a degree or two).
 _ROM_MARGIN = 3.0
@@ -449,19 +466,57 @@ def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
     return depth.max(axis=(0, 2))
 
 
+def _support_depth(poses: np.ndarray, support: tuple[float, float, float, float],
+                   stature: float) -> np.ndarray:
+    """How deep the trunk and legs (``_SUPPORT_FREE_PARTS``) of poses (C, J, 3) go into
+    the furniture under a target, plus ``_BOARD_CLEARANCE``, metres (C,); negative:
+    clear. ``support = (nx, ny, offset, top)`` (start frame): the furniture is where
+    ``nx * x + ny * y >= offset`` ((nx, ny) the unit normal into it from its edge), from
+    the floor up to height ``top``."""
+    from ltl_human_motion.scene.occupancy import BODY_PARTS
+    keep = np.array([BODY_PARTS.index(name) for name in _SUPPORT_FREE_PARTS])
+    return _slab_depth(poses, (*support[:3], -1.0, support[3]), stature, keep)
+
+
+def _slab_depth(poses: np.ndarray, slab: tuple[float, float, float, float, float],
+                stature: float, parts: np.ndarray | None = None) -> np.ndarray:
+    """How deep the body's capsules (``parts``: indices (K,), default all) of poses
+    (C, J, 3) go into ``slab = (nx, ny, offset, bottom, top)`` (start frame: where
+    ``nx * x + ny * y >= offset`` between heights bottom and top), plus
+    ``_BOARD_CLEARANCE``, metres (C,); negative: clear."""
+    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    nx, ny, offset, bottom, top = slab
+    ia, ib = capsule_ends()
+    radii = capsule_radii(stature)
+    if parts is not None:
+        ia, ib, radii = ia[parts], ib[parts], radii[parts]
+    s = np.linspace(0.0, 1.0, _CAPSULE_SAMPLES)[:, None, None, None]
+    pts = poses[:, ia] + s * (poses[:, ib] - poses[:, ia])          # (S, C, K, 3)
+    into = nx * pts[..., 0] + ny * pts[..., 1] - offset              # beyond the edge
+    out_z = np.maximum(bottom - pts[..., 2], pts[..., 2] - top)      # above or below
+    dist = np.where((into >= 0.0) & (out_z <= 0.0), -np.minimum(into, -out_z),
+                    np.hypot(np.maximum(-into, 0.0), np.maximum(out_z, 0.0)))
+    return (radii + _BOARD_CLEARANCE - dist).max(axis=(0, 2))
+
+
 def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
           task: str | None = None, board: tuple[float, float, float] | None = None,
-          obstacles: ObstacleClearance | None = None, strict: bool = False
+          obstacles: ObstacleClearance | None = None, strict: bool = False,
+          furniture: tuple[tuple[float, ...] | None, tuple[float, ...] | None] | None = None
           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Costs of trunk flexion / pelvis drop candidates for hand targets.
 
     A candidate is infeasible when a hand cannot reach its target, or when its posture
     with the hands on the targets (:func:`_contact_poses`) puts a body part through
     another (a low reach with the hand in the thigh) or into the low ``board`` (edge,
-    bottom, top) over the targets, or, with ``obstacles``, when it or the trunk and legs
-    on the way to it come nearer an obstacle than ``_OBSTACLE_CLEARANCE``
-    (:func:`_obstacle_blocked`; unless every candidate does and not ``strict``; where
-    the cheapest candidate is clear the others are not measured).
+    bottom, top) over the targets; unless no candidate keeps out of it (the planner's
+    exact check decides then), when the trunk or legs go into the furniture under the
+    targets (``furniture[0]``, :func:`_support_depth`) or the body into a board over them
+    (``furniture[1]``, (nx, ny, offset, bottom, top), :func:`_slab_depth`); and, with
+    ``obstacles``, when it or the trunk and legs on the way to it come nearer an obstacle
+    than ``_OBSTACLE_CLEARANCE`` (:func:`_obstacle_blocked`; unless every candidate does
+    and not ``strict``; where the cheapest candidate is clear the others are not
+    measured).
 
     Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
     """
@@ -479,6 +534,12 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
         if board is not None:
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
+        under, over = furniture or (None, None)
+        for depth in ([] if under is None else [_support_depth(poses, under, skeleton.stature)]) \
+                + ([] if over is None else [_slab_depth(poses, over, skeleton.stature)]):
+            # The furniture under the targets, then the board over them (a shelf's).
+            if not np.all(blocked | (depth > 0.0)):
+                blocked |= depth > 0.0
         if obstacles is not None and not np.all(blocked):
             free = np.flatnonzero(~blocked)
             # The cheapest candidate first: where it is clear it is the posture (the
@@ -628,9 +689,11 @@ def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray,
 def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
                  task: str, target: np.ndarray,
                  board: tuple[float, float, float] | None = None,
-                 obstacles: ObstacleClearance | None = None) -> tuple[float, float, float]:
+                 obstacles: ObstacleClearance | None = None,
+                 furniture: tuple | None = None) -> tuple[float, float, float]:
     """Trunk flexion, pelvis drop and shift of the cheapest feasible posture (:func:`_grid`)."""
-    P, D, S, cost = _grid(skeleton, st, targets, active, task, board, obstacles)
+    P, D, S, cost = _grid(skeleton, st, targets, active, task, board, obstacles,
+                          furniture=furniture)
     i = int(np.argmin(cost))
     if not np.isfinite(cost[i]):
         raise ValueError(
@@ -826,12 +889,18 @@ def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
     t1, t2, total = times
     if task == "insert":
         push = min(0.5, 0.6 * (t2 - t1))
-        return [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
-                (total, rel_home)], t1 + push
+        keys = [(0.0, rel_home), (t1, rel_pre), (t1 + push, rel_goal), (t2, rel_goal),
+                (total, rel_home)]
+        if level:           # out the straight way it pushed in (PUSH_LEVEL_TASKS)
+            keys.insert(-1, (t2 + (1.0 - _PUSH_IN_AT) * (total - t2), rel_pre))
+        return keys, t1 + push
     if task == "extract":
         pull = min(0.5, 0.6 * (t2 - t1))
-        return [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
-                (total, rel_home)], t2
+        keys = [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
+                (total, rel_home)]
+        if level:           # in the straight way it pulls out (PUSH_LEVEL_TASKS)
+            keys.insert(1, (_PUSH_IN_AT * t1, rel_pre))
+        return keys, t2
     keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
     if task in ("grasp", "release", "move"):
         # Parts rest on surfaces: come down onto a target below the shoulder from
@@ -896,16 +965,44 @@ def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
     return rel
 
 
+def _push_travel(task: str, target: np.ndarray, st: _Start, hand: str,
+                 travel: float | None, path: str,
+                 support: tuple[float, float, float, float] | None) -> tuple[float, bool]:
+    """Length of the straight push of insert or pull of extract, metres: ``travel``
+    (default ``_INSERT_TRAVEL``); on the ``"level"`` path (:data:`PUSH_LEVEL_TASKS`) over
+    furniture (``support``, :func:`_support_depth`), long enough (up to ``_MAX_TRAVEL``)
+    that the push starts and the pull ends ``_BOARD_FRONT`` in front of its edge, where
+    the hand comes from and goes back to the hip without passing under the edge (and
+    extract goes in the same straight way). Also whether the hand takes that level
+    path."""
+    travel = _INSERT_TRAVEL if travel is None else float(travel)
+    if support is None or path != "level" or task not in PUSH_LEVEL_TASKS:
+        return travel, False
+    t = np.asarray(target, dtype=np.float64)
+    targets, active, _ = _hand_targets(task, t, hand)
+    a = targets[active[0]] - st.shoulders[active[0]]
+    a[2] = 0.0
+    a /= max(float(np.linalg.norm(a)), 1e-9)
+    nx, ny, offset, _ = support
+    towards = nx * a[0] + ny * a[1]                   # how fast the push goes in
+    if towards <= 1e-6:
+        return travel, False
+    need = (nx * t[0] + ny * t[1] - offset + _BOARD_FRONT) / towards
+    return float(np.clip(need, travel, _MAX_TRAVEL)), True
+
+
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
                fps: float, path: str = "arc", travel: float | None = None,
                board: tuple[float, float, float] | None = None,
-               obstacles: ObstacleClearance | None = None) -> MotionPrimitive:
+               obstacles: ObstacleClearance | None = None,
+               furniture: tuple | None = None) -> MotionPrimitive:
     H = skeleton.stature
     arm = _arm_length(skeleton)
-    travel = _INSERT_TRAVEL if travel is None else float(travel)
+    travel, pushed = _push_travel(task, target, st, hand, travel, path,
+                                  None if furniture is None else furniture[0])
     board = board if task in LEVEL_PATH_TASKS else None
-    level = (path == "level" or board is not None) and task in LEVEL_PATH_TASKS
+    level = pushed or ((path == "level" or board is not None) and task in LEVEL_PATH_TASKS)
     target = _checked_target(task, target, skeleton)
     targets, active, hand_name = _hand_targets(task, target, hand)
     # insert pushes into the target from a point before it; extract pulls back from it
@@ -917,7 +1014,7 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
         n = np.linalg.norm(a)
         approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
     pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board,
-                                         obstacles)
+                                         obstacles, furniture)
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
     total = t_reach + hold + t_ret
@@ -1002,6 +1099,21 @@ def _check_board(board: tuple[float, float, float]) -> tuple[float, float, float
     if b.shape != (3,) or not np.all(np.isfinite(b)) or not b[1] <= b[2]:
         raise ValueError(f"board must be (edge, bottom, top) with bottom <= top, got {board!r}")
     return float(b[0]), float(b[1]), float(b[2])
+
+
+def _check_furniture(board: tuple | None, support: tuple | None, ceiling: tuple | None
+                     ) -> tuple[tuple[float, ...] | None, tuple | None]:
+    """``board`` (edge, bottom, top), and ``support`` (nx, ny, offset, top) and ``ceiling``
+    (nx, ny, offset, bottom, top) as one pair (None without either), as floats;
+    ValueError if malformed."""
+    board = None if board is None else _check_board(board)
+    out = []
+    for name, value, n in (("support", support, 4), ("ceiling", ceiling, 5)):
+        v = None if value is None else np.asarray(value, dtype=np.float64)
+        if v is not None and (v.shape != (n,) or not np.all(np.isfinite(v))):
+            raise ValueError(f"{name} must be {n} finite numbers, got {value!r}")
+        out.append(None if v is None else tuple(float(x) for x in v))
+    return board, (None if out == [None, None] else tuple(out))
 
 
 def _fmt(target: np.ndarray | None) -> str:
@@ -1240,7 +1352,9 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
                         hand: str = "auto", fps: float = LIBRARY_FPS,
                         path: str = "arc", travel: float | None = None,
                         board: tuple[float, float, float] | None = None,
-                        obstacles: ObstacleClearance | None = None) -> MotionPrimitive:
+                        obstacles: ObstacleClearance | None = None,
+                        support: tuple | None = None, ceiling: tuple | None = None
+                        ) -> MotionPrimitive:
     """A goal primitive for one Table I task, made for the exact target.
 
     Parameters
@@ -1272,25 +1386,24 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         "l_hand" kneels on the left knee.
     fps : float
     path : {"arc", "level"}
-        Hand path of grasp, release and move (:data:`HAND_PATHS`); other tasks ignore it.
+        Hand path of grasp, release and move (:data:`HAND_PATHS`; insert and extract over
+        a ``support``: :data:`PUSH_LEVEL_TASKS`); other tasks ignore it.
     travel : float, optional
-        Length of the straight push of insert and pull of extract, metres (default
-        8 cm; a part deep in a fixture needs a longer pull to come out).
+        Length of insert's straight push and extract's pull, metres (default 8 cm).
     board : (edge, bottom, top), optional
-        A low board over the target of grasp, release or move (start frame: its front
-        edge at x = edge, its underside and top at heights bottom and top, metres): the
-        posture keeps every body part clear of it and the hand takes the level path with
-        its turn point in front of the edge (down there, then in under the board).
+        A low board over the target of grasp, release or move (start frame: front edge
+        at x = edge, underside and top at heights bottom and top, metres): the posture
+        keeps clear of it; the hand comes in level under it from in front of its edge.
     obstacles : ObstacleClearance, optional
-        The obstacles around the worker: a hand task's posture keeps the body clear of
-        them where one does (:func:`_obstacle_blocked`).
+        The obstacles around the worker, kept clear of where a posture does.
+    support, ceiling : (nx, ny, offset, top), (nx, ny, offset, bottom, top), optional
+        The furniture under a hand target and a board over it (:func:`_slab_depth`).
 
     Returns
     -------
     MotionPrimitive
-        ``meta``: ``contact_frame`` (frame where the hand reaches the target / the task's
-        termination condition first holds), ``hand`` (``"l_hand"``, ``"r_hand"``,
-        ``"both"`` or ``"none"``), ``target``, ``hold_frames``, ``posture``.
+        ``meta``: ``contact_frame`` (where the task's termination condition first holds),
+        ``hand`` (l_hand, r_hand, both or none), ``target``, ``hold_frames``, ``posture``.
 
     Raises
     ------
@@ -1303,10 +1416,9 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     if task in HAND_TASKS:
         if travel is not None and not 0.0 < float(travel) <= _MAX_TRAVEL:
             raise ValueError(f"travel must be in (0, {_MAX_TRAVEL}] m, got {travel!r}")
-        if board is not None:
-            board = _check_board(board)
+        board, furniture = _check_furniture(board, support, ceiling)
         return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel,
-                          board, obstacles)
+                          board, obstacles, furniture)
     if task in ("bend", "stoop", "kneel"):
         return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
     if task == "wait":

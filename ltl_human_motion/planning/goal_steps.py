@@ -18,7 +18,11 @@ from collections.abc import Callable
 import numpy as np
 
 from ltl_human_motion.errors import PlanningError
-from ltl_human_motion.motion.goals import HAND_PATHS, LEVEL_PATH_TASKS
+from ltl_human_motion.motion.goals import (
+    HAND_PATHS,
+    LEVEL_PATH_TASKS,
+    PUSH_LEVEL_TASKS,
+)
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import SearchBudget
@@ -35,11 +39,13 @@ from ltl_human_motion.planning.plan_state import (
 from ltl_human_motion.planning.standing import (
     SQUARE_BOARD_HEIGHT,
     board_local,
+    ceiling_local,
     ideal_placement,
     low_board,
     posture_clearance,
     pull_length,
     release_targets,
+    support_local,
 )
 from ltl_human_motion.planning.steps import StepExecutor
 from ltl_human_motion.planning.walk_goals import WalkGoals
@@ -159,11 +165,9 @@ class GoalSteps:
             kwargs["hand"] = hand
         if kind == "extract" and part is not None and container is not None:
             kwargs["travel"] = self.pull_length(part, container)
-        board = board_local(self.ctx.cell, target, local, yaw,
-                            self.ctx.stature) if local is not None \
-            and kind in LEVEL_PATH_TASKS and not seated else None
-        if board is not None:
-            kwargs["board"] = board
+        furniture = self.furniture(kind, target, local) if not seated else {}
+        kwargs.update(furniture)
+        board = furniture.get("board")
         if kind in HAND_TASKS and not seated and self.ctx.cell.obstacles:   # the body clear
             kwargs["obstacles"] = posture_clearance(self.ctx, self.state.pose)
         hand_fixed = "hand" in kwargs
@@ -176,7 +180,7 @@ class GoalSteps:
         blocked: list[MotionPrimitive] = []
         attempts = self.ctx.options.goal_attempts if attempts is None else attempts
         for attempt in range(attempts):
-            if kind in LEVEL_PATH_TASKS:
+            if kind in LEVEL_PATH_TASKS or (kind in PUSH_LEVEL_TASKS and "support" in kwargs):
                 # Every other try comes in level (over a shelf board, under the one above).
                 kwargs["path"] = HAND_PATHS[attempt % len(HAND_PATHS)]
             try:
@@ -206,6 +210,31 @@ class GoalSteps:
         self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
         self.state.gait_state = None
         return seg, mp
+
+    def furniture(self, kind: str, target: np.ndarray | None, local: np.ndarray | None
+                  ) -> dict:
+        """The furniture the goal primitive of ``kind`` for ``target`` (world (3,);
+        ``local``: in the start frame) keeps the body clear of, as its keyword arguments:
+        a low board over the target (``board``, :func:`.standing.board_local`), else any
+        board over it (``ceiling``, :func:`.standing.ceiling_local`), and what the target
+        rests on or in (``support``, :func:`.standing.support_local`)."""
+        out: dict = {}
+        if local is None:
+            return out
+        yaw = self.state.pose[2]
+        if kind in LEVEL_PATH_TASKS:
+            board = board_local(self.ctx.cell, target, local, yaw, self.ctx.stature)
+            if board is not None:
+                out["board"] = board
+        if kind in HAND_TASKS:
+            support = support_local(self.ctx.cell, target, local, yaw)
+            if support is not None:
+                out["support"] = support
+            if "board" not in out:
+                ceiling = ceiling_local(self.ctx.cell, target, local, yaw)
+                if ceiling is not None:
+                    out["ceiling"] = ceiling
+        return out
 
     def first_clear_try(self, i: int, text: str, kind: str, args: tuple[str, ...],
                         tries: list, carrying_before: bool
@@ -321,6 +350,9 @@ class GoalSteps:
         desc = f"reach {text} at ({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})"
         goal, back = self.goals.reach(target, placement, desc, text, sector=sector,
                                       stand_yaw=stand_yaw)
+        if sector is None and stand_yaw is None and self.state.seat is None:
+            # (From a side or facing a board, the alternatives walk round instead.)
+            self.executor.step_towards(target, placement, back)
         walked = self.executor.walk(goal, text, -1, carry=self.state.carrying, budget=budget)
         if not self.executor.adjust_to(target, placement, text, back, stand_yaw):
             # No clear step from where the walk ended: walk on to a spot that needs

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ltl_human_motion.motion.automaton import REFERENCE_STATURE
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive
 from ltl_human_motion.planning.blend import PlacedSegment
@@ -85,6 +86,29 @@ class PlanContext:
     def stature(self) -> float:
         """The worker's stature, metres."""
         return float(self.library.skeleton.stature)
+
+    @property
+    def body_scale(self) -> float:
+        """How much more floor room the worker's body needs than the reference worker's
+        (``REFERENCE_STATURE``, for whom ``PlannerOptions.stand_clearance`` and
+        ``turn_clearance`` were set): ``stature / REFERENCE_STATURE``, at least 1. A tall
+        worker's knees come further forward as it turns or steps and its hanging hands
+        reach bench height (a 1.95 m worker turning 87 degrees 0.27 m from a table put
+        its thigh 5 cm into the top); a short worker keeps the reference room."""
+        return max(1.0, self.stature / REFERENCE_STATURE)
+
+    @property
+    def stand_room(self) -> float:
+        """Floor clearance of the spot a goal primitive starts from for this worker,
+        metres (``options.stand_clearance`` scaled by :attr:`body_scale`)."""
+        return float(self.options.stand_clearance) * self.body_scale
+
+    @property
+    def turn_room(self) -> float:
+        """Floor clearance a walk must end with to turn there by more than the heading
+        tolerance for this worker, metres (``options.turn_clearance`` scaled by
+        :attr:`body_scale`)."""
+        return float(self.options.turn_clearance) * self.body_scale
 
     def stance(self, carrying: bool) -> np.ndarray:
         """The standing pose (J, 3), root-relative: arms down, or in the carry stance."""

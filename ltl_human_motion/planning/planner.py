@@ -104,10 +104,12 @@ class PlannerOptions:
         the spot covers the rest (like the analytic expansion of hybrid A*).
     turn_clearance : float
         Floor clearance a walk must end with to turn there by more than the heading
-        tolerance, metres.
+        tolerance, metres, for the 1.75 m reference worker (a taller one needs
+        proportionally more: :attr:`.plan_state.PlanContext.turn_room`).
     stand_clearance : float
         Floor clearance of the spot a goal primitive starts from (hips and a slight
-        forward lean need more room than the walking legs), metres.
+        forward lean need more room than the walking legs), metres, for the 1.75 m
+        reference worker (:attr:`.plan_state.PlanContext.stand_room`).
     max_step_back : float
         How much further from the target than the preferred reach the worker may stand
         when an obstacle (a bench) is in the way; the goal primitive leans further.

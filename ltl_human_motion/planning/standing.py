@@ -102,10 +102,7 @@ def board_local(cell, target: np.ndarray, local: np.ndarray, yaw: float, stature
     low = low_board(cell, target, stature, below=SQUARE_BOARD_HEIGHT)
     if low is None:
         return None
-    c, s = math.cos(-yaw), math.sin(-yaw)
-    n = np.array([c * low[3][0] - s * low[3][1], s * low[3][0] + c * low[3][1]])
-    edge = float(local[0]) + low[0] * n[0] - BOARD_EDGE_SPAN * abs(n[1])
-    return edge, low[1], low[2]
+    return _edge_local(low[0], low[3], local, yaw), low[1], low[2]
 
 
 def posture_clearance(ctx: PlanContext, pose: Pose
@@ -186,7 +183,7 @@ def ideal_placement(ctx: PlanContext, target: np.ndarray, placement: tuple[float
     px = target[0] - (c[..., None] * (d + back) - s[..., None] * lat)
     py = target[1] - (s[..., None] * (d + back) + c[..., None] * lat)
     pts = np.stack([px, py], axis=-1).reshape(-1, 2)
-    free = ctx.stand_map(pts).reshape(px.shape) > ctx.options.stand_clearance
+    free = ctx.stand_map(pts).reshape(px.shape) > ctx.stand_room
     k = np.argmax(free, axis=-1)
     pick = np.take_along_axis
     out = (pick(px, k[..., None], -1)[..., 0], pick(py, k[..., None], -1)[..., 0], yaw,
@@ -195,6 +192,69 @@ def ideal_placement(ctx: PlanContext, target: np.ndarray, placement: tuple[float
         return out
     walk_map = ctx.clearance if walk_map is None else walk_map
     return (*out, walk_map(np.stack([x, y], axis=-1).reshape(-1, 2)).reshape(np.shape(x)))
+
+
+def _edge_local(depth: float, normal: np.ndarray, local: np.ndarray, yaw: float) -> float:
+    """The x (start frame of a goal primitive whose heading is ``yaw``; ``local``: the
+    target in it, (3,)) of the nearest edge of a part the target lies ``depth`` metres
+    behind, with outward ``normal`` (2,) (world), within ``BOARD_EDGE_SPAN`` either side
+    of the target."""
+    c, s = math.cos(-yaw), math.sin(-yaw)
+    n = np.array([c * normal[0] - s * normal[1], s * normal[0] + c * normal[1]])
+    return float(local[0]) + depth * float(n[0]) - BOARD_EDGE_SPAN * abs(float(n[1]))
+
+
+def support_local(cell, target: np.ndarray, local: np.ndarray, yaw: float
+                  ) -> tuple[float, float, float, float] | None:
+    """The furniture under ``target`` (world (3,); ``local``: it in the start frame of
+    the goal primitive, whose heading is ``yaw``) as the goal primitive keeps the trunk
+    and legs out of it: the obstacle part under the target (its footprint holds the
+    target's floor point, its top is no higher than the target) whose nearest edge is
+    nearest the worker, as the half space beyond that edge, (nx, ny, offset, top) (see
+    :func:`~ltl_human_motion.motion.goals.make_goal_primitive`); None if there is none."""
+    xy = np.asarray(target[:2], dtype=np.float64)
+    probe = xy + np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
+    c, s = math.cos(-yaw), math.sin(-yaw)
+    best = None
+    for ob in cell.obstacles:
+        for part in ob.parts:
+            top = float(part.aabb()[1][2])
+            sd = part.footprint().signed_distance(probe)
+            if top > float(target[2]) or sd[0] > 0.0:
+                continue
+            grad = (sd[1:] - sd[0]) / max(float(np.linalg.norm(sd[1:] - sd[0])), 1e-12)
+            inward = -np.array([c * grad[0] - s * grad[1], s * grad[0] + c * grad[1]])
+            # The edge lies -sd metres from the target along the outward normal.
+            offset = float(inward @ np.asarray(local[:2], dtype=np.float64)) + float(sd[0])
+            if best is None or (offset, -top) < (best[2], -best[3]):
+                best = (float(inward[0]), float(inward[1]), offset, top)
+    return best
+
+
+def ceiling_local(cell, target: np.ndarray, local: np.ndarray, yaw: float
+                  ) -> tuple[float, float, float, float, float] | None:
+    """The board over ``target`` (world (3,); ``local``: it in the start frame of the
+    goal primitive, whose heading is ``yaw``) as the goal primitive keeps the body out of
+    it: the lowest obstacle part above the target (its footprint holds the target's
+    floor point, its underside is higher than the target) as the slab beyond its nearest
+    edge, (nx, ny, offset, bottom, top) (see
+    :func:`~ltl_human_motion.motion.goals.make_goal_primitive`); None if there is none."""
+    xy = np.asarray(target[:2], dtype=np.float64)
+    probe = xy + np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
+    c, s = math.cos(-yaw), math.sin(-yaw)
+    best = None
+    for ob in cell.obstacles:
+        for part in ob.parts:
+            lo, hi = part.aabb()
+            sd = part.footprint().signed_distance(probe)
+            if float(lo[2]) <= float(target[2]) or sd[0] > 0.0 \
+                    or (best is not None and float(lo[2]) >= best[3]):
+                continue
+            grad = (sd[1:] - sd[0]) / max(float(np.linalg.norm(sd[1:] - sd[0])), 1e-12)
+            inward = -np.array([c * grad[0] - s * grad[1], s * grad[0] + c * grad[1]])
+            offset = float(inward @ np.asarray(local[:2], dtype=np.float64)) + float(sd[0])
+            best = (float(inward[0]), float(inward[1]), offset, float(lo[2]), float(hi[2]))
+    return best
 
 
 def palm_clear_of_support(cell, stature: float, point: np.ndarray, part) -> np.ndarray:

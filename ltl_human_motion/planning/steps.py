@@ -83,6 +83,10 @@ ADJUST_BACKS: tuple[float, ...] = (0.0, 0.05, 0.1, 0.15)
 #: A standing adjustment shorter than this (metres, radians) is not made: the worker
 #: already stands where the goal primitive reaches from.
 ADJUST_STILL = (0.02, 0.05)
+#: How far from the ideal placement (in adjust radii) a worker standing still takes a
+#: model-made step towards it before walking (:meth:`StepExecutor.step_towards`): two
+#: steps reach it, where a 1.95 m worker's gait start and stop (0.5 m each) overshoot.
+STEP_TOWARDS_REACH = 2.0
 #: The gait index's step straight back (metres ahead, left), the first step tried to
 #: get room in front (:meth:`StepExecutor.step_back`).
 GAIT_STEP_BACK = [-0.3, 0.0]
@@ -350,6 +354,10 @@ class StepExecutor:
         the path it returns is then checked as the verifier does (exact capsules, held
         parts). A primitive that collides is forbidden from its pose and the search runs
         again (at most ``WALK_REPAIRS`` times)."""
+        # A step of the same task (a grasp at a rack, then the step back its arms needed)
+        # may have left the worker where no walk may start.
+        if self.state.seat is None:
+            self.step_out()
         forbidden: set[tuple[int, int, int, int]] = set()
         noise_state = self.ctx.rng.bit_generator.state
         budget = budget or self.ctx.options.budget
@@ -389,11 +397,15 @@ class StepExecutor:
             if res.reason == "budget":
                 why = (f"the search budget ran out ({used} nodes; closest approach "
                        f"{res.closest:.2f} m)")
+            elif res.reason == "no_stop":
+                why = (f"the search reached the goal's neighbourhood but no place to stop "
+                       f"there keeps the body clear and passes the goal test ({used} nodes)")
             else:
                 why = (f"obstacles block every way to the target (searched {res.expanded} "
                        f"placements; closest approach {res.closest:.2f} m)")
+            # No stop at the goal is a blocked goal (the caller may try other placements).
             raise PlanningError(f"task {task}: {goal.description}: {why}", task=task,
-                                reason=res.reason)
+                                reason="blocked" if res.reason == "no_stop" else res.reason)
         for prim_id, pose in zip(res.primitives, res.poses):
             self.add(self.ctx.index.primitives[prim_id], pose, label, self.ctx.overlap)
         if res.primitives:
@@ -416,6 +428,35 @@ class StepExecutor:
         stops = np.flatnonzero(self.ctx.index.stops & ~self.ctx.index.standing).tolist()
         return {(int(p), i + di, j + dj, k) for p in stops
                 for di in (-1, 0, 1) for dj in (-1, 0, 1)}
+
+    def step_towards(self, target: np.ndarray, placement: tuple[float, float],
+                     back_limit: float, stand_yaw: float | None = None) -> bool:
+        """Where the ideal placement for ``target`` (:func:`.standing.ideal_placement`) is
+        further than ``options.adjust_radius`` but within ``STEP_TOWARDS_REACH`` of it, a
+        model-made step of ``adjust_radius`` straight towards it (no turn), if clear: the
+        gait's shortest start and stop overshoot a spot this near (a 1.95 m worker's
+        stop strides 0.5 m). Returns whether it stepped."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        x, y, yaw = self.state.pose
+        px, py, _, free = (float(v[0]) for v in ideal_placement(
+            self.ctx, target, placement, np.array([x]), np.array([y]), back_limit,
+            stand_yaw=stand_yaw))
+        reach = self.ctx.options.adjust_radius
+        far = math.hypot(px - x, py - y)
+        if not free or not reach < far <= STEP_TOWARDS_REACH * reach:
+            return False
+        c, s = math.cos(yaw), math.sin(yaw)
+        k = reach / far
+        dx, dy = k * (c * (px - x) + s * (py - y)), k * (-s * (px - x) + c * (py - y))
+        lib = self.ctx.library
+        mp = make_step_primitive(self.ctx.stance(self.state.carrying), lib.standing_height,
+                                 dx, dy, 0.0, lib.skeleton, lib.fps,
+                                 "carry" if self.state.carrying else "walk")
+        if not self.placed_clear(mp, self.state.pose):
+            return False
+        self.add(mp, self.state.pose, -1, self.ctx.overlap)
+        self.state.pose = self.hand_over_pose(mp, self.state.pose)
+        return True
 
     def adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str,
                   back_limit: float, stand_yaw: float | None = None) -> bool:

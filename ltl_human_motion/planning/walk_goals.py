@@ -191,7 +191,7 @@ class WalkGoals:
             r = np.hypot(tx - xy[:, 0], ty - xy[:, 1])
             out = (r >= dist - tol) & (r <= dist + limit[0]) & side(xy[:, 0], xy[:, 1])
             # The floor clearance only where the distance fits (few of the cells).
-            out[out] = self.ctx.stand_map(xy[out]) > self.ctx.options.stand_clearance
+            out[out] = self.ctx.stand_map(xy[out]) > self.ctx.stand_room
             return out
 
         def near_ring(xy: np.ndarray, clearance=None) -> np.ndarray:
@@ -205,7 +205,7 @@ class WalkGoals:
         # no such place (a tall worker at a bench) stand up to max_step_back further.
         def ring_key() -> tuple:
             return ("ring", tx, ty, dist, tol, float(limit[0]),
-                    float(self.ctx.options.stand_clearance), sector)
+                    self.ctx.stand_room, sector)
 
         limit = [tol]                    # how much further back than ideal, per field
 
@@ -227,7 +227,7 @@ class WalkGoals:
                                                          room=True, walk_map=walk_map,
                                                          stand_yaw=stand_yaw)
             # Turning on the spot needs room for the hips; facing nearly right needs none.
-            room = here > self.ctx.options.turn_clearance
+            room = here > self.ctx.turn_room
             facing = np.abs(wrap_angle(pyaw - yaw)) <= self.ctx.options.heading_tolerance
             out = free & (np.hypot(px - x, py - y) <= adjust) & (room | facing) & side(x, y)
             if stand_yaw is not None:
@@ -253,7 +253,7 @@ class WalkGoals:
         carrying = self.state.carrying
         entry = RegionEntry(region, self.ctx.stance(carrying), self.ctx.library.standing_height,
                             stature, float(capsule_radii(stature).max()))
-        room = self.ctx.options.turn_clearance
+        room = self.ctx.turn_room
 
         def cells(xy: np.ndarray, clearance: Callable[[np.ndarray], np.ndarray]
                   ) -> np.ndarray:
