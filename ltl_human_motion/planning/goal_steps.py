@@ -38,6 +38,7 @@ from ltl_human_motion.planning.standing import (
     low_board,
     pull_length,
     release_targets,
+    standing_offset,
 )
 from ltl_human_motion.planning.steps import StepExecutor
 from ltl_human_motion.planning.walk_goals import WalkGoals
@@ -53,11 +54,15 @@ SEATED_WAIT_SECONDS = 2.0
 ALTERNATIVE_ATTEMPTS = 2
 
 #: Other ways to stand for a reach whose motions all hit an obstacle, in order: (turn of
-#: the approach direction about the target, rad; extra distance from the target, m).
-#: First a step further back (a knee or thigh at a desk or low shelf front), then the
-#: target's other sides (an arm hitting a crate beside it).
-ALTERNATE_APPROACHES: tuple[tuple[float, float], ...] = (
-    (0.0, 0.08), (math.pi / 3, 0.0), (-math.pi / 3, 0.0))
+#: the approach direction about the target, rad; extra distance from the target, m;
+#: whether the other hand reaches). First a step further back (a knee or thigh at a desk
+#: or low shelf front), then the other hand from the placement mirrored across the
+#: target (the body beside the target on its other side: a floor part next to a cart
+#: the stooping head and shoulder hit), then the target's other sides (an arm hitting a
+#: crate beside it).
+ALTERNATE_APPROACHES: tuple[tuple[float, float, bool], ...] = (
+    (0.0, 0.08, False), (0.0, 0.0, True), (math.pi / 3, 0.0, False),
+    (-math.pi / 3, 0.0, False))
 
 #: Node budget of the walk to an alternative approach (most are a few steps round the
 #: target; a side that needs a long way round is not worth the search).
@@ -85,6 +90,10 @@ IN_PLACE_TASKS = ("bend", "stoop", "kneel", "wait")
 #: Floor clearance around the root a kneel or stoop needs, metres (the knee goes about
 #: 0.5 m ahead of the root and the head as far when stooping, plus a hand's width).
 IN_PLACE_ROOM = 0.6
+
+#: Tasks whose goal primitive reaches with whichever hand the target is on the side of
+#: (the planner's placement decides; both hands or a named hand otherwise).
+ONE_HAND_AUTO_TASKS = ("grasp", "release", "move", "insert", "extract")
 
 #: Stride of the frames on which the planner checks that an extract takes its part out.
 EXTRACT_CHECK_STRIDE = 4
@@ -128,6 +137,64 @@ class GoalSteps:
         it; for extract, the part taken out of ``container``). A grasp or extract while
         one hand holds a part is done by the other hand.
         """
+        local, kwargs, board = self.goal_kwargs(kind, target, carry_stance, seconds,
+                                                grasped, part, container)
+        seated = self.state.seat is not None and kind != "standUp"
+        hand_fixed = "hand" in kwargs
+        mp = None
+        kept_in = 0
+        switched = None          # the hand tried first, after switching to the other one
+        attempts = self.ctx.options.goal_attempts if attempts is None else attempts
+        for attempt in range(attempts):
+            if kind in LEVEL_PATH_TASKS:
+                # Every other try comes in level (over a shelf board, under the one above).
+                kwargs["path"] = HAND_PATHS[attempt % len(HAND_PATHS)]
+            try:
+                candidate = self.executor.sit_still(kwargs.get("duration", SEATED_WAIT_SECONDS)) \
+                    if seated and kind == "wait" else self.ctx.library.goal(kind, local, **kwargs)
+            except ValueError as exc:
+                if switched:
+                    # The placement put the target within the first hand's reach, not
+                    # necessarily the other's (a low part to the right): keep the first.
+                    kwargs["hand"], switched = switched, None
+                    continue
+                raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
+                                    f"target: {exc}", task=text, reason="unreachable") from None
+            clear = self.goal_clear(candidate, grasped)
+            if clear and kind == "extract" and part is not None and container is not None \
+                    and not self.pulls_out(candidate, part, container):
+                kept_in += 1
+                clear = False
+            if clear:
+                mp = candidate
+                break
+            if attempt == 1 and kind in ("grasp", "release") and not hand_fixed \
+                    and board is None:
+                other = OTHER_HAND.get(candidate.meta.get("hand"))
+                if other:
+                    kwargs["hand"], switched = other, candidate.meta.get("hand")
+        if mp is None and kept_in:
+            raise PlanningError(f"task {text}: {kept_in} of the {attempts} {kind} motions "
+                                f"tried keep {part} in {container} (the hand does not take "
+                                "it out far enough from where the worker stands), the others "
+                                "run into an obstacle", task=text, reason="blocked")
+        if mp is None:
+            raise PlanningError(f"task {text}: every {kind} motion tried "
+                                f"({attempts}) runs into an obstacle; "
+                                "an obstacle blocks the reach", task=text, reason="blocked")
+        seg = self.executor.add(mp, self.state.pose, label, self.ctx.overlap)
+        self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
+        self.state.gait_state = None
+        return seg, mp
+
+    def goal_kwargs(self, kind: str, target: np.ndarray | None, carry_stance: bool,
+                    seconds: float | None, grasped: str | None, part: str | None,
+                    container: str | None
+                    ) -> tuple[np.ndarray | None, dict, tuple[float, float, float] | None]:
+        """What :meth:`segment` makes its primitives from: the target in the start frame
+        (3,) (None without one), the goal model's keyword arguments (start pose, hand,
+        extract travel, low board, wait duration) and the low board (edge, underside,
+        top) over the target, or None."""
         x, y, yaw = self.state.pose
         local = None
         if target is not None:
@@ -148,50 +215,11 @@ class GoalSteps:
             and kind in LEVEL_PATH_TASKS and not seated else None
         if board is not None:
             kwargs["board"] = board
-        hand_fixed = "hand" in kwargs
         if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
             kwargs["duration"] = (seconds + (2 * self.ctx.overlap + WAIT_EXTRA_FRAMES)
                                   / self.ctx.library.fps)
-        mp = None
-        kept_in = 0
-        attempts = self.ctx.options.goal_attempts if attempts is None else attempts
-        for attempt in range(attempts):
-            if kind in LEVEL_PATH_TASKS:
-                # Every other try comes in level (over a shelf board, under the one above).
-                kwargs["path"] = HAND_PATHS[attempt % len(HAND_PATHS)]
-            try:
-                candidate = self.executor.sit_still(kwargs.get("duration", SEATED_WAIT_SECONDS)) \
-                    if seated and kind == "wait" else self.ctx.library.goal(kind, local, **kwargs)
-            except ValueError as exc:
-                raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
-                                    f"target: {exc}", task=text, reason="unreachable") from None
-            clear = self.goal_clear(candidate, grasped)
-            if clear and kind == "extract" and part is not None and container is not None \
-                    and not self.pulls_out(candidate, part, container):
-                kept_in += 1
-                clear = False
-            if clear:
-                mp = candidate
-                break
-            if attempt == 1 and kind in ("grasp", "release") and not hand_fixed \
-                    and board is None:
-                other = OTHER_HAND.get(candidate.meta.get("hand"))
-                if other:
-                    kwargs["hand"] = other
-        if mp is None and kept_in:
-            raise PlanningError(f"task {text}: {kept_in} of the {attempts} {kind} motions "
-                                f"tried keep {part} in {container} (the hand does not take "
-                                "it out far enough from where the worker stands), the others "
-                                "run into an obstacle", task=text, reason="blocked")
-        if mp is None:
-            raise PlanningError(f"task {text}: every {kind} motion tried "
-                                f"({attempts}) runs into an obstacle; "
-                                "an obstacle blocks the reach", task=text, reason="blocked")
-        seg = self.executor.add(mp, self.state.pose, label, self.ctx.overlap)
-        self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
-        self.state.gait_state = None
-        return seg, mp
+        return local, kwargs, board
 
     def first_clear_try(self, i: int, text: str, kind: str, args: tuple[str, ...],
                         tries: list, carrying_before: bool
@@ -244,13 +272,15 @@ class GoalSteps:
         if placement is None:
             return [(target, None)]
         first = math.atan2(self.state.pose[1] - target[1], self.state.pose[0] - target[0])
+        mirrored = self.other_hand_placement(kind, args, target, placement, text)
 
-        def approach(turn: float, back: float) -> int:
+        def approach(turn: float, back: float, other: bool) -> int:
             lowered = raised and not self.state.held
             if lowered:
                 self.executor.arm_transition(True, -1)
             self.executor.step_out()            # the first try may have left the worker at a rack
-            walked = self.approach(target, (placement[0] + back, placement[1]), text,
+            d, lat = mirrored if other else placement
+            walked = self.approach(target, (d + back, lat), text,
                                     sector=(first + turn, APPROACH_HALF_WIDTH),
                                     budget=SearchBudget(ALTERNATIVE_NODES))
             if lowered:
@@ -258,8 +288,24 @@ class GoalSteps:
             return walked
 
         return [(target, None)] + [
-            (target, functools.partial(approach, turn, back))
-            for turn, back in ALTERNATE_APPROACHES]
+            (target, functools.partial(approach, turn, back, other))
+            for turn, back, other in ALTERNATE_APPROACHES if mirrored is not None or not other]
+
+    def other_hand_placement(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                             placement: tuple[float, float], text: str
+                             ) -> tuple[float, float] | None:
+        """Where ``target`` (3,) is in the standing root's frame for the other hand than
+        the one ``placement`` (ahead, left) is for (:func:`.standing.standing_offset`, the
+        goal model's reach for that hand), if the task leaves the hand free; else None."""
+        if placement[1] == 0.0 or kind not in ONE_HAND_AUTO_TASKS \
+                or acting_hand(self.state, kind, args[0] if args else None) is not None:
+            return None
+        hand = "l_hand" if placement[1] < 0.0 else "r_hand"
+        try:
+            return standing_offset(self.ctx, kind, target, text, hand,
+                                   carry_stance=self.state.carrying)
+        except PlanningError:
+            return None
 
     def approach(self, target: np.ndarray, placement: tuple[float, float], text: str,
                  sector: tuple[float, float] | None = None,
