@@ -85,6 +85,11 @@ _LOW_REACH_WIDE = 0.05
 HAND_PATHS: tuple[str, ...] = ("arc", "level")
 #: Tasks whose hand may take the level path (the palm comes in over a support).
 LEVEL_PATH_TASKS: tuple[str, ...] = ("grasp", "release", "move")
+#: Tasks whose hands may take the level path into a region (no part to come down onto):
+#: the palms rise near the body to the target's height and come in over a bench top or
+#: table edge below it instead of swinging up through its front (a short worker's hands
+#: in the carry stance, and a part held in them, are below a 0.92 m bench top).
+LEVEL_REGION_TASKS: tuple[str, ...] = ("assemble", "leftHand", "rightHand")
 #: Horizontal distance from the shoulder of the level path's turn point, fraction of
 #: stature (0.12 m at 1.75 m: in front of the chest, behind the front edge of a shelf the
 #: worker stands at, also one overhead).
@@ -731,6 +736,9 @@ def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
         return [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
                 (total, rel_home)], t2
     keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
+    if level and task in LEVEL_REGION_TASKS:
+        return _level_keys(targets, active, sh1, rel_home, rel_goal, 0.0, t1, t2, total, H,
+                           arm), t1
     if task in ("grasp", "release", "move"):
         # Parts rest on surfaces: come down onto a target below the shoulder from
         # _APPROACH_LIFT above it, and lift off the same way.
@@ -802,7 +810,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     arm = _arm_length(skeleton)
     travel = _INSERT_TRAVEL if travel is None else float(travel)
     board = board if task in LEVEL_PATH_TASKS else None
-    level = (path == "level" or board is not None) and task in LEVEL_PATH_TASKS
+    level = (path == "level" or board is not None) and task in LEVEL_PATH_TASKS \
+        or path == "level" and task in LEVEL_REGION_TASKS
     target = _checked_target(task, target, skeleton)
     targets, active, hand_name = _hand_targets(task, target, hand)
     # insert pushes into the target from a point before it; extract pulls back from it

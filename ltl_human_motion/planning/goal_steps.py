@@ -18,7 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ltl_human_motion.errors import PlanningError
-from ltl_human_motion.motion.goals import HAND_PATHS, LEVEL_PATH_TASKS
+from ltl_human_motion.motion.goals import HAND_PATHS, LEVEL_PATH_TASKS, LEVEL_REGION_TASKS
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import SearchBudget
@@ -146,8 +146,9 @@ class GoalSteps:
         switched = None          # the hand tried first, after switching to the other one
         attempts = self.ctx.options.goal_attempts if attempts is None else attempts
         for attempt in range(attempts):
-            if kind in LEVEL_PATH_TASKS:
-                # Every other try comes in level (over a shelf board, under the one above).
+            if kind in LEVEL_PATH_TASKS + LEVEL_REGION_TASKS:
+                # Every other try comes in level (over a shelf board, under the one above;
+                # over a bench top into the region above it).
                 kwargs["path"] = HAND_PATHS[attempt % len(HAND_PATHS)]
             try:
                 candidate = self.executor.sit_still(kwargs.get("duration", SEATED_WAIT_SECONDS)) \
