@@ -299,6 +299,13 @@ class _Start:
         self.hand_dir = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
         self.elbow_pole = np.stack([p0[_J["l_elbow"]], p0[_J["r_elbow"]]]) - self.shoulders
         self.knee_pole = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+        self.seated = bool(p0[0, 2] < SEATED_PELVIS_MAX * skeleton.stature)
+
+
+#: A start pose whose pelvis is lower than this fraction of the stature is seated: above
+#: the highest seat (0.34 H, :func:`seat_height_range`) by the pelvis joint's 0.085 H over
+#: the seat (0.15 m at 1.75 m, measured on the sit model), below the standing 0.53 H.
+SEATED_PELVIS_MAX = 0.45
 
 
 def _support_x(ankles: np.ndarray, toes: np.ndarray, stature: float) -> tuple[float, float]:
@@ -316,6 +323,10 @@ def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
     T = pelvis.shape[0]
     shift = np.zeros(T)
     lo, hi = _support_x(st.ankles, st.toes, skeleton.stature)
+    if st.seated:
+        # The seat bears the weight: the centre of mass may be anywhere from over it to
+        # the feet (sliding the pelvis forward on it pushes the knees into a desk).
+        lo = min(lo, float(st.pelvis[0]))
     for _ in range(3):
         pel = pelvis.copy()
         pel[:, 0] += shift

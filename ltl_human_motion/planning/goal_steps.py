@@ -186,6 +186,10 @@ class GoalSteps:
         seg = self.executor.add(mp, self.state.pose, label, self.ctx.overlap)
         self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
         self.state.gait_state = None
+        if kind == "standUp" and not np.array_equal(kwargs["start_pose"],
+                                                    self.ctx.stance(self.state.carrying)):
+            # Sat down holding a part that a seated task used up (or the other way round).
+            self.executor.arm_transition(not self.state.carrying, label)
         return seg, mp
 
     def goal_kwargs(self, kind: str, target: np.ndarray | None, carry_stance: bool,
@@ -203,6 +207,10 @@ class GoalSteps:
             dx, dy = target[0] - x, target[1] - y
             local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
         seated = self.state.seat is not None and kind != "standUp"
+        if kind == "standUp" and self.state.seat is not None:
+            # Stand up with the arms as they are on the seat (:meth:`segment` brings them
+            # to the stance of what the hands hold afterwards).
+            carry_stance = self.executor.seated_in_carry_stance()
         kwargs = {"rng": self.ctx.rng,
                   "start_pose": self.executor.seated_pose() if seated
                   else self.ctx.stance(self.state.carrying or carry_stance)}

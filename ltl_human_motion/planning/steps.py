@@ -184,6 +184,21 @@ class StepExecutor:
         dx, dy = last[:, 0] - x, last[:, 1] - y
         return np.stack([c * dx - s * dy, s * dx + c * dy, last[:, 2]], axis=-1)
 
+    def seated_in_carry_stance(self) -> bool:
+        """Whether the seated worker's arms are in the carry stance (the stance nearer the
+        last frame's hands relative to the shoulders; the seat keeps the stance the worker
+        sat down in, also after a seated task took the part out of the hands)."""
+        last = self.state.segments[-1].positions[-1]
+        hands = [JOINT_INDEX[n] for n in ("l_hand", "r_hand")]
+        shoulders = [JOINT_INDEX[n] for n in ("l_shoulder", "r_shoulder")]
+
+        def offset(pose: np.ndarray) -> np.ndarray:
+            return np.linalg.norm(pose[hands] - pose[shoulders], axis=-1)
+
+        seated = offset(np.asarray(last))
+        return bool(np.sum(np.abs(offset(self.ctx.stance(True)) - seated))
+                    < np.sum(np.abs(offset(self.ctx.stance(False)) - seated)))
+
     def arm_transition(self, carrying_before: bool, label: int) -> None:
         """Bring the arms from the walk stance to the carry stance or back.
 
