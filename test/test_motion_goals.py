@@ -172,7 +172,7 @@ def test_a_seated_reach_keeps_the_pelvis_on_the_seat() -> None:
     does not slide the pelvis (and the knees with it) forward towards the feet, where
     they went into the desk front (seats/job/seated_assembly)."""
     seat = np.array([reach_placement("sit", 0.45, SK)[0], 0.0, 0.45])
-    sit, w = _make("sit", seat)
+    _sit, w = _make("sit", seat)
     seated = w[-1] - np.array([w[-1, 0, 0], w[-1, 0, 1], 0.0])
     for path in ("arc", "level"):
         mp, wa = _make("assemble", [0.6, -0.05, 0.9], start_pose=seated, path=path)

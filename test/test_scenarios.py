@@ -301,6 +301,9 @@ FIXED_FAMILY_RUNS = {
     ("seats/job/fetch_then_sit", 1.75, 1): "standUp:seated_stance",
     # the other hand's try ended the step as out of reach; the mirrored placement
     ("under_shelf/single/grasp(O1)", 1.95, 0): "grasp:switched_hand",
+    # every place to let go around a short worker at the shelf was in it: from a roomy spot
+    ("bench_assembly/single/release(O1)", 1.55, 0): "release:at_the_shelf",
+    ("paper_frame/single/release(O1)", 1.55, 1): "release:at_the_shelf",
     # a hand swung into a crate between the search's samples
     ("cluttered/single/assemble(R2)", 1.95, 0): "walk:between_samples",
     ("cluttered/single/grasp(O1)", 1.95, 0): "walk:between_samples",

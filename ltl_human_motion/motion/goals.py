@@ -821,8 +821,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     arm = _arm_length(skeleton)
     travel = _INSERT_TRAVEL if travel is None else float(travel)
     board = board if task in LEVEL_PATH_TASKS else None
-    level = (path == "level" or board is not None) and task in LEVEL_PATH_TASKS \
-        or path == "level" and task in LEVEL_REGION_TASKS
+    level = ((path == "level" or board is not None) and task in LEVEL_PATH_TASKS) \
+        or (path == "level" and task in LEVEL_REGION_TASKS)
     target = _checked_target(task, target, skeleton)
     targets, active, hand_name = _hand_targets(task, target, hand)
     # insert pushes into the target from a point before it; extract pulls back from it

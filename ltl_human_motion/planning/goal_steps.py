@@ -234,7 +234,8 @@ class GoalSteps:
                         tries: list, carrying_before: bool
                         ) -> tuple[int, MotionPrimitive, np.ndarray | None, int]:
         """Make the goal primitive of step ``i`` from the first of ``tries`` (see
-        :meth:`alternatives`) that works; returns (segment, primitive, the target it
+        :meth:`alternatives`; a target may be a function of where the preparation left the
+        worker) that works; returns (segment, primitive, the target it
         reached, gait primitives its preparation walked). Raises the first failure, with
         how many other placements were tried."""
         failure = None
@@ -242,6 +243,8 @@ class GoalSteps:
             mark = self.state.mark()
             try:
                 walked = prepare() if prepare is not None else 0
+                if callable(target):
+                    target = target()          # where the preparation left the worker
                 seg, mp = self.segment(
                     kind, target, i, text, carry_stance=carrying_before,
                     seconds=float(args[0]) if kind == "wait" and args else None,
@@ -266,15 +269,20 @@ class GoalSteps:
 
     def alternatives(self, kind: str, args: tuple[str, ...], target: np.ndarray | None,
                      placement: tuple[float, float] | None, text: str, raised: bool
-                     ) -> list[tuple[np.ndarray | None, Callable[[], int] | None]]:
+                     ) -> list[tuple[np.ndarray | Callable[[], np.ndarray] | None,
+                                     Callable[[], int] | None]]:
         """What to try when the goal primitive is blocked, in order: (target, prepare),
         where ``prepare()`` moves the worker first and returns the primitives walked.
 
-        release: other places to let go; bend/stoop/kneel/wait: a roomier spot; tasks
+        release: other places to let go, then ahead from a roomy spot; bend/stoop/kneel/
+        wait: a roomier spot; tasks
         with a target: the other ``ALTERNATE_APPROACHES`` (further back, other sides).
         """
         if kind == "release":
-            return [(t, None) for t in self.release_targets(args[0])]
+            # Last, where every place around the worker is in the furniture (a short
+            # worker at a shelf it took the part from): from a roomy spot, straight ahead.
+            return [(t, None) for t in self.release_targets(args[0])] + [
+                (lambda: self.release_targets(args[0])[0], lambda: self.walk_to_room(text))]
         if target is None:
             return [(None, None)] + ([(None, lambda: self.walk_to_room(text))]
                                      if kind in IN_PLACE_TASKS else [])
