@@ -31,6 +31,7 @@ from ltl_human_motion.planning.navigation import floor_grid
 from ltl_human_motion.planning.plan_state import PlanContext, Pose, WorkerState
 from ltl_human_motion.planning.standing import ideal_placement
 from ltl_human_motion.planning.walk_goals import PASSAGE_RADIUS
+from ltl_human_motion.scene.occupancy import part_indices
 
 #: Clearance (m) the planner keeps between the body and obstacles on the frames it
 #: checks exactly: the verifier allows none below 0; blends between segments move
@@ -54,6 +55,11 @@ EXACT_BELOW = 0.01
 #: margin) these samples turned away steps along an aisle's boards that the exact check
 #: of the path passes (4 aisle runs that verified failed).
 SWEEP_MARGIN = -0.4
+#: The body parts checked on those samples: the arms, which swing across the body's
+#: path between the samples (every collision the 5 samples missed in cluttered was a
+#: hand, palm or forearm); the trunk and legs move with the root path the search checks.
+SWEEP_PARTS: tuple[str, ...] = ("l_upper_arm", "r_upper_arm", "l_lower_arm", "r_lower_arm",
+                                "l_hand", "r_hand", "l_palm", "r_palm")
 
 #: Searches run again after the path found collided on a frame the search did not
 #: sample (each forbids the colliding primitive at its pose).
@@ -163,9 +169,9 @@ class StepExecutor:
 
     def body_clear(self, poses: np.ndarray, standing: np.ndarray) -> np.ndarray:
         """Whether sampled poses (M, S, J, 3) (S odd: ``gait_index.BODY_SAMPLES``) keep
-        1 cm from every obstacle on the even samples and do not enter one
-        (``SWEEP_MARGIN``) on the odd ones between them, shape (M,); standing primitives
-        (``standing`` (M,)) need only not come closer."""
+        1 cm from every obstacle on the even samples and whose arms do not enter one
+        (``SWEEP_MARGIN``, ``SWEEP_PARTS``) on the odd ones between them, shape (M,);
+        standing primitives (``standing`` (M,)) need only not come closer."""
         out = np.ones(len(poses), dtype=bool)
         stature = self.ctx.stature
         field = self.ctx.obstacle_field
@@ -179,7 +185,8 @@ class StepExecutor:
                     between = np.r_[0, 1:poses.shape[1]:2] if rel else \
                         np.arange(1, poses.shape[1], 2)
                     ok[ok] = field.clear(poses[keep][:, between], stature,
-                                         margin=SWEEP_MARGIN * field.res, relative=rel)
+                                         margin=SWEEP_MARGIN * field.res, relative=rel,
+                                         parts=part_indices(SWEEP_PARTS))
                 out[sel] = ok
         return out
 
