@@ -303,6 +303,9 @@ FIXED_FAMILY_RUNS = {
     ("seats/job/fetch_then_sit", 1.55, 1): "assemble:beyond_seated_reach",
     # the other hand's try ended the step as out of reach; the mirrored placement
     ("under_shelf/single/grasp(O1)", 1.95, 0): "grasp:switched_hand",
+    # a tall worker's thigh at a low table, held back by it further than the placement:
+    # the step back from where the worker stood
+    ("bench_assembly/single/assemble(R2)", 1.95, 0): "assemble:thigh_low_table",
     # every place to let go around a short worker at the shelf was in it: from a roomy spot
     ("bench_assembly/single/release(O1)", 1.55, 0): "release:at_the_shelf",
     ("paper_frame/single/release(O1)", 1.55, 1): "release:at_the_shelf",

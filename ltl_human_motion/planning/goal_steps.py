@@ -288,16 +288,24 @@ class GoalSteps:
                                      if kind in IN_PLACE_TASKS else [])
         if placement is None:
             return [(target, None)]
-        first = math.atan2(self.state.pose[1] - target[1], self.state.pose[0] - target[0])
+        x, y, yaw = self.state.pose
+        first = math.atan2(y - target[1], x - target[0])
         mirrored = self.other_hand_placement(kind, args, target, placement, text)
+        # Last, a step back from where the first try stood, when furniture in front kept
+        # the worker further back than the placement already (the step back from the
+        # placement then comes to the same spot), if the goal model reaches from there.
+        stood = float(math.cos(yaw) * (target[0] - x) + math.sin(yaw) * (target[1] - y))
+        back = max(b for _, b, _ in ALTERNATE_APPROACHES)
+        further = stood > placement[0] + back and self.reaches(
+            kind, args, (stood + back, placement[1], target[2]), raised)
 
-        def approach(turn: float, back: float, other: bool) -> int:
+        def approach(turn: float, back: float, other: bool, ahead: float | None = None) -> int:
             lowered = raised and not self.state.held
             if lowered:
                 self.executor.arm_transition(True, -1)
             self.executor.step_out()            # the first try may have left the worker at a rack
             d, lat = mirrored if other else placement
-            walked = self.approach(target, (d + back, lat), text,
+            walked = self.approach(target, (d + back if ahead is None else ahead, lat), text,
                                     sector=(first + turn, APPROACH_HALF_WIDTH),
                                     budget=SearchBudget(ALTERNATIVE_NODES))
             if lowered:
@@ -306,7 +314,26 @@ class GoalSteps:
 
         return [(target, None)] + [
             (target, functools.partial(approach, turn, back, other))
-            for turn, back, other in ALTERNATE_APPROACHES if mirrored is not None or not other]
+            for turn, back, other in ALTERNATE_APPROACHES if mirrored is not None or not other
+        ] + ([(target, functools.partial(approach, 0.0, 0.0, False, stood + back))]
+             if further else [])
+
+    def reaches(self, kind: str, args: tuple[str, ...], local: tuple[float, float, float],
+                raised: bool) -> bool:
+        """Whether the goal model of ``kind`` reaches ``local`` (ahead, left, height) in the
+        start frame from the stance the reach starts in (the carry stance if ``raised``
+        or a part is held)."""
+        hand = acting_hand(self.state, kind, args[0] if kind != "grasp" and args else None)
+        try:
+            # The model's own reach test (its seeds only vary the timing: a fixed one
+            # keeps the plan's random stream as it was).
+            self.ctx.library.goal(kind, np.asarray(local, dtype=np.float64),
+                                  rng=np.random.default_rng(0),
+                                  start_pose=self.ctx.stance(self.state.carrying or raised),
+                                  **({"hand": hand} if hand else {}))
+        except ValueError:
+            return False
+        return True
 
     def other_hand_placement(self, kind: str, args: tuple[str, ...], target: np.ndarray,
                              placement: tuple[float, float], text: str
