@@ -167,6 +167,36 @@ def test_kneel_sit_and_stand_up() -> None:
         _make("sit", [0.3, 0.0, 0.45])
 
 
+def test_a_seated_reach_keeps_the_pelvis_on_the_seat() -> None:
+    """Seated, the seat bears the weight: a reach to a desk in front leans the trunk but
+    does not slide the pelvis (and the knees with it) forward towards the feet, where
+    they went into the desk front (seats/job/seated_assembly)."""
+    seat = np.array([reach_placement("sit", 0.45, SK)[0], 0.0, 0.45])
+    _sit, w = _make("sit", seat)
+    seated = w[-1] - np.array([w[-1, 0, 0], w[-1, 0, 1], 0.0])
+    for path in ("arc", "level"):
+        mp, wa = _make("assemble", [0.6, -0.05, 0.9], start_pose=seated, path=path)
+        knee = wa[:, J["r_knee"], 0]
+        assert np.ptp(wa[:, 0, 0]) < 1e-6 and np.ptp(knee) < 1e-6
+        assert np.linalg.norm(wa[mp.meta["contact_frame"], J["r_hand"]]
+                              - [0.6, -0.05 - 0.035, 0.9]) < 0.03
+
+
+def test_the_level_path_of_a_region_task_rises_before_it_comes_in() -> None:
+    """assemble / leftHand / rightHand on the level path bring the palms up near the body
+    to the target's height before they move in over what is under it (a short worker's
+    hands, and a part in them, swung up through a bench front on the arc)."""
+    sk = Skeleton(1.55)
+    target = np.array([0.55, 0.0, 1.05])
+    for task in ("assemble", "rightHand"):
+        mp, w = _make(task, target, sk=sk, path="level",
+                      start_pose=standing_pose(sk)[0])
+        hand = w[: mp.meta["contact_frame"] + 1, J["r_hand"]]
+        below = hand[:, 2] < target[2] - 0.05
+        # While the palm is still well below the target it stays near the body.
+        assert np.max(hand[below, 0]) < target[0] - 0.2
+
+
 def test_wait_stays_within_a_small_ball() -> None:
     mp, w = _make("wait", duration=3.0)
     assert mp.n_frames == round(3.0 * 120) + 1

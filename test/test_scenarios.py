@@ -336,6 +336,41 @@ def test_run_verifies_with_the_biomechanical_checks(pair_id: str, stature: float
                 f"{family}: {outcome.message[:300]}")
 
 
+#: Corpus runs (pair, stature, seed) of fixed planner failure families: each must verify.
+FIXED_FAMILY_RUNS = {
+    # a short worker's held part swung up through the bench front (level region path)
+    ("bench_assembly/job/two_parts", 1.55, 1): "assemble:bench_front",
+    ("bench_assembly/dwyer/absence_after/0", 1.55, 1): "walk_region:bench_front",
+    ("big_table/job/edge_assembly", 1.55, 1): "assemble:table_edge",
+    # seated: the pelvis slid forward and the knees into the desk; standUp in the
+    # stance the arms are in after the seated assemble used the part up
+    ("seats/job/seated_assembly", 1.75, 0): "assemble:seated_knees",
+    ("seats/job/fetch_then_sit", 1.75, 1): "standUp:seated_stance",
+    # seated, the goal model did not reach the desk target: the worker stands up for it
+    ("seats/job/fetch_then_sit", 1.55, 1): "assemble:beyond_seated_reach",
+    # the other hand's try ended the step as out of reach; the mirrored placement
+    ("under_shelf/single/grasp(O1)", 1.95, 0): "grasp:switched_hand",
+    # a tall worker's thigh at a low table, held back by it further than the placement:
+    # the step back from where the worker stood
+    ("bench_assembly/single/assemble(R2)", 1.95, 0): "assemble:thigh_low_table",
+    # every place to let go around a short worker at the shelf was in it: from a roomy spot
+    ("bench_assembly/single/release(O1)", 1.55, 0): "release:at_the_shelf",
+    ("paper_frame/single/release(O1)", 1.55, 1): "release:at_the_shelf",
+    # a hand swung into a crate between the search's samples
+    ("cluttered/single/assemble(R2)", 1.95, 0): "walk:between_samples",
+    ("cluttered/single/grasp(O1)", 1.95, 0): "walk:between_samples",
+}
+
+
+@pytest.mark.parametrize("run", list(FIXED_FAMILY_RUNS), ids=lambda r: f"{r[0]}@{r[1]}/{r[2]}")
+def test_fixed_family_run_verifies(run: tuple[str, float, int]) -> None:
+    pair_id, stature, seed = run
+    pair = BY_ID[pair_id]
+    outcome = run_pair(pair.spec, pair.cell_file, stature, seed, timeout=10.0)
+    ok, family = judge(pair.expect, pair.reason, outcome)
+    assert ok, f"{pair.id} ({FIXED_FAMILY_RUNS[run]}): {family}: {outcome.message[:300]}"
+
+
 def test_generator_frame_and_floor_variants_keep_the_layout() -> None:
     import yaml
 

@@ -97,6 +97,11 @@ PUSH_LEVEL_TASKS: tuple[str, ...] = ("insert", "extract")
 #: straight way in (the rest goes in straight, as the pull comes out); insert's comes
 #: back out straight in the same fraction of its return time.
 _PUSH_IN_AT = 0.6
+#: Tasks whose hands may take the level path into a region (no part to come down onto):
+#: the palms rise near the body to the target's height and come in over a bench top or
+#: table edge below it instead of swinging up through its front (a short worker's hands
+#: in the carry stance, and a part held in them, are below a 0.92 m bench top).
+LEVEL_REGION_TASKS: tuple[str, ...] = ("assemble", "leftHand", "rightHand")
 #: Horizontal distance from the shoulder of the level path's turn point, fraction of
 #: stature (0.12 m at 1.75 m: in front of the chest, behind the front edge of a shelf the
 #: worker stands at, also one overhead).
@@ -333,6 +338,13 @@ class _Start:
         self.hand_dir = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
         self.elbow_pole = np.stack([p0[_J["l_elbow"]], p0[_J["r_elbow"]]]) - self.shoulders
         self.knee_pole = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+        self.seated = bool(p0[0, 2] < SEATED_PELVIS_MAX * skeleton.stature)
+
+
+#: A start pose whose pelvis is lower than this fraction of the stature is seated: above
+#: the highest seat (0.34 H, :func:`seat_height_range`) by the pelvis joint's 0.085 H over
+#: the seat (0.15 m at 1.75 m, measured on the sit model), below the standing 0.53 H.
+SEATED_PELVIS_MAX = 0.45
 
 
 def _support_x(ankles: np.ndarray, toes: np.ndarray, stature: float) -> tuple[float, float]:
@@ -350,6 +362,10 @@ def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
     T = pelvis.shape[0]
     shift = np.zeros(T)
     lo, hi = _support_x(st.ankles, st.toes, skeleton.stature)
+    if st.seated:
+        # The seat bears the weight: the centre of mass may be anywhere from over it to
+        # the feet (sliding the pelvis forward on it pushes the knees into a desk).
+        lo = min(lo, float(st.pelvis[0]))
     for _ in range(3):
         pel = pelvis.copy()
         pel[:, 0] += shift
@@ -902,6 +918,9 @@ def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
             keys.insert(1, (_PUSH_IN_AT * t1, rel_pre))
         return keys, t2
     keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
+    if level and task in LEVEL_REGION_TASKS:
+        return _level_keys(targets, active, sh1, rel_home, rel_goal, 0.0, t1, t2, total, H,
+                           arm), t1
     if task in ("grasp", "release", "move"):
         # Parts rest on surfaces: come down onto a target below the shoulder from
         # _APPROACH_LIFT above it, and lift off the same way.
@@ -991,6 +1010,19 @@ def _push_travel(task: str, target: np.ndarray, st: _Start, hand: str,
     return float(np.clip(need, travel, _MAX_TRAVEL)), True
 
 
+def _push_direction(task: str, target: np.ndarray, st: _Start, active: tuple[int, ...]
+                    ) -> np.ndarray:
+    """The horizontal unit direction (3,) from the acting shoulder to ``target`` (3,) along
+    which insert pushes into it (from a point before it) and extract pulls back from it;
+    zeros for other tasks."""
+    if task not in ("insert", "extract"):
+        return np.zeros(3)
+    a = target - st.shoulders[active[0]]
+    a[2] = 0.0
+    n = np.linalg.norm(a)
+    return a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
+
+
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
                fps: float, path: str = "arc", travel: float | None = None,
@@ -1002,17 +1034,11 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     travel, pushed = _push_travel(task, target, st, hand, travel, path,
                                   None if furniture is None else furniture[0])
     board = board if task in LEVEL_PATH_TASKS else None
-    level = pushed or ((path == "level" or board is not None) and task in LEVEL_PATH_TASKS)
+    level = pushed or ((path == "level" or board is not None) and task in LEVEL_PATH_TASKS) \
+        or (path == "level" and task in LEVEL_REGION_TASKS)
     target = _checked_target(task, target, skeleton)
     targets, active, hand_name = _hand_targets(task, target, hand)
-    # insert pushes into the target from a point before it; extract pulls back from it
-    approach = np.zeros(3)
-    if task in ("insert", "extract"):
-        sh = st.shoulders[active[0]]
-        a = target - sh
-        a[2] = 0.0
-        n = np.linalg.norm(a)
-        approach = a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
+    approach = _push_direction(task, target, st, active)
     pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board,
                                          obstacles, furniture)
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)

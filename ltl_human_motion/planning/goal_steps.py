@@ -21,6 +21,7 @@ from ltl_human_motion.errors import PlanningError
 from ltl_human_motion.motion.goals import (
     HAND_PATHS,
     LEVEL_PATH_TASKS,
+    LEVEL_REGION_TASKS,
     PUSH_LEVEL_TASKS,
 )
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
@@ -45,6 +46,7 @@ from ltl_human_motion.planning.standing import (
     posture_clearance,
     pull_length,
     release_targets,
+    standing_offset,
     support_local,
 )
 from ltl_human_motion.planning.steps import StepExecutor
@@ -62,11 +64,15 @@ SEATED_WAIT_SECONDS = 2.0
 ALTERNATIVE_ATTEMPTS = 2
 
 #: Other ways to stand for a reach whose motions all hit an obstacle, in order: (turn of
-#: the approach direction about the target, rad; extra distance from the target, m).
-#: First a step further back (a knee or thigh at a desk or low shelf front), then the
-#: target's other sides (an arm hitting a crate beside it).
-ALTERNATE_APPROACHES: tuple[tuple[float, float], ...] = (
-    (0.0, 0.08), (math.pi / 3, 0.0), (-math.pi / 3, 0.0))
+#: the approach direction about the target, rad; extra distance from the target, m;
+#: whether the other hand reaches). First a step further back (a knee or thigh at a desk
+#: or low shelf front), then the other hand from the placement mirrored across the
+#: target (the body beside the target on its other side: a floor part next to a cart
+#: the stooping head and shoulder hit), then the target's other sides (an arm hitting a
+#: crate beside it).
+ALTERNATE_APPROACHES: tuple[tuple[float, float, bool], ...] = (
+    (0.0, 0.08, False), (0.0, 0.0, True), (math.pi / 3, 0.0, False),
+    (-math.pi / 3, 0.0, False))
 
 #: More ways to stand, tried after ``ALTERNATE_APPROACHES`` and only where the posture
 #: search finds a reach clear of the obstacles from there (:meth:`GoalSteps.posture_room`,
@@ -107,6 +113,10 @@ IN_PLACE_TASKS = ("bend", "stoop", "kneel", "wait")
 #: Floor clearance around the root a kneel or stoop needs, metres (the knee goes about
 #: 0.5 m ahead of the root and the head as far when stooping, plus a hand's width).
 IN_PLACE_ROOM = 0.6
+
+#: Tasks whose goal primitive reaches with whichever hand the target is on the side of
+#: (the planner's placement decides; both hands or a named hand otherwise).
+ONE_HAND_AUTO_TASKS = ("grasp", "release", "move", "insert", "extract")
 
 #: Stride of the frames on which the planner checks that an extract takes its part out.
 EXTRACT_CHECK_STRIDE = 4
@@ -150,43 +160,31 @@ class GoalSteps:
         it; for extract, the part taken out of ``container``). A grasp or extract while
         one hand holds a part is done by the other hand.
         """
-        x, y, yaw = self.state.pose
-        local = None
-        if target is not None:
-            c, s = math.cos(-yaw), math.sin(-yaw)
-            dx, dy = target[0] - x, target[1] - y
-            local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
+        local, kwargs, board = self.goal_kwargs(kind, target, carry_stance, seconds,
+                                                grasped, part, container)
         seated = self.state.seat is not None and kind != "standUp"
-        kwargs = {"rng": self.ctx.rng,
-                  "start_pose": self.executor.seated_pose() if seated
-                  else self.ctx.stance(self.state.carrying or carry_stance)}
-        hand = acting_hand(self.state, kind, part if kind != "grasp" else grasped)
-        if hand is not None:
-            kwargs["hand"] = hand
-        if kind == "extract" and part is not None and container is not None:
-            kwargs["travel"] = self.pull_length(part, container)
-        furniture = self.furniture(kind, target, local) if not seated else {}
-        kwargs.update(furniture)
-        board = furniture.get("board")
-        if kind in HAND_TASKS and not seated and self.ctx.cell.obstacles:   # the body clear
-            kwargs["obstacles"] = posture_clearance(self.ctx, self.state.pose)
         hand_fixed = "hand" in kwargs
-        if kind == "wait" and target is None and seconds is not None:
-            # Longer than asked by the blends at both ends, so the stillness lasts.
-            kwargs["duration"] = (seconds + (2 * self.ctx.overlap + WAIT_EXTRA_FRAMES)
-                                  / self.ctx.library.fps)
         mp = None
         kept_in = 0
         blocked: list[MotionPrimitive] = []
+        switched = None          # the hand tried first, after switching to the other one
         attempts = self.ctx.options.goal_attempts if attempts is None else attempts
         for attempt in range(attempts):
-            if kind in LEVEL_PATH_TASKS or (kind in PUSH_LEVEL_TASKS and "support" in kwargs):
-                # Every other try comes in level (over a shelf board, under the one above).
+            if kind in LEVEL_PATH_TASKS + LEVEL_REGION_TASKS \
+                    or (kind in PUSH_LEVEL_TASKS and "support" in kwargs):
+                # Every other try comes in level (over a shelf board, under the one above;
+                # over a bench top into the region above it; a push or pull in front of
+                # the furniture under the target).
                 kwargs["path"] = HAND_PATHS[attempt % len(HAND_PATHS)]
             try:
                 candidate = self.executor.sit_still(kwargs.get("duration", SEATED_WAIT_SECONDS)) \
                     if seated and kind == "wait" else self.ctx.library.goal(kind, local, **kwargs)
             except ValueError as exc:
+                if switched:
+                    # The placement put the target within the first hand's reach, not
+                    # necessarily the other's (a low part to the right): keep the first.
+                    kwargs["hand"], switched = switched, None
+                    continue
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
             clear = self.goal_clear(candidate, grasped)
@@ -202,13 +200,17 @@ class GoalSteps:
                     and board is None:
                 other = OTHER_HAND.get(candidate.meta.get("hand"))
                 if other:
-                    kwargs["hand"] = other
+                    kwargs["hand"], switched = other, candidate.meta.get("hand")
         if mp is None:
             raise self.refusal(text, kind, attempts, blocked, grasped, kept_in,
                                part, container)
         seg = self.executor.add(mp, self.state.pose, label, self.ctx.overlap)
         self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
         self.state.gait_state = None
+        if kind == "standUp" and not np.array_equal(kwargs["start_pose"],
+                                                    self.ctx.stance(self.state.carrying)):
+            # Sat down holding a part that a seated task used up (or the other way round).
+            self.executor.arm_transition(not self.state.carrying, label)
         return seg, mp
 
     def furniture(self, kind: str, target: np.ndarray | None, local: np.ndarray | None
@@ -236,11 +238,49 @@ class GoalSteps:
                     out["ceiling"] = ceiling
         return out
 
+    def goal_kwargs(self, kind: str, target: np.ndarray | None, carry_stance: bool,
+                    seconds: float | None, grasped: str | None, part: str | None,
+                    container: str | None
+                    ) -> tuple[np.ndarray | None, dict, tuple[float, float, float] | None]:
+        """What :meth:`segment` makes its primitives from: the target in the start frame
+        (3,) (None without one), the goal model's keyword arguments (start pose, hand,
+        extract travel, furniture, obstacles around, wait duration) and the low board
+        (edge, underside, top) over the target, or None."""
+        x, y, yaw = self.state.pose
+        local = None
+        if target is not None:
+            c, s = math.cos(-yaw), math.sin(-yaw)
+            dx, dy = target[0] - x, target[1] - y
+            local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
+        seated = self.state.seat is not None and kind != "standUp"
+        if kind == "standUp" and self.state.seat is not None:
+            # Stand up with the arms as they are on the seat (:meth:`segment` brings them
+            # to the stance of what the hands hold afterwards).
+            carry_stance = self.executor.seated_in_carry_stance()
+        kwargs = {"rng": self.ctx.rng,
+                  "start_pose": self.executor.seated_pose() if seated
+                  else self.ctx.stance(self.state.carrying or carry_stance)}
+        hand = acting_hand(self.state, kind, part if kind != "grasp" else grasped)
+        if hand is not None:
+            kwargs["hand"] = hand
+        if kind == "extract" and part is not None and container is not None:
+            kwargs["travel"] = self.pull_length(part, container)
+        furniture = self.furniture(kind, target, local) if not seated else {}
+        kwargs.update(furniture)
+        if kind in HAND_TASKS and not seated and self.ctx.cell.obstacles:   # the body clear
+            kwargs["obstacles"] = posture_clearance(self.ctx, self.state.pose)
+        if kind == "wait" and target is None and seconds is not None:
+            # Longer than asked by the blends at both ends, so the stillness lasts.
+            kwargs["duration"] = (seconds + (2 * self.ctx.overlap + WAIT_EXTRA_FRAMES)
+                                  / self.ctx.library.fps)
+        return local, kwargs, furniture.get("board")
+
     def first_clear_try(self, i: int, text: str, kind: str, args: tuple[str, ...],
                         tries: list, carrying_before: bool
                         ) -> tuple[int, MotionPrimitive, np.ndarray | None, int]:
         """Make the goal primitive of step ``i`` from the first of ``tries`` (see
-        :meth:`alternatives`) that works; returns (segment, primitive, the target it
+        :meth:`alternatives`; a target may be a function of where the preparation left the
+        worker) that works; returns (segment, primitive, the target it
         reached, gait primitives its preparation walked). Raises the first failure, with
         how many other placements were tried."""
         failure = None
@@ -248,6 +288,8 @@ class GoalSteps:
             mark = self.state.mark()
             try:
                 walked = prepare() if prepare is not None else 0
+                if callable(target):
+                    target = target()          # where the preparation left the worker
                 seg, mp = self.segment(
                     kind, target, i, text, carry_stance=carrying_before,
                     seconds=float(args[0]) if kind == "wait" and args else None,
@@ -272,23 +314,38 @@ class GoalSteps:
 
     def alternatives(self, kind: str, args: tuple[str, ...], target: np.ndarray | None,
                      placement: tuple[float, float] | None, text: str, raised: bool
-                     ) -> list[tuple[np.ndarray | None, Callable[[], int] | None]]:
+                     ) -> list[tuple[np.ndarray | Callable[[], np.ndarray] | None,
+                                     Callable[[], int] | None]]:
         """What to try when the goal primitive is blocked, in order: (target, prepare),
         where ``prepare()`` moves the worker first and returns the primitives walked.
 
-        release: other places to let go; bend/stoop/kneel/wait: a roomier spot; tasks
+        release: other places to let go, then ahead from a roomy spot; bend/stoop/kneel/
+        wait: a roomier spot; tasks
         with a target: the other ``ALTERNATE_APPROACHES`` (further back, other sides).
         """
         if kind == "release":
-            return [(t, None) for t in self.release_targets(args[0])]
+            # Last, where every place around the worker is in the furniture (a short
+            # worker at a shelf it took the part from): from a roomy spot, straight ahead.
+            return [(t, None) for t in self.release_targets(args[0])] + [
+                (lambda: self.release_targets(args[0])[0], lambda: self.walk_to_room(text))]
         if target is None:
             return [(None, None)] + ([(None, lambda: self.walk_to_room(text))]
                                      if kind in IN_PLACE_TASKS else [])
         if placement is None:
             return [(target, None)]
-        first = math.atan2(self.state.pose[1] - target[1], self.state.pose[0] - target[0])
+        x, y, yaw = self.state.pose
+        first = math.atan2(y - target[1], x - target[0])
+        mirrored = self.other_hand_placement(kind, args, target, placement, text)
+        # Last, a step back from where the first try stood, when furniture in front kept
+        # the worker further back than the placement already (the step back from the
+        # placement then comes to the same spot), if the goal model reaches from there.
+        stood = float(math.cos(yaw) * (target[0] - x) + math.sin(yaw) * (target[1] - y))
+        back = max(b for _, b, _ in ALTERNATE_APPROACHES)
+        further = stood > placement[0] + back and self.reaches(
+            kind, args, (stood + back, placement[1], target[2]), raised)
 
-        def approach(turn: float, back: float, checked: bool = False) -> int:
+        def approach(turn: float, back: float, other: bool, ahead: float | None = None,
+                     checked: bool = False) -> int:
             if checked and not self.posture_room(kind, args, target, placement,
                                                  first + turn, back, raised):
                 raise PlanningError(f"task {text}: no reach clear of the obstacles from "
@@ -297,7 +354,8 @@ class GoalSteps:
             if lowered:
                 self.executor.arm_transition(True, -1)
             self.executor.step_out()            # the first try may have left the worker at a rack
-            walked = self.approach(target, (placement[0] + back, placement[1]), text,
+            d, lat = mirrored if other else placement
+            walked = self.approach(target, (d + back if ahead is None else ahead, lat), text,
                                     sector=(first + turn, APPROACH_HALF_WIDTH),
                                     budget=SearchBudget(ALTERNATIVE_NODES))
             if lowered:
@@ -305,9 +363,11 @@ class GoalSteps:
             return walked
 
         return [(target, None)] + [
-            (target, functools.partial(approach, turn, back))
-            for turn, back in ALTERNATE_APPROACHES] + [
-            (target, functools.partial(approach, turn, back, True))
+            (target, functools.partial(approach, turn, back, other))
+            for turn, back, other in ALTERNATE_APPROACHES if mirrored is not None or not other
+        ] + ([(target, functools.partial(approach, 0.0, 0.0, False, stood + back))]
+             if further else []) + [
+            (target, functools.partial(approach, turn, back, False, checked=True))
             for turn, back in CHECKED_APPROACHES]
 
     def posture_room(self, kind: str, args: tuple[str, ...], target: np.ndarray,
@@ -340,6 +400,39 @@ class GoalSteps:
                              hand=fixed or "auto", board=board):
                 return True
         return False
+
+    def reaches(self, kind: str, args: tuple[str, ...], local: tuple[float, float, float],
+                raised: bool) -> bool:
+        """Whether the goal model of ``kind`` reaches ``local`` (ahead, left, height) in the
+        start frame from the stance the reach starts in (the carry stance if ``raised``
+        or a part is held)."""
+        hand = acting_hand(self.state, kind, args[0] if kind != "grasp" and args else None)
+        try:
+            # The model's own reach test (its seeds only vary the timing: a fixed one
+            # keeps the plan's random stream as it was).
+            self.ctx.library.goal(kind, np.asarray(local, dtype=np.float64),
+                                  rng=np.random.default_rng(0),
+                                  start_pose=self.ctx.stance(self.state.carrying or raised),
+                                  **({"hand": hand} if hand else {}))
+        except ValueError:
+            return False
+        return True
+
+    def other_hand_placement(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                             placement: tuple[float, float], text: str
+                             ) -> tuple[float, float] | None:
+        """Where ``target`` (3,) is in the standing root's frame for the other hand than
+        the one ``placement`` (ahead, left) is for (:func:`.standing.standing_offset`, the
+        goal model's reach for that hand), if the task leaves the hand free; else None."""
+        if placement[1] == 0.0 or kind not in ONE_HAND_AUTO_TASKS \
+                or acting_hand(self.state, kind, args[0] if args else None) is not None:
+            return None
+        hand = "l_hand" if placement[1] < 0.0 else "r_hand"
+        try:
+            return standing_offset(self.ctx, kind, target, text, hand,
+                                   carry_stance=self.state.carrying)
+        except PlanningError:
+            return None
 
     def approach(self, target: np.ndarray, placement: tuple[float, float], text: str,
                  sector: tuple[float, float] | None = None,

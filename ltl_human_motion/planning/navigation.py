@@ -370,7 +370,7 @@ class ObstacleField:
         return out.reshape(pts.shape[:-1])
 
     def clear(self, poses: np.ndarray, stature: float, margin: float = 0.01,
-              relative: bool = False) -> np.ndarray:
+              relative: bool = False, parts: np.ndarray | None = None) -> np.ndarray:
         """Whether body poses keep ``margin`` from every obstacle, or, for body parts
         already closer at the first sample, get no closer.
 
@@ -382,6 +382,8 @@ class ObstacleField:
         margin : float
         relative : bool
             For standing primitives that start where the last motion ended.
+        parts : ndarray of int, shape (K,), optional
+            Only these body capsules (indices into ``occupancy.BODY_PARTS``); default all.
 
         Returns
         -------
@@ -394,9 +396,11 @@ class ObstacleField:
         # Each capsule is sampled at its end points (joints) and its middle; the joints
         # are shared by capsules, so the field is read once per joint.
         ia, ib = capsule_ends()
+        radii = capsule_radii(stature)
+        if parts is not None:
+            ia, ib, radii = ia[parts], ib[parts], radii[parts]
         long = ia != ib                                  # spheres: the middle is the joint
         pos = np.asarray(poses, dtype=np.float64)
-        radii = capsule_radii(stature)
         ok = np.ones(pos.shape[0], dtype=bool)
         # A candidate whose joints (and so its sample points) all keep more than the
         # largest radius, the margins and the largest interpolation error (sqrt(3) res)

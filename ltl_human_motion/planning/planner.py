@@ -321,13 +321,29 @@ class SequencePlanner:
 
     def _beyond_seated_reach(self, kind: str, args: tuple[str, ...]) -> bool:
         """Whether the target of a hand task lies further from the seat than even a
-        standing worker reaches at its height (the worker stands up and walks to it)."""
+        standing worker reaches at its height, or than the goal model reaches from the
+        seated pose (the worker stands up and walks to it)."""
         target = self.target_of(kind, args)
         if target is None or self.state.seat is None:
             return False
         envelope = reach_envelope(self.ctx.stature)
         away = float(np.hypot(*(np.asarray(target[:2]) - np.asarray(self.state.seat[:2]))))
-        return away > envelope.horizontal(float(target[2]), float(target[2]))
+        if away > envelope.horizontal(float(target[2]), float(target[2])):
+            return True
+        x, y, yaw = self.state.pose
+        c, s = np.cos(-yaw), np.sin(-yaw)
+        dx, dy = target[0] - x, target[1] - y
+        local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
+        hand = acting_hand(self.state, kind, args[0] if kind != "grasp" and args else None)
+        try:
+            # The model's own reach test (its seeds only vary the timing: a fixed one
+            # keeps the plan's random stream as it was).
+            self.ctx.library.goal(kind, local, rng=np.random.default_rng(0),
+                                  start_pose=self.executor.seated_pose(),
+                                  **({"hand": hand} if hand else {}))
+        except ValueError:
+            return True
+        return False
 
     def _goal_step(self, i: int, text: str, kind: str, args: tuple[str, ...],
                    keep_hold: bool, facing: np.ndarray | None, expanded0: int) -> StepPlan:

@@ -31,6 +31,7 @@ from ltl_human_motion.planning.navigation import floor_grid
 from ltl_human_motion.planning.plan_state import PlanContext, Pose, WorkerState
 from ltl_human_motion.planning.standing import ideal_placement
 from ltl_human_motion.planning.walk_goals import PASSAGE_RADIUS
+from ltl_human_motion.scene.occupancy import part_indices
 
 #: Clearance (m) the planner keeps between the body and obstacles on the frames it
 #: checks exactly: the verifier allows none below 0; blends between segments move
@@ -45,6 +46,20 @@ CLEAR_EXACT = 0.1
 #: The clearance below which the planner's other checks measure exactly, metres (only
 #: clearances near ``PLACED_MARGIN`` decide a check; farther ones may be bounds).
 EXACT_BELOW = 0.01
+
+#: Clearance the search asks of the body on the gait samples between those it keeps
+#: 1 cm on (``gait_index.BODY_SAMPLES``), in units of the obstacle field's resolution
+#: and counted from the field's own interpolation allowance (0.4 resolution): -0.4, the
+#: capsules only must not be inside an obstacle by the field. That catches a hand
+#: swinging 1-7 cm into a crate between the 1 cm samples; with the allowance (or a
+#: margin) these samples turned away steps along an aisle's boards that the exact check
+#: of the path passes (4 aisle runs that verified failed).
+SWEEP_MARGIN = -0.4
+#: The body parts checked on those samples: the arms, which swing across the body's
+#: path between the samples (every collision the 5 samples missed in cluttered was a
+#: hand, palm or forearm); the trunk and legs move with the root path the search checks.
+SWEEP_PARTS: tuple[str, ...] = ("l_upper_arm", "r_upper_arm", "l_lower_arm", "r_lower_arm",
+                                "l_hand", "r_hand", "l_palm", "r_palm")
 
 #: Searches run again after the path found collided on a frame the search did not
 #: sample (each forbids the colliding primitive at its pose).
@@ -157,14 +172,26 @@ class StepExecutor:
         self.add(mp, self.state.pose, label, self.ctx.overlap)
 
     def body_clear(self, poses: np.ndarray, standing: np.ndarray) -> np.ndarray:
-        """Whether sampled poses (M, S, J, 3) keep 1 cm from every obstacle, shape (M,);
+        """Whether sampled poses (M, S, J, 3) (S odd: ``gait_index.BODY_SAMPLES``) keep
+        1 cm from every obstacle on the even samples and whose arms do not enter one
+        (``SWEEP_MARGIN``, ``SWEEP_PARTS``) on the odd ones between them, shape (M,);
         standing primitives (``standing`` (M,)) need only not come closer."""
         out = np.ones(len(poses), dtype=bool)
         stature = self.ctx.stature
+        field = self.ctx.obstacle_field
         for rel in (False, True):
-            sel = standing == rel
-            if sel.any():
-                out[sel] = self.ctx.obstacle_field.clear(poses[sel], stature, relative=rel)
+            sel = np.flatnonzero(standing == rel)
+            if sel.size:
+                ok = field.clear(poses[sel, ::2], stature, relative=rel)
+                if ok.any():
+                    keep = sel[ok]
+                    # (with ``relative``, after the start they are measured from)
+                    between = np.r_[0, 1:poses.shape[1]:2] if rel else \
+                        np.arange(1, poses.shape[1], 2)
+                    ok[ok] = field.clear(poses[keep][:, between], stature,
+                                         margin=SWEEP_MARGIN * field.res, relative=rel,
+                                         parts=part_indices(SWEEP_PARTS))
+                out[sel] = ok
         return out
 
     def sit_still(self, seconds: float) -> MotionPrimitive:
@@ -187,6 +214,21 @@ class StepExecutor:
         c, s = math.cos(-yaw), math.sin(-yaw)
         dx, dy = last[:, 0] - x, last[:, 1] - y
         return np.stack([c * dx - s * dy, s * dx + c * dy, last[:, 2]], axis=-1)
+
+    def seated_in_carry_stance(self) -> bool:
+        """Whether the seated worker's arms are in the carry stance (the stance nearer the
+        last frame's hands relative to the shoulders; the seat keeps the stance the worker
+        sat down in, also after a seated task took the part out of the hands)."""
+        last = self.state.segments[-1].positions[-1]
+        hands = [JOINT_INDEX[n] for n in ("l_hand", "r_hand")]
+        shoulders = [JOINT_INDEX[n] for n in ("l_shoulder", "r_shoulder")]
+
+        def offset(pose: np.ndarray) -> np.ndarray:
+            return np.linalg.norm(pose[hands] - pose[shoulders], axis=-1)
+
+        seated = offset(np.asarray(last))
+        return bool(np.sum(np.abs(offset(self.ctx.stance(True)) - seated))
+                    < np.sum(np.abs(offset(self.ctx.stance(False)) - seated)))
 
     def arm_transition(self, carrying_before: bool, label: int) -> None:
         """Bring the arms from the walk stance to the carry stance or back.
