@@ -204,6 +204,27 @@ def _edge_local(depth: float, normal: np.ndarray, local: np.ndarray, yaw: float)
     return float(local[0]) + depth * float(n[0]) - BOARD_EDGE_SPAN * abs(float(n[1]))
 
 
+def _parts_over(cell, target: np.ndarray, local: np.ndarray, yaw: float):
+    """The obstacle parts whose footprint holds the floor point of ``target`` (world
+    (3,); ``local``: it in the start frame of a goal primitive whose heading is ``yaw``),
+    each as ``(lo (3,), hi (3,), inward (2,), offset)``: its bounds, and the half space
+    beyond its nearest edge in the start frame (``inward @ xy >= offset``)."""
+    xy = np.asarray(target[:2], dtype=np.float64)
+    probe = xy + np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
+    c, s = math.cos(-yaw), math.sin(-yaw)
+    for ob in cell.obstacles:
+        for part in ob.parts:
+            sd = part.footprint().signed_distance(probe)
+            if sd[0] > 0.0:
+                continue
+            grad = (sd[1:] - sd[0]) / max(float(np.linalg.norm(sd[1:] - sd[0])), 1e-12)
+            inward = -np.array([c * grad[0] - s * grad[1], s * grad[0] + c * grad[1]])
+            # The edge lies -sd metres from the target along the outward normal.
+            offset = float(inward @ np.asarray(local[:2], dtype=np.float64)) + float(sd[0])
+            lo, hi = part.aabb()
+            yield lo, hi, inward, offset
+
+
 def support_local(cell, target: np.ndarray, local: np.ndarray, yaw: float
                   ) -> tuple[float, float, float, float] | None:
     """The furniture under ``target`` (world (3,); ``local``: it in the start frame of
@@ -212,22 +233,13 @@ def support_local(cell, target: np.ndarray, local: np.ndarray, yaw: float
     target's floor point, its top is no higher than the target) whose nearest edge is
     nearest the worker, as the half space beyond that edge, (nx, ny, offset, top) (see
     :func:`~ltl_human_motion.motion.goals.make_goal_primitive`); None if there is none."""
-    xy = np.asarray(target[:2], dtype=np.float64)
-    probe = xy + np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
-    c, s = math.cos(-yaw), math.sin(-yaw)
     best = None
-    for ob in cell.obstacles:
-        for part in ob.parts:
-            top = float(part.aabb()[1][2])
-            sd = part.footprint().signed_distance(probe)
-            if top > float(target[2]) or sd[0] > 0.0:
-                continue
-            grad = (sd[1:] - sd[0]) / max(float(np.linalg.norm(sd[1:] - sd[0])), 1e-12)
-            inward = -np.array([c * grad[0] - s * grad[1], s * grad[0] + c * grad[1]])
-            # The edge lies -sd metres from the target along the outward normal.
-            offset = float(inward @ np.asarray(local[:2], dtype=np.float64)) + float(sd[0])
-            if best is None or (offset, -top) < (best[2], -best[3]):
-                best = (float(inward[0]), float(inward[1]), offset, top)
+    for _, hi, inward, offset in _parts_over(cell, target, local, yaw):
+        top = float(hi[2])
+        if top > float(target[2]):
+            continue
+        if best is None or (offset, -top) < (best[2], -best[3]):
+            best = (float(inward[0]), float(inward[1]), offset, top)
     return best
 
 
@@ -239,21 +251,11 @@ def ceiling_local(cell, target: np.ndarray, local: np.ndarray, yaw: float
     floor point, its underside is higher than the target) as the slab beyond its nearest
     edge, (nx, ny, offset, bottom, top) (see
     :func:`~ltl_human_motion.motion.goals.make_goal_primitive`); None if there is none."""
-    xy = np.asarray(target[:2], dtype=np.float64)
-    probe = xy + np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
-    c, s = math.cos(-yaw), math.sin(-yaw)
     best = None
-    for ob in cell.obstacles:
-        for part in ob.parts:
-            lo, hi = part.aabb()
-            sd = part.footprint().signed_distance(probe)
-            if float(lo[2]) <= float(target[2]) or sd[0] > 0.0 \
-                    or (best is not None and float(lo[2]) >= best[3]):
-                continue
-            grad = (sd[1:] - sd[0]) / max(float(np.linalg.norm(sd[1:] - sd[0])), 1e-12)
-            inward = -np.array([c * grad[0] - s * grad[1], s * grad[0] + c * grad[1]])
-            offset = float(inward @ np.asarray(local[:2], dtype=np.float64)) + float(sd[0])
-            best = (float(inward[0]), float(inward[1]), offset, float(lo[2]), float(hi[2]))
+    for lo, hi, inward, offset in _parts_over(cell, target, local, yaw):
+        if float(lo[2]) <= float(target[2]) or (best is not None and float(lo[2]) >= best[3]):
+            continue
+        best = (float(inward[0]), float(inward[1]), offset, float(lo[2]), float(hi[2]))
     return best
 
 
