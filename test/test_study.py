@@ -109,3 +109,14 @@ def test_cli_errors(capsys, tmp_path):
     assert "no_such_cell" in capsys.readouterr().err
     with pytest.raises(ValueError, match="one cell or two"):
         StudyConfig(cells=(), spec="S1")
+
+
+def test_the_demo_studys_layout_a_loses_no_item(tmp_path):
+    """The demo's study (S2, 10 variants x 3 statures, paper cell): every item verifies.
+    One needed over 4000 search nodes at its goal before it found its stop; the early
+    end of a search at its goal (``astar.AT_GOAL_NODES``) once refused it."""
+    cfg = StudyConfig(cells=CELLS[:1], spec="S2", variants=10, statures=(1.6, 1.75, 1.9),
+                      robot="config/ur_pick_place.yaml", out=tmp_path, workers=0)
+    layout = run_study(cfg, progress=False)["layouts"]["A"]
+    assert layout["failed"]["count"] == 0, layout["failed"]["errors"]
+    assert len(layout["items"]) == 30

@@ -26,12 +26,13 @@ STALL_PROGRESS = 0.05
 #: A search stuck closer than this to the goal (metres of the heuristic's distance) does
 #: not stall: it is finding a way to stand there, not a way around an obstacle.
 STALL_FAR = 0.5
-#: Nodes a search may expand after it first reached the goal's floor cells (heuristic
-#: distance 0) without ending: there it only looks for a place to stop that the goal
-#: and the body tests accept. Successful searches at 1.95 m in nine corpus cells needed
-#: up to 1670 such nodes, the paper's S1 (seed 3, two cycles, 1.75 m) 3048; a search
-#: around a spot no stop reaches (a 5 cm final adjustment at a table) used all 8000 of
-#: its budget for nothing.
+#: Nodes the final adjusting walk to a reach's spot (a goal a few centimetres wide) may
+#: expand after it first reached the goal's floor cells (heuristic distance 0) without
+#: ending: there it only looks for a place to stop that the goal and the body tests
+#: accept. Next to a table edge no stop may fit (a 1.95 m worker's 5 cm final adjustment
+#: used all 8000 nodes of its budget for nothing); then the other placements are tried.
+#: Only that walk ends early: an approach walk that needs more nodes at its goal still
+#: finds its stop (an S2 study item needed over 4000).
 AT_GOAL_NODES = 4000
 
 
@@ -81,7 +82,7 @@ class SearchBudget:
 
     max_nodes: int = 8000
     max_seconds: float | None = None
-    at_goal_nodes: int | None = AT_GOAL_NODES
+    at_goal_nodes: int | None = None
 
 
 @dataclass

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -26,7 +27,7 @@ from ltl_human_motion.motion.goals import (
 )
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
-from ltl_human_motion.planning.astar import SearchBudget
+from ltl_human_motion.planning.astar import AT_GOAL_NODES, SearchBudget
 from ltl_human_motion.planning.plan_state import (
     OTHER_HAND,
     PlanContext,
@@ -453,8 +454,9 @@ class GoalSteps:
             goal, back = self.goals.reach(target, placement, desc, text,
                                           adjust=FINAL_ADJUST_RADIUS, sector=sector,
                                           stand_yaw=stand_yaw)
+            final = replace(budget or self.ctx.options.budget, at_goal_nodes=AT_GOAL_NODES)
             walked += self.executor.walk(goal, text, -1, carry=self.state.carrying,
-                                         budget=budget)
+                                         budget=final)
             self.executor.adjust_to(target, placement, text, back, stand_yaw)
         return walked
 
