@@ -336,26 +336,31 @@ class GoalSteps:
             return [(target, None)]
         x, y, yaw = self.state.pose
         first = math.atan2(y - target[1], x - target[0])
-        mirrored = self.other_hand_placement(kind, args, target, placement, text)
-        # Last, a step back from where the first try stood, when furniture in front kept
-        # the worker further back than the placement already (the step back from the
-        # placement then comes to the same spot), if the goal model reaches from there.
+        # Asked only when the try comes (most first tries succeed): where the other hand
+        # stands, and whether the goal model reaches from a step back from where the
+        # first try stood (when furniture in front kept the worker further back than the
+        # placement already, the step back from the placement comes to the same spot).
+        mirrored = functools.cache(
+            lambda: self.other_hand_placement(kind, args, target, placement, text))
         stood = float(math.cos(yaw) * (target[0] - x) + math.sin(yaw) * (target[1] - y))
         back = max(b for _, b, _ in ALTERNATE_APPROACHES)
-        further = stood > placement[0] + back and self.reaches(
-            kind, args, (stood + back, placement[1], target[2]), raised)
+
+        def further() -> bool:
+            return stood > placement[0] + back and self.reaches(
+                kind, args, (stood + back, placement[1], target[2]), raised)
 
         def approach(turn: float, back: float, other: bool, ahead: float | None = None,
                      checked: bool = False) -> int:
-            if checked and not self.posture_room(kind, args, target, placement,
-                                                 first + turn, back, raised):
+            if (other and mirrored() is None) or (ahead is not None and not further()) \
+                    or (checked and not self.posture_room(kind, args, target, placement,
+                                                          first + turn, back, raised)):
                 raise PlanningError(f"task {text}: no reach clear of the obstacles from "
                                     "that side", task=text, reason="blocked")
             lowered = raised and not self.state.held
             if lowered:
                 self.executor.arm_transition(True, -1)
             self.executor.step_out()            # the first try may have left the worker at a rack
-            d, lat = mirrored if other else placement
+            d, lat = mirrored() if other else placement
             walked = self.approach(target, (d + back if ahead is None else ahead, lat), text,
                                     sector=(first + turn, APPROACH_HALF_WIDTH),
                                     budget=SearchBudget(ALTERNATIVE_NODES))
@@ -365,9 +370,8 @@ class GoalSteps:
 
         return [(target, None)] + [
             (target, functools.partial(approach, turn, back, other))
-            for turn, back, other in ALTERNATE_APPROACHES if mirrored is not None or not other
-        ] + ([(target, functools.partial(approach, 0.0, 0.0, False, stood + back))]
-             if further else []) + [
+            for turn, back, other in ALTERNATE_APPROACHES
+        ] + [(target, functools.partial(approach, 0.0, 0.0, False, stood + back))] + [
             (target, functools.partial(approach, turn, back, False, checked=True))
             for turn, back in CHECKED_APPROACHES]
 
