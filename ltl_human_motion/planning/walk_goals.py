@@ -192,6 +192,13 @@ class WalkGoals:
             out = (r >= dist - tol) & (r <= dist + limit[0]) & side(xy[:, 0], xy[:, 1])
             # The floor clearance only where the distance fits (few of the cells).
             out[out] = self.ctx.stand_map(xy[out]) > self.ctx.stand_room
+            # And only where the standing spot the goal test puts the worker on from
+            # there is free: a ring cell beside a bench whose spot (further back, turned
+            # by the lateral offset) lies within the bench's room never passes `reached`,
+            # and a field of only such cells kept the walk at the bench until the search
+            # gave up, where `max_step_back` would have found a spot.
+            out[out] = ideal_placement(self.ctx, target, placement, xy[out, 0], xy[out, 1],
+                                       limit[0], stand_yaw=stand_yaw)[3]
             return out
 
         def near_ring(xy: np.ndarray, clearance=None) -> np.ndarray:
