@@ -38,6 +38,12 @@ SQUEEZE_PASSAGE = PASSAGE_RADIUS + TALL_EXTRA
 #: reroutes, metres (:data:`.steps.STALL_NODES` says when a search stalls).
 STALL_BLOCK_RADIUS = 0.3
 
+#: Radii and directions sampled on the ring of standing spots within the reach tolerance
+#: (:meth:`WalkGoals.reach`) to tell whether any of them has a free spot for the goal
+#: test: 8 radii over the 0.3 m band (4 cm apart, half the 0.08 m search grid) and
+#: 72 directions (5 degrees, 2-3 cm apart at the 0.25-0.4 m ring).
+RING_SAMPLES = (8, 72)
+
 #: Navigation fields by floor grid and goal (see :meth:`WalkGoals.field`).
 _FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
 
@@ -50,6 +56,27 @@ def _in_sector(x: np.ndarray, y: np.ndarray, target: tuple[float, float],
         return np.ones(np.shape(x), dtype=bool)
     tx, ty = target
     return np.abs(wrap_angle(np.arctan2(y - ty, x - tx) - sector[0])) <= sector[1]
+
+
+def _ring_stands(ctx: PlanContext, target: np.ndarray, placement: tuple[float, float],
+                 side: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                 stand_yaw: float | None) -> bool:
+    """Whether any spot (sampled, ``RING_SAMPLES``) of the ring of :meth:`WalkGoals.reach`
+    within the reach tolerance, on its ``side`` and with floor room, has a free standing
+    spot for the goal test (:func:`.standing.ideal_placement`, ``target`` (3,) at
+    ``placement`` (ahead, left)). Beside a bench at a wall every spot the tolerance allows
+    lies in the bench's room (further back and turned by the lateral offset): no walk
+    passed the goal test and the search gave up at the bench, where ``max_step_back``
+    finds a spot."""
+    tol = ctx.options.reach_tolerance
+    dist = float(np.hypot(*placement))
+    r = np.linspace(max(dist - tol, 0.0), dist + tol, RING_SAMPLES[0])
+    a = np.linspace(-np.pi, np.pi, RING_SAMPLES[1], endpoint=False)
+    x = (float(target[0]) + np.outer(r, np.cos(a))).ravel()
+    y = (float(target[1]) + np.outer(r, np.sin(a))).ravel()
+    on = side(x, y) & (ctx.stand_map(np.stack([x, y], axis=-1)) > ctx.stand_room)
+    return bool(on.any()) and bool(ideal_placement(ctx, target, placement, x[on], y[on], tol,
+                                                   stand_yaw=stand_yaw)[3].any())
 
 
 def _towards(led: NavigationField, target: tuple[float, float], near: float, offset: float
@@ -212,7 +239,8 @@ class WalkGoals:
         def solve(squeeze: bool) -> tuple[NavigationField, float]:
             limit[0] = tol
             field = self.field(ring, ring_key(), squeeze)
-            if not field.has_goal:
+            if not field.has_goal or not _ring_stands(self.ctx, target, placement, side,
+                                                      stand_yaw):
                 limit[0] = self.ctx.options.max_step_back
                 field = self.field(ring, ring_key(), squeeze)
             if not field.has_goal:
