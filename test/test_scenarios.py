@@ -374,6 +374,12 @@ FIXED_FAMILY_RUNS = {
     ("kitting/single/insert(bolt, kit_a)", 1.75, 1): "every start blocked",
     # the upper arm of the reach under a shelf board at 0.69 of the stature (ceiling)
     ("kitting/single/grasp(bolt)", 1.95, 1): "upper arm into the board above",
+    # a floor part 0.14 m from a cart's long face: the stooping head and the reaching
+    # upper arm in the cart from every 60 degree approach; from the side where the goal
+    # primitive itself is clear (goal_steps.motion_room), also with O1 in the other hand
+    ("cluttered/single/grasp(O2)", 1.95, 1): "head into the cart stooping",
+    ("cluttered/single/move(O2, R1)", 1.75, 1): "head into the cart stooping",
+    ("cluttered/dwyer/absence_after/0", 1.95, 1): "head into the cart, other hand full",
 }
 
 
