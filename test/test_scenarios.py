@@ -378,6 +378,12 @@ FIXED_FAMILY_RUNS = {
     # those further back (the goal test's spots; generated cell gen_0_7)
     ("bench_at_wall/single/grasp(P2)", 1.75, 0): "no place to stop at the bench",
     ("bench_at_wall/single/carry(P3, Zone12)", 1.75, 0): "no place to stop at the bench",
+    # a floor part 0.14 m from a cart's long face: the stooping head and the reaching
+    # upper arm in the cart from every 60 degree approach; from the side where the goal
+    # primitive itself is clear (goal_steps.motion_room), also with O1 in the other hand
+    ("cluttered/single/grasp(O2)", 1.95, 1): "head into the cart stooping",
+    ("cluttered/single/move(O2, R1)", 1.75, 1): "head into the cart stooping",
+    ("cluttered/dwyer/absence_after/0", 1.95, 1): "head into the cart, other hand full",
 }
 
 

@@ -88,6 +88,22 @@ CHECKED_APPROACHES: tuple[tuple[float, float], ...] = (
 #: walk ends anywhere in the side).
 ROOM_SIDE_SPREAD: tuple[float, ...] = (0.0, -0.5, 0.5)
 
+#: Sides of the target (evenly spaced, from the first approach's) at which
+#: :meth:`GoalSteps.motion_room` makes the goal primitive itself, for each hand, when no
+#: other approach gave a clear one: every 15 degrees. A floor part 0.14 m from a cart's
+#: long face is reached clear only from spots 15 degrees wide (the body beside the cart,
+#: the arm between them), which the 60 degree sectors of the other approaches miss.
+MOTION_ROOM_SIDES = 24
+
+#: Half width of the side the walk to a spot :meth:`GoalSteps.motion_room` found ends in,
+#: rad (the spacing of ``MOTION_ROOM_SIDES``: a walk to half of it ran out of nodes
+#: without a place to stop).
+MOTION_ROOM_HALF_WIDTH = 2 * math.pi / MOTION_ROOM_SIDES
+
+#: Node budget of the walk to a spot :meth:`GoalSteps.motion_room` found (the walk
+#: from the front of a cart round to the 30 degree side beside it took 816 nodes).
+MOTION_ROOM_NODES = 1000
+
 #: Node budget of the walk to an alternative approach (most are a few steps round the
 #: target; a side that needs a long way round is not worth the search).
 ALTERNATIVE_NODES = 500
@@ -368,12 +384,32 @@ class GoalSteps:
                 self.executor.arm_transition(False, -1)
             return walked
 
+        def room() -> int:
+            # Last: the side where the goal primitive itself was clear (made there first).
+            found = self.motion_room(kind, args, target, first,
+                                     [placement] + ([mirrored] if mirrored else []), raised)
+            if found is None:
+                raise PlanningError(f"task {text}: no side of the target where the "
+                                    "motion keeps clear of the obstacles", task=text,
+                                    reason="blocked")
+            side, yaw, spot = found
+            lowered = raised and not self.state.held
+            if lowered:
+                self.executor.arm_transition(True, -1)
+            self.executor.step_out()
+            walked = self.approach(target, spot, text,
+                                   sector=(side, MOTION_ROOM_HALF_WIDTH),
+                                   budget=SearchBudget(MOTION_ROOM_NODES), stand_yaw=yaw)
+            if lowered:
+                self.executor.arm_transition(False, -1)
+            return walked
+
         return [(target, None)] + [
             (target, functools.partial(approach, turn, back, other))
             for turn, back, other in ALTERNATE_APPROACHES
         ] + [(target, functools.partial(approach, 0.0, 0.0, False, stood + back))] + [
             (target, functools.partial(approach, turn, back, False, checked=True))
-            for turn, back in CHECKED_APPROACHES]
+            for turn, back in CHECKED_APPROACHES] + [(target, room)]
 
     def posture_room(self, kind: str, args: tuple[str, ...], target: np.ndarray,
                      placement: tuple[float, float], side: float, back: float,
@@ -405,6 +441,51 @@ class GoalSteps:
                              hand=fixed or "auto", board=board):
                 return True
         return False
+
+    def motion_room(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                    first: float, placements: list[tuple[float, float]], raised: bool
+                    ) -> tuple[float, float, tuple[float, float]] | None:
+        """The first side of ``target`` (3,) (``MOTION_ROOM_SIDES`` of them, from
+        ``first``, rad, outwards both ways) and placement of ``placements`` ((ahead, left)
+        for each hand) where the worker standing as :func:`.standing.ideal_placement`
+        puts it makes a goal primitive that keeps clear (:meth:`goal_clear`, made with a
+        fixed seed: the plan's random stream stays as it was; only where the posture
+        search finds a clear posture, :func:`.motion.goals.posture_clear`), as (side,
+        facing yaw there, placement), rad, rad, m; or None."""
+        from ltl_human_motion.motion.goals import posture_clear
+        step = 2.0 * math.pi / MOTION_ROOM_SIDES
+        order = np.arange(MOTION_ROOM_SIDES)
+        sides = first + step * ((order + 1) // 2) * np.where(order % 2 == 1, 1.0, -1.0)
+        grasped = args[0] if kind == "grasp" and args else None
+        part = args[0] if kind in ("move", "insert", "release", "extract") and args else None
+        container = args[1] if kind == "extract" and len(args) > 1 else None
+        saved = self.state.pose
+        stance = self.ctx.stance(self.state.carrying or raised)
+        try:
+            for spot in placements:
+                far = 2.0 * math.hypot(*spot)
+                px, py, yaw, free = ideal_placement(
+                    self.ctx, target, spot, target[0] + far * np.cos(sides),
+                    target[1] + far * np.sin(sides), self.ctx.options.max_step_back)
+                for k in np.flatnonzero(free):
+                    self.state.pose = (float(px[k]), float(py[k]), float(yaw[k]))
+                    local, kwargs, _ = self.goal_kwargs(kind, target, self.state.carrying
+                                                        or raised, None, grasped, part,
+                                                        container)
+                    kwargs["rng"] = np.random.default_rng(0)
+                    if not posture_clear(kind, local, self.ctx.library.skeleton,
+                                         kwargs["obstacles"], start_pose=stance,
+                                         hand=kwargs.get("hand", "auto")):
+                        continue
+                    try:
+                        mp = self.ctx.library.goal(kind, local, **kwargs)
+                    except ValueError:
+                        continue
+                    if self.goal_clear(mp, grasped):
+                        return float(sides[k]), float(yaw[k]), spot
+        finally:
+            self.state.pose = saved
+        return None
 
     def reaches(self, kind: str, args: tuple[str, ...], local: tuple[float, float, float],
                 raised: bool) -> bool:
