@@ -337,8 +337,9 @@ class GoalSteps:
         where ``prepare()`` moves the worker first and returns the primitives walked.
 
         release: other places to let go, then ahead from a roomy spot; bend/stoop/kneel/
-        wait: a roomier spot; tasks
-        with a target: the other ``ALTERNATE_APPROACHES`` (further back, other sides).
+        wait: a roomier spot; tasks with a target: the other ``ALTERNATE_APPROACHES``
+        (further back, other sides), then ``CHECKED_APPROACHES``, then a side where the
+        motion itself is clear (:meth:`motion_room`).
         """
         if kind == "release":
             # Last, where every place around the worker is in the furniture (a short
@@ -365,6 +366,18 @@ class GoalSteps:
             return stood > placement[0] + back and self.reaches(
                 kind, args, (stood + back, placement[1], target[2]), raised)
 
+        def walk_there(spot: tuple[float, float], sector: tuple[float, float], nodes: int,
+                       stand_yaw: float | None = None) -> int:
+            lowered = raised and not self.state.held
+            if lowered:
+                self.executor.arm_transition(True, -1)
+            self.executor.step_out()            # the first try may have left the worker at a rack
+            walked = self.approach(target, spot, text, sector=sector,
+                                   budget=SearchBudget(nodes), stand_yaw=stand_yaw)
+            if lowered:
+                self.executor.arm_transition(False, -1)
+            return walked
+
         def approach(turn: float, back: float, other: bool, ahead: float | None = None,
                      checked: bool = False) -> int:
             if (other and mirrored() is None) or (ahead is not None and not further()) \
@@ -372,37 +385,20 @@ class GoalSteps:
                                                           first + turn, back, raised)):
                 raise PlanningError(f"task {text}: no reach clear of the obstacles from "
                                     "that side", task=text, reason="blocked")
-            lowered = raised and not self.state.held
-            if lowered:
-                self.executor.arm_transition(True, -1)
-            self.executor.step_out()            # the first try may have left the worker at a rack
             d, lat = mirrored() if other else placement
-            walked = self.approach(target, (d + back if ahead is None else ahead, lat), text,
-                                    sector=(first + turn, APPROACH_HALF_WIDTH),
-                                    budget=SearchBudget(ALTERNATIVE_NODES))
-            if lowered:
-                self.executor.arm_transition(False, -1)
-            return walked
+            return walk_there((d + back if ahead is None else ahead, lat),
+                              (first + turn, APPROACH_HALF_WIDTH), ALTERNATIVE_NODES)
 
         def room() -> int:
             # Last: the side where the goal primitive itself was clear (made there first).
-            found = self.motion_room(kind, args, target, first,
-                                     [placement] + ([mirrored] if mirrored else []), raised)
+            found = self.motion_room(kind, args, target, first, [placement] + (
+                [mirrored()] if mirrored() is not None else []), raised)
             if found is None:
                 raise PlanningError(f"task {text}: no side of the target where the "
                                     "motion keeps clear of the obstacles", task=text,
                                     reason="blocked")
             side, yaw, spot = found
-            lowered = raised and not self.state.held
-            if lowered:
-                self.executor.arm_transition(True, -1)
-            self.executor.step_out()
-            walked = self.approach(target, spot, text,
-                                   sector=(side, MOTION_ROOM_HALF_WIDTH),
-                                   budget=SearchBudget(MOTION_ROOM_NODES), stand_yaw=yaw)
-            if lowered:
-                self.executor.arm_transition(False, -1)
-            return walked
+            return walk_there(spot, (side, MOTION_ROOM_HALF_WIDTH), MOTION_ROOM_NODES, yaw)
 
         return [(target, None)] + [
             (target, functools.partial(approach, turn, back, other))
