@@ -74,9 +74,13 @@ STEP_OUT_MARGIN = 0.02
 #: Steps aside (m, left positive) tried when no backward step clears what follows.
 SIDE_STEPS: tuple[float, ...] = (0.1, -0.1, 0.2, -0.2)
 
-#: Node budget of a squeezing walk: along a gap the body barely fits the search gets
-#: through at once or not at all (the aisle's walks take under 20 nodes; a goal the
-#: body cannot stand at took the whole 8000 and the pair's time limit).
+#: Node budget of a squeezing walk without getting ``astar.STALL_PROGRESS`` nearer
+#: its goal (``SearchBudget.idle_nodes``): along a gap the body barely fits the search
+#: gets on at once or not at all (the aisle's walks take under 20 nodes; a goal the
+#: body cannot stand at took the whole 8000 and the pair's time limit). It was the
+#: whole budget; a tall worker's walk out of the aisle from a task inside it, whose
+#: first steps must find the few gait starts that keep the hands off the 0.91 m board
+#: and the elbows off the 1.2 m board, needed more (aisle, 1.95 m: 5 walks to R1).
 SQUEEZE_NODES = 1000
 
 #: A walk's search that expands this many nodes without getting nearer the goal stalls
@@ -404,7 +408,7 @@ class StepExecutor:
         noise_state = self.ctx.rng.bit_generator.state
         budget = budget or self.ctx.options.budget
         if goal.clearance is self.ctx.stand_map:
-            budget = replace(budget, max_nodes=min(budget.max_nodes, SQUEEZE_NODES))
+            budget = replace(budget, idle_nodes=SQUEEZE_NODES)
         used, repairs, reroutes = 0, 0, 0
         while True:
             self.ctx.rng.bit_generator.state = noise_state      # the same costs every time
