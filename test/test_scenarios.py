@@ -359,6 +359,8 @@ FIXED_FAMILY_RUNS = {
     # a tall worker's walk out of the aisle after a task inside it: the squeeze search's
     # budget counts the nodes without getting nearer, not all of them
     ("aisle/single/grasp(O2)", 1.95, 0): "walk:squeeze_idle_budget",
+    # ... and where that search still runs out, squared up to the aisle's axis in its middle
+    ("aisle/job/aisle_carry_out", 1.95, 0): "carry:squeeze_square_up",
     # a hand swung into a crate between the search's samples
     ("cluttered/single/assemble(R2)", 1.95, 0): "walk:between_samples",
     ("cluttered/single/grasp(O1)", 1.95, 0): "walk:between_samples",
