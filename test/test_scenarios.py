@@ -361,6 +361,8 @@ FIXED_FAMILY_RUNS = {
     ("aisle/single/grasp(O2)", 1.95, 0): "walk:squeeze_idle_budget",
     # ... and where that search still runs out, squared up to the aisle's axis in its middle
     ("aisle/job/aisle_carry_out", 1.95, 0): "carry:squeeze_square_up",
+    # ... to the body's middle, where the most gait starts keep the swinging arms clear
+    ("aisle/single/carry(O2, R2)", 1.95, 1): "walk:squeeze_body_middle",
     # a hand swung into a crate between the search's samples
     ("cluttered/single/assemble(R2)", 1.95, 0): "walk:between_samples",
     ("cluttered/single/grasp(O1)", 1.95, 0): "walk:between_samples",

@@ -371,6 +371,10 @@ class StepExecutor:
         k = int(np.argmax(gap))
         if not 0 < k < len(spots) - 1 or gap[k] >= SQUARE_UP_GAP:
             return False                    # open floor, or a single wall
+        # The body's middle: where the most gait starts keep clear (a gait's arms swing
+        # out further on one side), nearest the footprint's middle among those.
+        room = self.gait_room(spots, axis, carrying)
+        k = int(np.argmax(room * 1e3 - np.abs(np.arange(len(spots)) - k)))
         c, s = math.cos(yaw), math.sin(yaw)
         dxw, dyw = spots[k, 0] - x, spots[k, 1] - y
         if math.hypot(dxw, dyw) < ADJUST_STILL[0] and \
@@ -387,6 +391,21 @@ class StepExecutor:
         self.state.pose = self.hand_over_pose(mp, self.state.pose)
         self.state.gait_state = None
         return True
+
+    def gait_room(self, spots: np.ndarray, yaw: float, carrying: bool) -> np.ndarray:
+        """How many of the gait's starts from standing (walk or carry ones) keep the body
+        clear (:meth:`body_clear`) from each of ``spots`` (N, 2) facing ``yaw``, (N,)."""
+        index = self.ctx.index
+        starts = index.starts[index.carry[index.starts] == carrying]
+        if not starts.size or not index.body.size:
+            return np.zeros(len(spots))
+        c, s = math.cos(yaw), math.sin(yaw)
+        body = index.body[starts] @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T
+        out = np.zeros(len(spots))
+        for n, (x, y) in enumerate(spots):
+            placed = body + np.array([x, y, 0.0])
+            out[n] = np.count_nonzero(self.body_clear(placed, index.standing[starts]))
+        return out
 
     def gap_axis(self, goal: Goal) -> float | None:
         """The heading (rad) along the floor around the worker: of the lines through its
