@@ -356,6 +356,13 @@ FIXED_FAMILY_RUNS = {
     # every place to let go around a short worker at the shelf was in it: from a roomy spot
     ("bench_assembly/single/release(O1)", 1.55, 0): "release:at_the_shelf",
     ("paper_frame/single/release(O1)", 1.55, 1): "release:at_the_shelf",
+    # a tall worker's walk out of the aisle after a task inside it: the squeeze search's
+    # budget counts the nodes without getting nearer, not all of them
+    ("aisle/single/grasp(O2)", 1.95, 0): "walk:squeeze_idle_budget",
+    # ... and where that search still runs out, squared up to the aisle's axis in its middle
+    ("aisle/job/aisle_carry_out", 1.95, 0): "carry:squeeze_square_up",
+    # ... to the body's middle, where the most gait starts keep the swinging arms clear
+    ("aisle/single/carry(O2, R2)", 1.95, 1): "walk:squeeze_body_middle",
     # a hand swung into a crate between the search's samples
     ("cluttered/single/assemble(R2)", 1.95, 0): "walk:between_samples",
     ("cluttered/single/grasp(O1)", 1.95, 0): "walk:between_samples",

@@ -74,7 +74,9 @@ class SearchOptions:
 class SearchBudget:
     """Limits of one search: expanded nodes, and optionally wall-clock seconds; and the
     nodes expanded after the search first reached the goal's floor cells
-    (``at_goal_nodes``, None: no limit), beyond which it ends as ``"no_stop"``.
+    (``at_goal_nodes``, None: no limit), beyond which it ends as ``"no_stop"``; and
+    the nodes expanded without coming ``STALL_PROGRESS`` nearer the goal
+    (``idle_nodes``, None: no limit), beyond which it ends as ``"budget"``.
 
     Only the node limit is on by default, so a result never depends on the machine's
     load (the same inputs give the same motion or the same error).
@@ -83,6 +85,7 @@ class SearchBudget:
     max_nodes: int = 8000
     max_seconds: float | None = None
     at_goal_nodes: int | None = None
+    idle_nodes: int | None = None
 
 
 @dataclass
@@ -301,6 +304,8 @@ def _over_budget(budget: SearchBudget, t0: float, expanded: int, stall_nodes: in
     ``""``."""
     if expanded > budget.max_nodes or (budget.max_seconds is not None
                                        and time.perf_counter() - t0 > budget.max_seconds):
+        return "budget"
+    if budget.idle_nodes is not None and expanded - near.progress_at > budget.idle_nodes:
         return "budget"
     if budget.at_goal_nodes is not None and near.at_goal_since is not None \
             and expanded - near.at_goal_since > budget.at_goal_nodes:

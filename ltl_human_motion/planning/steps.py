@@ -74,9 +74,34 @@ STEP_OUT_MARGIN = 0.02
 #: Steps aside (m, left positive) tried when no backward step clears what follows.
 SIDE_STEPS: tuple[float, ...] = (0.1, -0.1, 0.2, -0.2)
 
-#: Node budget of a squeezing walk: along a gap the body barely fits the search gets
-#: through at once or not at all (the aisle's walks take under 20 nodes; a goal the
-#: body cannot stand at took the whole 8000 and the pair's time limit).
+#: A squeezing walk whose search ran out of budget in a gap whose middle has less floor
+#: clearance (footprint map) than this, metres, squares up to the gap's axis, steps to
+#: that middle and searches again: half the corpus aisle's 0.8 m width and 5 cm, the
+#: widest gap whose walls a tall worker's swinging hands (0.91 m board) and elbows
+#: (1.2 m board) reach when walking a few degrees off its axis or a few centimetres
+#: off its middle (aisle at 1.95 m: 126 of 300 gait
+#: candidates rejected for the left hand at the 0.91 m board, 58 for the right forearm
+#: at the 1.2 m board, from a start 7 cm off the middle turned 33 deg).
+SQUARE_UP_GAP = 0.45
+
+#: Side offsets tried for the middle of the gap when squaring up (metres, across the
+#: walk's heading): the spot with the most floor clearance among them, if not at either
+#: end (a gap, not a single wall the clearance grows away from); 2.5 cm steps up to a
+#: short side step (a quarter step more than ``SIDE_STEPS``' 0.2 m).
+SQUARE_UP_OFFSETS = np.linspace(-0.25, 0.25, 21)
+
+#: Axis directions tried for a gap (rad, 5 deg apart over a half turn), and how far the
+#: line along each is followed either way (metres, about one gait step).
+SQUARE_UP_AXES = np.radians(np.arange(0.0, 180.0, 5.0))
+SQUARE_UP_REACH = 0.5
+
+#: Node budget of a squeezing walk without getting ``astar.STALL_PROGRESS`` nearer
+#: its goal (``SearchBudget.idle_nodes``): along a gap the body barely fits the search
+#: gets on at once or not at all (the aisle's walks take under 20 nodes; a goal the
+#: body cannot stand at took the whole 8000 and the pair's time limit). It was the
+#: whole budget; a tall worker's walk out of the aisle from a task inside it, whose
+#: first steps must find the few gait starts that keep the hands off the 0.91 m board
+#: and the elbows off the 1.2 m board, needed more (aisle, 1.95 m: 5 walks to R1).
 SQUEEZE_NODES = 1000
 
 #: A walk's search that expands this many nodes without getting nearer the goal stalls
@@ -326,6 +351,79 @@ class StepExecutor:
                 self.state.pose = self.hand_over_pose(mp, self.state.pose)
                 return
 
+    def square_up(self, goal: Goal, carrying: bool) -> bool:
+        """In a narrow gap (its middle has less floor clearance on the footprint map than
+        ``SQUARE_UP_GAP``): turn on the spot to the gap's axis, the way towards ``goal``,
+        and step sideways to its middle (``SQUARE_UP_OFFSETS``), in one standing step, if
+        that keeps the body clear on every frame and is not shorter than
+        ``ADJUST_STILL``. A gait cycle started turned or off the middle there swings a
+        hand or elbow into a rack's board (a tall worker's hands at the 0.91 m board,
+        elbows at the 1.2 m board) and the search floods the spot until its budget runs
+        out; square to the gap it may walk out. Returns whether the step was added."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        x, y, yaw = self.state.pose
+        axis = self.gap_axis(goal)
+        if axis is None:
+            return False
+        side = np.array([-math.sin(axis), math.cos(axis)])
+        spots = np.array([x, y]) + SQUARE_UP_OFFSETS[:, None] * side
+        gap = self.ctx.stand_map(spots)
+        k = int(np.argmax(gap))
+        if not 0 < k < len(spots) - 1 or gap[k] >= SQUARE_UP_GAP:
+            return False                    # open floor, or a single wall
+        # The body's middle: where the most gait starts keep clear (a gait's arms swing
+        # out further on one side), nearest the footprint's middle among those.
+        room = self.gait_room(spots, axis, carrying)
+        k = int(np.argmax(room * 1e3 - np.abs(np.arange(len(spots)) - k)))
+        c, s = math.cos(yaw), math.sin(yaw)
+        dxw, dyw = spots[k, 0] - x, spots[k, 1] - y
+        if math.hypot(dxw, dyw) < ADJUST_STILL[0] and \
+                abs(float(wrap_angle(axis - yaw))) < ADJUST_STILL[1]:
+            return False                    # square already
+        lib = self.ctx.library
+        mp = make_step_primitive(self.ctx.stance(carrying), lib.standing_height,
+                                 c * dxw + s * dyw, -s * dxw + c * dyw,
+                                 float(wrap_angle(axis - yaw)), lib.skeleton, lib.fps,
+                                 "carry" if carrying else "walk")
+        if not self.placed_clear(mp, self.state.pose, samples=None):
+            return False
+        self.add(mp, self.state.pose, -1, self.ctx.overlap)
+        self.state.pose = self.hand_over_pose(mp, self.state.pose)
+        self.state.gait_state = None
+        return True
+
+    def gait_room(self, spots: np.ndarray, yaw: float, carrying: bool) -> np.ndarray:
+        """How many of the gait's starts from standing (walk or carry ones) keep the body
+        clear (:meth:`body_clear`) from each of ``spots`` (N, 2) facing ``yaw``, (N,)."""
+        index = self.ctx.index
+        starts = index.starts[index.carry[index.starts] == carrying]
+        if not starts.size or not index.body.size:
+            return np.zeros(len(spots))
+        c, s = math.cos(yaw), math.sin(yaw)
+        body = index.body[starts] @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T
+        out = np.zeros(len(spots))
+        for n, (x, y) in enumerate(spots):
+            placed = body + np.array([x, y, 0.0])
+            out[n] = np.count_nonzero(self.body_clear(placed, index.standing[starts]))
+        return out
+
+    def gap_axis(self, goal: Goal) -> float | None:
+        """The heading (rad) along the floor around the worker: of the lines through its
+        spot (``SQUARE_UP_AXES``, ``SQUARE_UP_REACH`` either way) the one keeping the most
+        footprint clearance (a gap's axis), pointing the way ``goal`` is nearer; None
+        where the goal's distance is infinite both ways."""
+        x, y, _ = self.state.pose
+        t = np.linspace(-SQUARE_UP_REACH, SQUARE_UP_REACH, 11)
+        u = np.stack([np.cos(SQUARE_UP_AXES), np.sin(SQUARE_UP_AXES)], axis=-1)     # (A, 2)
+        pts = np.array([x, y]) + t[None, :, None] * u[:, None, :]                 # (A, 11, 2)
+        keep = self.ctx.stand_map(pts.reshape(-1, 2)).reshape(pts.shape[:2]).min(axis=1)
+        a = int(np.argmax(keep))
+        ends = np.array([x, y]) + SQUARE_UP_REACH * np.array([u[a], -u[a]])
+        left = goal.distance(ends[:, 0], ends[:, 1])
+        if not np.isfinite(left).any():
+            return None
+        return float(SQUARE_UP_AXES[a] + (0.0 if left[0] <= left[1] else np.pi))
+
     def walkable(self, x: float, y: float) -> bool:
         """Whether a walk may start at (x, y): ``STEP_OUT_MARGIN`` more floor clearance
         than ``options.body_radius``, and the navigation grid's cell there is free (the
@@ -404,7 +502,7 @@ class StepExecutor:
         noise_state = self.ctx.rng.bit_generator.state
         budget = budget or self.ctx.options.budget
         if goal.clearance is self.ctx.stand_map:
-            budget = replace(budget, max_nodes=min(budget.max_nodes, SQUEEZE_NODES))
+            budget = replace(budget, idle_nodes=SQUEEZE_NODES)
         used, repairs, reroutes = 0, 0, 0
         while True:
             self.ctx.rng.bit_generator.state = noise_state      # the same costs every time
@@ -435,6 +533,9 @@ class StepExecutor:
                 raise PlanningError(f"task {task}: {goal.description}: every path found "
                                     f"({WALK_REPAIRS + 1}) collides on a frame the search "
                                     "did not sample", task=task, reason="blocked")
+        if isinstance(res, SearchFailure) and res.reason == "budget" and \
+                goal.clearance is self.ctx.stand_map and self.square_up(goal, carry):
+            return self.walk(goal, task, label, carry, budget)    # square to the gap
         if isinstance(res, SearchFailure):
             if res.reason == "budget":
                 why = (f"the search budget ran out ({used} nodes; closest approach "
