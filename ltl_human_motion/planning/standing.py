@@ -204,6 +204,11 @@ def _edge_local(depth: float, normal: np.ndarray, local: np.ndarray, yaw: float)
     return float(local[0]) + depth * float(n[0]) - BOARD_EDGE_SPAN * abs(float(n[1]))
 
 
+#: Metres a part's bounding box is widened by before its footprint is asked whether it
+#: holds a point (rounding only: the box holds every point of the footprint).
+_BOX_SLACK = 1e-9
+
+
 def _parts_over(cell, target: np.ndarray, local: np.ndarray, yaw: float):
     """The obstacle parts whose footprint holds the floor point of ``target`` (world
     (3,); ``local``: it in the start frame of a goal primitive whose heading is ``yaw``),
@@ -212,17 +217,19 @@ def _parts_over(cell, target: np.ndarray, local: np.ndarray, yaw: float):
     xy = np.asarray(target[:2], dtype=np.float64)
     probe = xy + np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
     c, s = math.cos(-yaw), math.sin(-yaw)
-    for ob in cell.obstacles:
-        for part in ob.parts:
-            sd = part.footprint().signed_distance(probe)
-            if sd[0] > 0.0:
-                continue
-            grad = (sd[1:] - sd[0]) / max(float(np.linalg.norm(sd[1:] - sd[0])), 1e-12)
-            inward = -np.array([c * grad[0] - s * grad[1], s * grad[0] + c * grad[1]])
-            # The edge lies -sd metres from the target along the outward normal.
-            offset = float(inward @ np.asarray(local[:2], dtype=np.float64)) + float(sd[0])
-            lo, hi = part.aabb()
-            yield lo, hi, inward, offset
+    parts = cell.part_set                       # every obstacle's parts, in their order
+    # A footprint that holds the point has a bounding box that holds it.
+    boxed = np.all((parts.lo[:, :2] - _BOX_SLACK <= xy) & (xy <= parts.hi[:, :2] + _BOX_SLACK),
+                   axis=1)
+    for k in np.flatnonzero(boxed):
+        sd = parts.parts[k].footprint().signed_distance(probe)
+        if sd[0] > 0.0:
+            continue
+        grad = (sd[1:] - sd[0]) / max(float(np.linalg.norm(sd[1:] - sd[0])), 1e-12)
+        inward = -np.array([c * grad[0] - s * grad[1], s * grad[0] + c * grad[1]])
+        # The edge lies -sd metres from the target along the outward normal.
+        offset = float(inward @ np.asarray(local[:2], dtype=np.float64)) + float(sd[0])
+        yield parts.lo[k], parts.hi[k], inward, offset
 
 
 def support_local(cell, target: np.ndarray, local: np.ndarray, yaw: float
