@@ -293,14 +293,15 @@ class GoalSteps:
         return local, kwargs, furniture.get("board")
 
     def first_clear_try(self, i: int, text: str, kind: str, args: tuple[str, ...],
-                        tries: list, carrying_before: bool
+                        tries: list, carrying_before: bool,
+                        failure: PlanningError | None = None
                         ) -> tuple[int, MotionPrimitive, np.ndarray | None, int]:
         """Make the goal primitive of step ``i`` from the first of ``tries`` (see
         :meth:`alternatives`; a target may be a function of where the preparation left the
-        worker) that works; returns (segment, primitive, the target it
-        reached, gait primitives its preparation walked). Raises the first failure, with
-        how many other placements were tried."""
-        failure = None
+        worker) that works; returns (segment, primitive, the target it reached, gait
+        primitives its preparation walked). Raises the first failure (``failure`` if
+        given: the blocked walk to the first placement), with how many other placements
+        were tried."""
         for k, (target, prepare) in enumerate(tries):
             mark = self.state.mark()
             try:

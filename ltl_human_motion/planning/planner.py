@@ -368,10 +368,8 @@ class SequencePlanner:
         if target is not None and kind not in ("release", "standUp") and self.state.seat is None:
             # (Seated, the hands work from the seat.)
             placement, arms_up = self._placement(kind, target, text, args)
-            walked = self.goal_steps.approach_under(target, placement, text) \
-                if kind in LEVEL_PATH_TASKS and facing is None else None
-            if walked is None:
-                walked = self.goal_steps.approach_facing(target, placement, text, facing)
+            walked, approach_failed = self._first_approach(kind, target, placement, text,
+                                                           facing)
         carrying_before = self.state.carrying
         raised = kind in HAND_TASKS and not carrying_before and self.state.seat is None \
             and arms_up
@@ -382,8 +380,8 @@ class SequencePlanner:
             self.executor.arm_transition(False, -1)
             carrying_before = True
         tries = self.goal_steps.alternatives(kind, args, target, placement, text, raised)
-        seg, mp, target, prepared = self.goal_steps.first_clear_try(i, text, kind, args, tries,
-                                                          carrying_before)
+        seg, mp, target, prepared = self.goal_steps.first_clear_try(
+            i, text, kind, args, tries, carrying_before, approach_failed)
         walked += prepared
         hand = mp.meta.get("hand")
         joints = dict(self.state.held)
@@ -405,6 +403,28 @@ class SequencePlanner:
                         lift_frame=lift, hand=hand, expanded=self.state.expanded - expanded0,
                         primitive=mp.name,
                         objects_effect=effect, sub_steps=subs)
+
+    def _first_approach(self, kind: str, target: np.ndarray, placement: tuple[float, float],
+                        text: str, facing: np.ndarray | None
+                        ) -> tuple[int, PlanningError | None]:
+        """Walk to the placement for ``target`` (3,) (under a low board, or facing
+        ``facing``); returns the gait primitives walked and None. Where that walk is
+        blocked (no place to stop there keeps the body clear), what it placed is taken
+        back and (0, the error) returned: the goal step's alternatives
+        (:meth:`.goal_steps.GoalSteps.alternatives`, from other sides and further back)
+        are tried from where the worker stood, and the error is what a refusal names."""
+        mark = self.state.mark()
+        try:
+            walked = self.goal_steps.approach_under(target, placement, text) \
+                if kind in LEVEL_PATH_TASKS and facing is None else None
+            if walked is None:
+                walked = self.goal_steps.approach_facing(target, placement, text, facing)
+        except PlanningError as exc:
+            if exc.reason != "blocked":
+                raise
+            self.state.restore(mark)
+            return 0, exc
+        return walked, None
 
     def _placement(self, kind: str, target: np.ndarray, text: str, args: tuple[str, ...]
                    ) -> tuple[tuple[float, float], bool]:
