@@ -363,7 +363,7 @@ class SequencePlanner:
         if kind in ("move", "insert") and args[0] in self.state.held_offsets:
             # The hand puts the part's centre (held at its offset) on the target.
             target = target - self.state.held_offsets[args[0]]
-        walked = 0
+        walked, approach_failed = 0, None
         placement, arms_up = None, True
         if target is not None and kind not in ("release", "standUp") and self.state.seat is None:
             # (Seated, the hands work from the seat.)
