@@ -84,3 +84,33 @@ def test_synthesis_with_foot_locking_pins_the_feet_or_falls_back_when_it_collide
                    options=on)[0]
     assert m.verification["passed"] and m.verification["collision"]["passed"]
     assert m.stats["foot_locking"] is False
+
+
+def test_compiled_sequential_passes_equal_the_python_loops() -> None:
+    """The numba loops of the yaw-lock envelope and the rate limiter give the Python
+    loops' numbers exactly."""
+    import math
+
+    from ltl_human_motion.kernel.segments import compiled_module
+    nb = compiled_module("ltl_human_motion.planning._motion_numba")
+    if nb is None:
+        import pytest
+        pytest.skip("numba kernels not in use")
+    rng = np.random.default_rng(3)
+    for n in (1, 2, 50, 700):
+        w = rng.random(n) * (rng.random(n) > 0.7)
+        ref = w.tolist()
+        for t in range(n - 2, -1, -1):
+            ref[t] = max(ref[t], ref[t + 1] - 0.05)
+        for t in range(1, n):
+            ref[t] = max(ref[t], ref[t - 1] - 0.05)
+        np.testing.assert_array_equal(nb.decay_envelope(w, 0.05), ref)
+        x = np.cumsum(rng.normal(size=(n, 3)) * 0.02, axis=0)
+        rows = x.tolist()
+        for order, back in ((range(1, n), 1), (range(n - 2, -1, -1), -1)):
+            for t in order:
+                d = [c - p for c, p in zip(rows[t], rows[t - back])]
+                size = math.sqrt(sum(v * v for v in d))
+                if size > 0.01:
+                    rows[t] = [p + v * (0.01 / size) for p, v in zip(rows[t - back], d)]
+        np.testing.assert_array_equal(nb.rate_limited(x, 0.01), np.array(rows))

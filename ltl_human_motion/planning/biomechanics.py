@@ -59,7 +59,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ltl_human_motion.kernel.segments import joint_segment_distances
+from ltl_human_motion.kernel.segments import compiled_module, joint_segment_distances
 from ltl_human_motion.kernel.vectors import cross3, dot3, norm3
 from ltl_human_motion.motion.ik import center_of_mass
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, JOINT_NAMES
@@ -153,9 +153,11 @@ def _speed_limits(n: int, labels: Sequence[str], lim: BiomechanicsLimits,
                   scale: float) -> np.ndarray:
     """Per-interval, per-joint speed limit (n, J) from the activity label of each frame."""
     out = np.full((n, len(JOINT_NAMES)), lim.other_speed)
-    lab = np.asarray([_kind(x) for x in labels[:n]], dtype=object)
-    hand_goal = np.isin(lab, HAND_GOAL_TASKS)
-    posture = np.isin(lab, POSTURE_TRANSITION_TASKS)
+    names, code = np.unique(np.asarray(labels[:n], dtype=object).astype(str),
+                            return_inverse=True)
+    kinds = [_kind(x) for x in names]
+    hand_goal = np.isin(kinds, HAND_GOAL_TASKS)[code]
+    posture = np.isin(kinds, POSTURE_TRANSITION_TASKS)[code]
     for s in "lr":
         out[:, _J[f"{s}_hand"]] = np.where(hand_goal, lim.hand_speed_goal, lim.hand_speed)
         out[:, _J[f"{s}_wrist"]] = np.where(hand_goal, lim.hand_speed_goal, lim.hand_speed)
@@ -299,8 +301,11 @@ def _hull_distance(points: np.ndarray, p: np.ndarray) -> np.ndarray:
     ``ConvexHull``, for all frames at once: an edge of two points belongs to the hull
     when no other point lies beyond it (to within ``1e-12`` of the points' extent).
     """
-    P = np.asarray(points, dtype=np.float64)
-    q = np.asarray(p, dtype=np.float64)
+    P = np.ascontiguousarray(points, dtype=np.float64)
+    q = np.ascontiguousarray(p, dtype=np.float64)
+    nb = compiled_module("ltl_human_motion.planning._motion_numba")
+    if nb is not None:
+        return nb.hull_distance(P, q)
     i, j = np.nonzero(~np.eye(P.shape[1], dtype=bool))        # every ordered pair
     x, y = P[..., 0], P[..., 1]
     xi, yi = x[:, i], y[:, i]                                  # (T, E)

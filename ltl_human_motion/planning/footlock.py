@@ -22,10 +22,12 @@ from __future__ import annotations
 
 import itertools
 import math
+from types import ModuleType
 
 import numpy as np
 from scipy.ndimage import maximum_filter1d, uniform_filter1d
 
+from ltl_human_motion.kernel.segments import compiled_module
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
@@ -155,13 +157,7 @@ def _keep_heading(joints: np.ndarray, h: np.ndarray, stance: np.ndarray, fps: fl
         w[flat] = np.clip(2.0 - twist / MAX_TWIST, 0.0, 1.0)
     # the lock is in full by the time the foot is flat: it fades in over YAW_RAMP before
     # (while the heel is down and the ball comes down) and out over YAW_RAMP after
-    step = 1.0 / max(1.0, YAW_RAMP * fps)
-    wl = w.tolist()                                 # plain floats: sequential loops
-    for t in range(T - 2, -1, -1):
-        wl[t] = max(wl[t], wl[t + 1] - step)
-    for t in range(1, T):
-        wl[t] = max(wl[t], wl[t - 1] - step)
-    w = np.minimum(np.array(wl), stance.astype(float))
+    w = np.minimum(_decay_envelope(w, 1.0 / max(1.0, YAW_RAMP * fps)), stance.astype(float))
     out = joints.copy()
     idx = np.flatnonzero((w > 0) & stance)
     if not idx.size:
@@ -342,11 +338,32 @@ def _unit3(v: np.ndarray) -> np.ndarray:
     return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
 
 
+def _compiled() -> ModuleType | None:
+    return compiled_module("ltl_human_motion.planning._motion_numba")
+
+
+def _decay_envelope(w: np.ndarray, step: float) -> np.ndarray:
+    """``w`` (T,) raised so that no value falls by more than ``step`` per frame towards
+    either end (a backward pass, then a forward pass)."""
+    nb = _compiled()
+    if nb is not None:
+        return nb.decay_envelope(np.ascontiguousarray(w, dtype=np.float64), float(step))
+    wl = w.tolist()                                 # plain floats: sequential loops
+    for t in range(len(wl) - 2, -1, -1):
+        wl[t] = max(wl[t], wl[t + 1] - step)
+    for t in range(1, len(wl)):
+        wl[t] = max(wl[t], wl[t - 1] - step)
+    return np.array(wl, dtype=np.float64)
+
+
 def _rate_limited(x: np.ndarray, step: float) -> np.ndarray:
     """``x`` (T, 3) with every frame-to-frame change at most ``step`` (forward and backward
     passes, so the result stays within ``x``'s envelope towards zero)."""
     if not len(x) or np.max(np.linalg.norm(np.diff(x, axis=0), axis=-1), initial=0.0) <= step:
         return x.copy()                 # no change is too fast
+    nb = _compiled()
+    if nb is not None:
+        return nb.rate_limited(np.ascontiguousarray(x, dtype=np.float64), float(step))
     rows = x.tolist()                   # plain floats: this loop is sequential
     for order, back in ((range(1, len(rows)), 1), (range(len(rows) - 2, -1, -1), -1)):
         for t in order:
