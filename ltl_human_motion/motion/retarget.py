@@ -61,6 +61,9 @@ _RIGID = {JOINT_INDEX[n]: "pelvis" for n in _PELVIS_RIGID} | {
 #: Joints placed along their source bone, and their parents.
 _FREE_J = np.array([j for j in range(1, len(JOINT_NAMES)) if j not in _RIGID])
 _FREE_P = np.array([PARENTS[j] for j in _FREE_J])
+_FREE_HIPS_J = np.array([j for j in range(1, len(JOINT_NAMES))
+                         if j not in _RIGID or _RIGID[j] == "pelvis"])
+_FREE_HIPS_P = np.array([PARENTS[j] for j in _FREE_HIPS_J])
 
 
 def _build(points: dict[str, np.ndarray], pelvis: np.ndarray, skeleton: Skeleton) -> np.ndarray:
@@ -77,12 +80,14 @@ def _build(points: dict[str, np.ndarray], pelvis: np.ndarray, skeleton: Skeleton
     return _build_array(src, pelvis, skeleton)
 
 
-def _build_array(src: np.ndarray, pelvis: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+def _build_array(src: np.ndarray, pelvis: np.ndarray, skeleton: Skeleton,
+                 rigid_hips: bool = True) -> np.ndarray:
     """Canonical positions (T, J, 3) from source points ``src`` (T, J, 3) and a pelvis path.
 
     Limb bones keep their source direction (a degenerate source bone the rest direction)
-    and get the canonical length; hips, clavicles and shoulders follow the frames of
-    the source pelvis and chest. Each joint is its parent plus its bone. The work is
+    and get the canonical length; hips (unless not ``rigid_hips``: then they are free
+    bones too), clavicles and shoulders follow the frames of the source pelvis and
+    chest. Each joint is its parent plus its bone. The work is
     done on a joint-, then coordinate-major copy (J, 3, T), so every step runs over
     contiguous rows.
     """
@@ -99,16 +104,18 @@ def _build_array(src: np.ndarray, pelvis: np.ndarray, skeleton: Skeleton) -> np.
               "chest": frame_from_axes(point("l_shoulder") - point("r_shoulder"),
                                        point("neck") - point("chest"))}
     bone = np.empty((J, 3, T))                          # each joint minus its parent
+    free_j, free_p = (_FREE_J, _FREE_P) if rigid_hips else (_FREE_HIPS_J, _FREE_HIPS_P)
     for j, which in _RIGID.items():
-        bone[j] = (frames[which] @ (rest[j] - rest[PARENTS[j]])).T
-    vec = s[_FREE_J] - s[_FREE_P]                                       # (n, 3, T)
+        if rigid_hips or which != "pelvis":
+            bone[j] = (frames[which] @ (rest[j] - rest[PARENTS[j]])).T
+    vec = s[free_j] - s[free_p]                                         # (n, 3, T)
     norm = np.sqrt(vec[:, 0] * vec[:, 0] + vec[:, 1] * vec[:, 1]
                    + vec[:, 2] * vec[:, 2])[:, None]                     # (n, 1, T)
     # a degenerate (zero-length) source bone keeps the canonical rest direction
-    rest_vec = rest[_FREE_J] - rest[_FREE_P]
+    rest_vec = rest[free_j] - rest[free_p]
     rest_dir = rest_vec / np.maximum(np.linalg.norm(rest_vec, axis=-1, keepdims=True), 1e-12)
     direction = np.where(norm > 1e-9, vec / np.maximum(norm, 1e-12), rest_dir[:, :, None])
-    bone[_FREE_J] = lengths[_FREE_J][:, None, None] * direction
+    bone[free_j] = lengths[free_j][:, None, None] * direction
     out = np.empty((J, 3, T))
     out[0] = np.asarray(pelvis, dtype=np.float64).T
     for j in range(1, J):                               # parents come before children
@@ -241,12 +248,19 @@ def fix_feet(positions: np.ndarray, fps: float, skeleton: Skeleton, clearance: f
     return out
 
 
-def enforce_bone_lengths(positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+def enforce_bone_lengths(positions: np.ndarray, skeleton: Skeleton,
+                         rigid_hips: bool = True) -> np.ndarray:
     """Re-impose canonical bone lengths on canonical-skeleton positions (keeps directions).
 
     Parameters
     ----------
     positions : ndarray, shape (T, J, 3)
+    rigid_hips : bool
+        Place the hips rigidly in the pelvis frame (lateral from hip to hip, up towards
+        the chest), as retargeting does. False keeps each hip's direction from the pelvis
+        like any other bone's: a model-made pose whose pelvis tilts less than its chest
+        (a crouch) keeps its legs and feet where the model put them (rebuilt rigidly,
+        the hips of a 60 degree trunk flexion swing 3-4 cm back, and the feet with them).
 
     Returns
     -------
@@ -254,7 +268,7 @@ def enforce_bone_lengths(positions: np.ndarray, skeleton: Skeleton) -> np.ndarra
         Same pelvis path; every bone has its canonical length.
     """
     pos = np.asarray(positions, dtype=np.float64)
-    return _build_array(pos, pos[:, 0], skeleton)
+    return _build_array(pos, pos[:, 0], skeleton, rigid_hips)
 
 
 def mirror_positions(positions: np.ndarray) -> np.ndarray:

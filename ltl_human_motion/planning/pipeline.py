@@ -344,7 +344,7 @@ def _blended(plan: Plan, floor_cell, floor_z: float, library, realism: bool,
         plan.segments, spread=round(JUNCTION_SPREAD * library.fps) if realism else 0,
         fps=library.fps if realism else None)
     # Linear blends of joint positions shorten bones between unlike poses; restore them.
-    positions = enforce_bone_lengths(positions, library.skeleton)
+    positions = enforce_bone_lengths(positions, library.skeleton, rigid_hips=False)
     if realism:
         positions = lock_feet(positions, library.fps, library.skeleton, 0.0)
     tracks, held = _object_tracks(floor_cell, plan, spans, positions, library.overlap)

@@ -292,7 +292,7 @@ class StepExecutor:
             rel = np.concatenate([rel, np.repeat(rel[-1:], self.ctx.overlap + 2 - len(rel), 0)])
         # The pipeline restores bone lengths after blending, so the transition is checked
         # as it will be played.
-        rel = enforce_bone_lengths(rel, self.ctx.library.skeleton)
+        rel = enforce_bone_lengths(rel, self.ctx.library.skeleton, rigid_hips=False)
         rel.flags.writeable = False
         if len(_ARM_POSES) >= 32:
             _ARM_POSES.clear()
