@@ -177,3 +177,60 @@ def test_hull_distance_matches_qhull_facets() -> None:
     ref = [float(np.max(h.equations[:, :2] @ c + h.equations[:, 2]))
            for h, c in ((ConvexHull(q), c) for q, c in zip(poly, com))]
     np.testing.assert_allclose(_hull_distance(poly, com), ref, rtol=0, atol=1e-12)
+
+
+def test_compiled_hull_distance_equals_the_numpy_path(monkeypatch) -> None:
+    """The numba support-polygon distance gives the numpy path's numbers exactly, with
+    repeated corners too."""
+    from ltl_human_motion.kernel import segments
+    from ltl_human_motion.planning import biomechanics
+    rng = np.random.default_rng(2)
+    poly = rng.normal(size=(300, 8, 2)) * 0.2
+    poly[:20, 4:] = poly[:20, :4]
+    com = rng.normal(size=(300, 2)) * 0.2
+    compiled = biomechanics._hull_distance(poly, com)
+    monkeypatch.setattr(segments, "compiled_module", lambda name: None)
+    monkeypatch.setattr(biomechanics, "compiled_module", lambda name: None)
+    np.testing.assert_array_equal(compiled, biomechanics._hull_distance(poly, com))
+
+
+def test_a_crouch_keeps_its_feet_when_bone_lengths_are_restored() -> None:
+    """A deep model-made grasp (pelvis tilt capped, trunk flexed 60+ degrees) keeps its
+    feet where the model put them through the pipeline's bone-length restoration; the
+    rigid-hip rebuild of retargeting swings the hips back with the chest and the feet
+    slide by centimetres."""
+    from ltl_human_motion.motion.goals import make_goal_primitive, reach_placement
+    from ltl_human_motion.motion.retarget import enforce_bone_lengths
+    sk = Skeleton(1.55)
+    x, y = reach_placement("grasp", 0.08, sk, board=(0.115, 0.40, 0.42))
+    mp = make_goal_primitive("grasp", np.array([x, y, 0.08]), sk,
+                             rng=np.random.default_rng(0), board=(x - 0.115, 0.40, 0.42))
+    world = mp.poses + mp.root[:, None, :3]
+    feet = [J["l_ankle"], J["l_toe"], J["r_ankle"], J["r_toe"]]
+    kept = enforce_bone_lengths(world, sk, rigid_hips=False)
+    assert np.abs(kept[:, feet] - world[:, feet]).max() < 1e-3
+    rigid = enforce_bone_lengths(world, sk)
+    assert np.abs(rigid[:, feet] - world[:, feet]).max() > 0.01
+    angles = joint_angles(kept)
+    assert max(angles["l_hip_flexion"].max(), angles["r_hip_flexion"].max()) <= 125.0
+
+
+def test_a_low_reach_from_the_carry_stance_keeps_the_forearm_out_of_the_thigh(
+        monkeypatch) -> None:
+    """A 1.85 m worker grasping near the feet from the carry stance (the paper cell's O1)
+    swings the hand wider past the thigh where the usual swing passes the forearm through
+    it (the thigh rises towards the flexed trunk; at the contact pose the arm is clear)."""
+    from ltl_human_motion.motion import goals
+    from ltl_human_motion.planning.pipeline import get_library
+    sk = Skeleton(1.85)
+    carry = get_library(1.85).carry_standing_pose
+
+    def deepest() -> float:
+        mp = goals.make_goal_primitive("grasp", np.array([0.278, -0.129, 0.25]), sk,
+                                       rng=np.random.default_rng(0), start_pose=carry)
+        return float(self_penetration(mp.poses + mp.root[:, None, :3], 1.85)[0].max())
+
+    assert deepest() <= 0.0
+    monkeypatch.setattr(goals, "_WIDER_SWINGS", (1.0,))
+    monkeypatch.setattr(goals, "_POSTURE_TRIES", 1)
+    assert deepest() > 0.0

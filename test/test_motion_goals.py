@@ -156,10 +156,11 @@ def test_kneel_sit_and_stand_up() -> None:
     f = sit.meta["contact_frame"]
     assert f == sit.n_frames - 1
     hips = w[f, [J["l_hip"], J["r_hip"]]].mean(axis=0)
-    assert hips[2] - seat[2] == pytest.approx(0.055 * SK.stature, abs=1e-6)
+    # (the hips turn with the seated pelvis's 3.4 degree tilt: 0.1 mm lower)
+    assert hips[2] - seat[2] == pytest.approx(0.055 * SK.stature, abs=2e-4)
     assert np.linalg.norm(hips[:2] - seat[:2]) < 0.03
     _up, w = _make("standUp", [0.0, 0.0, 0.45])
-    assert w[0, J["l_hip"], 2] == pytest.approx(0.45 + 0.055 * SK.stature, abs=1e-6)
+    assert w[0, J["l_hip"], 2] == pytest.approx(0.45 + 0.055 * SK.stature, abs=2e-4)
     assert w[-1, 0, 2] == pytest.approx(STAND_Z, abs=1e-6)
     with pytest.raises(ValueError, match="seat height"):
         _make("sit", [seat[0], 0.0, hi + 0.1])
@@ -282,3 +283,45 @@ def test_extract_over_furniture_pulls_out_in_front_of_its_edge() -> None:
     palm = world_positions(mp, 0.0, 0.0, 0.0)[:, J["r_hand"]]
     beyond = palm[:, 0] > 0.4
     assert beyond.any() and np.all(palm[beyond, 2] > 0.98)
+
+
+@pytest.mark.parametrize(("z", "seed"), [(0.9, 4), (0.9, 1), (0.3, 2), (1.2, 3)])
+def test_a_retimed_reach_is_slower_along_the_same_path(monkeypatch, z: float,
+                                                       seed: int) -> None:
+    """A reach whose hand would pass the retiming speed is made again slower from the same
+    random draws: the palm keeps within 1 cm of the fast version's path (the body's lead
+    over the hand is timed, not placed; other draws bow it 1-2 cm away) and its peak
+    speed is under the limit."""
+    from scipy.spatial.distance import cdist
+
+    from ltl_human_motion.motion import goals
+    x, y = goals.reach_placement("grasp", z, SK)
+    target = np.array([x, y, z])
+
+    def made(limit: float) -> np.ndarray:
+        monkeypatch.setattr(goals, "HAND_RETIME_SPEED", limit)
+        mp = goals.make_goal_primitive("grasp", target, SK, rng=np.random.default_rng(seed))
+        return mp.poses + mp.root[:, None, :3]
+
+    fast, slow = made(1e9), made(0.6)
+    assert len(slow) > len(fast)
+    assert goals._peak_hand_speed(slow, (1,), 120.0) <= 0.6 * SK.stature / 1.75 + 1e-9
+    d = cdist(slow[:, J["r_hand"]], fast[:, J["r_hand"]])
+    assert max(d.min(axis=1).max(), d.min(axis=0).max()) < 0.01
+
+
+def test_hips_stay_level_in_a_standing_bend_and_turn_with_a_crouching_pelvis() -> None:
+    """A bend from the standing height keeps the hips where the pelvis holds them (the
+    legs stay straight enough to reach the floor); a crouch turns them with the pelvis's
+    tilt, back and up about the pelvis joint."""
+    from ltl_human_motion.motion import goals
+    rest = SK.rest_positions()
+    hips = [J["l_hip"], J["r_hip"]]
+    pelvis = np.array([rest[0], rest[0] - [0.0, 0.0, 0.3 * SK.stature]])
+    pitch = np.array([0.8, 0.8])
+    tr = goals._trunk(SK, pelvis, pitch)
+    np.testing.assert_allclose(tr[0, hips] - pelvis[0], rest[hips] - rest[0], atol=1e-12)
+    off = tr[1, hips] - pelvis[1]
+    assert np.all(off[:, 0] < rest[hips, 0] - rest[0, 0] - 0.01)
+    np.testing.assert_allclose(np.linalg.norm(off, axis=1),
+                               np.linalg.norm(rest[hips] - rest[0], axis=1), atol=1e-12)

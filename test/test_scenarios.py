@@ -324,6 +324,18 @@ BIOMECHANICS_RUNS = {
     ("shelf_heights/dwyer/existence_between/0", 1.75): "joint_speed:knee_push_off",
     ("seats/single/assemble(R2)", 1.55): "joint_speed:knee_push_off",
     ("stations/job/station_tour", 1.95): "joint_speed:knee_push_off",
+    # a reach under a low board took the pelvis's full tilt (hip flexion 125-163 deg),
+    # and restoring bone lengths swung a crouch's hips 3-4 cm back with the trunk (the
+    # feet slid, the locked leg folded further); fixed by goals._grid_base (capped
+    # postures first) and enforce_bone_lengths(rigid_hips=False); the crouch's hips turn
+    # with the pelvis, the posture keeps the shoulder behind the hand's turn point and
+    # the body and free arm clear of the board on the way (goals._turns_before_edge,
+    # goals._board_way_blocked)
+    ("under_shelf/single/grasp(O1)", 1.55): "range_of_motion:hip_under_board",
+    ("under_shelf/single/grasp(O1)", 1.75): "range_of_motion:hip_under_board",
+    ("under_shelf/single/grasp(O2)", 1.75): "range_of_motion:hip_under_board",
+    ("under_shelf/job/kneel_pick", 1.55): "range_of_motion:hip_under_board",
+    ("under_shelf/dwyer/absence_after/0", 1.75): "range_of_motion:hip_under_board",
 }
 
 

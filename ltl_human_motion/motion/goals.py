@@ -76,12 +76,20 @@ _APPROACH_LIFT = 0.08           # m, grasp/release/move come down onto low targe
 #: Peak palm speed of a goal reach, m/s at 1.75 m: under the 2.5 m/s limit of
 #: planning.biomechanics with room for the seeded bow and the body's own motion.
 HAND_GOAL_PEAK_SPEED = 1.8
+#: Fastest a hand or wrist of a model-made hand goal primitive moves over 1/30 s, m/s at
+#: 1.75 m (scaled by stature): 10 % under the verifier's 2.5 m/s hand limit in goal tasks
+#: (planning.biomechanics), room for the offset blending of its junctions.
+HAND_RETIME_SPEED = 2.25
 #: Length of the arced palm path (slerped about the shoulder, plus the bow and the
 #: approach from above) over the straight distance.
 _ARC_PATH_FACTOR = 1.35
 #: Extra outward bow of the palm path for a target below the hips, fraction of stature
 #: (full up to 0.45 H, none from 0.6 H): the hand passes outside the thigh.
 _LOW_REACH_WIDE = 0.05
+#: Factors on :data:`_LOW_REACH_WIDE` a hand task tries, in order, where the swing past the
+#: thigh still passes the forearm through it (the thigh rises towards a deeply flexed
+#: trunk; 1.75-1.95 m workers reaching near their feet from the carry stance).
+_WIDER_SWINGS = (1.0, 2.0, 3.0)
 #: Hand paths of ``make_goal_primitive``: ``"arc"`` swings the palm about the shoulder
 #: straight to the target; ``"level"`` first brings it, near the body, to the height it
 #: comes in at, then moves it in horizontally (over a shelf board's edge, under the
@@ -245,35 +253,48 @@ PELVIS_TILT_MAX = 0.35
 #: bend or a shallow crouch tilts the pelvis with the trunk; the hips pass 120 degrees
 #: only from a drop of about 0.22 H (the posture grid at 1.55 and 1.75 m).
 _CROUCH_DROP = (0.12, 0.22)
+#: Cost added to a posture under a low board whose pelvis tilts in full (past the hips'
+#: 125 degree range of motion at the depth such reaches take): larger than any capped
+#: posture's, so it is taken only where none reaches.
+_UNCAPPED_COST = 100.0
 
 _TRUNK = (("spine", "pelvis", 0.5), ("chest", "spine", 0.85), ("neck", "chest", 1.0),
           ("head", "neck", 1.0), ("l_clavicle", "chest", 1.0), ("l_shoulder", "l_clavicle", 1.0),
           ("r_clavicle", "chest", 1.0), ("r_shoulder", "r_clavicle", 1.0))
 
 
-def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, cap: bool = True
-           ) -> np.ndarray:
+def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
+           cap: bool | np.ndarray = True, hips: np.ndarray | None = None) -> np.ndarray:
     """Pelvis, spine, head, clavicles, shoulders and hips of frames (T,) -> (T, J, 3);
-    ``cap``: a crouch's pelvis tilts at most :data:`PELVIS_TILT_MAX` (not under a low
-    board, where the reach needs the pelvis's full tilt)."""
+    ``cap`` (bool, or (T,) of bool): a crouch's pelvis tilts at most
+    :data:`PELVIS_TILT_MAX` (a reach under a low board that no capped posture makes
+    tilts it in full, past the hips' range of motion). In a crouch (a pelvis drop past
+    ``_CROUCH_DROP[0]``) the hips turn with the pelvis's tilt; they keep the offsets
+    ``hips`` (2, 3) from it where given (on a seat, which holds the thighs where they
+    rest: :meth:`_Start.hips`)."""
+    capped = np.asarray(cap, dtype=bool)
     rest = skeleton.rest_positions()
     T = pelvis.shape[0]
     out = np.zeros((T, len(rest), 3))
     out[:, 0] = pelvis
+    drop = (rest[0, 2] - pelvis[..., 2]) / skeleton.stature
+    crouch = np.clip((drop - _CROUCH_DROP[0]) / (_CROUCH_DROP[1] - _CROUCH_DROP[0]), 0.0, 1.0)
     rot: dict[float, np.ndarray] = {}          # one rotation per distinct flexion fraction
+    tilt = 0.5 * pitch
     for name, parent, frac in _TRUNK:
         j, p = _J[name], _J[parent]
         if frac not in rot:
             angle = frac * pitch
-            if name == "spine" and cap:    # the pelvis's own tilt (the hips' flexion)
-                drop = (rest[0, 2] - pelvis[..., 2]) / skeleton.stature
-                crouch = np.clip((drop - _CROUCH_DROP[0]) / (_CROUCH_DROP[1] - _CROUCH_DROP[0]),
-                                 0.0, 1.0)
-                angle = angle - crouch * np.maximum(angle - PELVIS_TILT_MAX, 0.0)
+            if name == "spine":                 # the pelvis's own tilt (hip flexion)
+                angle = angle - capped * crouch * np.maximum(angle - PELVIS_TILT_MAX, 0.0)
+                tilt = angle
             rot[frac] = _rot_y(angle)
         out[:, j] = out[:, p] + rot[frac] @ (rest[j] - rest[p])
-    for name in ("l_hip", "r_hip"):
-        out[:, _J[name]] = pelvis + (rest[_J[name]] - rest[0])
+    # in a crouch the hips turn with the pelvis's tilt (standing bends keep them level)
+    turn = _rot_y(crouch * tilt) if hips is None else None
+    for k, name in enumerate(("l_hip", "r_hip")):
+        out[:, _J[name]] = pelvis + (turn @ (rest[_J[name]] - rest[0]) if hips is None
+                                     else hips[k])
     return out
 
 
@@ -340,6 +361,13 @@ class _Start:
         self.knee_pole = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
         self.seated = bool(p0[0, 2] < SEATED_PELVIS_MAX * skeleton.stature)
 
+    def hips(self) -> np.ndarray | None:
+        """The hips' offsets (2, 3) from the pelvis that a seated posture keeps, or None
+        (standing: they turn with the pelvis, :func:`_trunk`)."""
+        if not self.seated:
+            return None
+        return self.pose[[_J["l_hip"], _J["r_hip"]]] - self.pose[0]
+
 
 #: A start pose whose pelvis is lower than this fraction of the stature is seated: above
 #: the highest seat (0.34 H, :func:`seat_height_range`) by the pelvis joint's 0.085 H over
@@ -356,8 +384,8 @@ def _support_x(ankles: np.ndarray, toes: np.ndarray, stature: float) -> tuple[fl
 
 
 def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
-                   st: _Start, hands: np.ndarray | None = None, cap: bool = True
-                   ) -> np.ndarray:
+                   st: _Start, hands: np.ndarray | None = None,
+                   cap: bool | np.ndarray = True) -> np.ndarray:
     """Pelvis x shift (T,) that keeps the centre of mass over the feet (2 iterations)."""
     T = pelvis.shape[0]
     shift = np.zeros(T)
@@ -369,7 +397,7 @@ def _balance_shift(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
     for _ in range(3):
         pel = pelvis.copy()
         pel[:, 0] += shift
-        tr = _trunk(skeleton, pel, pitch, cap)
+        tr = _trunk(skeleton, pel, pitch, cap, st.hips())
         sh = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
         hnd = sh + st.hand_rel if hands is None else hands
         pose = _body(skeleton, pel, pitch, np.broadcast_to(st.ankles, (T, 2, 3)),
@@ -394,20 +422,40 @@ def _grid_base(skeleton: Skeleton, st: _Start, low_board: bool = False
     Balance shifts, trunk poses, the posture cost and the leg/head feasibility depend only
     on the skeleton and the start pose, of which a worker has a few (walking and carrying
     stance), so they are computed once per pair and kept (read-only arrays). Under a low
-    board (``low_board``) the pelvis tilt is not capped and the hip and knee ranges of
-    motion are not asked for: the reach in under the board needs the deepest postures.
+    board (``low_board``) the capped postures, within the hip and knee ranges of motion,
+    come with a second set: the pelvis tilted in full and the ranges not asked for (the
+    deepest reach in under the board), at :data:`_UNCAPPED_COST` more, so that one is
+    taken only where no capped posture reaches.
 
     Returns
     -------
     P, D, shift, base_cost : ndarray, shape (C,)
     shoulders : ndarray, shape (C, 2, 3)
         Left and right shoulder of each candidate.
-    feasible : ndarray of bool, shape (C,)
+    feasible, capped : ndarray of bool, shape (C,)
+        Whether the candidate can be taken; whether its pelvis tilt is capped.
     """
     key = (skeleton, st.pose.tobytes(), low_board)
     hit = _GRID_CACHE.get(key)
     if hit is not None:
         return hit
+    if low_board:
+        out = tuple(np.concatenate([a, b]) for a, b in zip(
+            _grid_set(skeleton, st, True), _grid_set(skeleton, st, False)))
+        out[3][out[3].size // 2:] += _UNCAPPED_COST
+    else:
+        out = _grid_set(skeleton, st, True)
+    for arr in out:
+        arr.flags.writeable = False
+    if len(_GRID_CACHE) >= 32:
+        _GRID_CACHE.clear()
+    _GRID_CACHE[key] = out
+    return out
+
+
+def _grid_set(skeleton: Skeleton, st: _Start, cap: bool) -> tuple[np.ndarray, ...]:
+    """One set of :func:`_grid_base`'s candidates: capped pelvis tilt within the hip and
+    knee ranges of motion, or (not ``cap``) full tilt with the ranges not asked for."""
     H = skeleton.stature
     b = _bones(skeleton)
     leg = b[_J["l_knee"]] + b[_J["l_ankle"]]
@@ -417,9 +465,9 @@ def _grid_base(skeleton: Skeleton, st: _Start, low_board: bool = False
     P, D = P.ravel(), D.ravel()
     pelvis = np.tile(st.pelvis, (P.size, 1))
     pelvis[:, 2] -= D
-    shift = _balance_shift(skeleton, pelvis, P, st, cap=not low_board)
+    shift = _balance_shift(skeleton, pelvis, P, st, cap=cap)
     pelvis[:, 0] += shift
-    tr = _trunk(skeleton, pelvis, P, not low_board)
+    tr = _trunk(skeleton, pelvis, P, cap, st.hips())
     cost = P ** 2 + (D / (0.14 * H)) ** 2
     feasible = np.ones(P.size, bool)
     for k, s in enumerate(_SIDES):
@@ -429,15 +477,9 @@ def _grid_base(skeleton: Skeleton, st: _Start, low_board: bool = False
     # the head must not go below the hands' height band (no diving into the floor)
     feasible &= tr[:, _J["head"], 2] > 0.12 * H
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
-    if not low_board:
+    if cap:
         feasible &= _legs_in_range(skeleton, st, pelvis, P, tr, shoulders)
-    out = (P, D, shift, cost, shoulders, feasible)
-    for arr in out:
-        arr.flags.writeable = False
-    if len(_GRID_CACHE) >= 32:
-        _GRID_CACHE.clear()
-    _GRID_CACHE[key] = out
-    return out
+    return P, D, shift, cost, shoulders, feasible, np.full(P.size, cap)
 
 
 def _legs_in_range(skeleton: Skeleton, st: _Start, pelvis: np.ndarray, pitch: np.ndarray,
@@ -464,13 +506,17 @@ def _legs_in_range(skeleton: Skeleton, st: _Start, pelvis: np.ndarray, pitch: np
 
 
 def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
-                 stature: float) -> np.ndarray:
-    """How deep the body's capsules of poses (C, J, 3) go into a board beyond x = edge
-    between heights bottom and top (``board = (edge, bottom, top)``, start frame), plus
-    ``_BOARD_CLEARANCE``, metres (C,); negative: clear."""
+                 stature: float, parts: np.ndarray | None = None) -> np.ndarray:
+    """How deep the body's capsules (or the capsules ``parts``, indices) of poses
+    (C, J, 3) go into a board beyond x = edge between heights bottom and top
+    (``board = (edge, bottom, top)``, start frame), plus ``_BOARD_CLEARANCE``, metres
+    (C,); negative: clear."""
     from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
     edge, bottom, top = board
     ia, ib = capsule_ends()
+    radii = capsule_radii(stature)
+    if parts is not None:
+        ia, ib, radii = ia[parts], ib[parts], radii[parts]
     s = np.linspace(0.0, 1.0, _CAPSULE_SAMPLES)[:, None, None, None]
     pts = poses[:, ia] + s * (poses[:, ib] - poses[:, ia])          # (S, C, K, 3)
     x, z = pts[..., 0], pts[..., 2]
@@ -478,8 +524,51 @@ def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
     out_x, out_z = np.maximum(edge - x, 0.0), np.maximum(dz, 0.0)
     dist = np.where((x >= edge) & (dz <= 0.0), -np.minimum(x - edge, -dz),
                     np.hypot(out_x, out_z))
-    depth = capsule_radii(stature) + _BOARD_CLEARANCE - dist
+    depth = radii + _BOARD_CLEARANCE - dist
     return depth.max(axis=(0, 2))
+
+
+def _way_poses(skeleton: Skeleton, st: _Start,
+               posture: tuple[np.ndarray, np.ndarray, np.ndarray], cap: np.ndarray,
+               by_hip: tuple[int, ...] = ()) -> np.ndarray:
+    """Poses (S C, J, 3) on the way into posture candidates (pitch, drop, shift), each
+    (C,), at the fractions :data:`_POSTURE_WAY` (S), fraction-major: the hands held as in
+    the start pose relative to the shoulders, those in ``by_hip`` (0 left, 1 right) by the
+    hip as :func:`_hand_task` holds a free hand; ``cap`` (C,) as :func:`_trunk`'s."""
+    pitch, drop, shift = posture
+    C, S = pitch.size, len(_POSTURE_WAY)
+    frac = np.repeat(np.asarray(_POSTURE_WAY), C)                    # (S C,)
+    pelvis = np.tile(st.pelvis, (S * C, 1))
+    pelvis[:, 2] -= frac * np.tile(drop, S)
+    pelvis[:, 0] += frac * np.tile(shift, S)
+    pit = frac * np.tile(pitch, S)
+    tr = _trunk(skeleton, pelvis, pit, np.tile(cap, S), st.hips())
+    hands = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1) + st.hand_rel
+    for k in by_hip:
+        hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.outer(frac, [0.0, 0.0, 0.04])
+    n = S * C
+    return _body(skeleton, pelvis, pit, np.broadcast_to(st.ankles, (n, 2, 3)),
+                 np.broadcast_to(st.toes, (n, 2, 3)), np.broadcast_to(st.knee_pole, (n, 2, 3)),
+                 hands, np.broadcast_to(st.hand_dir, (n, 2, 3)),
+                 np.broadcast_to(st.elbow_pole, (n, 2, 3)), tr)
+
+
+def _board_way_blocked(skeleton: Skeleton, st: _Start,
+                       posture: tuple[np.ndarray, np.ndarray, np.ndarray],
+                       active: tuple[int, ...], board: tuple[float, float, float],
+                       cap: np.ndarray) -> np.ndarray:
+    """Whether posture candidates (pitch, drop, shift), each (C,), bring the body or a free
+    arm (hanging by the hip, as :func:`_hand_task` holds it) nearer the low board than
+    ``_BOARD_CLEARANCE`` on the way into the posture (:data:`_POSTURE_WAY`), shape (C,)
+    of bool. The acting arm follows the level path, which turns before the board's edge
+    (:func:`_level_keys`)."""
+    from ltl_human_motion.scene.occupancy import part_indices
+    free = tuple(k for k in range(2) if k not in active)
+    way = _way_poses(skeleton, st, posture, cap, free)
+    S, C = len(_POSTURE_WAY), posture[0].size
+    parts = part_indices(_WAY_PARTS + tuple(f"{_SIDES[k]}_{p}" for k in free
+                                            for p in ("upper_arm", "lower_arm", "hand")))
+    return (_board_depth(way, board, skeleton.stature, parts).reshape(S, C) > 0.0).any(axis=0)
 
 
 def _support_depth(poses: np.ndarray, support: tuple[float, float, float, float],
@@ -519,7 +608,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
           task: str | None = None, board: tuple[float, float, float] | None = None,
           obstacles: ObstacleClearance | None = None, strict: bool = False,
           furniture: tuple[tuple[float, ...] | None, tuple[float, ...] | None] | None = None
-          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Costs of trunk flexion / pelvis drop candidates for hand targets.
 
     A candidate is infeasible when a hand cannot reach its target, or when its posture
@@ -534,22 +623,28 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     and not ``strict``; where the cheapest candidate is clear the others are not
     measured).
 
-    Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible).
+    Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible) and
+    whether the pelvis tilt is capped (C,) (:func:`_grid_base`).
     """
     arm = _arm_length(skeleton)
-    P, D, shift, cost, shoulders, feasible = _grid_base(skeleton, st, board is not None)
+    P, D, shift, cost, shoulders, feasible, capped = _grid_base(skeleton, st,
+                                                                board is not None)
     for k in active:
         d = np.linalg.norm(targets[k] - shoulders[:, k], axis=-1)
         feasible = feasible & (d <= _REACH_FRACTION * arm)
         cost = cost + 0.5 * (d / arm - 0.8) ** 2
+    if board is not None:
+        feasible = feasible & _turns_before_edge(shoulders, active, board)
     idx = np.flatnonzero(feasible)
     if idx.size:
         from ltl_human_motion.planning.biomechanics import self_penetration
         poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
-                               task, cap=board is None)
+                               task, cap=capped[idx])
         blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
         if board is not None:
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
+            blocked |= _board_way_blocked(skeleton, st, (P[idx], D[idx], shift[idx]), active,
+                                          board, capped[idx])
         under, over = furniture or (None, None)
         for depth in ([] if under is None else [_support_depth(poses, under, skeleton.stature)]) \
                 + ([] if over is None else [_slab_depth(poses, over, skeleton.stature)]):
@@ -564,7 +659,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
             for some in (free[:1], free[1:]):
                 hit = _obstacle_blocked(skeleton, st, (P[idx[some]], D[idx[some]],
                                                        shift[idx[some]]), poses[some],
-                                        active, obstacles, board is None)
+                                        active, obstacles, capped[idx[some]])
                 if not hit[0] and some.size == 1:
                     break
                 if some.size > 1 and (strict or not np.all(hit)):
@@ -572,13 +667,24 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         feasible = feasible.copy()
         feasible[idx[blocked]] = False
     cost = np.where(feasible, cost, np.inf)
-    return P, D, shift, cost
+    return P, D, shift, cost, capped
+
+
+def _turns_before_edge(shoulders: np.ndarray, active: tuple[int, ...],
+                       board: tuple[float, float, float]) -> np.ndarray:
+    """Whether the acting shoulders of postures (C, 2, 3) stay behind the level path's
+    turn point, ``_BOARD_FRONT`` before the edge of the low board (edge, bottom, top) over
+    the targets, shape (C,) of bool: the hand goes down there, in under the board and
+    out and up the same way (:func:`_level_keys`); from a shoulder past it the hand would
+    go down under the board's edge."""
+    front = board[0] - _BOARD_FRONT
+    return np.all(shoulders[:, list(active), 0] <= front, axis=1)
 
 
 def _obstacle_blocked(skeleton: Skeleton, st: _Start,
                       posture: tuple[np.ndarray, np.ndarray, np.ndarray], contact: np.ndarray,
-                      active: tuple[int, ...], obstacles: ObstacleClearance, cap: bool
-                      ) -> np.ndarray:
+                      active: tuple[int, ...], obstacles: ObstacleClearance,
+                      cap: np.ndarray) -> np.ndarray:
     """Whether posture candidates come nearer the obstacles than ``_OBSTACLE_CLEARANCE``.
 
     Parameters
@@ -591,7 +697,7 @@ def _obstacle_blocked(skeleton: Skeleton, st: _Start,
     active : tuple of int
         The acting hands (0 left, 1 right).
     obstacles : ObstacleClearance
-    cap : bool
+    cap : ndarray of bool, shape (C,)
         As :func:`_trunk`'s.
 
     Returns
@@ -603,20 +709,8 @@ def _obstacle_blocked(skeleton: Skeleton, st: _Start,
                                                                                "r_foot"}
     whole = tuple(p for p in BODY_PARTS if p not in fixed)
     hit = obstacles(contact, whole) <= _OBSTACLE_CLEARANCE
-    pitch, drop, shift = posture
-    C, S = pitch.size, len(_POSTURE_WAY)
-    frac = np.repeat(np.asarray(_POSTURE_WAY), C)                    # (S C,)
-    pelvis = np.tile(st.pelvis, (S * C, 1))
-    pelvis[:, 2] -= frac * np.tile(drop, S)
-    pelvis[:, 0] += frac * np.tile(shift, S)
-    pit = frac * np.tile(pitch, S)
-    tr = _trunk(skeleton, pelvis, pit, cap)
-    shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
-    n = S * C
-    way = _body(skeleton, pelvis, pit, np.broadcast_to(st.ankles, (n, 2, 3)),
-                np.broadcast_to(st.toes, (n, 2, 3)), np.broadcast_to(st.knee_pole, (n, 2, 3)),
-                shoulders + st.hand_rel, np.broadcast_to(st.hand_dir, (n, 2, 3)),
-                np.broadcast_to(st.elbow_pole, (n, 2, 3)), tr)
+    way = _way_poses(skeleton, st, posture, cap)
+    S, C = len(_POSTURE_WAY), posture[0].size
     near = obstacles(way, _WAY_PARTS).reshape(S, C) <= _OBSTACLE_CLEARANCE
     return hit | near.any(axis=0)
 
@@ -656,14 +750,14 @@ def _goal_elbow_pole(k: int) -> np.ndarray:
 
 def _contact_poses(skeleton: Skeleton, st: _Start, pitch: np.ndarray, drop: np.ndarray,
                    shift: np.ndarray, targets: np.ndarray, active: tuple[int, ...],
-                   task: str | None, cap: bool = True) -> np.ndarray:
+                   task: str | None, cap: bool | np.ndarray = True) -> np.ndarray:
     """Poses (C, J, 3) of posture candidates (C,) with the active hands on ``targets``
     (2, 3) and a free hand by the hip, as :func:`_hand_task` holds them at contact."""
     C = pitch.size
     pelvis = np.tile(st.pelvis, (C, 1))
     pelvis[:, 2] -= drop
     pelvis[:, 0] += shift
-    tr = _trunk(skeleton, pelvis, pitch, cap)
+    tr = _trunk(skeleton, pelvis, pitch, cap, st.hips())
     hands = np.empty((C, 2, 3))
     hand_dir = np.broadcast_to(st.hand_dir, (C, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (C, 2, 3)).copy()
@@ -702,20 +796,30 @@ def _hand_targets(task: str, target: np.ndarray, hand: str) -> tuple[np.ndarray,
     return targets, ((0,) if side == "l" else (1,)), f"{side}_hand"
 
 
-def _solve_reach(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
-                 task: str, target: np.ndarray,
-                 board: tuple[float, float, float] | None = None,
-                 obstacles: ObstacleClearance | None = None,
-                 furniture: tuple | None = None) -> tuple[float, float, float]:
-    """Trunk flexion, pelvis drop and shift of the cheapest feasible posture (:func:`_grid`)."""
-    P, D, S, cost = _grid(skeleton, st, targets, active, task, board, obstacles,
-                          furniture=furniture)
-    i = int(np.argmin(cost))
-    if not np.isfinite(cost[i]):
+#: Postures a hand task tries, cheapest first, for one whose whole motion keeps the arms
+#: out of the body (the posture search checks the contact pose; the way out, with the
+#: body rising and the hand coming home, can pass a forearm through a thigh).
+_POSTURE_TRIES = 4
+
+
+def _reach_postures(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
+                    task: str, target: np.ndarray,
+                    board: tuple[float, float, float] | None = None,
+                    obstacles: ObstacleClearance | None = None,
+                    furniture: tuple | None = None
+                    ) -> list[tuple[float, float, float, bool]]:
+    """Trunk flexion, pelvis drop and shift of the cheapest feasible postures
+    (:func:`_grid`, at most :data:`_POSTURE_TRIES`, cheapest first), and whether each one's
+    pelvis tilt is capped; ValueError where none reaches."""
+    P, D, S, cost, capped = _grid(skeleton, st, targets, active, task, board, obstacles,
+                                  furniture=furniture)
+    order = np.argsort(cost, kind="stable")[:_POSTURE_TRIES]
+    order = order[np.isfinite(cost[order])]
+    if order.size == 0:
         raise ValueError(
             f"{task}: target {np.round(target, 3).tolist()} (start frame) is out of reach for a "
             f"{skeleton.stature:.2f} m worker; place the worker with reach_placement()")
-    return float(P[i]), float(D[i]), float(S[i])
+    return [(float(P[i]), float(D[i]), float(S[i]), bool(capped[i])) for i in order]
 
 
 # ----------------------------------------------------------------------- timelines
@@ -827,8 +931,9 @@ def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: n
     back the same way. Arrays (2, 3); ``sh1`` (2, 3): the shoulders in the reach posture;
     ``arm``: the arm's length (the turn point keeps the elbow clearly bent, not folded);
     ``board`` (edge, bottom, top): a low board over the targets (start frame): the turn
-    point goes out to ``_BOARD_FRONT`` before its edge (down in front of the edge, then
-    in under the board, and out and up the same way)."""
+    point is ``_BOARD_FRONT`` before its edge (down in front of the edge, then in under
+    the board, and out and up the same way; the posture keeps the shoulder behind it,
+    :func:`_turns_before_edge`)."""
     front = None if board is None else board[0] - _BOARD_FRONT
     rel_above, rel_near = rel_goal.copy(), rel_goal.copy()
     for k in active:
@@ -839,7 +944,7 @@ def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: n
         unfolded = np.sqrt(max((_LEVEL_MIN_EXTENSION * arm) ** 2 - rel_above[k, 2] ** 2, 0.0))
         near = min(dh, max(_LEVEL_NEAR * H, unfolded))
         if front is not None and flat[0] > 1e-9:
-            near = min(dh, max(near, dh * (front - sh1[k, 0]) / flat[0]))
+            near = min(dh, max(dh * (front - sh1[k, 0]) / flat[0], 0.0))
         rel_near[k, :2] = flat * (near / dh) if dh > 1e-9 else flat
         rel_near[k, 2] = rel_above[k, 2]
     r = total - t2
@@ -942,10 +1047,11 @@ def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
                times: tuple[float, float, float], active: tuple, targets: np.ndarray,
                shoulders: np.ndarray, sh1: np.ndarray, st: _Start, level: bool,
                board: tuple[float, float, float] | None, dist: float, H: float, arm: float,
-               rng: np.random.Generator) -> np.ndarray:
+               rng: np.random.Generator, wide: float = 1.0) -> np.ndarray:
     """Shoulder-to-palm vectors (T, 2, 3) through ``keys`` at times ``t`` (T,), with a
     small seeded bow; ``times``: (reach end, hold end, total), ``shoulders`` (T, 2, 3):
-    the moving shoulders, ``sh1`` (2, 3): at the reach's end."""
+    the moving shoulders, ``sh1`` (2, 3): at the reach's end; ``wide`` scales a low
+    reach's swing outside the thigh."""
     rel = _arc_keys(t, keys)
     if level:
         # Straight legs (an arc about the shoulder bulges forward, into the shelf), except
@@ -970,7 +1076,7 @@ def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
         out_dir /= np.linalg.norm(out_dir)
         amp = rng.uniform(0.02, 0.05) * min(1.0, dist / 0.5)
         # a hand going down past the thigh swings wide of it (no hand through the leg)
-        amp += _LOW_REACH_WIDE * H * float(np.clip((0.6 * H - targets[k][2]) / (0.15 * H),
+        amp += wide * _LOW_REACH_WIDE * H * float(np.clip((0.6 * H - targets[k][2]) / (0.15 * H),
                                                    0.0, 1.0))
         rel[:, k] += amp * bow[:, None] * out_dir
         if board is not None:
@@ -1030,7 +1136,6 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                obstacles: ObstacleClearance | None = None,
                furniture: tuple | None = None) -> MotionPrimitive:
     H = skeleton.stature
-    arm = _arm_length(skeleton)
     travel, pushed = _push_travel(task, target, st, hand, travel, path,
                                   None if furniture is None else furniture[0])
     board = board if task in LEVEL_PATH_TASKS else None
@@ -1039,64 +1144,128 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     target = _checked_target(task, target, skeleton)
     targets, active, hand_name = _hand_targets(task, target, hand)
     approach = _push_direction(task, target, st, active)
-    pitch1, drop1, shift1 = _solve_reach(skeleton, st, targets, active, task, target, board,
-                                         obstacles, furniture)
-    dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
-    t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
-    total = t_reach + hold + t_ret
-    T = _n_frames(total, fps)
-    t = np.arange(T) / fps
-    t1, t2 = t_reach, t_reach + hold
-    # body posture leads the hand: it is reached at 85 % of the reach time (level path:
-    # before the hand comes in, and kept until it is out again)
-    body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + 0.5 * t_ret, 1.0), (total, 0.0)] if level
-                 else [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)])
-    sb = _profile(t, body_keys)
-    pelvis = np.tile(st.pelvis, (T, 1))
-    pelvis[:, 2] -= drop1 * sb
-    pelvis[:, 0] += shift1 * sb
-    pitch = pitch1 * sb
-    tr = _trunk(skeleton, pelvis, pitch, board is None)
-    shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)   # (T,2,3)
-    f1 = min(round(t1 * fps), T - 1)
-    f2 = min(round(t2 * fps), T - 1)
-    sh1 = shoulders[f1]
-    # hand key positions relative to the shoulder
-    rel_home = st.hand_rel
-    rel_goal = rel_home.copy()
-    rel_pre = rel_home.copy()
-    for k in active:
-        rel_goal[k] = targets[k] - sh1[k]
-        rel_pre[k] = targets[k] - travel * approach - sh1[k]
-    keys, contact_t = _hand_keys(task, targets, active, sh1, rel_home, rel_goal, rel_pre,
-                                 (t1, t2, total), level, board, H, arm)
-    rel = _hand_path(t, keys, (t1, t2, total), active, targets, shoulders, sh1, st, level,
-                     board, dist, H, arm, rng)
-    # small manipulation movements while the hands are in the region
-    if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
-        env = _profile(t, [(t1, 0.0), (t1 + 0.2, 1.0), (t2 - 0.2, 1.0), (t2, 0.0)])
-        env = np.where((t > t1) & (t < t2), env, 0.0)
-        for k in active:
-            f = rng.uniform(0.7, 1.4, size=3)
-            ph = rng.uniform(0.0, 2 * np.pi, size=3)
-            amp = np.array([0.010, 0.008, 0.008])
-            wob = amp * np.sin(2 * np.pi * f * t[:, None] + ph)
-            rel[:, k] += env[:, None] * wob
-    hands = shoulders + rel
-    # A free hand stays by the hip while the trunk leans (it does not swing forward into
-    # the furniture the other hand reaches over).
-    for k in range(2):
-        if k not in active:
-            hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04]) * \
-                sb[:, None]
-    hand_dir, elbow_pole = _hand_orientation(task, active, st, t, (t1, t2, total), rel_goal)
-    world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
+    postures = _reach_postures(skeleton, st, targets, active, task, target, board, obstacles,
+                               furniture)
+    # the cheapest posture, swinging wider past the thigh where the arm would pass through
+    # it, then the next postures
+    tries = [(postures[0], w) for w in _WIDER_SWINGS] + [(p, 1.0) for p in postures[1:]]
+    draws = rng.bit_generator.state
+    for n, (posture, wide) in enumerate(tries):
+        rng.bit_generator.state = draws
+        world, f1, f2, contact_t = _reach_motion(
+            task, skeleton, st, targets, active, posture, (level, travel, approach, board),
+            rng, duration, fps, wide)
+        if n + 1 == len(tries) or not _self_penetrates(world, H):
+            break
+    T = world.shape[0]
     contact = min(round(contact_t * fps), T - 1)
     meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
-            "hold_frames": [f1, f2], "trunk_flexion": pitch1, "pelvis_drop": drop1,
+            "hold_frames": [f1, f2], "trunk_flexion": posture[0], "pelvis_drop": posture[1],
             "posture": _posture_name(world[f1], skeleton)}
     return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
                    f"goals.make_goal_primitive({task!r}, target={_fmt(target)})", meta)
+
+
+def _self_penetrates(world: np.ndarray, stature: float) -> bool:
+    """Whether a body capsule's bone axis enters another, non-neighbouring one in any frame
+    of ``world`` (T, J, 3) (the verifier's self-penetration check)."""
+    from ltl_human_motion.planning.biomechanics import self_penetration
+    return bool(np.max(self_penetration(world, stature)[0]) > 0.0)
+
+
+def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray,
+                  active: tuple[int, ...], posture: tuple[float, float, float, bool],
+                  path: tuple, rng: np.random.Generator, duration: float | None, fps: float,
+                  wide: float = 1.0) -> tuple[np.ndarray, int, int, float]:
+    """Frames (T, J, 3) of a hand task's reach into ``posture`` (pitch, drop, shift,
+    capped), its hold and its return; the first and last hold frame and the contact time
+    (s). ``path``: (level, travel, approach (2, 3) or None, board) of :func:`_hand_task`;
+    ``wide`` scales the low reach's swing outside the thigh (:func:`_hand_path`)."""
+    H = skeleton.stature
+    arm = _arm_length(skeleton)
+    level, travel, approach, board = path
+    pitch1, drop1, shift1, capped = posture
+    dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
+    t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
+    # Timed for the arced path's palm speed; where the posture's trunk motion or a level
+    # path makes a hand or wrist faster than HAND_RETIME_SPEED, the reach and return are
+    # slowed by what they exceed and the motion made again (at most twice), from the
+    # same random draws (the same path, only slower).
+    draws = rng.bit_generator.state
+    for _ in range(3):
+        rng.bit_generator.state = draws
+        total = t_reach + hold + t_ret
+        T = _n_frames(total, fps)
+        t = np.arange(T) / fps
+        t1, t2 = t_reach, t_reach + hold
+        # body posture leads the hand: it is reached at 85 % of the reach time (level path:
+        # before the hand comes in, and kept until it is out again)
+        body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + 0.5 * t_ret, 1.0), (total, 0.0)] if level
+                     else [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)])
+        sb = _profile(t, body_keys)
+        pelvis = np.tile(st.pelvis, (T, 1))
+        pelvis[:, 2] -= drop1 * sb
+        pelvis[:, 0] += shift1 * sb
+        pitch = pitch1 * sb
+        tr = _trunk(skeleton, pelvis, pitch, capped, st.hips())
+        shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)   # (T,2,3)
+        f1 = min(round(t1 * fps), T - 1)
+        f2 = min(round(t2 * fps), T - 1)
+        sh1 = shoulders[f1]
+        # hand key positions relative to the shoulder
+        rel_home = st.hand_rel
+        rel_goal = rel_home.copy()
+        rel_pre = rel_home.copy()
+        for k in active:
+            rel_goal[k] = targets[k] - sh1[k]
+            rel_pre[k] = targets[k] - travel * approach - sh1[k]
+        keys, contact_t = _hand_keys(task, targets, active, sh1, rel_home, rel_goal, rel_pre,
+                                     (t1, t2, total), level, board, H, arm)
+        rel = _hand_path(t, keys, (t1, t2, total), active, targets, shoulders, sh1, st, level,
+                         board, dist, H, arm, rng, wide)
+        if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
+            _add_manipulation(rel, t, t1, t2, active, rng)
+        hands = shoulders + rel
+        # A free hand stays by the hip while the trunk leans (it does not swing forward into
+        # the furniture the other hand reaches over).
+        for k in range(2):
+            if k not in active:
+                hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04]) * \
+                    sb[:, None]
+        hand_dir, elbow_pole = _hand_orientation(task, active, st, t, (t1, t2, total), rel_goal)
+        world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
+        peak = _peak_hand_speed(world, active, fps)
+        limit = HAND_RETIME_SPEED * H / DEFAULT_STATURE
+        if peak <= limit or duration is not None:
+            break
+        t_reach *= 1.03 * peak / limit
+        t_ret *= 1.03 * peak / limit
+    return world, f1, f2, contact_t
+
+
+def _add_manipulation(rel: np.ndarray, t: np.ndarray, t1: float, t2: float,
+                      active: tuple[int, ...], rng: np.random.Generator) -> None:
+    """Add small manipulation movements (1 cm, 0.7-1.4 Hz) to the acting hands' shoulder
+    offsets ``rel`` (T, 2, 3) while they are in the region, between times t1 and t2."""
+    env = _profile(t, [(t1, 0.0), (t1 + 0.2, 1.0), (t2 - 0.2, 1.0), (t2, 0.0)])
+    env = np.where((t > t1) & (t < t2), env, 0.0)
+    for k in active:
+        f = rng.uniform(0.7, 1.4, size=3)
+        ph = rng.uniform(0.0, 2 * np.pi, size=3)
+        amp = np.array([0.010, 0.008, 0.008])
+        wob = amp * np.sin(2 * np.pi * f * t[:, None] + ph)
+        rel[:, k] += env[:, None] * wob
+
+
+def _peak_hand_speed(world: np.ndarray, active: tuple[int, ...], fps: float) -> float:
+    """Largest speed (m/s) of an acting hand's palm or wrist in ``world`` (T, J, 3), as
+    displacements over 1/30 s (the verifier's window)."""
+    w = max(1, round(fps / 30.0))
+    if len(world) <= w:
+        return 0.0
+    joints = [_J[f"{_SIDES[k]}_{n}"] for k in active for n in ("hand", "wrist")]
+    d = world[w:, joints] - world[:-w, joints]
+    return float(np.sqrt(np.max(np.sum(d * d, axis=-1)))) * fps / w
 
 
 def _hand_orientation(task: str, active: tuple, st: _Start, t: np.ndarray,
@@ -1532,7 +1701,7 @@ def _wait(skeleton: Skeleton, st: _Start, rng: np.random.Generator, duration: fl
 @lru_cache(maxsize=512)
 def _placement(task: str, height: float, stature: float, hand: str,
                board: tuple[float, float, float] | None = None,
-               start: bytes | None = None) -> tuple[float, float]:
+               start: bytes | None = None, full_tilt: bool = True) -> tuple[float, float]:
     """:func:`reach_placement` (``start``: the start pose's float64 bytes, or None)."""
     skeleton = Skeleton(stature)
     H = stature
@@ -1546,15 +1715,20 @@ def _placement(task: str, height: float, stature: float, hand: str,
     st = _Start(skeleton, None if start is None
                 else np.frombuffer(start, dtype=np.float64).reshape(-1, 3))
     best = (np.inf, None)
-    # Under a low board: with _BOARD_PLACE_MARGIN where that leaves a place, else without.
-    for margin in (0.0,) if board is None else (_BOARD_PLACE_MARGIN, 0.0):
+    # Under a low board: with _BOARD_PLACE_MARGIN where that leaves a place, else without;
+    # a place for a capped posture before one for a full pelvis tilt (_grid_base).
+    tries = [(0.0, False)] if board is None else [
+        (m, full) for full in ((False, True) if full_tilt else (False,))
+        for m in (_BOARD_PLACE_MARGIN, 0.0)]
+    for margin, full in tries:
         for x in np.linspace(0.12 * H, 0.45 * H, 12):
             target = np.array([x, lateral, height])
             targets, active, _ = _hand_targets(task, target, "both" if both else (
                 "l_hand" if lateral > 0 else "r_hand"))
-            _, _, _, cost = _grid(skeleton, st, targets, active, task, None if board is None
-                                  else (x - board[0] - margin, board[1], board[2]))
-            c = float(np.min(cost))
+            _, _, _, cost, capped = _grid(skeleton, st, targets, active, task,
+                                          None if board is None
+                                          else (x - board[0] - margin, board[1], board[2]))
+            c = float(np.min(cost if full else np.where(capped, cost, np.inf)))
             if c < best[0]:
                 best = (c, float(x))
         if best[1] is not None:
@@ -1566,7 +1740,8 @@ def _placement(task: str, height: float, stature: float, hand: str,
 
 def reach_placement(task: str, target_height: float, skeleton: Skeleton,
                     hand: str = "auto", board: tuple[float, float, float] | None = None,
-                    start_pose: np.ndarray | None = None) -> tuple[float, float]:
+                    start_pose: np.ndarray | None = None, full_tilt: bool = True
+                    ) -> tuple[float, float]:
     """Where to put the target relative to the standing root for a comfortable posture.
 
     Parameters
@@ -1585,6 +1760,9 @@ def reach_placement(task: str, target_height: float, skeleton: Skeleton,
         The pose the goal primitive will start from (as :func:`make_goal_primitive`
         takes it); default the skeleton's rest pose. A reach under a low board is tight
         enough that the start's feet and arms decide whether a place reaches.
+    full_tilt : bool
+        Under a low board, whether a place may need the pelvis tilted in full, past the
+        hips' range of motion (only where no place reaches without it).
 
     Returns
     -------
@@ -1612,5 +1790,6 @@ def reach_placement(task: str, target_height: float, skeleton: Skeleton,
         board = None
     start = None if start_pose is None else \
         np.ascontiguousarray(start_pose, dtype=np.float64).tobytes()
-    return _placement(task, round(h, 4), float(skeleton.stature), hand, board, start)
+    return _placement(task, round(h, 4), float(skeleton.stature), hand, board, start,
+                      bool(full_tilt))
 

@@ -432,16 +432,22 @@ class SequencePlanner:
         (:func:`.standing.standing_offset`), and whether the arms come up to the carry
         stance before the goal primitive. They do, except under a low board that no
         place reaches from the carry stance while the hands are free (a short worker's
-        floor grasp under a board at knee height reaches from the arms down)."""
+        floor grasp under a board at knee height reaches from the arms down). Under a low
+        board a place whose posture keeps the hips in their range of motion comes first,
+        from either stance; one that needs the pelvis tilted in full only after."""
         hand = acting_hand(self.state, kind, args[0] if args else None)
-        try:
-            return standing_offset(self.ctx, kind, target, text, hand), True
-        except PlanningError:
-            if self.state.carrying or kind not in LEVEL_PATH_TASKS \
-                    or low_board(self.ctx.cell, target, self.ctx.stature) is None:
-                raise
-            return standing_offset(self.ctx, kind, target, text, hand,
-                                   carry_stance=False), False
+        low = kind in LEVEL_PATH_TASKS \
+            and low_board(self.ctx.cell, target, self.ctx.stature) is not None
+        stances = (True, False) if low and not self.state.carrying else (True,)
+        error = None
+        for full_tilt in (False, True) if low else (True,):
+            for carry in stances:
+                try:
+                    return standing_offset(self.ctx, kind, target, text, hand,
+                                           carry_stance=carry, full_tilt=full_tilt), carry
+                except PlanningError as exc:
+                    error = exc
+        raise error
 
     def _fetch(self, i: int, obj: str) -> StepPlan:
         """Grasp ``obj`` as part of step ``i`` (which needs it in hand)."""

@@ -130,14 +130,15 @@ def posture_clearance(ctx: PlanContext, pose: Pose
 
 
 def standing_offset(ctx: PlanContext, kind: str, target: np.ndarray, task: str,
-                    hand: str | None = None, carry_stance: bool = True
-                    ) -> tuple[float, float]:
+                    hand: str | None = None, carry_stance: bool = True,
+                    full_tilt: bool = True) -> tuple[float, float]:
     """Where ``target`` (3,) should be in the standing root's frame for goal task
     ``kind``: (ahead, left), metres (for ``hand``, if given: the left hand reaches a
     target on the left). Raises PlanningError (``unreachable``) for a height no goal
     model reaches. Under a low board the reach is planned from the stance the goal
     primitive starts from: the carry stance (``carry_stance``: the planner raises the
-    arms first, or they hold a part), else arms down."""
+    arms first, or they hold a part), else arms down;
+    ``full_tilt`` as :func:`.motion.goals.reach_placement`'s."""
     from ltl_human_motion.motion import goals
     low = low_board(ctx.cell, target, ctx.stature, below=SQUARE_BOARD_HEIGHT) \
         if kind in LEVEL_PATH_TASKS else None
@@ -145,7 +146,8 @@ def standing_offset(ctx: PlanContext, kind: str, target: np.ndarray, task: str,
         d, lat = goals.reach_placement(kind, float(target[2]), ctx.library.skeleton,
                                        hand=hand or "auto",
                                        board=None if low is None else low[:3],
-                                       start_pose=None if low is None else ctx.stance(carry_stance))
+                                       start_pose=None if low is None else ctx.stance(carry_stance),
+                                       full_tilt=full_tilt)
         return float(d), float(lat)
     except ValueError as exc:
         raise PlanningError(f"task {task}: the target at height {target[2]:.2f} m is "
