@@ -74,21 +74,31 @@ def test_trilinear_matches_map_coordinates(shape, compiled, monkeypatch) -> None
     assert got.tobytes() == map_coordinates(grid, u.T, order=1, mode="nearest").tobytes()
 
 
-@pytest.mark.parametrize("compiled", [False, True])
-def test_obstacle_field_clear_matches_reading_every_capsule(paper, compiled, monkeypatch
-                                                            ) -> None:
-    """Both paths (the compiled loop stops at a capsule's first failing gap) give what
-    reading every capsule's ends and middle gives."""
+def _field_on_path(cell, compiled: bool, monkeypatch) -> ObstacleField:
+    """The obstacle field of ``cell``, read by the compiled loops or (``compiled``
+    False) by numpy; skips where numba is not in use."""
     from ltl_human_motion.planning import navigation
     if not compiled:
         monkeypatch.setattr(navigation, "_compiled_loops", lambda: None)
     elif navigation._compiled_loops() is None:
         pytest.skip("numba is not in use")
-    field = ObstacleField(paper)
-    rng = np.random.default_rng(2)
+    return ObstacleField(cell)
+
+
+def _scattered_poses(rng: np.random.Generator, m: int, s: int, jitter: float) -> np.ndarray:
+    """Rest poses placed over the paper cell's floor, (m, s, J, 3), jittered per sample."""
     rest = Skeleton().rest_positions()
-    where = rng.uniform([-2.5, -2.5, 0.0], [2.5, 2.5, 0.0], (60, 1, 1, 3))
-    poses = rest[None, None] + where + rng.normal(scale=0.02, size=(60, 4, *rest.shape))
+    where = rng.uniform([-2.5, -2.5, 0.0], [2.5, 2.5, 0.0], (m, 1, 1, 3))
+    return rest[None, None] + where + rng.normal(scale=jitter, size=(m, s, *rest.shape))
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_obstacle_field_clear_matches_reading_every_capsule(paper, compiled, monkeypatch
+                                                            ) -> None:
+    """Both paths (the compiled loop stops at a capsule's first failing gap) give what
+    reading every capsule's ends and middle gives."""
+    field = _field_on_path(paper, compiled, monkeypatch)
+    poses = _scattered_poses(np.random.default_rng(2), 60, 4, 0.02)
     for relative in (False, True):
         got = field.clear(poses, 1.75, relative=relative)
         seg, rad = capsules_from_positions(poses, 1.75)
@@ -97,6 +107,32 @@ def test_obstacle_field_clear_matches_reading_every_capsule(paper, compiled, mon
         allowed = np.minimum(gap[:, :1], 0.0) - 0.005 if relative else 0.0
         np.testing.assert_array_equal(got, np.all(gap >= allowed, axis=(1, 2)))
     assert got.any() and not got.all()
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_clear_samples_equals_clear_of_the_selection(paper, compiled, monkeypatch) -> None:
+    """The search's one-call test of some candidates at some samples (with the bounding
+    box pre-test in the compiled loop) answers as :meth:`ObstacleField.clear` of the
+    selected poses, for the whole body and for the arms with the sweep margin."""
+    from ltl_human_motion.planning.steps import SWEEP_MARGIN, SWEEP_PARTS
+    from ltl_human_motion.scene.occupancy import part_indices
+    field = _field_on_path(paper, compiled, monkeypatch)
+    rng = np.random.default_rng(5)
+    poses = _scattered_poses(rng, 80, 9, 0.03)
+    cand = np.sort(rng.choice(80, 50, replace=False))
+    arms = part_indices(SWEEP_PARTS)
+    answers = []
+    for samples in (np.arange(0, 9, 2), np.r_[0, 1:9:2]):
+        for relative in (False, True):
+            for margin, parts in ((0.01, None), (SWEEP_MARGIN * field.res, arms)):
+                got = field.clear_samples(poses, cand, samples, 1.75, margin=margin,
+                                          relative=relative, parts=parts)
+                want = field.clear(poses[cand][:, samples], 1.75, margin=margin,
+                                   relative=relative, parts=parts)
+                np.testing.assert_array_equal(got, want)
+                answers.append(got)
+    answers = np.concatenate(answers)
+    assert answers.any() and not answers.all()
 
 
 def test_fields_on_a_shared_grid_equal_fields_built_alone(paper) -> None:

@@ -134,3 +134,78 @@ def body_field_clear(grid, lo, res, far, pos, ia, ib, long, need, relative, out)
             if not ok:
                 break
         out[m] = ok
+
+
+@_jit
+def _sample_gaps(grid, lo, res, far, pos, m, s, ia, ib, long, need, used, dj, gaps) -> None:
+    """gaps[k] = :func:`_capsule_gap` of every capsule at sample s of candidate m, each
+    joint (``used`` (J,) bool) read once into dj (J,)."""
+    for j in range(used.shape[0]):
+        if used[j]:
+            dj[j] = _field_distance(grid, lo, res, far, pos[m, s, j, 0], pos[m, s, j, 1],
+                                    pos[m, s, j, 2])
+    for k in range(ia.shape[0]):
+        a, b = ia[k], ib[k]
+        d = min(dj[a], dj[b])
+        if long[k]:
+            mid = _field_distance(grid, lo, res, far, (pos[m, s, a, 0] + pos[m, s, b, 0]) / 2.0,
+                                  (pos[m, s, a, 1] + pos[m, s, b, 1]) / 2.0,
+                                  (pos[m, s, a, 2] + pos[m, s, b, 2]) / 2.0)
+            d = min(d, mid)
+        gaps[k] = d - need[k]
+
+
+@_jit
+def body_samples_clear(grid, lo, res, far, pos, cand, samples, ia, ib, long, need,
+                       relative, part_lo, part_hi, limit, out) -> None:
+    """``ObstacleField.clear`` of ``pos[cand][:, samples]`` in one call: out[n] for
+    candidate cand[n] of pos (M, S, J, 3), sampled at ``samples`` (S',). A candidate
+    whose sampled joints' bounding box keeps ``limit`` from every obstacle part's box
+    (part_lo, part_hi (P, 3)) passes unread, as the numpy pre-test (``box_gap`` of
+    ``point_bounds``, the same arithmetic); the others as :func:`body_field_clear`, each
+    joint's distance read once per sample."""
+    K = ia.shape[0]
+    J = pos.shape[2]
+    used = np.zeros(J, dtype=np.bool_)
+    for k in range(K):
+        used[ia[k]] = True
+        used[ib[k]] = True
+    dj = np.empty(J)
+    gaps = np.empty(K)
+    first = np.zeros(K)
+    for n in range(cand.shape[0]):
+        m = cand[n]
+        blo0 = blo1 = blo2 = np.inf
+        bhi0 = bhi1 = bhi2 = -np.inf
+        for t in range(samples.shape[0]):
+            s = samples[t]
+            for j in range(J):
+                x, y, z = pos[m, s, j, 0], pos[m, s, j, 1], pos[m, s, j, 2]
+                blo0, bhi0 = min(blo0, x), max(bhi0, x)
+                blo1, bhi1 = min(blo1, y), max(bhi1, y)
+                blo2, bhi2 = min(blo2, z), max(bhi2, z)
+        box = np.inf
+        for p in range(part_lo.shape[0]):
+            g0 = max(max(part_lo[p, 0] - bhi0, blo0 - part_hi[p, 0]), 0.0)
+            g1 = max(max(part_lo[p, 1] - bhi1, blo1 - part_hi[p, 1]), 0.0)
+            g2 = max(max(part_lo[p, 2] - bhi2, blo2 - part_hi[p, 2]), 0.0)
+            box = min(box, math.sqrt(g0 * g0 + g1 * g1 + g2 * g2))
+        if not box < limit:
+            out[n] = True
+            continue
+        ok = True
+        if relative:
+            _sample_gaps(grid, lo, res, far, pos, m, samples[0], ia, ib, long, need, used,
+                         dj, gaps)
+            for k in range(K):
+                first[k] = min(gaps[k], 0.0) - 0.005
+        for t in range(samples.shape[0]):
+            _sample_gaps(grid, lo, res, far, pos, m, samples[t], ia, ib, long, need, used,
+                         dj, gaps)
+            for k in range(K):
+                if not gaps[k] >= first[k]:
+                    ok = False
+                    break
+            if not ok:
+                break
+        out[n] = ok

@@ -436,6 +436,57 @@ class ObstacleField:
         ok[check] = np.all(gap >= allowed, axis=(1, 2))
         return ok
 
+    def clear_samples(self, poses: np.ndarray, cand: np.ndarray, samples: np.ndarray,
+                      stature: float, margin: float = 0.01, relative: bool = False,
+                      parts: np.ndarray | None = None) -> np.ndarray:
+        """:meth:`clear` of ``poses[cand][:, samples]``, in one compiled call where the
+        compiled kernel is in use (the same answers; the search's hot path).
+
+        Parameters
+        ----------
+        poses : ndarray, shape (M, S, J, 3)
+        cand : ndarray of int, shape (N,)
+        samples : ndarray of int, shape (S',)
+        stature, margin, relative, parts
+            As for :meth:`clear`.
+
+        Returns
+        -------
+        ok : ndarray of bool, shape (N,)
+        """
+        nb = _compiled_loops()
+        pos = np.asarray(poses, dtype=np.float64)
+        if self.empty or nb is None or not np.isfinite(pos).all():
+            return self.clear(pos[cand][:, samples], stature, margin, relative, parts)
+        ia, ib, long, radii = _capsule_table(float(stature), None if parts is None
+                                             else tuple(np.asarray(parts).tolist()))
+        limit = radii.max() + margin + self.res * (0.4 + np.sqrt(3.0))
+        out = np.empty(len(cand), dtype=np.bool_)
+        nb.body_samples_clear(
+            np.ascontiguousarray(self.dist, dtype=np.float64),
+            np.asarray(self.lo, dtype=np.float64), float(self.res), float(self.far),
+            np.ascontiguousarray(pos), np.asarray(cand, dtype=np.int64),
+            np.asarray(samples, dtype=np.int64), ia, ib, long,
+            radii + margin + self.res * 0.4, bool(relative), self.part_lo, self.part_hi,
+            float(limit) if limit <= self.far else np.inf, out)
+        return out
+
+
+@lru_cache(maxsize=32)
+def _capsule_table(stature: float, parts: tuple[int, ...] | None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The capsules :meth:`ObstacleField.clear` reads: end joints (K,), whether each is
+    long (not a sphere) and radii (K,) at ``stature``, of ``parts`` (default all).
+    Shared: callers must not write to them."""
+    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    ia, ib = capsule_ends()
+    radii = capsule_radii(stature)
+    if parts is not None:
+        sel = np.asarray(parts, dtype=np.int64)
+        ia, ib, radii = ia[sel], ib[sel], radii[sel]
+    ia, ib = np.ascontiguousarray(ia, dtype=np.int64), np.ascontiguousarray(ib, dtype=np.int64)
+    return ia, ib, ia != ib, radii
+
 
 _CLEARANCE_CACHE: BoundedCache[tuple[ClearanceMap, ObstacleField]] = BoundedCache(64)
 _FIELDS_FORMAT = 4

@@ -60,6 +60,7 @@ SWEEP_MARGIN = -0.4
 #: hand, palm or forearm); the trunk and legs move with the root path the search checks.
 SWEEP_PARTS: tuple[str, ...] = ("l_upper_arm", "r_upper_arm", "l_lower_arm", "r_lower_arm",
                                 "l_hand", "r_hand", "l_palm", "r_palm")
+_SWEEP_INDICES = part_indices(SWEEP_PARTS)
 
 #: Searches run again after the path found collided on a frame the search did not
 #: sample (each forbids the colliding primitive at its pose).
@@ -204,18 +205,19 @@ class StepExecutor:
         out = np.ones(len(poses), dtype=bool)
         stature = self.ctx.stature
         field = self.ctx.obstacle_field
+        n_samples = poses.shape[1]
         for rel in (False, True):
             sel = np.flatnonzero(standing == rel)
             if sel.size:
-                ok = field.clear(poses[sel, ::2], stature, relative=rel)
+                ok = field.clear_samples(poses, sel, np.arange(0, n_samples, 2), stature,
+                                         relative=rel)
                 if ok.any():
                     keep = sel[ok]
                     # (with ``relative``, after the start they are measured from)
-                    between = np.r_[0, 1:poses.shape[1]:2] if rel else \
-                        np.arange(1, poses.shape[1], 2)
-                    ok[ok] = field.clear(poses[keep][:, between], stature,
-                                         margin=SWEEP_MARGIN * field.res, relative=rel,
-                                         parts=part_indices(SWEEP_PARTS))
+                    between = np.r_[0, 1:n_samples:2] if rel else np.arange(1, n_samples, 2)
+                    ok[ok] = field.clear_samples(poses, keep, between, stature,
+                                                 margin=SWEEP_MARGIN * field.res,
+                                                 relative=rel, parts=_SWEEP_INDICES)
                 out[sel] = ok
         return out
 

@@ -1,7 +1,8 @@
 """Compiled bounds of :meth:`ltl_human_motion.scene.clearance.PartSet.body_clearance`
 (imported on first use): the bounding-box gaps of bodies and of their capsules to the
 parts, operation for operation as the numpy path computes them (the same numbers; tests
-hold them together), without its temporaries of frames x parts x capsules."""
+hold them together), without its temporaries of frames x parts x capsules; and the
+exact segment-box distance of ``geometry.segment_aabb_distance`` the same way."""
 
 from __future__ import annotations
 
@@ -56,3 +57,55 @@ def body_bounds(seg, rad, lo, hi, plo, phi, exact_below):
                               np.maximum(a[1], b[1]), np.maximum(a[2], b[2]),
                               plo[p], phi[p]) - rad[k]
     return body, f_idx[:M].copy(), p_idx[:M].copy(), caps
+
+
+@_jit
+def _box_point(a, d, t, lo, hi, n):
+    """``point_box_distance`` of the point a + t d (3,) to box n of lo, hi (N, 3)."""
+    e0 = max(max(lo[n, 0] - (a[0] + t * d[0]), (a[0] + t * d[0]) - hi[n, 0]), 0.0)
+    e1 = max(max(lo[n, 1] - (a[1] + t * d[1]), (a[1] + t * d[1]) - hi[n, 1]), 0.0)
+    e2 = max(max(lo[n, 2] - (a[2] + t * d[2]), (a[2] + t * d[2]) - hi[n, 2]), 0.0)
+    return math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+
+
+@_jit
+def segment_aabb_distance(a, b, lo, hi, out) -> None:
+    """out[n] = ``geometry.segment_aabb_distance`` of segment [a[n], b[n]] and box
+    lo[n], hi[n] (all (N, 3)): the 15 candidates of the closed form (ends, face
+    crossings, clipped stationary points of the pieces), operation for operation."""
+    knots = np.empty(8)
+    d = np.empty(3)
+    an = np.empty(3)
+    for n in range(a.shape[0]):
+        for k in range(3):
+            an[k] = a[n, k]
+            d[k] = b[n, k] - a[n, k]
+        knots[0], knots[1] = 0.0, 1.0
+        for k in range(3):
+            for j, face in ((2 + k, lo[n, k]), (5 + k, hi[n, k])):
+                c = (face - an[k]) / d[k]
+                knots[j] = min(max(c, 0.0), 1.0) if math.isfinite(c) else 0.0
+        knots.sort()
+        best = np.inf
+        for i in range(8):
+            best = min(best, _box_point(an, d, knots[i], lo, hi, n))
+        for i in range(7):
+            t0, t1 = knots[i], knots[i + 1]
+            half = 0.5 * (t0 + t1)
+            num = 0.0
+            den = 0.0
+            for k in range(3):
+                mid = an[k] + half * d[k]
+                if mid < lo[n, k]:
+                    off, slope = an[k] - lo[n, k], d[k]
+                elif mid > hi[n, k]:
+                    off, slope = an[k] - hi[n, k], d[k]
+                else:
+                    off, slope = 0.0, 0.0
+                num = num + off * slope if k else off * slope
+                den = den + slope * slope if k else slope * slope
+            num = -num
+            stat = num / den if den > 0 else t0
+            stat = min(max(stat, t0), t1)
+            best = min(best, _box_point(an, d, stat, lo, hi, n))
+        out[n] = best

@@ -71,7 +71,16 @@ class PartSet:
         box = self.is_box[part]
         if box.any():
             c, h = self.center[part[box]], self.half[part[box]]
-            out[box] = segment_aabb_distance(a[box] - c, b[box] - c, -h, h) - radii[box]
+            nb = _compiled_bounds()
+            if nb is not None:
+                dist = np.empty(int(box.sum()))
+                nb.segment_aabb_distance(np.ascontiguousarray(a[box] - c),
+                                         np.ascontiguousarray(b[box] - c),
+                                         np.ascontiguousarray(-h), np.ascontiguousarray(h),
+                                         dist)
+            else:
+                dist = segment_aabb_distance(a[box] - c, b[box] - c, -h, h)
+            out[box] = dist - radii[box]
         for k in self._others:
             sel = part == k
             if sel.any():
