@@ -14,7 +14,7 @@ from ltl_human_motion.ltl import Atom, build_specification, evaluate_lasso
 from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
 from ltl_human_motion.tasks import CellModel, Limits, plan_sequences
 from ltl_human_motion.tasks.kitting import kitting_cell_yaml, kitting_spec
-from ltl_human_motion.tasks.model import HELD
+from ltl_human_motion.tasks.model import HELD, IN_PLACE_WALK_PENALTY
 from ltl_human_motion.tasks.product import ProductSearch
 from ltl_human_motion.tasks.sequences import RANDOM_COST_FACTOR, product_search
 
@@ -73,7 +73,8 @@ def test_model_preconditions_and_effects():
     assert m.step(s1, _t("grasp(P3)")) is None            # two-handed: both hands
     s3, _ = m.step(s2, _t("move(P0, R1)"))              # set down in R1, hand free
     assert s3.held == (1,) and s3.location == m.region_location("R1")
-    assert m.step(s3, _t("walk(R1)")) is None             # already there
+    here, cost = m.step(s3, _t("walk(R1)"))              # already there: stands in R1
+    assert here == s3 and cost == m.durations["walk"] + IN_PLACE_WALK_PENALTY
     assert m.step(s3, _t("grasp(kit)")) is None           # a fixed object
     assert s3.parts[0] == m.region_location("R1")
     s4, _ = m.step(s3, _t("insert(P1, kit)"))

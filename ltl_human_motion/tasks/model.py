@@ -16,7 +16,9 @@ Preconditions and effects follow Table I of the paper and what the planner does:
 * ``extract(O, C)`` needs O inside C and a free hand; O ends in hand.
 * ``assemble(R)`` (the shorthand ``leftHand(R) & rightHand(R)``) uses up the parts in
   hand; a later grasp takes a fresh one from its supply position (paper Fig. 3).
-* ``walk(R)`` needs the worker elsewhere (a walk on the spot is pointless).
+* ``walk(R)`` where the worker already is holds once it stands still there (a carry
+  into R, then ``F walk(R)``); it costs :data:`IN_PLACE_WALK_PENALTY` more, so that a
+  search takes it only where the specification asks for it.
 * ``sit(O)`` needs to be standing, or seated already (the worker stays seated);
   ``standUp`` stands up (a no-op when standing); ``kneel`` kneels. Tasks that walk or
   work away from a seat stand up first, as the planner does.
@@ -35,8 +37,8 @@ import numpy as np
 from ltl_human_motion.ltl.formula import Atom
 from ltl_human_motion.vocabulary import two_hand_region
 
-__all__ = ["DONE", "IMPLICIT_FETCH_PENALTY", "NOMINAL_DURATION", "WALK_SPEED", "CellModel",
-           "CellState", "Limits"]
+__all__ = ["DONE", "IMPLICIT_FETCH_PENALTY", "IN_PLACE_WALK_PENALTY", "NOMINAL_DURATION",
+           "WALK_SPEED", "CellModel", "CellState", "Limits"]
 
 #: Walking speed of the cost estimate, m/s. Slower than free walking (about 1.3 m/s,
 #: Bohannon 1997) because walks in a cell are short and start and stop.
@@ -60,6 +62,10 @@ HELD = -1
 #: Extra cost (s) of a ``release`` that fetches its part first, so that a search prefers
 #: an explicit ``grasp`` wherever the specification allows one (a choice, not a measure).
 IMPLICIT_FETCH_PENALTY = 0.5
+#: Extra cost (s) of a ``walk(R)`` where the worker already is (see the module
+#: docstring): more than the small differences between real options, so the search
+#: never prefers such a step to one the specification does not force (a choice).
+IN_PLACE_WALK_PENALTY = 1.0
 INSIDE = -2
 
 #: Where a part is once the specification no longer mentions it and no hand holds it:
@@ -363,7 +369,7 @@ class CellModel:
         else:
             dest = self.target(task, state)
             if kind == "walk" and dest == loc:
-                return None                     # already there: a pointless walk
+                cost += IN_PLACE_WALK_PENALTY   # already there: stands still in R
             if dest is not None:
                 cost += self._walk[loc][dest]
                 loc = dest
