@@ -47,11 +47,15 @@ class MotionFormatError(LtlHumanMotionError, ValueError):
 
 
 class PlanningError(LtlHumanMotionError):
-    """Motion planning failed; the message names the task and the reason."""
+    """Motion planning failed; the message names the task and the reason.
+
+    ``step_index``: the position of the failed step in the task sequence being planned
+    (None where the failure is not a step's, or before any step)."""
 
     def __init__(self, message: str, task: str | None = None, reason: str | None = None) -> None:
         self.task = task
         self.reason = reason
+        self.step_index: int | None = None
         super().__init__(message)
 
 

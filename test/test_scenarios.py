@@ -406,6 +406,13 @@ FIXED_FAMILY_RUNS = {
     ("cluttered/single/grasp(O2)", 1.95, 1): "head into the cart stooping",
     ("cluttered/single/move(O2, R1)", 1.75, 1): "head into the cart stooping",
     ("cluttered/dwyer/absence_after/0", 1.95, 1): "head into the cart, other hand full",
+    # a step the first order of the tasks cannot do (a grasp beside the shelf wall with
+    # the other hand full; an insert from where the walk before it ended): the next
+    # order of the product search that comes to it in another situation
+    ("kitting/job/kit_grasp_insert", 1.95, 1): "grasp with the other hand full",
+    ("machine_tending/job/load_repeatedly", 1.55, 1): "insert after the walk: other order",
+    # walk(R1) where the carry left the worker (task model: stands still in R1)
+    ("stations/job/carry_then_walk_there", 1.75, 0): "walk to where the worker is",
 }
 
 

@@ -15,6 +15,7 @@ import functools
 import inspect
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -22,6 +23,7 @@ import numpy as np
 
 from ltl_human_motion.deadline import Deadline, checkpoint
 from ltl_human_motion.deadline import active as active_deadline
+from ltl_human_motion.errors import PlanningError
 from ltl_human_motion.motion.realism import realism_summary
 from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
@@ -318,19 +320,105 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     else:
         t_library = 0.0
     checkpoint("library")
-    results = []
-    for v in range(variants):
-        seq = sequences[v % len(sequences)]
-        # Refuse, before any search, what no worker of this stature can do.
-        check_steps(cell, [(t.name, tuple(t.args)) for t in seq.tasks], float(stature))
+
+    def one(seq, v: int) -> SynthesizedMotion:
         rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, v])
-        results.append(_synthesize_one(spec, specification, seq, cell, library, rng, seed, v,
-                                       options, t_automaton, t_sequence, t_library,
-                                       float(stature)))
+        return _synthesize_one(spec, specification, seq, cell, library, rng, seed, v,
+                               options, t_automaton, t_sequence, t_library, float(stature))
+    others = functools.partial(_other_sequences, specification, cell,
+                               variants + ORDER_CANDIDATES, seed, options, cycles)
+    results = [_variant(one, sequences[v % len(sequences)], v, others, cell, float(stature))
+               for v in range(variants)]
     total = time.perf_counter() - t_all
     for r in results:
         r.stats["batch_total_time"] = total
     return results
+
+
+#: Other task sequences (the next best of the product search) tried when the motion
+#: planner cannot do a step in the order of the first; only those that never reach
+#: the failed task after the same set of tasks (the same situation fails the same
+#: way). A worker holding a bolt in one hand reached for a gear beside a shelf wall
+#: with the other at 1.95 m; grasping the gear first worked (kitting, 1.95 m).
+OTHER_ORDERS = 2
+#: Sequences of the product search those are chosen from (many of the next best differ
+#: from the first only by a task done again or a walk to where the worker is).
+ORDER_CANDIDATES = 8
+
+#: The planning failures another order of the steps may avoid (a blocked reach, a
+#: search out of budget); the cell's own limits (reach, size, enclosed ...) are found
+#: before any search and hold in every order.
+_ORDER_REASONS = ("blocked", "budget", "unreachable")
+
+
+def _variant(one: Callable[[Any, int], SynthesizedMotion], seq, v: int,
+             others: Callable[[], list], cell, stature: float) -> SynthesizedMotion:
+    """Variant ``v``: ``one(seq, v)``, refused before any search where no worker of
+    this stature can do a step (:func:`.feasibility.check_steps`), else in another
+    order of the tasks where the motion planner cannot (:func:`_in_another_order`)."""
+    check_steps(cell, [(t.name, tuple(t.args)) for t in seq.tasks], stature)
+    try:
+        return one(seq, v)
+    except PlanningError as exc:
+        return _in_another_order(functools.partial(one, v=v), seq, exc, others, cell,
+                                 stature)
+
+
+def _other_sequences(specification, cell, n: int, seed: int, options: SynthesisOptions,
+                     cycles: int) -> list:
+    """The first ``n`` task sequences of the product search (:func:`_task_sequences`)."""
+    return _task_sequences(specification, cell, n, seed, options.sequence_mode, cycles,
+                           options.backend)[0]
+
+
+def _task_text(task) -> str:
+    return f"{task.name}({', '.join(task.args)})" if task.args else task.name
+
+
+def _same_situation(other, seq, at: int, failed: set[str]) -> bool:
+    """Whether sequence ``other`` comes to one of the ``failed`` tasks (texts) after the
+    same tasks as ``seq`` came to its step ``at``, in any order and number (a task
+    done again, a walk to where the worker is, leaves it in the same situation)."""
+    before = {_task_text(t) for t in seq.tasks[:at]}
+    done: set[str] = set()
+    for task in other.tasks:
+        if _task_text(task) in failed and done == before:
+            return True
+        done.add(_task_text(task))
+    return False
+
+
+def _in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
+                      failure: PlanningError, others: Callable[[], list], cell,
+                      stature: float) -> SynthesizedMotion:
+    """``one(sequence)`` for the next sequences of ``others()`` (up to ``OTHER_ORDERS``)
+    that do not come to the task ``failure`` (raised by ``one(seq)``) names in the same
+    situation (:func:`_same_situation`); the first that plans. Raises ``failure``
+    (saying how many orders were tried) if none does, or if its reason is not one
+    another order can change."""
+    at = failure.step_index
+    if failure.reason not in _ORDER_REASONS or at is None:
+        raise failure
+    failed = {_task_text(seq.tasks[at])} | ({failure.task} if failure.task else set())
+    tried = 0
+    for other in others():
+        if tried >= OTHER_ORDERS:
+            break
+        if _same_situation(other, seq, at, failed):
+            continue
+        try:
+            check_steps(cell, [(t.name, tuple(t.args)) for t in other.tasks], stature)
+        except PlanningError:
+            continue
+        tried += 1
+        try:
+            return one(other)
+        except PlanningError:
+            continue
+    if tried:
+        raise PlanningError(f"{failure}; {tried} other order(s) of the tasks failed too",
+                            task=failure.task, reason=failure.reason) from failure
+    raise failure
 
 
 def _blended(plan: Plan, floor_cell, floor_z: float, library, realism: bool,

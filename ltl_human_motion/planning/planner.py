@@ -244,7 +244,11 @@ class SequencePlanner:
         for i, task in enumerate(tasks):
             first = len(self.state.segments)
             facing = self._seated_work(tasks[i + 1:]) if task.kind == "sit" else None
-            step = self._plan_step(i, task.text, task.kind, task.args, facing=facing)
+            try:
+                step = self._plan_step(i, task.text, task.kind, task.args, facing=facing)
+            except PlanningError as exc:
+                exc.step_index = i              # where the order of the tasks failed
+                raise
             step.first_segment = first
             step.last_segment = len(self.state.segments) - 1
             self.steps.append(step)
