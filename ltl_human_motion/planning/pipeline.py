@@ -295,7 +295,9 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     CellError
         Malformed cell.
     PlanningError
-        A task could not be planned (the message names the task and why).
+        A task could not be planned (the message names the task and why). Where a step
+        fails in the order of the tasks chosen first, up to ``OTHER_ORDERS`` other
+        orders are planned before this is raised (the message says how many).
     VerificationError
         A motion failed a check (the message names it).
     """
