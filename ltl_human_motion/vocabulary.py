@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from ltl_human_motion.errors import PlanningError
 
 __all__ = ["ENTERING_TASKS", "HAND_TASKS", "REGION_ATOM", "TASK_ARGUMENTS", "TASK_NAMES",
-           "TaskStep", "shorthand_conjuncts", "task_step", "two_hand_region"]
+           "TaskStep", "shorthand_conjuncts", "task_step", "task_text", "two_hand_region"]
 
 TASK_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "wait": ("duration",),
@@ -129,6 +129,11 @@ class TaskStep:
     args: tuple[str, ...]
 
 
+def task_text(name: str, args: tuple[str, ...]) -> str:
+    """How task ``name(args)`` is written: ``"grasp(O1)"``, ``"standUp"``."""
+    return f"{name}({', '.join(args)})" if args else name
+
+
 def task_step(name: str, args: tuple[str, ...],
               shorthands: Mapping[str, tuple[tuple[str, ...], str]],
               text: str | None = None) -> TaskStep:
@@ -141,7 +146,7 @@ def task_step(name: str, args: tuple[str, ...],
         ``leftHand(R) & rightHand(R)`` is one step (``assemble``).
     """
     args = tuple(str(a) for a in args)
-    text = text if text is not None else (f"{name}({', '.join(args)})" if args else name)
+    text = text if text is not None else task_text(name, args)
     if name in shorthands:
         params, body = shorthands[name]
         if len(args) == 1 and two_hand_region(params, body):

@@ -95,8 +95,8 @@ def _scattered_poses(rng: np.random.Generator, m: int, s: int, jitter: float) ->
 @pytest.mark.parametrize("compiled", [False, True])
 def test_obstacle_field_clear_matches_reading_every_capsule(paper, compiled, monkeypatch
                                                             ) -> None:
-    """Both paths (the compiled loop stops at a capsule's first failing gap) give what
-    reading every capsule's ends and middle gives."""
+    """Both paths (the compiled loop stops at a candidate's first failing sample) give
+    what reading every capsule's ends and middle gives."""
     field = _field_on_path(paper, compiled, monkeypatch)
     poses = _scattered_poses(np.random.default_rng(2), 60, 4, 0.02)
     for relative in (False, True):

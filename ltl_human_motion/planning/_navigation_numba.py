@@ -95,51 +95,10 @@ def _field_distance(grid, lo, res, far, p0, p1, p2):
 
 
 @_jit
-def _capsule_gap(grid, lo, res, far, pos, m, s, a, b, long, need):
-    """Gap of one capsule (joints a, b of sample s of candidate m) by the field: the
-    nearer of its ends' distances (and of its middle's, for a long capsule) less
-    ``need``."""
-    da = _field_distance(grid, lo, res, far, pos[m, s, a, 0], pos[m, s, a, 1], pos[m, s, a, 2])
-    db = _field_distance(grid, lo, res, far, pos[m, s, b, 0], pos[m, s, b, 1], pos[m, s, b, 2])
-    d = min(da, db)
-    if long:
-        mid = _field_distance(grid, lo, res, far, (pos[m, s, a, 0] + pos[m, s, b, 0]) / 2.0,
-                              (pos[m, s, a, 1] + pos[m, s, b, 1]) / 2.0,
-                              (pos[m, s, a, 2] + pos[m, s, b, 2]) / 2.0)
-        d = min(d, mid)
-    return d - need
-
-
-@_jit
-def body_field_clear(grid, lo, res, far, pos, ia, ib, long, need, relative, out) -> None:
-    """out[m] = whether every capsule of every sample of candidate m (pos (M, S, J, 3);
-    capsule k from joint ia[k] to ib[k]) keeps its field gap >= 0, or with ``relative``
-    >= min(its gap at the first sample, 0) - 0.005 (``ObstacleField.clear``; ``need``
-    (K,): radius, margin and interpolation allowance). Stops at the first failing gap."""
-    K = ia.shape[0]
-    first = np.empty(K)
-    for m in range(pos.shape[0]):
-        ok = True
-        if relative:
-            for k in range(K):
-                first[k] = min(_capsule_gap(grid, lo, res, far, pos, m, 0, ia[k], ib[k],
-                                            long[k], need[k]), 0.0) - 0.005
-        for s in range(pos.shape[1]):
-            for k in range(K):
-                gap = _capsule_gap(grid, lo, res, far, pos, m, s, ia[k], ib[k], long[k],
-                                   need[k])
-                if not gap >= (first[k] if relative else 0.0):
-                    ok = False
-                    break
-            if not ok:
-                break
-        out[m] = ok
-
-
-@_jit
 def _sample_gaps(grid, lo, res, far, pos, m, s, ia, ib, long, need, used, dj, gaps) -> None:
-    """gaps[k] = :func:`_capsule_gap` of every capsule at sample s of candidate m, each
-    joint (``used`` (J,) bool) read once into dj (J,)."""
+    """gaps[k] = the field gap of capsule k (joints ia[k], ib[k]) at sample s of candidate
+    m: the nearer of its ends' distances (and of its middle's, for a long capsule) less
+    need[k]; each joint (``used`` (J,) bool) read once into dj (J,)."""
     for j in range(used.shape[0]):
         if used[j]:
             dj[j] = _field_distance(grid, lo, res, far, pos[m, s, j, 0], pos[m, s, j, 1],
@@ -162,8 +121,10 @@ def body_samples_clear(grid, lo, res, far, pos, cand, samples, ia, ib, long, nee
     candidate cand[n] of pos (M, S, J, 3), sampled at ``samples`` (S',). A candidate
     whose sampled joints' bounding box keeps ``limit`` from every obstacle part's box
     (part_lo, part_hi (P, 3)) passes unread, as the numpy pre-test (``box_gap`` of
-    ``point_bounds``, the same arithmetic); the others as :func:`body_field_clear`, each
-    joint's distance read once per sample."""
+    ``point_bounds``, the same arithmetic); for the others, whether every capsule
+    keeps its field gap (:func:`_sample_gaps`) >= 0 at every sample, or with
+    ``relative`` >= min(its gap at the first sample, 0) - 0.005 (``need`` (K,): radius,
+    margin and interpolation allowance). Stops at the first failing sample."""
     K = ia.shape[0]
     J = pos.shape[2]
     used = np.zeros(J, dtype=np.bool_)

@@ -390,16 +390,11 @@ class ObstacleField:
         ok : ndarray of bool, shape (M,)
         """
         from ltl_human_motion.scene.geometry import box_gap, point_bounds
-        from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
         if self.empty:
             return np.ones(poses.shape[0], dtype=bool)
         # Each capsule is sampled at its end points (joints) and its middle; the joints
         # are shared by capsules, so the field is read once per joint.
-        ia, ib = capsule_ends()
-        radii = capsule_radii(stature)
-        if parts is not None:
-            ia, ib, radii = ia[parts], ib[parts], radii[parts]
-        long = ia != ib                                  # spheres: the middle is the joint
+        ia, ib, long, radii = _capsule_table(float(stature), _parts_key(parts))
         pos = np.asarray(poses, dtype=np.float64)
         ok = np.ones(pos.shape[0], dtype=bool)
         # A candidate whose joints (and so its sample points) all keep more than the
@@ -418,12 +413,10 @@ class ObstacleField:
         pos = pos[check]
         nb = _compiled_loops()
         if nb is not None and np.isfinite(pos).all():
-            out = np.empty(pos.shape[0], dtype=np.bool_)
-            nb.body_field_clear(np.ascontiguousarray(self.dist, dtype=np.float64),
-                                np.asarray(self.lo, dtype=np.float64), float(self.res),
-                                float(self.far), np.ascontiguousarray(pos), ia, ib, long,
-                                radii + margin + self.res * 0.4, bool(relative), out)
-            ok[check] = out
+            # (every candidate and sample; the bounding-box test is done)
+            ok[check] = self._compiled_clear(nb, pos, np.arange(len(pos)),
+                                             np.arange(pos.shape[1]), (ia, ib, long, radii),
+                                             margin, relative, np.inf)
             return ok
         d_joint = self.distance(pos)                                        # (m, S, J)
         d_mid = self.distance((pos[..., ia[long], :] + pos[..., ib[long], :]) / 2.0)
@@ -458,9 +451,18 @@ class ObstacleField:
         pos = np.asarray(poses, dtype=np.float64)
         if self.empty or nb is None or not np.isfinite(pos).all():
             return self.clear(pos[cand][:, samples], stature, margin, relative, parts)
-        ia, ib, long, radii = _capsule_table(float(stature), None if parts is None
-                                             else tuple(np.asarray(parts).tolist()))
-        limit = radii.max() + margin + self.res * (0.4 + np.sqrt(3.0))
+        capsules = _capsule_table(float(stature), _parts_key(parts))
+        limit = capsules[3].max() + margin + self.res * (0.4 + np.sqrt(3.0))
+        return self._compiled_clear(nb, pos, cand, samples, capsules, margin, relative,
+                                    float(limit) if limit <= self.far else np.inf)
+
+    def _compiled_clear(self, nb: ModuleType, pos: np.ndarray, cand: np.ndarray,
+                        samples: np.ndarray, capsules: tuple[np.ndarray, ...], margin: float,
+                        relative: bool, limit: float) -> np.ndarray:
+        """The compiled test of :meth:`clear_samples` for the ``capsules`` of
+        :func:`_capsule_table` (``limit``: of the bounding-box pre-test, ``inf`` to read
+        the field for every candidate), shape (N,)."""
+        ia, ib, long, radii = capsules
         out = np.empty(len(cand), dtype=np.bool_)
         nb.body_samples_clear(
             np.ascontiguousarray(self.dist, dtype=np.float64),
@@ -468,8 +470,13 @@ class ObstacleField:
             np.ascontiguousarray(pos), np.asarray(cand, dtype=np.int64),
             np.asarray(samples, dtype=np.int64), ia, ib, long,
             radii + margin + self.res * 0.4, bool(relative), self.part_lo, self.part_hi,
-            float(limit) if limit <= self.far else np.inf, out)
+            limit, out)
         return out
+
+
+def _parts_key(parts: np.ndarray | None) -> tuple[int, ...] | None:
+    """``parts`` (capsule indices) as the key of :func:`_capsule_table`."""
+    return None if parts is None else tuple(np.asarray(parts).tolist())
 
 
 @lru_cache(maxsize=32)

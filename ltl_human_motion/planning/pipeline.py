@@ -35,7 +35,7 @@ from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlan
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, failure_error, verify_motion
 from ltl_human_motion.scene.cell_yaml import resolve_cell
-from ltl_human_motion.vocabulary import task_step
+from ltl_human_motion.vocabulary import task_step, task_text
 
 __all__ = ["SynthesisOptions", "get_library", "resolve_cell", "synthesize"]
 
@@ -374,7 +374,7 @@ def _other_sequences(specification, cell, n: int, seed: int, options: SynthesisO
 
 
 def _task_text(task) -> str:
-    return f"{task.name}({', '.join(task.args)})" if task.args else task.name
+    return task_text(task.name, tuple(task.args))
 
 
 def _same_situation(other, seq, at: int, failed: set[str]) -> bool:
