@@ -498,17 +498,19 @@ def _capsule_table(stature: float, parts: tuple[int, ...] | None
 _CLEARANCE_CACHE: BoundedCache[tuple[ClearanceMap, ObstacleField]] = BoundedCache(64)
 _FIELDS_FORMAT = 4
 _GRID_CACHE: BoundedCache[FloorGrid] = BoundedCache(16)
-#: Extra cost of a metre through the narrowest walkable floor (see :func:`floor_grid`):
-#: a gap the body barely fits counts twice its length (a choice: 3 served the cell with
-#: crates better, 1 the wall with a doorway, over both together 1 did a little better).
+#: Default extra cost of a metre through the narrowest walkable floor (see
+#: :func:`floor_grid`): a gap the body barely fits counts twice its length. The squeeze
+#: through a narrow aisle uses it; the walking map's fields count such floor far longer
+#: (:data:`.walk_goals.LANE_NARROW_COST`).
 NARROW_COST = 1.0
 
 
 def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: float,
-               resolution: float, passage: float | None = None) -> FloorGrid:
+               resolution: float, passage: float | None = None,
+               narrow_cost: float = NARROW_COST) -> FloorGrid:
     """The :class:`FloorGrid` whose free cells keep ``radius`` of floor clearance; with
     ``passage``, a metre through a cell with less clearance than that counts up to
-    ``1 + NARROW_COST`` metres (linear from ``passage`` down to ``radius``), so the
+    ``1 + narrow_cost`` metres (linear from ``passage`` down to ``radius``), so the
     fields lead through gaps the body barely fits only when there is no roomier way.
 
     Built once per clearance map (one per obstacle layout, :func:`clearance_maps`),
@@ -523,11 +525,11 @@ def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: 
     """
     key = (np.asarray(lo, dtype=np.float64).tobytes(),
            np.asarray(hi, dtype=np.float64).tobytes(), float(radius), float(resolution),
-           None if passage is None else float(passage))
+           None if passage is None else float(passage), float(narrow_cost))
 
     def cell_cost(xy: np.ndarray) -> np.ndarray:
         narrow = (passage - clearance(xy)) / max(passage - radius, 1e-9)
-        return 1.0 + NARROW_COST * np.clip(narrow, 0.0, 1.0)
+        return 1.0 + narrow_cost * np.clip(narrow, 0.0, 1.0)
 
     def build() -> FloorGrid:
         grid = FloorGrid(lo, hi, lambda xy: clearance(xy) > radius, resolution,

@@ -30,7 +30,7 @@ from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.navigation import floor_grid
 from ltl_human_motion.planning.plan_state import PlanContext, Pose, WorkerState
 from ltl_human_motion.planning.standing import ideal_placement
-from ltl_human_motion.planning.walk_goals import PASSAGE_RADIUS
+from ltl_human_motion.planning.walk_goals import LANE_NARROW_COST, PASSAGE_RADIUS
 from ltl_human_motion.scene.occupancy import part_indices
 
 #: Clearance (m) the planner keeps between the body and obstacles on the frames it
@@ -435,7 +435,8 @@ class StepExecutor:
             return False
         grid = floor_grid(self.ctx.clearance, self.ctx.cell.workspace_lo[:2],
                           self.ctx.cell.workspace_hi[:2], self.ctx.options.body_radius,
-                          self.ctx.options.grid_resolution, passage=PASSAGE_RADIUS)
+                          self.ctx.options.grid_resolution, passage=PASSAGE_RADIUS,
+                          narrow_cost=LANE_NARROW_COST)
         i = int(np.clip(np.rint((x - grid.lo[0]) / grid.res), 0, grid.shape[0] - 1))
         j = int(np.clip(np.rint((y - grid.lo[1]) / grid.res), 0, grid.shape[1] - 1))
         return bool(grid.free[i, j])
