@@ -325,3 +325,55 @@ def test_hips_stay_level_in_a_standing_bend_and_turn_with_a_crouching_pelvis() -
     assert np.all(off[:, 0] < rest[hips, 0] - rest[0, 0] - 0.01)
     np.testing.assert_allclose(np.linalg.norm(off, axis=1),
                                np.linalg.norm(rest[hips] - rest[0], axis=1), atol=1e-12)
+
+
+def _into_board(w: np.ndarray, side: str, board_lo: np.ndarray, board_hi: np.ndarray,
+                radius: float) -> float:
+    """How deep (m) the hand capsule (wrist to hand, ``radius``) of frames ``w`` (T, J, 3)
+    comes into the box board_lo-board_hi at its deepest; negative: clear by that much."""
+    s = np.linspace(0.0, 1.0, 9)[:, None, None]
+    pts = w[None, :, J[f"{side}_wrist"]] + s * (w[None, :, J[f"{side}_hand"]]
+                                                - w[None, :, J[f"{side}_wrist"]])
+    gap = np.maximum(np.maximum(board_lo - pts, pts - board_hi), 0.0)
+    return float(radius - np.linalg.norm(gap, axis=-1).min())
+
+
+def test_a_grasp_over_a_board_above_the_shoulders_rises_in_front_of_its_edge() -> None:
+    """A 1.55 m worker grasps a part 5 cm behind the edge of a wall shelf whose board
+    (1.58-1.60 m) is above the shoulders: told of the board (``support``), every path
+    raises the hand in front of the edge and comes in over it with the palm level,
+    clear of the board on every frame. Without it the arc about the shoulder swings the
+    hand under the board at arm's length and up through it (shelf_heights' O_over)."""
+    sk = Skeleton(1.55)
+    edge, top = 0.25, 1.60
+    target = np.array([0.30, -0.18, 1.685])
+    lo, hi = np.array([edge, -0.6, top - 0.02]), np.array([edge + 0.3, 0.6, top])
+    radius = 0.045 * 1.55 / 1.75
+    for path in ("arc", "level"):
+        mp, w = _make("grasp", target, sk=sk, path=path, hand="r_hand",
+                      support=(1.0, 0.0, edge, top), start_pose=standing_pose(sk)[0])
+        assert np.linalg.norm(w[mp.meta["contact_frame"], J["r_hand"]] - target) < 1e-3
+        assert _into_board(w, "r", lo, hi, radius) < 0.0
+    _, w = _make("grasp", target, sk=sk, path="arc", hand="r_hand",
+                 start_pose=standing_pose(sk)[0])
+    assert _into_board(w, "r", lo, hi, radius) > 0.02
+
+
+def test_a_grasp_under_a_board_close_over_the_part_keeps_the_palm_level() -> None:
+    """A 1.95 m worker grasps a part in a shelf compartment, 16 cm under the board above
+    it (generated cell gen_0_10): the palm comes in level, so the wrist is not a hand's
+    length above it, in the board (4.9 cm deep with the palm pointing down as the arm
+    does); the hand clears the board on every frame of both paths."""
+    sk = Skeleton(1.95)
+    edge, bottom, top = 0.5665, 0.88, 0.90
+    target = np.array([0.70, -0.14, 0.717])
+    lo, hi = np.array([edge, -0.6, bottom]), np.array([edge + 0.35, 0.6, top])
+    radius = 0.045 * 1.95 / 1.75
+    for path in ("arc", "level"):
+        mp, w = _make("grasp", target, sk=sk, path=path, hand="r_hand",
+                      board=(edge, bottom, top), support=(1.0, 0.0, edge, 0.6),
+                      start_pose=standing_pose(sk)[0])
+        contact = mp.meta["contact_frame"]
+        assert np.linalg.norm(w[contact, J["r_hand"]] - target) < 1e-3
+        assert abs(w[contact, J["r_wrist"], 2] - target[2]) < 0.01
+        assert _into_board(w, "r", lo, hi, radius) < 0.0

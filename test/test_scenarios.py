@@ -413,6 +413,16 @@ FIXED_FAMILY_RUNS = {
     ("machine_tending/job/load_repeatedly", 1.55, 1): "insert after the walk: other order",
     # walk(R1) where the carry left the worker (task model: stands still in R1)
     ("stations/job/carry_then_walk_there", 1.75, 0): "walk to where the worker is",
+    # a part on a wall shelf whose board is above a 1.55 m worker's shoulders: the arc
+    # about the shoulder swung the hand under the board and up through it; the palm
+    # rises in front of the edge and comes in level (goals._rise_points)
+    ("shelf_heights/single/grasp(O_over)", 1.55, 0): "hand up through the shelf board",
+    ("shelf_heights/job/overhead_down", 1.55, 1): "hand up through the shelf board",
+    # a part in a shelf compartment, the next board 16 cm above it: a palm pointing down
+    # as the arm does put the wrist in that board; the palm comes in level (generated
+    # cell gen_0_10; the cubbies cell)
+    ("cubbies/single/grasp(O_mid)", 1.95, 0): "wrist in the board above the part",
+    ("cubbies/job/cubby_pick_assemble", 1.75, 0): "wrist in the board above the part",
 }
 
 

@@ -80,6 +80,10 @@ HAND_GOAL_PEAK_SPEED = 1.8
 #: 1.75 m (scaled by stature): 10 % under the verifier's 2.5 m/s hand limit in goal tasks
 #: (planning.biomechanics), room for the offset blending of its junctions.
 HAND_RETIME_SPEED = 2.25
+#: The same for an acting arm's elbow: 10 % under the verifier's 3.5 m/s for other
+#: joints. The palm rising close in front of the body to a board above the shoulders
+#: (:func:`_rise_points`) swings the elbow up faster than the palm moves.
+ELBOW_RETIME_SPEED = 3.15
 #: Length of the arced palm path (slerped about the shoulder, plus the bow and the
 #: approach from above) over the straight distance.
 _ARC_PATH_FACTOR = 1.35
@@ -117,6 +121,23 @@ _LEVEL_NEAR = 0.07
 #: Shortest shoulder-to-palm distance on the level path, fraction of the arm's length
 #: (a palm nearer the shoulder folds the elbow fully and its two-bone solution flips).
 _LEVEL_MIN_EXTENSION = 0.5
+#: Horizontal distance (m) a palm rising to a target on furniture above the shoulders
+#: keeps in front of that furniture's edge on the level path (:func:`_rise_points`): the
+#: hand capsule's radius (4.5 cm at 1.75 m) and a margin. An arc about the shoulder from
+#: the hip up to such a target passes under the board at arm's length and up through it
+#: (a 1.55 m worker at a wall shelf whose board is at 1.6 m).
+_RISE_FRONT = 0.08
+#: How far below the top of such furniture (m) the palm rises in front of its edge
+#: before it goes straight up: on the way up and down the wrist is up to a hand's length
+#: above the palm and the arc about the shoulder to and from the hip swings it forward.
+_RISE_BELOW = 0.25
+#: Least horizontal distance (m) of such a rise from the shoulder: a board edge nearer
+#: than this and ``_RISE_FRONT`` leaves no room to raise the hand in front of it.
+_RISE_LEAST = 0.12
+#: A board over a part this close above its grasp point (m) leaves no room for a palm
+#: that points down as the arm does (the wrist a hand's length above it, in the board):
+#: the palm comes in level (:func:`_goal_hand_dir`; a part in a shelf compartment).
+_LEVEL_PALM_GAP = 0.25
 #: Reach time of the level path over the arc's (its path is about this much longer).
 _LEVEL_TIME = 1.3
 #: Clearance (m) a reaching posture keeps between body parts at contact, over the
@@ -730,9 +751,13 @@ def posture_clear(task: str, target: np.ndarray, skeleton: Skeleton,
     return bool(np.isfinite(cost).any())
 
 
-def _goal_hand_dir(task: str | None, k: int, rel_goal: np.ndarray) -> np.ndarray:
+def _goal_hand_dir(task: str | None, k: int, rel_goal: np.ndarray, level: bool = False
+                   ) -> np.ndarray:
     """Palm direction(s) (..., 3) of hand ``k`` on its target, ``rel_goal`` (..., 3) the
-    shoulder-to-target vector(s)."""
+    shoulder-to-target vector(s); ``level``: horizontal (a hand come in over furniture
+    above the shoulders, whose wrist a palm pointing up as the arm does puts below the
+    board's top at its edge, or under a board close over the target, whose wrist a palm
+    pointing down puts in the board)."""
     if task == "assemble":
         reach_dir = np.broadcast_to(np.array([0.75, -0.35 if k == 0 else 0.35, -0.55]),
                                     rel_goal.shape)
@@ -740,6 +765,9 @@ def _goal_hand_dir(task: str | None, k: int, rel_goal: np.ndarray) -> np.ndarray
         reach_dir = rel_goal / np.maximum(np.linalg.norm(rel_goal, axis=-1, keepdims=True),
                                           1e-9)
     goal_dir = reach_dir + np.array([0.0, 0.0, -0.3])
+    if level:
+        goal_dir = goal_dir.copy()
+        goal_dir[..., 2] = 0.0
     return goal_dir / np.linalg.norm(goal_dir, axis=-1, keepdims=True)
 
 
@@ -924,8 +952,9 @@ def _frames(skeleton: Skeleton, st: _Start, t: np.ndarray, pelvis: np.ndarray,
 
 def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: np.ndarray,
                 rel_goal: np.ndarray, lift: float, t1: float, t2: float, total: float,
-                H: float, arm: float, board: tuple[float, float, float] | None = None
-                ) -> list[tuple[float, np.ndarray]]:
+                H: float, arm: float, board: tuple[float, float, float] | None = None,
+                rise: np.ndarray | None = None
+                ) -> tuple[list[tuple[float, np.ndarray]], frozenset[int]]:
     """Shoulder-to-palm keys of the level path (see :data:`HAND_PATHS`): home, the turn
     point near the body at the approach height, above the target, the target (held), and
     back the same way. Arrays (2, 3); ``sh1`` (2, 3): the shoulders in the reach posture;
@@ -933,7 +962,10 @@ def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: n
     ``board`` (edge, bottom, top): a low board over the targets (start frame): the turn
     point is ``_BOARD_FRONT`` before its edge (down in front of the edge, then in under
     the board, and out and up the same way; the posture keeps the shoulder behind it,
-    :func:`_turns_before_edge`)."""
+    :func:`_turns_before_edge`); ``rise`` (2, 3) (:func:`_rise_points`): the palms first
+    rise at it in front of the furniture under the targets, then straight up to the
+    turn point above it, and go back down the same way. Returns the keys and the legs
+    (index of a leg's first key) the path takes straight."""
     front = None if board is None else board[0] - _BOARD_FRONT
     rel_above, rel_near = rel_goal.copy(), rel_goal.copy()
     for k in active:
@@ -945,12 +977,52 @@ def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: n
         near = min(dh, max(_LEVEL_NEAR * H, unfolded))
         if front is not None and flat[0] > 1e-9:
             near = min(dh, max(dh * (front - sh1[k, 0]) / flat[0], 0.0))
+        if rise is not None:
+            near = float(np.linalg.norm(rise[k, :2]))
         rel_near[k, :2] = flat * (near / dh) if dh > 1e-9 else flat
         rel_near[k, 2] = rel_above[k, 2]
     r = total - t2
+    if rise is not None:
+        rel_rise = rel_home.copy()
+        rel_rise[list(active)] = rise[list(active)]
+        return ([(0.0, rel_home), (0.3 * t1, rel_rise), (0.55 * t1, rel_near),
+                 (0.8 * t1, rel_above), (t1, rel_goal), (t2, rel_goal),
+                 (t2 + 0.2 * r, rel_above), (t2 + 0.45 * r, rel_near),
+                 (t2 + 0.7 * r, rel_rise), (total, rel_home)], frozenset(range(1, 8)))
     return [(0.0, rel_home), (0.5 * t1, rel_near), (0.8 * t1, rel_above), (t1, rel_goal),
             (t2, rel_goal), (t2 + 0.2 * r, rel_above), (t2 + 0.5 * r, rel_near),
-            (total, rel_home)]
+            (total, rel_home)], frozenset()
+
+
+def _rise_points(targets: np.ndarray, active: tuple, sh1: np.ndarray,
+                 support: tuple[float, float, float, float] | None, arm: float
+                 ) -> np.ndarray | None:
+    """Shoulder-to-palm points (2, 3) in front of the edge of the furniture under the
+    targets (``support`` (nx, ny, offset, top), start frame, :func:`_slab_depth`),
+    towards each active hand's target: where the level path's palms rise before they
+    come straight up and in over the furniture. Each is as high above the shoulder as
+    keeps it ``_LEVEL_MIN_EXTENSION`` of ``arm`` from it (the elbow not folded on the
+    way up), and no higher than ``_RISE_BELOW`` under the furniture's top. None unless
+    that top is above every active shoulder of ``sh1`` (2, 3) (below, the palms come
+    down onto it) and each edge leaves ``_RISE_LEAST`` in front of the shoulder."""
+    if support is None:
+        return None
+    nx, ny, offset, top = support
+    rise = np.zeros((2, 3))
+    for k in active:
+        flat = targets[k, :2] - sh1[k, :2]
+        dh = float(np.linalg.norm(flat))
+        toward = (nx * flat[0] + ny * flat[1]) / dh if dh > 1e-9 else 0.0
+        if top <= sh1[k, 2] or toward < 0.3:
+            return None
+        ahead = (offset - (nx * sh1[k, 0] + ny * sh1[k, 1])) / toward - _RISE_FRONT
+        if ahead < _RISE_LEAST:
+            return None
+        rise[k, :2] = flat / dh * min(ahead, dh)
+        least = _LEVEL_MIN_EXTENSION * arm
+        rise[k, 2] = min(np.sqrt(max(least ** 2 - float(np.sum(rise[k, :2] ** 2)), 0.0)),
+                         top - sh1[k, 2] - _RISE_BELOW)
+    return rise
 
 
 def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> float:
@@ -1002,11 +1074,13 @@ def _reach_times(task: str, dist: float, pitch1: float, drop1: float, H: float, 
 def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
                rel_home: np.ndarray, rel_goal: np.ndarray, rel_pre: np.ndarray,
                times: tuple[float, float, float], level: bool,
-               board: tuple[float, float, float] | None, H: float, arm: float
-               ) -> tuple[list[tuple[float, np.ndarray]], float]:
-    """Shoulder-to-palm keys (arrays (2, 3)) of a hand task and its contact time (s);
-    ``times``: (t1 reach end, t2 hold end, total), ``rel_pre``: where insert's push starts
-    and extract's pull ends."""
+               board: tuple[float, float, float] | None, H: float, arm: float,
+               rise: np.ndarray | None = None
+               ) -> tuple[list[tuple[float, np.ndarray]], float, frozenset[int]]:
+    """Shoulder-to-palm keys (arrays (2, 3)) of a hand task, its contact time (s) and the
+    legs its path takes straight (:func:`_level_keys`); ``times``: (t1 reach end, t2
+    hold end, total), ``rel_pre``: where insert's push starts and extract's pull ends,
+    ``rise``: :func:`_rise_points`."""
     t1, t2, total = times
     if task == "insert":
         push = min(0.5, 0.6 * (t2 - t1))
@@ -1014,18 +1088,19 @@ def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
                 (total, rel_home)]
         if level:           # out the straight way it pushed in (PUSH_LEVEL_TASKS)
             keys.insert(-1, (t2 + (1.0 - _PUSH_IN_AT) * (total - t2), rel_pre))
-        return keys, t1 + push
+        return keys, t1 + push, frozenset()
     if task == "extract":
         pull = min(0.5, 0.6 * (t2 - t1))
         keys = [(0.0, rel_home), (t1, rel_goal), (t2 - pull, rel_goal), (t2, rel_pre),
                 (total, rel_home)]
         if level:           # in the straight way it pulls out (PUSH_LEVEL_TASKS)
             keys.insert(1, (_PUSH_IN_AT * t1, rel_pre))
-        return keys, t2
+        return keys, t2, frozenset()
     keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
     if level and task in LEVEL_REGION_TASKS:
-        return _level_keys(targets, active, sh1, rel_home, rel_goal, 0.0, t1, t2, total, H,
-                           arm), t1
+        keys, straight = _level_keys(targets, active, sh1, rel_home, rel_goal, 0.0, t1, t2,
+                                     total, H, arm)
+        return keys, t1, straight
     if task in ("grasp", "release", "move"):
         # Parts rest on surfaces: come down onto a target below the shoulder from
         # _APPROACH_LIFT above it, and lift off the same way.
@@ -1034,24 +1109,27 @@ def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
             if targets[k][2] < sh1[k][2] - 0.1:
                 lift[k, 2] = _APPROACH_LIFT
         if level:
-            keys = _level_keys(targets, active, sh1, rel_home, rel_goal, _APPROACH_LIFT,
-                               t1, t2, total, H, arm, board)
-        elif np.any(lift):
+            keys, straight = _level_keys(targets, active, sh1, rel_home, rel_goal,
+                                         _APPROACH_LIFT, t1, t2, total, H, arm, board, rise)
+            return keys, t1, straight
+        if np.any(lift):
             rel_above = rel_goal + lift
             keys = [(0.0, rel_home), (0.7 * t1, rel_above), (t1, rel_goal), (t2, rel_goal),
                     (t2 + 0.3 * (total - t2), rel_above), (total, rel_home)]
-    return keys, t1
+    return keys, t1, frozenset()
 
 
 def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
                times: tuple[float, float, float], active: tuple, targets: np.ndarray,
                shoulders: np.ndarray, sh1: np.ndarray, st: _Start, level: bool,
                board: tuple[float, float, float] | None, dist: float, H: float, arm: float,
-               rng: np.random.Generator, wide: float = 1.0) -> np.ndarray:
+               rng: np.random.Generator, wide: float = 1.0,
+               straight_legs: frozenset[int] = frozenset()) -> np.ndarray:
     """Shoulder-to-palm vectors (T, 2, 3) through ``keys`` at times ``t`` (T,), with a
     small seeded bow; ``times``: (reach end, hold end, total), ``shoulders`` (T, 2, 3):
     the moving shoulders, ``sh1`` (2, 3): at the reach's end; ``wide`` scales a low
-    reach's swing outside the thigh."""
+    reach's swing outside the thigh; ``straight_legs``: legs (index of their first key)
+    of the level path taken straight whatever their distance from the shoulder."""
     rel = _arc_keys(t, keys)
     if level:
         # Straight legs (an arc about the shoulder bulges forward, into the shelf), except
@@ -1059,10 +1137,11 @@ def _hand_path(t: np.ndarray, keys: list[tuple[float, np.ndarray]],
         # (under a low board every leg: the arc would swing the hand into its edge).
         straight = _interp_keys(t, keys)
         least = _LEVEL_MIN_EXTENSION * arm
-        for (t0, v0), (t1_, v1) in itertools.pairwise(keys):
+        for i, ((t0, v0), (t1_, v1)) in enumerate(itertools.pairwise(keys)):
             leg = (t >= t0) & (t <= t1_)
             for k in active:
-                if board is not None or _segment_origin_distance(v0[k], v1[k]) >= least:
+                if board is not None or i in straight_legs \
+                        or _segment_origin_distance(v0[k], v1[k]) >= least:
                     rel[leg, k] = straight[leg, k]
     # a small seeded bow of the hand path (outward and up), zero at every key pose (level
     # path: only between home and the turn point)
@@ -1139,7 +1218,15 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     travel, pushed = _push_travel(task, target, st, hand, travel, path,
                                   None if furniture is None else furniture[0])
     board = board if task in LEVEL_PATH_TASKS else None
-    level = pushed or ((path == "level" or board is not None) and task in LEVEL_PATH_TASKS) \
+    support = None if furniture is None or task not in LEVEL_PATH_TASKS else furniture[0]
+    ceiling = None if furniture is None or task not in LEVEL_PATH_TASKS else furniture[1]
+    above = [b for b in ((board[1] if board is not None else None),
+                         (ceiling[3] if ceiling is not None else None)) if b is not None]
+    flat_palm = bool(above) and min(above) - float(target[2]) < _LEVEL_PALM_GAP
+    # Over furniture above the shoulders every path rises in front of its edge first.
+    over = support is not None and support[3] > float(st.shoulders[:, 2].max())
+    level = pushed or ((path == "level" or board is not None or over)
+                       and task in LEVEL_PATH_TASKS) \
         or (path == "level" and task in LEVEL_REGION_TASKS)
     target = _checked_target(task, target, skeleton)
     targets, active, hand_name = _hand_targets(task, target, hand)
@@ -1153,8 +1240,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     for n, (posture, wide) in enumerate(tries):
         rng.bit_generator.state = draws
         world, f1, f2, contact_t = _reach_motion(
-            task, skeleton, st, targets, active, posture, (level, travel, approach, board),
-            rng, duration, fps, wide)
+            task, skeleton, st, targets, active, posture,
+            (level, travel, approach, board, support, flat_palm), rng, duration, fps, wide)
         if n + 1 == len(tries) or not _self_penetrates(world, H):
             break
     T = world.shape[0]
@@ -1179,18 +1266,20 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
                   wide: float = 1.0) -> tuple[np.ndarray, int, int, float]:
     """Frames (T, J, 3) of a hand task's reach into ``posture`` (pitch, drop, shift,
     capped), its hold and its return; the first and last hold frame and the contact time
-    (s). ``path``: (level, travel, approach (2, 3) or None, board) of :func:`_hand_task`;
-    ``wide`` scales the low reach's swing outside the thigh (:func:`_hand_path`)."""
+    (s). ``path``: (level, travel, approach (2, 3) or None, board, support, flat_palm)
+    of :func:`_hand_task`; ``wide`` scales the low reach's swing outside the thigh
+    (:func:`_hand_path`)."""
     H = skeleton.stature
     arm = _arm_length(skeleton)
-    level, travel, approach, board = path
+    level, travel, approach, board, support, flat_palm = path
     pitch1, drop1, shift1, capped = posture
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
     # Timed for the arced path's palm speed; where the posture's trunk motion or a level
-    # path makes a hand or wrist faster than HAND_RETIME_SPEED, the reach and return are
-    # slowed by what they exceed and the motion made again (at most twice), from the
-    # same random draws (the same path, only slower).
+    # path makes a hand or wrist faster than HAND_RETIME_SPEED (an elbow faster than
+    # ELBOW_RETIME_SPEED), the reach and return are slowed by what they exceed and the
+    # motion made again (at most twice), from the same random draws (the same path,
+    # only slower).
     draws = rng.bit_generator.state
     for _ in range(3):
         rng.bit_generator.state = draws
@@ -1219,10 +1308,13 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
         for k in active:
             rel_goal[k] = targets[k] - sh1[k]
             rel_pre[k] = targets[k] - travel * approach - sh1[k]
-        keys, contact_t = _hand_keys(task, targets, active, sh1, rel_home, rel_goal, rel_pre,
-                                     (t1, t2, total), level, board, H, arm)
+        rise = _rise_points(targets, active, sh1, support, arm) if level and board is None \
+            else None
+        keys, contact_t, straight = _hand_keys(task, targets, active, sh1, rel_home, rel_goal,
+                                               rel_pre, (t1, t2, total), level, board, H, arm,
+                                               rise)
         rel = _hand_path(t, keys, (t1, t2, total), active, targets, shoulders, sh1, st, level,
-                         board, dist, H, arm, rng, wide)
+                         board, dist, H, arm, rng, wide, straight)
         if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
             _add_manipulation(rel, t, t1, t2, active, rng)
         hands = shoulders + rel
@@ -1232,9 +1324,12 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
             if k not in active:
                 hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04]) * \
                     sb[:, None]
-        hand_dir, elbow_pole = _hand_orientation(task, active, st, t, (t1, t2, total), rel_goal)
+        hand_dir, elbow_pole = _hand_orientation(task, active, st, t, (t1, t2, total), rel_goal,
+                                                 flat_palm or rise is not None)
         world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
-        peak = _peak_hand_speed(world, active, fps)
+        peak = max(_peak_hand_speed(world, active, fps),
+                   _peak_hand_speed(world, active, fps, ("elbow",))
+                   * HAND_RETIME_SPEED / ELBOW_RETIME_SPEED)
         limit = HAND_RETIME_SPEED * H / DEFAULT_STATURE
         if peak <= limit or duration is not None:
             break
@@ -1257,30 +1352,31 @@ def _add_manipulation(rel: np.ndarray, t: np.ndarray, t1: float, t2: float,
         rel[:, k] += env[:, None] * wob
 
 
-def _peak_hand_speed(world: np.ndarray, active: tuple[int, ...], fps: float) -> float:
-    """Largest speed (m/s) of an acting hand's palm or wrist in ``world`` (T, J, 3), as
-    displacements over 1/30 s (the verifier's window)."""
+def _peak_hand_speed(world: np.ndarray, active: tuple[int, ...], fps: float,
+                     parts: tuple[str, ...] = ("hand", "wrist")) -> float:
+    """Largest speed (m/s) of an acting arm's ``parts`` (default the palm and wrist) in
+    ``world`` (T, J, 3), as displacements over 1/30 s (the verifier's window)."""
     w = max(1, round(fps / 30.0))
     if len(world) <= w:
         return 0.0
-    joints = [_J[f"{_SIDES[k]}_{n}"] for k in active for n in ("hand", "wrist")]
+    joints = [_J[f"{_SIDES[k]}_{n}"] for k in active for n in parts]
     d = world[w:, joints] - world[:-w, joints]
     return float(np.sqrt(np.max(np.sum(d * d, axis=-1)))) * fps / w
 
 
 def _hand_orientation(task: str, active: tuple, st: _Start, t: np.ndarray,
-                      times: tuple[float, float, float], rel_goal: np.ndarray
-                      ) -> tuple[np.ndarray, np.ndarray]:
+                      times: tuple[float, float, float], rel_goal: np.ndarray,
+                      level: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Palm directions and elbow poles (T, 2, 3): blended from the start pose's to the
     reaching posture's over the reach and back over the return (``times``: reach end,
-    hold end, total)."""
+    hold end, total; ``level``: see :func:`_goal_hand_dir`)."""
     t1, t2, total = times
     T = t.size
     s_hand = _interp_keys(t, [(0.0, 0.0), (t1, 1.0), (t2, 1.0), (total, 0.0)])
     hand_dir = np.broadcast_to(st.hand_dir, (T, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (T, 2, 3)).copy()
     for k in active:
-        goal_dir = _goal_hand_dir(task, k, rel_goal[k])
+        goal_dir = _goal_hand_dir(task, k, rel_goal[k], level)
         hd = (1 - s_hand)[:, None] * st.hand_dir[k] + s_hand[:, None] * goal_dir
         hand_dir[:, k] = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
         elbow_pole[:, k] = ((1 - s_hand)[:, None] * st.elbow_pole[k]
@@ -1577,8 +1673,7 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         Total length in seconds (hand and down-up tasks: the hold absorbs the change;
         sit/standUp: the descent/ascent; wait: the wait). ValueError when too short.
     hand : {"auto", "l_hand", "r_hand", "both"}
-        Acting hand; auto = left for targets with y > 0, else right. For kneel,
-        "l_hand" kneels on the left knee.
+        Acting hand; auto = left for targets with y > 0, else right (kneel: its knee).
     fps : float
     path : {"arc", "level"}
         Hand path of grasp, release and move (:data:`HAND_PATHS`; insert and extract over
@@ -1592,7 +1687,8 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
     obstacles : ObstacleClearance, optional
         The obstacles around the worker, kept clear of where a posture does.
     support, ceiling : (nx, ny, offset, top), (nx, ny, offset, bottom, top), optional
-        The furniture under a hand target and a board over it (:func:`_slab_depth`).
+        The furniture under a hand target and a board over it (:func:`_slab_depth`);
+        over a support above the shoulders the level path rises (:func:`_rise_points`).
 
     Returns
     -------
