@@ -1220,15 +1220,14 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     board = board if task in LEVEL_PATH_TASKS else None
     support = None if furniture is None or task not in LEVEL_PATH_TASKS else furniture[0]
     ceiling = None if furniture is None or task not in LEVEL_PATH_TASKS else furniture[1]
-    above = [b for b in ((board[1] if board is not None else None),
-                         (ceiling[3] if ceiling is not None else None)) if b is not None]
-    flat_palm = bool(above) and min(above) - float(target[2]) < _LEVEL_PALM_GAP
     # Over furniture above the shoulders every path rises in front of its edge first.
     over = support is not None and support[3] > float(st.shoulders[:, 2].max())
     level = pushed or ((path == "level" or board is not None or over)
                        and task in LEVEL_PATH_TASKS) \
         or (path == "level" and task in LEVEL_REGION_TASKS)
     target = _checked_target(task, target, skeleton)
+    lid = min(np.inf if board is None else board[1], np.inf if ceiling is None else ceiling[3])
+    flat_palm = lid - float(target[2]) < _LEVEL_PALM_GAP
     targets, active, hand_name = _hand_targets(task, target, hand)
     approach = _push_direction(task, target, st, active)
     postures = _reach_postures(skeleton, st, targets, active, task, target, board, obstacles,

@@ -27,10 +27,9 @@ from ltl_human_motion.planning.astar import (
     placement_key,
 )
 from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
-from ltl_human_motion.planning.navigation import floor_grid
 from ltl_human_motion.planning.plan_state import PlanContext, Pose, WorkerState
 from ltl_human_motion.planning.standing import ideal_placement
-from ltl_human_motion.planning.walk_goals import LANE_NARROW_COST, PASSAGE_RADIUS
+from ltl_human_motion.planning.walk_goals import walk_grid
 from ltl_human_motion.scene.occupancy import part_indices
 
 #: Clearance (m) the planner keeps between the body and obstacles on the frames it
@@ -433,10 +432,7 @@ class StepExecutor:
         if float(self.ctx.clearance(np.array([[x, y]]))[0]) <= (self.ctx.options.body_radius
                                                                + STEP_OUT_MARGIN):
             return False
-        grid = floor_grid(self.ctx.clearance, self.ctx.cell.workspace_lo[:2],
-                          self.ctx.cell.workspace_hi[:2], self.ctx.options.body_radius,
-                          self.ctx.options.grid_resolution, passage=PASSAGE_RADIUS,
-                          narrow_cost=LANE_NARROW_COST)
+        grid = walk_grid(self.ctx)
         i = int(np.clip(np.rint((x - grid.lo[0]) / grid.res), 0, grid.shape[0] - 1))
         j = int(np.clip(np.rint((y - grid.lo[1]) / grid.res), 0, grid.shape[1] - 1))
         return bool(grid.free[i, j])

@@ -22,6 +22,7 @@ from ltl_human_motion.planning.blend import wrap_angle
 from ltl_human_motion.planning.navigation import (
     NARROW_COST,
     TALL_EXTRA,
+    FloorGrid,
     NavigationField,
     floor_grid,
 )
@@ -109,6 +110,21 @@ def _towards(led: NavigationField, target: tuple[float, float], near: float, off
     return towards
 
 
+def walk_grid(ctx: PlanContext, squeeze: bool = False) -> FloorGrid:
+    """The floor grid the walk fields of :meth:`WalkGoals.field` are solved on: free
+    cells keep ``body_radius`` of clearance on the walking map, floor with less than
+    ``PASSAGE_RADIUS`` counting up to ``1 + LANE_NARROW_COST`` metres a metre; with
+    ``squeeze``, on the footprint map (``stand_map``, ``SQUEEZE_PASSAGE``,
+    ``NARROW_COST``). Shared by every field on that floor (:func:`.navigation.floor_grid`)."""
+    clearance = ctx.stand_map if squeeze else ctx.clearance
+    radius = ctx.options.body_radius
+    passage = SQUEEZE_PASSAGE if squeeze else PASSAGE_RADIUS
+    return floor_grid(clearance, ctx.cell.workspace_lo[:2], ctx.cell.workspace_hi[:2],
+                      radius, ctx.options.grid_resolution,
+                      passage=passage if radius < passage else None,
+                      narrow_cost=NARROW_COST if squeeze else LANE_NARROW_COST)
+
+
 class WalkGoals:
     """Makes the walk goals of one plan.
 
@@ -140,11 +156,19 @@ class WalkGoals:
         footprint map (:attr:`stand_map`, no allowance for the arms at tall parts),
         whose walks the search keeps clear with the whole-body check. The walk keeps its
         clearance on ``field.grid.clearance``."""
-        if squeeze:
-            return self.field_with(self.ctx.stand_map, self.ctx.options.body_radius,
-                                   goal_cells, key)
-        return self.field_with(self.ctx.clearance, self.ctx.options.body_radius, goal_cells, key,
-                               narrow_cost=LANE_NARROW_COST)
+        grid = walk_grid(self.ctx, squeeze)
+        cells = functools.partial(goal_cells, clearance=grid.clearance)
+        if key is None:
+            return NavigationField.on_grid(grid, cells)
+        full = (id(grid), *key)
+        hit = _FIELD_CACHE.get(full)
+        if hit is not None and hit[0] is grid:         # the grid is held, its id unique
+            return hit[1]
+        field = NavigationField.on_grid(grid, cells)
+        if len(_FIELD_CACHE) >= 16:
+            _FIELD_CACHE.pop(next(iter(_FIELD_CACHE)))
+        _FIELD_CACHE[full] = (grid, field)
+        return field
 
     def leads(self, field: NavigationField) -> bool:
         """Whether ``field`` leads from the worker's spot to a goal cell."""
@@ -159,29 +183,6 @@ class WalkGoals:
             return plain
         squeezed = solve(True)
         return squeezed if self.leads(squeezed[0]) else plain
-
-    def field_with(self, clearance, radius: float, goal_cells, key: tuple | None,
-                   narrow_cost: float = NARROW_COST) -> NavigationField:
-        """:meth:`field` on the floor grid of map ``clearance`` whose free cells keep
-        ``radius``, floor narrower than the passage counting up to ``1 + narrow_cost``
-        metres a metre."""
-        passage = SQUEEZE_PASSAGE if clearance is self.ctx.stand_map else PASSAGE_RADIUS
-        grid = floor_grid(clearance, self.ctx.cell.workspace_lo[:2],
-                          self.ctx.cell.workspace_hi[:2], radius, self.ctx.options.grid_resolution,
-                          passage=passage if radius < passage else None,
-                          narrow_cost=narrow_cost)
-        cells = functools.partial(goal_cells, clearance=clearance)
-        if key is None:
-            return NavigationField.on_grid(grid, cells)
-        full = (id(grid), *key)
-        hit = _FIELD_CACHE.get(full)
-        if hit is not None and hit[0] is grid:         # the grid is held, its id unique
-            return hit[1]
-        field = NavigationField.on_grid(grid, cells)
-        if len(_FIELD_CACHE) >= 16:
-            _FIELD_CACHE.pop(next(iter(_FIELD_CACHE)))
-        _FIELD_CACHE[full] = (grid, field)
-        return field
 
     def from_field(self, field: NavigationField, reached, desc: str, task: str,
                    heading: Callable[[NavigationField], Callable] | None = None
