@@ -68,8 +68,10 @@ def test_a_flat_turning_foot_does_not_jump_between_heel_and_ball() -> None:
     assert _bone_error(out) < 1e-6
 
 
-def test_synthesis_with_foot_locking_pins_the_feet_or_falls_back_when_it_collides() -> None:
+def test_synthesis_with_foot_locking_pins_the_feet_or_falls_back_when_it_collides(
+        monkeypatch) -> None:
     from ltl_human_motion.ltl.spec import PAPER_SPECS
+    from ltl_human_motion.planning import pipeline
     from ltl_human_motion.planning.pipeline import SynthesisOptions, resolve_cell, synthesize
 
     on = SynthesisOptions(foot_locking=True)
@@ -78,10 +80,14 @@ def test_synthesis_with_foot_locking_pins_the_feet_or_falls_back_when_it_collide
     assert foot_skate(s1.motion.positions, s1.motion.fps, 1.75)[0].max() < 0.03
     off = synthesize(PAPER_SPECS["S1"], resolve_cell("paper_cell"), seed=0)[0]
     assert off.stats["foot_locking"] is False
-    # next to the demo cell's table foot locking moves a pose into it: the motion is
-    # blended again without it, and verified
-    m = synthesize("F(grasp(O1) & X release(O1))", resolve_cell("demo_cell"), seed=0,
-                   options=on)[0]
+    # next to the demo cell's table the blend moves a pose into it: its junctions are
+    # blended again (junction_repair), and the motion keeps foot locking; without those
+    # repairs it is blended again without foot locking, and verified
+    spec, demo = "F(grasp(O1) & X release(O1))", resolve_cell("demo_cell")
+    m = synthesize(spec, demo, seed=0, options=on)[0]
+    assert m.verification["passed"] and m.stats["foot_locking"] is True
+    monkeypatch.setattr(pipeline, "JUNCTION_REPAIRS", 0)
+    m = synthesize(spec, demo, seed=0, options=on)[0]
     assert m.verification["passed"] and m.verification["collision"]["passed"]
     assert m.stats["foot_locking"] is False
 

@@ -377,3 +377,76 @@ def test_a_grasp_under_a_board_close_over_the_part_keeps_the_palm_level() -> Non
         assert np.linalg.norm(w[contact, J["r_hand"]] - target) < 1e-3
         assert abs(w[contact, J["r_wrist"], 2] - target[2]) < 0.01
         assert _into_board(w, "r", lo, hi, radius) < 0.0
+
+
+def test_a_reach_deep_under_a_low_board_kneels_within_the_range_of_motion() -> None:
+    """A part on the floor 17 cm behind the edge of a board 0.44 m up (under_shelf's O3)
+    is out of reach of every crouch whose hips stay within their 125 degree range of
+    motion; the worker kneels on both knees instead (one foot steps back, then the
+    other), leans forward with the free palm on the floor, and reaches in under the
+    board. Every frame keeps the hips and knees within their range, the body clear of
+    the board, and each foot still while on the floor, one at a time off it."""
+    from ltl_human_motion.planning.biomechanics import BiomechanicsLimits, joint_angles
+    for stature in (1.55, 1.75, 1.95):
+        sk = Skeleton(stature)
+        start = standing_pose(sk)[0]
+        depth, bottom, top = 0.17, 0.44, 0.46
+        x, y = reach_placement("grasp", 0.10, sk, board=(depth, bottom, top),
+                               start_pose=start)
+        target = np.array([x, y, 0.10])
+        mp, w = _make("grasp", target, sk=sk, board=(x - depth, bottom, top),
+                      start_pose=start)
+        f1, _ = mp.meta["hold_frames"]
+        assert np.linalg.norm(w[mp.meta["contact_frame"], J[mp.meta["hand"]]] - target) < 1e-3
+        assert w[f1, J["l_knee"], 2] < 0.06 and w[f1, J["r_knee"], 2] < 0.06
+        free = "l" if mp.meta["hand"] == "r_hand" else "r"
+        assert w[f1, J[f"{free}_hand"], 2] < 0.06
+        rom = BiomechanicsLimits().rom
+        angles = joint_angles(w)
+        for name in ("hip_flexion", "knee_flexion"):
+            for s in ("l", "r"):
+                assert angles[f"{s}_{name}"].max() <= rom[name][1]
+                assert angles[f"{s}_{name}"].min() >= rom[name][0]
+        # no joint but the reaching arm's comes within 3 cm of the board
+        edge = x - depth
+        body = [j for n, j in J.items() if not n.startswith(mp.meta["hand"][0] + "_")
+                or n.endswith(("hip", "knee", "ankle", "toe"))]
+        r = 0.03
+        into = (w[:, body, 0] > edge - r) & (w[:, body, 2] > bottom - r) \
+            & (w[:, body, 2] < top + r)
+        assert not into.any()
+        rest_toe = w[0, J["l_toe"], 2]
+        lifted = np.stack([w[:, J[f"{s}_toe"], 2] > rest_toe + 0.005 for s in ("l", "r")], 1)
+        assert not np.all(lifted, axis=1).any()
+        for k, s in enumerate(("l", "r")):
+            moving = np.linalg.norm(np.diff(w[:, J[f"{s}_toe"], :2], axis=0), axis=1) > 1e-4
+            assert np.all(lifted[1:, k] | lifted[:-1, k] | ~moving)
+
+
+def test_without_kneeling_the_reach_under_the_low_board_folds_the_hips(monkeypatch) -> None:
+    """The same reach with the kneeling postures taken away falls back on the crouch with
+    the pelvis tilted in full, whose hips fold past their 125 degree range of motion
+    (the failure the kneel replaces)."""
+    from ltl_human_motion.motion import goals
+    from ltl_human_motion.planning.biomechanics import joint_angles
+    sk = Skeleton(1.75)
+    start = standing_pose(sk)[0]
+
+    kneel_set = goals._kneel_set
+
+    def no_kneel(skeleton, st):
+        out = list(kneel_set(skeleton, st))
+        out[5] = np.zeros_like(out[5])                 # none feasible
+        return tuple(out)
+
+    monkeypatch.setattr(goals, "_kneel_set", no_kneel)
+    monkeypatch.setattr(goals, "_GRID_CACHE", {})
+    goals._placement.cache_clear()
+    try:
+        x, y = reach_placement("grasp", 0.10, sk, board=(0.17, 0.44, 0.46), start_pose=start)
+        _, w = _make("grasp", np.array([x, y, 0.10]), sk=sk, board=(x - 0.17, 0.44, 0.46),
+                     start_pose=start)
+    finally:
+        goals._placement.cache_clear()
+    angles = joint_angles(w)
+    assert max(angles["l_hip_flexion"].max(), angles["r_hip_flexion"].max()) > 125.0

@@ -128,7 +128,7 @@ def test_floor_reach_postures_keep_the_hips_and_knees_in_range(stature: float) -
     st = goals._Start(skeleton, None)
     x, y = goals.reach_placement("grasp", 0.03, skeleton)
     targets = np.array([[x, y, 0.03], [x, y, 0.03]])
-    P, D, S, cost, _ = goals._grid(skeleton, st, targets, (1,), "grasp")
+    P, D, S, cost, _, _ = goals._grid(skeleton, st, targets, (1,), "grasp")
     ok = np.isfinite(cost)
     assert ok.any()
     poses = goals._contact_poses(skeleton, st, P[ok], D[ok], S[ok], targets, (1,), "grasp")

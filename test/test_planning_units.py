@@ -77,6 +77,45 @@ def test_a_foot_mismatch_at_a_junction_is_spread_to_the_speed_it_may_add() -> No
                                   pos[:, JOINT_INDEX["l_hand"]])
 
 
+def test_a_junction_share_puts_the_whole_mismatch_on_one_side() -> None:
+    """A junction whose share is 0 leaves the outgoing motion as it was and ramps the
+    whole mismatch out over twice the window after it (the same added speed as the
+    halves of the default); share 1 the other way round; a stretch of 2 halves the
+    added speed."""
+    from ltl_human_motion.planning.blend import junction_frames
+    fps, J, spread = 120.0, len(JOINT_INDEX), 24
+    a = PlacedSegment(np.zeros((200, J, 3)), np.zeros(200))
+    jump = np.zeros((200, J, 3))
+    jump[:, JOINT_INDEX["l_hand"], 0] = 0.10
+    b = PlacedSegment(jump, np.zeros(200), blend_in=6)
+    hand = JOINT_INDEX["l_hand"]
+    pos, _, _, spans = concatenate([a, b], spread=spread, fps=fps)
+    c = junction_frames(spans)[0]
+    assert c == 197
+    half = np.abs(np.diff(pos[:, hand, 0])).max() * fps
+    for share, kept, moved in ((0.0, slice(0, c), slice(c, None)),
+                               (1.0, slice(c, None), slice(0, c))):
+        one = concatenate([a, b], spread=spread, fps=fps, shares={0: share})[0]
+        ref = np.concatenate([a.positions[:c], b.positions[c - 194:]])
+        np.testing.assert_array_equal(one[kept, hand], ref[kept, hand])
+        assert np.abs(one[moved, hand] - ref[moved, hand]).max() > 0.09
+        assert np.abs(np.diff(one[:, hand, 0])).max() * fps <= half * 1.01
+    long = concatenate([a, b], spread=spread, fps=fps, stretch={0: 2.0})[0]
+    assert np.abs(np.diff(long[:, hand, 0])).max() * fps <= 0.51 * half
+
+
+def test_junctions_near_colliding_frames_move_their_mismatch_off_that_side() -> None:
+    from ltl_human_motion.planning.junction_repair import shares_off
+    hits = np.zeros(400, bool)
+    hits[95:99] = True                    # before the junction at 100
+    hits[305:307] = True                  # after the one at 300
+    assert shares_off(hits, [100, 120, 300], {}, 120.0, wide=False) == {0: 0.0, 2: 1.0}
+    wide = shares_off(hits, [100, 120, 300], {}, 120.0, wide=True)
+    assert wide == {0: 0.0, 1: 0.0, 2: 1.0}
+    assert shares_off(hits, [100, 120, 300], wide, 120.0, wide=True) is None
+    assert shares_off(np.zeros(400, bool), [100], {}, 120.0, wide=False) is None
+
+
 def _wall_free(xy: np.ndarray) -> np.ndarray:
     """Free floor: everything except a wall x in [0.9, 1.1], y in [-1, 3]."""
     inside = (np.abs(xy[:, 0] - 1.0) <= 0.1) & (xy[:, 1] >= -1.0) & (xy[:, 1] <= 3.0)

@@ -336,6 +336,20 @@ BIOMECHANICS_RUNS = {
     ("under_shelf/single/grasp(O2)", 1.75): "range_of_motion:hip_under_board",
     ("under_shelf/job/kneel_pick", 1.55): "range_of_motion:hip_under_board",
     ("under_shelf/dwyer/absence_after/0", 1.75): "range_of_motion:hip_under_board",
+    # ... deeper under the board no crouch within the hips' range reached: the full tilt
+    # (hip flexion 138-166 deg); fixed by kneeling on both knees (goals._kneel_set)
+    ("under_shelf/single/grasp(O3)", 1.75): "range_of_motion:kneel_under_board",
+    ("under_shelf/single/grasp(O1)", 1.95): "range_of_motion:kneel_under_board",
+    ("under_shelf/job/both_low_parts", 1.75): "range_of_motion:kneel_under_board",
+    # a junction's offset ramp moved a hand or foot the planner had kept clear into the
+    # furniture (0.3-2 cm); fixed by junction_repair (the mismatch on the other side)
+    ("cluttered/dwyer/absence_between/0", 1.75): "collision:junction_ramp",
+    ("wall_gap/single/carry(O1, R1)", 1.55): "collision:junction_ramp",
+    ("stations/dwyer/existence_after/0", 1.95): "collision:junction_ramp",
+    # ... or a toe or knee of a walk 1-3 % over its limit; fixed by junction_repair
+    # (the ramps near it twice as long)
+    ("stations/single/grasp(O1)", 1.55): "joint_speed:junction_ramp",
+    ("wall_gap/single/grasp(O1)", 1.75): "joint_speed:junction_ramp",
 }
 
 
@@ -496,10 +510,11 @@ def test_a_floor_part_under_a_board_at_the_wall_is_reached_square_to_its_edge(
     15 degrees off square, which brings the edge nearer across the shoulders than the
     reach under it was planned for; and from the carry stance no place reaches under it
     for a 1.55 m worker. The standing step now squares up, the placement is planned from
-    the stance the primitive starts from, and a 1.55 m worker reaches in with the arms
-    down (under_shelf grasp(O3))."""
+    the stance the primitive starts from, and the worker kneels on both knees to reach
+    in (under_shelf grasp(O3); a crouch that reached folded the hips past their range)."""
     from pathlib import Path
 
+    from ltl_human_motion.motion.skeleton import JOINT_INDEX as J
     from ltl_human_motion.planning.pipeline import get_library, synthesize
     from ltl_human_motion.planning.planner import SequencePlanner
     from ltl_human_motion.vocabulary import task_step
@@ -513,7 +528,7 @@ def test_a_floor_part_under_a_board_at_the_wall_is_reached_square_to_its_edge(
     grasp = plan.steps[0]
     yaw = plan.segments[grasp.goal_segment].root_yaw[0]
     assert abs(float(np.cos(yaw))) < 1e-6 and float(np.sin(yaw)) > 0.0   # into the board
-    names = [s.name for s in plan.segments[:grasp.goal_segment]]
-    assert ("arms_to_carry" in names) == (stature > 1.6)
+    knees = plan.segments[grasp.goal_segment].positions[:, [J["l_knee"], J["r_knee"]], 2]
+    assert knees.max(axis=1).min() < 0.06                 # both knees on the floor
 
 

@@ -278,6 +278,18 @@ _CROUCH_DROP = (0.12, 0.22)
 #: 125 degree range of motion at the depth such reaches take): larger than any capped
 #: posture's, so it is taken only where none reaches.
 _UNCAPPED_COST = 100.0
+#: Cost added to a posture kneeling on both knees (:func:`_kneel_set`): a reach under a
+#: low board that no crouch within the hips' range of motion makes is done kneeling,
+#: sat back and leant forward (thighs near vertical, so the hips flex by the pelvis's
+#: tilt and the sit-back only); before the full-tilt crouch, past that range.
+_KNEEL_COST = 50.0
+#: Largest trunk flexion of a kneeling reach, rad (92 degrees: the chest 78 degrees
+#: forward, the head a few degrees past horizontal, peering under the board).
+_KNEEL_PITCH_MAX = 1.6
+#: Seconds to go down onto both knees (one foot steps back, that knee goes down, then the
+#: other), as long again to get up: kneeling down and getting up take about as long as
+#: a sit-to-stand, 1.5-3 s (issue 13's timing; Janssen et al. 2002 for sit-to-stand).
+KNEEL_DOWN_SECONDS = 2.0
 
 _TRUNK = (("spine", "pelvis", 0.5), ("chest", "spine", 0.85), ("neck", "chest", 1.0),
           ("head", "neck", 1.0), ("l_clavicle", "chest", 1.0), ("l_shoulder", "l_clavicle", 1.0),
@@ -285,14 +297,16 @@ _TRUNK = (("spine", "pelvis", 0.5), ("chest", "spine", 0.85), ("neck", "chest", 
 
 
 def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
-           cap: bool | np.ndarray = True, hips: np.ndarray | None = None) -> np.ndarray:
+           cap: bool | np.ndarray = True, hips: np.ndarray | None = None,
+           kneel: bool | np.ndarray = False) -> np.ndarray:
     """Pelvis, spine, head, clavicles, shoulders and hips of frames (T,) -> (T, J, 3);
     ``cap`` (bool, or (T,) of bool): a crouch's pelvis tilts at most
     :data:`PELVIS_TILT_MAX` (a reach under a low board that no capped posture makes
     tilts it in full, past the hips' range of motion). In a crouch (a pelvis drop past
     ``_CROUCH_DROP[0]``) the hips turn with the pelvis's tilt; they keep the offsets
     ``hips`` (2, 3) from it where given (on a seat, which holds the thighs where they
-    rest: :meth:`_Start.hips`)."""
+    rest: :meth:`_Start.hips`), and their standing offsets where ``kneel`` (bool, or (T,)
+    of bool: on the knees, which hold them while the trunk leans)."""
     capped = np.asarray(cap, dtype=bool)
     rest = skeleton.rest_positions()
     T = pelvis.shape[0]
@@ -312,7 +326,7 @@ def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
             rot[frac] = _rot_y(angle)
         out[:, j] = out[:, p] + rot[frac] @ (rest[j] - rest[p])
     # in a crouch the hips turn with the pelvis's tilt (standing bends keep them level)
-    turn = _rot_y(crouch * tilt) if hips is None else None
+    turn = _rot_y(crouch * tilt * ~np.asarray(kneel, dtype=bool)) if hips is None else None
     for k, name in enumerate(("l_hip", "r_hip")):
         out[:, _J[name]] = pelvis + (turn @ (rest[_J[name]] - rest[0]) if hips is None
                                      else hips[k])
@@ -444,26 +458,30 @@ def _grid_base(skeleton: Skeleton, st: _Start, low_board: bool = False
     on the skeleton and the start pose, of which a worker has a few (walking and carrying
     stance), so they are computed once per pair and kept (read-only arrays). Under a low
     board (``low_board``) the capped postures, within the hip and knee ranges of motion,
-    come with a second set: the pelvis tilted in full and the ranges not asked for (the
-    deepest reach in under the board), at :data:`_UNCAPPED_COST` more, so that one is
-    taken only where no capped posture reaches.
+    come with two more sets: kneeling on both knees (:func:`_kneel_set`, from a standing
+    start), and the crouch with the pelvis tilted in full and the ranges not asked for
+    (the deepest reach in under the board), at :data:`_UNCAPPED_COST` more, so that one
+    is taken only where no other posture reaches.
 
     Returns
     -------
     P, D, shift, base_cost : ndarray, shape (C,)
     shoulders : ndarray, shape (C, 2, 3)
         Left and right shoulder of each candidate.
-    feasible, capped : ndarray of bool, shape (C,)
-        Whether the candidate can be taken; whether its pelvis tilt is capped.
+    feasible, capped, kneel : ndarray of bool, shape (C,)
+        Whether the candidate can be taken; whether its pelvis tilt is capped; whether
+        it kneels.
     """
     key = (skeleton, st.pose.tobytes(), low_board)
     hit = _GRID_CACHE.get(key)
     if hit is not None:
         return hit
     if low_board:
-        out = tuple(np.concatenate([a, b]) for a, b in zip(
-            _grid_set(skeleton, st, True), _grid_set(skeleton, st, False)))
-        out[3][out[3].size // 2:] += _UNCAPPED_COST
+        full = _grid_set(skeleton, st, False)
+        full[3][:] += _UNCAPPED_COST
+        sets = [_grid_set(skeleton, st, True)] + ([] if st.seated
+                                                  else [_kneel_set(skeleton, st)]) + [full]
+        out = tuple(np.concatenate(arrays) for arrays in zip(*sets))
     else:
         out = _grid_set(skeleton, st, True)
     for arr in out:
@@ -500,19 +518,43 @@ def _grid_set(skeleton: Skeleton, st: _Start, cap: bool) -> tuple[np.ndarray, ..
     shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
     if cap:
         feasible &= _legs_in_range(skeleton, st, pelvis, P, tr, shoulders)
-    return P, D, shift, cost, shoulders, feasible, np.full(P.size, cap)
+    return P, D, shift, cost, shoulders, feasible, np.full(P.size, cap), np.zeros(P.size, bool)
+
+
+def _standing_legs(st: _Start, C: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The start pose's ankles, toes and knee poles for C postures, each (C, 2, 3)."""
+    return (np.broadcast_to(st.ankles, (C, 2, 3)), np.broadcast_to(st.toes, (C, 2, 3)),
+            np.broadcast_to(st.knee_pole, (C, 2, 3)))
+
+
+def _posture_legs(skeleton: Skeleton, st: _Start, trunk: np.ndarray,
+                  kneel: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Ankles, toes and knee poles (each (C, 2, 3)) of postures with trunks (C, J, 3):
+    the start pose's, or where ``kneel`` ((C,) of bool) on both knees
+    (:func:`_kneel_legs`)."""
+    C = trunk.shape[0]
+    legs = _standing_legs(st, C)
+    if kneel is None or not np.any(kneel):
+        return legs
+    hips = np.stack([trunk[:, _J["l_hip"]], trunk[:, _J["r_hip"]]], 1)
+    knelt = _kneel_legs(skeleton, hips)[:3]
+    on = np.asarray(kneel, dtype=bool)[:, None, None]
+    return tuple(np.where(on, k, s) for k, s in zip(knelt, legs))
 
 
 def _legs_in_range(skeleton: Skeleton, st: _Start, pelvis: np.ndarray, pitch: np.ndarray,
-                   trunk: np.ndarray, shoulders: np.ndarray) -> np.ndarray:
+                   trunk: np.ndarray, shoulders: np.ndarray,
+                   legs: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+                   ) -> np.ndarray:
     """Whether the hips and knees of postures (C,) (pelvis (C, 3), pitch (C,), their
-    trunk (C, J, 3) and shoulders (C, 2, 3)) stay within the biomechanical range of motion
+    trunk (C, J, 3) and shoulders (C, 2, 3); ``legs``: ankles, toes and knee poles (each
+    (C, 2, 3)), default the start pose's) stay within the biomechanical range of motion
     less :data:`_ROM_MARGIN` (a deep crouch with a flexed trunk folds the hip past
     125 degrees), shape (C,) of bool."""
     from ltl_human_motion.planning.biomechanics import BiomechanicsLimits, joint_angles
     C = pitch.size
-    poses = _body(skeleton, pelvis, pitch, np.broadcast_to(st.ankles, (C, 2, 3)),
-                  np.broadcast_to(st.toes, (C, 2, 3)), np.broadcast_to(st.knee_pole, (C, 2, 3)),
+    legs = _standing_legs(st, C) if legs is None else legs
+    poses = _body(skeleton, pelvis, pitch, *legs,
                   shoulders + st.hand_rel, np.broadcast_to(st.hand_dir, (C, 2, 3)),
                   np.broadcast_to(st.elbow_pole, (C, 2, 3)), trunk)
     angles = joint_angles(poses)
@@ -524,6 +566,65 @@ def _legs_in_range(skeleton: Skeleton, st: _Start, pelvis: np.ndarray, pitch: np
             a = angles[f"{s}_{name}"]
             ok &= (a >= lo + _ROM_MARGIN) & (a <= hi - _ROM_MARGIN)
     return ok
+
+
+def _kneel_legs(skeleton: Skeleton, hips: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Feet of kneeling on both knees under hips (C, 2, 3): each knee on the floor in
+    front of its hip (a thigh's length from it), the shank back from it to the ankle,
+    the toes tucked under on the floor (as :func:`_kneel_path`'s kneeling leg). Returns
+    ankles, toes, knee poles (each (C, 2, 3)) and whether both knees reach the floor
+    (C,) of bool."""
+    H = skeleton.stature
+    b = _bones(skeleton)
+    thigh, shank, foot = b[_J["l_knee"]], b[_J["l_ankle"]], b[_J["l_toe"]]
+    knee_z, ankle_z = 0.026 * H, 0.075 * H
+    toe_z = skeleton.rest_positions()[_J["l_toe"], 2]
+    above = hips[..., 2] - knee_z
+    ok = np.all((above <= thigh) & (above > 0.0), axis=-1)
+    knee = hips.copy()
+    knee[..., 0] += np.sqrt(np.clip(thigh ** 2 - above ** 2, 0.0, None))
+    ankles = knee.copy()
+    ankles[..., 0] -= np.sqrt(shank ** 2 - (ankle_z - knee_z) ** 2)
+    ankles[..., 2] = ankle_z
+    toes = ankles.copy()
+    toes[..., 0] += np.sqrt(foot ** 2 - (ankle_z - toe_z) ** 2)
+    toes[..., 2] = toe_z
+    pole = np.broadcast_to(np.array([0.35, 0.0, -1.0]), hips.shape).copy()
+    return ankles, toes, pole, ok
+
+
+def _kneel_set(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
+    """Kneeling candidates of :func:`_grid_base` (its return values): trunk flexion up to
+    :data:`_KNEEL_PITCH_MAX`, the hips from a thigh's length over the knees (upright) to
+    sat back 60 degrees, the knees from 0.1 m behind to 0.4 m in front of the standing
+    ankles; within the hip and knee ranges of motion (:data:`_ROM_MARGIN`), the head
+    clear of the floor. Cost: :data:`_KNEEL_COST`, the trunk flexion and the feet's
+    steps back."""
+    H = skeleton.stature
+    b = _bones(skeleton)
+    thigh = b[_J["l_knee"]]
+    rest = skeleton.rest_positions()
+    hip_z = rest[_J["l_hip"], 2] - rest[0, 2]
+    P, A, K = (a.ravel() for a in np.meshgrid(
+        np.linspace(0.0, _KNEEL_PITCH_MAX, 33),
+        thigh * np.cos(np.radians(np.linspace(0.0, 60.0, 13))),
+        np.linspace(-0.1, 0.4, 6), indexing="ij"))
+    pelvis = np.tile(st.pelvis, (P.size, 1))
+    pelvis[:, 2] = 0.026 * H + A - hip_z
+    pelvis[:, 0] = float(st.ankles[:, 0].mean()) + K - np.sqrt(thigh ** 2 - A ** 2)
+    D, shift = st.pelvis[2] - pelvis[:, 2], pelvis[:, 0] - st.pelvis[0]
+    tr = _trunk(skeleton, pelvis, P, False, kneel=True)
+    ankles, toes, pole, feasible = _kneel_legs(
+        skeleton, np.stack([tr[:, _J["l_hip"]], tr[:, _J["r_hip"]]], 1))
+    feasible &= tr[:, _J["head"], 2] > 0.12 * H
+    shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)
+    feasible &= _legs_in_range(skeleton, st, pelvis, P, tr, shoulders,
+                               (ankles, toes, pole))
+    step = np.abs(st.ankles[None, :, 0] - ankles[..., 0]).max(axis=1)
+    cost = P ** 2 + (D / (0.14 * H)) ** 2 + step + _KNEEL_COST
+    return (P, D, shift, cost, shoulders, feasible, np.zeros(P.size, bool),
+            np.ones(P.size, bool))
 
 
 def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
@@ -551,25 +652,28 @@ def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
 
 def _way_poses(skeleton: Skeleton, st: _Start,
                posture: tuple[np.ndarray, np.ndarray, np.ndarray], cap: np.ndarray,
-               by_hip: tuple[int, ...] = ()) -> np.ndarray:
+               by_hip: tuple[int, ...] = (), kneel: np.ndarray | None = None) -> np.ndarray:
     """Poses (S C, J, 3) on the way into posture candidates (pitch, drop, shift), each
     (C,), at the fractions :data:`_POSTURE_WAY` (S), fraction-major: the hands held as in
     the start pose relative to the shoulders, those in ``by_hip`` (0 left, 1 right) by the
-    hip as :func:`_hand_task` holds a free hand; ``cap`` (C,) as :func:`_trunk`'s."""
+    hip as :func:`_hand_task` holds a free hand; ``cap`` (C,) as :func:`_trunk`'s; a
+    kneeling candidate (``kneel``, (C,) of bool) on its knees, leaning forward (it kneels
+    down upright first, :func:`_kneel_progress`)."""
     pitch, drop, shift = posture
     C, S = pitch.size, len(_POSTURE_WAY)
     frac = np.repeat(np.asarray(_POSTURE_WAY), C)                    # (S C,)
+    knelt = np.zeros(S * C, bool) if kneel is None else np.tile(kneel, S)
+    down = np.where(knelt, 1.0, frac)
     pelvis = np.tile(st.pelvis, (S * C, 1))
-    pelvis[:, 2] -= frac * np.tile(drop, S)
-    pelvis[:, 0] += frac * np.tile(shift, S)
+    pelvis[:, 2] -= down * np.tile(drop, S)
+    pelvis[:, 0] += down * np.tile(shift, S)
     pit = frac * np.tile(pitch, S)
-    tr = _trunk(skeleton, pelvis, pit, np.tile(cap, S), st.hips())
+    tr = _trunk(skeleton, pelvis, pit, np.tile(cap, S), st.hips(), knelt)
     hands = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1) + st.hand_rel
     for k in by_hip:
         hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.outer(frac, [0.0, 0.0, 0.04])
     n = S * C
-    return _body(skeleton, pelvis, pit, np.broadcast_to(st.ankles, (n, 2, 3)),
-                 np.broadcast_to(st.toes, (n, 2, 3)), np.broadcast_to(st.knee_pole, (n, 2, 3)),
+    return _body(skeleton, pelvis, pit, *_posture_legs(skeleton, st, tr, knelt),
                  hands, np.broadcast_to(st.hand_dir, (n, 2, 3)),
                  np.broadcast_to(st.elbow_pole, (n, 2, 3)), tr)
 
@@ -577,7 +681,7 @@ def _way_poses(skeleton: Skeleton, st: _Start,
 def _board_way_blocked(skeleton: Skeleton, st: _Start,
                        posture: tuple[np.ndarray, np.ndarray, np.ndarray],
                        active: tuple[int, ...], board: tuple[float, float, float],
-                       cap: np.ndarray) -> np.ndarray:
+                       cap: np.ndarray, kneel: np.ndarray | None = None) -> np.ndarray:
     """Whether posture candidates (pitch, drop, shift), each (C,), bring the body or a free
     arm (hanging by the hip, as :func:`_hand_task` holds it) nearer the low board than
     ``_BOARD_CLEARANCE`` on the way into the posture (:data:`_POSTURE_WAY`), shape (C,)
@@ -585,7 +689,7 @@ def _board_way_blocked(skeleton: Skeleton, st: _Start,
     (:func:`_level_keys`)."""
     from ltl_human_motion.scene.occupancy import part_indices
     free = tuple(k for k in range(2) if k not in active)
-    way = _way_poses(skeleton, st, posture, cap, free)
+    way = _way_poses(skeleton, st, posture, cap, free, kneel)
     S, C = len(_POSTURE_WAY), posture[0].size
     parts = part_indices(_WAY_PARTS + tuple(f"{_SIDES[k]}_{p}" for k in free
                                             for p in ("upper_arm", "lower_arm", "hand")))
@@ -644,12 +748,13 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     and not ``strict``; where the cheapest candidate is clear the others are not
     measured).
 
-    Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible) and
-    whether the pelvis tilt is capped (C,) (:func:`_grid_base`).
+    Returns pitch (C,), drop (C,), shift (C,), cost (C,) (inf where infeasible),
+    whether the pelvis tilt is capped (C,) and whether the posture kneels (C,)
+    (:func:`_grid_base`).
     """
     arm = _arm_length(skeleton)
-    P, D, shift, cost, shoulders, feasible, capped = _grid_base(skeleton, st,
-                                                                board is not None)
+    P, D, shift, cost, shoulders, feasible, capped, kneel = _grid_base(skeleton, st,
+                                                                        board is not None)
     for k in active:
         d = np.linalg.norm(targets[k] - shoulders[:, k], axis=-1)
         feasible = feasible & (d <= _REACH_FRACTION * arm)
@@ -660,12 +765,12 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     if idx.size:
         from ltl_human_motion.planning.biomechanics import self_penetration
         poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
-                               task, cap=capped[idx])
+                               task, cap=capped[idx], kneel=kneel[idx])
         blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
         if board is not None:
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
             blocked |= _board_way_blocked(skeleton, st, (P[idx], D[idx], shift[idx]), active,
-                                          board, capped[idx])
+                                          board, capped[idx], kneel[idx])
         under, over = furniture or (None, None)
         for depth in ([] if under is None else [_support_depth(poses, under, skeleton.stature)]) \
                 + ([] if over is None else [_slab_depth(poses, over, skeleton.stature)]):
@@ -680,7 +785,8 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
             for some in (free[:1], free[1:]):
                 hit = _obstacle_blocked(skeleton, st, (P[idx[some]], D[idx[some]],
                                                        shift[idx[some]]), poses[some],
-                                        active, obstacles, capped[idx[some]])
+                                        active, obstacles, capped[idx[some]],
+                                        kneel[idx[some]])
                 if not hit[0] and some.size == 1:
                     break
                 if some.size > 1 and (strict or not np.all(hit)):
@@ -688,7 +794,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         feasible = feasible.copy()
         feasible[idx[blocked]] = False
     cost = np.where(feasible, cost, np.inf)
-    return P, D, shift, cost, capped
+    return P, D, shift, cost, capped, kneel
 
 
 def _turns_before_edge(shoulders: np.ndarray, active: tuple[int, ...],
@@ -705,7 +811,7 @@ def _turns_before_edge(shoulders: np.ndarray, active: tuple[int, ...],
 def _obstacle_blocked(skeleton: Skeleton, st: _Start,
                       posture: tuple[np.ndarray, np.ndarray, np.ndarray], contact: np.ndarray,
                       active: tuple[int, ...], obstacles: ObstacleClearance,
-                      cap: np.ndarray) -> np.ndarray:
+                      cap: np.ndarray, kneel: np.ndarray | None = None) -> np.ndarray:
     """Whether posture candidates come nearer the obstacles than ``_OBSTACLE_CLEARANCE``.
 
     Parameters
@@ -718,7 +824,7 @@ def _obstacle_blocked(skeleton: Skeleton, st: _Start,
     active : tuple of int
         The acting hands (0 left, 1 right).
     obstacles : ObstacleClearance
-    cap : ndarray of bool, shape (C,)
+    cap, kneel : ndarray of bool, shape (C,)
         As :func:`_trunk`'s.
 
     Returns
@@ -730,7 +836,7 @@ def _obstacle_blocked(skeleton: Skeleton, st: _Start,
                                                                                "r_foot"}
     whole = tuple(p for p in BODY_PARTS if p not in fixed)
     hit = obstacles(contact, whole) <= _OBSTACLE_CLEARANCE
-    way = _way_poses(skeleton, st, posture, cap)
+    way = _way_poses(skeleton, st, posture, cap, (), kneel)
     S, C = len(_POSTURE_WAY), posture[0].size
     near = obstacles(way, _WAY_PARTS).reshape(S, C) <= _OBSTACLE_CLEARANCE
     return hit | near.any(axis=0)
@@ -778,14 +884,17 @@ def _goal_elbow_pole(k: int) -> np.ndarray:
 
 def _contact_poses(skeleton: Skeleton, st: _Start, pitch: np.ndarray, drop: np.ndarray,
                    shift: np.ndarray, targets: np.ndarray, active: tuple[int, ...],
-                   task: str | None, cap: bool | np.ndarray = True) -> np.ndarray:
+                   task: str | None, cap: bool | np.ndarray = True,
+                   kneel: np.ndarray | None = None) -> np.ndarray:
     """Poses (C, J, 3) of posture candidates (C,) with the active hands on ``targets``
-    (2, 3) and a free hand by the hip, as :func:`_hand_task` holds them at contact."""
+    (2, 3) and a free hand by the hip, as :func:`_hand_task` holds them at contact;
+    ``kneel`` ((C,) of bool): the candidates on their knees (:func:`_kneel_legs`), the
+    free palm on the floor (:func:`_prop_point`)."""
     C = pitch.size
     pelvis = np.tile(st.pelvis, (C, 1))
     pelvis[:, 2] -= drop
     pelvis[:, 0] += shift
-    tr = _trunk(skeleton, pelvis, pitch, cap, st.hips())
+    tr = _trunk(skeleton, pelvis, pitch, cap, st.hips(), False if kneel is None else kneel)
     hands = np.empty((C, 2, 3))
     hand_dir = np.broadcast_to(st.hand_dir, (C, 2, 3)).copy()
     elbow_pole = np.broadcast_to(st.elbow_pole, (C, 2, 3)).copy()
@@ -796,8 +905,11 @@ def _contact_poses(skeleton: Skeleton, st: _Start, pitch: np.ndarray, drop: np.n
             elbow_pole[:, k] = _goal_elbow_pole(k)
         else:
             hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04])
-    return _body(skeleton, pelvis, pitch, np.broadcast_to(st.ankles, (C, 2, 3)),
-                 np.broadcast_to(st.toes, (C, 2, 3)), np.broadcast_to(st.knee_pole, (C, 2, 3)),
+            if kneel is not None and np.any(kneel):
+                prop = _prop_point(tr[:, _J[f"{s}_shoulder"]], skeleton.stature,
+                                   _arm_length(skeleton))
+                hands[:, k] = np.where(np.asarray(kneel)[:, None], prop, hands[:, k])
+    return _body(skeleton, pelvis, pitch, *_posture_legs(skeleton, st, tr, kneel),
                  hands, hand_dir, elbow_pole, tr)
 
 
@@ -835,11 +947,11 @@ def _reach_postures(skeleton: Skeleton, st: _Start, targets: np.ndarray, active:
                     board: tuple[float, float, float] | None = None,
                     obstacles: ObstacleClearance | None = None,
                     furniture: tuple | None = None
-                    ) -> list[tuple[float, float, float, bool]]:
+                    ) -> list[tuple[float, float, float, bool, bool]]:
     """Trunk flexion, pelvis drop and shift of the cheapest feasible postures
-    (:func:`_grid`, at most :data:`_POSTURE_TRIES`, cheapest first), and whether each one's
-    pelvis tilt is capped; ValueError where none reaches."""
-    P, D, S, cost, capped = _grid(skeleton, st, targets, active, task, board, obstacles,
+    (:func:`_grid`, at most :data:`_POSTURE_TRIES`, cheapest first), whether each one's
+    pelvis tilt is capped and whether it kneels; ValueError where none reaches."""
+    P, D, S, cost, capped, kneel = _grid(skeleton, st, targets, active, task, board, obstacles,
                                   furniture=furniture)
     order = np.argsort(cost, kind="stable")[:_POSTURE_TRIES]
     order = order[np.isfinite(cost[order])]
@@ -847,7 +959,8 @@ def _reach_postures(skeleton: Skeleton, st: _Start, targets: np.ndarray, active:
         raise ValueError(
             f"{task}: target {np.round(target, 3).tolist()} (start frame) is out of reach for a "
             f"{skeleton.stature:.2f} m worker; place the worker with reach_placement()")
-    return [(float(P[i]), float(D[i]), float(S[i]), bool(capped[i])) for i in order]
+    return [(float(P[i]), float(D[i]), float(S[i]), bool(capped[i]), bool(kneel[i]))
+            for i in order]
 
 
 # ----------------------------------------------------------------------- timelines
@@ -1265,15 +1378,17 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
                   wide: float = 1.0) -> tuple[np.ndarray, int, int, float]:
     """Frames (T, J, 3) of a hand task's reach into ``posture`` (pitch, drop, shift,
     capped), its hold and its return; the first and last hold frame and the contact time
-    (s). ``path``: (level, travel, approach (2, 3) or None, board, support, flat_palm)
-    of :func:`_hand_task`; ``wide`` scales the low reach's swing outside the thigh
-    (:func:`_hand_path`)."""
+    (s). ``posture`` may kneel (:func:`_kneel_progress`). ``path``: (level, travel,
+    approach (2, 3) or None, board, support, flat_palm) of :func:`_hand_task`; ``wide``
+    scales the low reach's swing outside the thigh (:func:`_hand_path`)."""
     H = skeleton.stature
     arm = _arm_length(skeleton)
     level, travel, approach, board, support, flat_palm = path
-    pitch1, drop1, shift1, capped = posture
+    pitch1, drop1, kneel = posture[0], posture[1], posture[4]
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
+    if kneel:       # the body is down at half the reach time and up again as long after
+        t_reach, t_ret = (max(v, 2.0 * KNEEL_DOWN_SECONDS) for v in (t_reach, t_ret))
     # Timed for the arced path's palm speed; where the posture's trunk motion or a level
     # path makes a hand or wrist faster than HAND_RETIME_SPEED (an elbow faster than
     # ELBOW_RETIME_SPEED), the reach and return are slowed by what they exceed and the
@@ -1286,16 +1401,8 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
         T = _n_frames(total, fps)
         t = np.arange(T) / fps
         t1, t2 = t_reach, t_reach + hold
-        # body posture leads the hand: it is reached at 85 % of the reach time (level path:
-        # before the hand comes in, and kept until it is out again)
-        body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + 0.5 * t_ret, 1.0), (total, 0.0)] if level
-                     else [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)])
-        sb = _profile(t, body_keys)
-        pelvis = np.tile(st.pelvis, (T, 1))
-        pelvis[:, 2] -= drop1 * sb
-        pelvis[:, 0] += shift1 * sb
-        pitch = pitch1 * sb
-        tr = _trunk(skeleton, pelvis, pitch, capped, st.hips())
+        sb, lean, legs, pelvis, pitch, tr = _body_path(skeleton, st, t, (t1, t2, total),
+                                                       posture, level, active[0])
         shoulders = np.stack([tr[:, _J["l_shoulder"]], tr[:, _J["r_shoulder"]]], 1)   # (T,2,3)
         f1 = min(round(t1 * fps), T - 1)
         f2 = min(round(t2 * fps), T - 1)
@@ -1317,15 +1424,13 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
         if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
             _add_manipulation(rel, t, t1, t2, active, rng)
         hands = shoulders + rel
-        # A free hand stays by the hip while the trunk leans (it does not swing forward into
-        # the furniture the other hand reaches over).
-        for k in range(2):
-            if k not in active:
-                hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04]) * \
-                    sb[:, None]
+        _free_hands(hands, active, st, pelvis, sb, lean if kneel else None, sh1, H, arm)
         hand_dir, elbow_pole = _hand_orientation(task, active, st, t, (t1, t2, total), rel_goal,
                                                  flat_palm or rise is not None)
-        world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, trunk=tr)
+        if kneel:
+            _prop_orientation(hand_dir, elbow_pole, lean, active)
+        world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, *legs,
+                        trunk=tr)
         peak = max(_peak_hand_speed(world, active, fps),
                    _peak_hand_speed(world, active, fps, ("elbow",))
                    * HAND_RETIME_SPEED / ELBOW_RETIME_SPEED)
@@ -1335,6 +1440,52 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
         t_reach *= 1.03 * peak / limit
         t_ret *= 1.03 * peak / limit
     return world, f1, f2, contact_t
+
+
+def _body_path(skeleton: Skeleton, st: _Start, t: np.ndarray,
+               times: tuple[float, float, float], posture: tuple, level: bool, first: int
+               ) -> tuple[np.ndarray, ...]:
+    """The body of a hand task at times ``t`` (T,) (``times`` = reach end, hold end,
+    total; ``posture`` as :func:`_reach_motion`'s): the pelvis's progress to the posture
+    and the trunk lean's (each (T,)), the ankles, toes and knee poles (each (T, 2, 3), or
+    None: the start pose's), the pelvis (T, 3), the trunk pitch (T,) and the trunk
+    (T, J, 3). The posture leads the hand: it is reached at 85 % of the reach time (level
+    path: half, before the hand comes in, and kept until it is out again); a kneeling
+    one kneels down in that time (:func:`_kneel_progress`, ``first`` the foot stepping
+    back first)."""
+    t1, t2, total = times
+    pitch1, drop1, shift1, capped, kneel = posture
+    t_ret = total - t2
+    body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + 0.5 * t_ret, 1.0), (total, 0.0)] if level
+                 else [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)])
+    sb = _profile(t, body_keys)
+    lean, legs = sb, (None, None, None)
+    if kneel:
+        sb, lean, legs = _kneel_progress(skeleton, st, t, (0.5 * t1, t2 + 0.5 * t_ret, total),
+                                         (drop1, shift1), first)
+    pelvis = np.tile(st.pelvis, (t.size, 1))
+    pelvis[:, 2] -= drop1 * sb
+    pelvis[:, 0] += shift1 * sb
+    pitch = pitch1 * lean
+    return sb, lean, legs, pelvis, pitch, _trunk(skeleton, pelvis, pitch, capped, st.hips(),
+                                                 kneel)
+
+
+def _free_hands(hands: np.ndarray, active: tuple[int, ...], st: _Start, pelvis: np.ndarray,
+                sb: np.ndarray, lean: np.ndarray | None, sh1: np.ndarray, stature: float,
+                arm: float) -> None:
+    """Set the hands (T, 2, 3) that are not ``active`` in place: by the hip while the
+    trunk leans (they do not swing forward into the furniture the other hand reaches
+    over; ``sb`` (T,): the body's progress); kneeling (``lean`` (T,) given), down onto
+    the floor under the shoulder (``sh1`` (2, 3) in the posture) as the trunk leans, to
+    prop it (:func:`_prop_point`)."""
+    for k in range(2):
+        if k in active:
+            continue
+        hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04]) * \
+            sb[:, None]
+        if lean is not None:
+            hands[:, k] += lean[:, None] * (_prop_point(sh1[k], stature, arm) - hands[:, k])
 
 
 def _add_manipulation(rel: np.ndarray, t: np.ndarray, t1: float, t2: float,
@@ -1502,6 +1653,88 @@ def _kneel_path(skeleton: Skeleton, st: _Start, hand: str, t: np.ndarray, s: np.
     pelvis = st.pelvis + s[:, None] * (pel1 - st.pelvis)
     pitch = 0.15 * s
     return pelvis, pitch
+
+
+#: Phases of kneeling down (fractions of the time to the posture; getting up runs them
+#: backwards): the first foot steps back as the pelvis goes half way down, the second
+#: foot steps back, both knees go down, and the trunk leans forward. (With the pelvis
+#: lower, the second foot passing under the hip folded the knee past 150 degrees.)
+_KNEEL_FIRST_STEP = (0.03, 0.28)
+_KNEEL_SECOND_STEP = (0.32, 0.62)
+_KNEEL_PELVIS = ((0.0, 0.0), (0.30, 0.55), (0.62, 0.6), (0.90, 1.0))
+_KNEEL_LEAN = ((0.62, 0.0), (1.0, 1.0))
+#: Where a kneeling worker's free palm props the leaning trunk (fractions of stature):
+#: this far in front of its shoulder, this high (on the floor, the palm's capsule above
+#: it), or as low as the arm reaches; and this fraction of the way in from the shoulder
+#: to the body's midline (under the chest: the palm outside the shoulder met the leg of
+#: the shelf the other hand reached under).
+_PROP_AHEAD = 0.0
+_PROP_IN = 0.4
+_PROP_HEIGHT = 0.03
+#: Direction (wrist to palm) of the propping hand: forward, nearly flat on the floor.
+_PROP_PALM = np.array([1.0, 0.0, -0.2]) / np.hypot(1.0, 0.2)
+
+
+def _prop_point(shoulder: np.ndarray, stature: float, arm: float) -> np.ndarray:
+    """Where the free palm of a kneeling worker props the trunk, below ``shoulder``
+    (..., 3, start frame) and in from it (:data:`_PROP_AHEAD`, :data:`_PROP_IN`,
+    :data:`_PROP_HEIGHT`), shape (..., 3)."""
+    prop = np.array(shoulder, dtype=np.float64)
+    prop[..., 0] += _PROP_AHEAD * stature
+    prop[..., 1] *= 1.0 - _PROP_IN
+    prop[..., 2] = np.maximum(_PROP_HEIGHT * stature, prop[..., 2] - 0.95 * arm)
+    return prop
+
+
+def _prop_orientation(hand_dir: np.ndarray, elbow_pole: np.ndarray, lean: np.ndarray,
+                      active: tuple[int, ...]) -> None:
+    """Turn the free hand's palm direction and elbow pole (each (T, 2, 3), in place) to
+    a palm flat on the floor, pointing forward, and the elbow out and back, with the
+    trunk's lean (T,) (:func:`_prop_point`)."""
+    w = lean[:, None]
+    for k in range(2):
+        if k in active:
+            continue
+        hd = (1.0 - w) * hand_dir[:, k] + w * _PROP_PALM
+        hand_dir[:, k] = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
+        out = np.array([-1.0, 0.5 if k == 0 else -0.5, 0.0])
+        elbow_pole[:, k] = (1.0 - w) * elbow_pole[:, k] + w * out
+
+
+def _kneel_progress(skeleton: Skeleton, st: _Start, t: np.ndarray,
+                    times: tuple[float, float, float], posture: tuple[float, float],
+                    first: int) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+    """Kneeling down onto both knees and getting up at times ``t`` (T,): the pelvis's
+    progress (T,) to the kneeling place (``posture`` = its drop and shift), the trunk
+    lean's (T,), and the ankles, toes and knee poles (each (T, 2, 3)), the foot ``first``
+    (0 left, 1 right) stepping back first and forward last. ``times`` = (down, rise,
+    total): the body is down at ``down`` and starts getting up at ``rise``. A foot moves
+    only while lifted (the first and last 15 % of its step are rise and set-down), so it
+    never slides over the floor; at most one foot is off the floor at a time."""
+    H = skeleton.stature
+    down, rise, total = times
+    tau = np.where(t <= down, t / down, np.where(t >= rise, (total - t) / (total - rise), 1.0))
+    tau = np.clip(tau, 0.0, 1.0)
+    drop, shift = posture
+    pelvis1 = st.pelvis + np.array([shift, 0.0, -drop])
+    hips1 = pelvis1 + skeleton.rest_positions()[[_J["l_hip"], _J["r_hip"]]] \
+        - skeleton.rest_positions()[0]
+    end = _kneel_legs(skeleton, hips1[None])[:3]
+    T = t.size
+    ankles = np.broadcast_to(st.ankles, (T, 2, 3)).copy()
+    toes = np.broadcast_to(st.toes, (T, 2, 3)).copy()
+    pole = np.broadcast_to(st.knee_pole, (T, 2, 3)).copy()
+    for k, (a, b) in ((first, _KNEEL_FIRST_STEP), (1 - first, _KNEEL_SECOND_STEP)):
+        w = b - a
+        s_foot = _profile(tau, [(a + 0.15 * w, 0.0), (b - 0.15 * w, 1.0)])[:, None]
+        lift = 0.05 * H * np.sin(np.pi * np.clip((tau - a) / w, 0.0, 1.0)) ** 2
+        for arr, start, goal in ((ankles, st.ankles, end[0]), (toes, st.toes, end[1]),
+                                 (pole, st.knee_pole, end[2])):
+            arr[:, k] = start[k] + s_foot * (goal[0, k] - start[k])
+        ankles[:, k, 2] += lift
+        toes[:, k, 2] += lift
+    return (_profile(tau, list(_KNEEL_PELVIS)), _profile(tau, list(_KNEEL_LEAN)),
+            (ankles, toes, pole))
 
 
 def _low_reach(task: str, skeleton: Skeleton, st: _Start, t: np.ndarray,
@@ -1811,7 +2044,8 @@ def _placement(task: str, height: float, stature: float, hand: str,
                 else np.frombuffer(start, dtype=np.float64).reshape(-1, 3))
     best = (np.inf, None)
     # Under a low board: with _BOARD_PLACE_MARGIN where that leaves a place, else without;
-    # a place for a capped posture before one for a full pelvis tilt (_grid_base).
+    # a place for a capped or kneeling posture before one for a full pelvis tilt
+    # (_grid_base).
     tries = [(0.0, False)] if board is None else [
         (m, full) for full in ((False, True) if full_tilt else (False,))
         for m in (_BOARD_PLACE_MARGIN, 0.0)]
@@ -1820,10 +2054,10 @@ def _placement(task: str, height: float, stature: float, hand: str,
             target = np.array([x, lateral, height])
             targets, active, _ = _hand_targets(task, target, "both" if both else (
                 "l_hand" if lateral > 0 else "r_hand"))
-            _, _, _, cost, capped = _grid(skeleton, st, targets, active, task,
-                                          None if board is None
-                                          else (x - board[0] - margin, board[1], board[2]))
-            c = float(np.min(cost if full else np.where(capped, cost, np.inf)))
+            _, _, _, cost, capped, kneel = _grid(
+                skeleton, st, targets, active, task,
+                None if board is None else (x - board[0] - margin, board[1], board[2]))
+            c = float(np.min(cost if full else np.where(capped | kneel, cost, np.inf)))
             if c < best[0]:
                 best = (c, float(x))
         if best[1] is not None:

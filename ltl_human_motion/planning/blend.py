@@ -19,6 +19,8 @@ where the hand, knee and swing-foot speed peaks of walks came from.
 
 from __future__ import annotations
 
+import itertools
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -86,7 +88,9 @@ class PlacedSegment:
     name: str = ""
 
 
-def concatenate(segments: list[PlacedSegment], spread: int = 0, fps: float | None = None
+def concatenate(segments: list[PlacedSegment], spread: int = 0, fps: float | None = None,
+                shares: Mapping[int, float] | None = None,
+                stretch: Mapping[int, float] | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[tuple[int, int]]]:
     """Concatenate placed segments, blending each overlap with the cubic weight.
 
@@ -94,6 +98,10 @@ def concatenate(segments: list[PlacedSegment], spread: int = 0, fps: float | Non
     blending (module docstring); 0 = the cross-fade of Eq. (2). With ``fps`` (frame
     rate) a foot whose mismatch would add more than :data:`JUNCTION_ADDED_SPEED` over
     ``spread`` frames gets a longer window, up to :data:`JUNCTION_FOOT_SPREAD_MAX`.
+    ``shares``: for junction ``i`` (between segments ``i`` and ``i + 1``), the share of
+    its mismatch the outgoing segment takes (default one half; 0 or 1 put it all on one
+    side, over twice the window, so that it adds the same speed); ``stretch``: a factor
+    on junction ``i``'s windows (both the body's and the feet's; default 1).
 
     Returns
     -------
@@ -127,7 +135,7 @@ def concatenate(segments: list[PlacedSegment], spread: int = 0, fps: float | Non
     labels[:end] = first.label
     spans = [(0, end)]
     offset = np.zeros_like(positions) if spread > 0 else None
-    for seg, nf in zip(segments[1:], nfs):
+    for i, (seg, nf) in enumerate(zip(segments[1:], nfs)):
         yaw_in = np.unwrap(seg.root_yaw)
         # Continue the heading without a 2*pi jump.
         ref = yaw[end - nf] if nf else yaw[end - 1]
@@ -137,7 +145,9 @@ def concatenate(segments: list[PlacedSegment], spread: int = 0, fps: float | Non
             c = nf // 2
             d = seg.positions[c] - positions[start + c]                  # (J, 3)
             positions[start + c:end] = seg.positions[c:nf]
-            _add_junction(offset, start + c, d, spread, fps)
+            _add_junction(offset, start + c, d, spread, fps,
+                          0.5 if shares is None else shares.get(i, 0.5),
+                          1.0 if stretch is None else stretch.get(i, 1.0))
         elif nf:
             w = blend_weights(nf)
             a_pos, b_pos = positions[start:end], seg.positions[:nf]
@@ -158,32 +168,48 @@ def concatenate(segments: list[PlacedSegment], spread: int = 0, fps: float | Non
     return positions, yaw, labels, spans
 
 
+def junction_frames(spans: list[tuple[int, int]]) -> list[int]:
+    """The frame at which each junction of :func:`concatenate` switches from one segment
+    to the next (the centre of their overlap), given its ``spans``."""
+    return [b0 + (a1 - b0) // 2 for (_a0, a1), (b0, _b1) in itertools.pairwise(spans)]
+
+
 def _add_junction(offset: np.ndarray, c: int, d: np.ndarray, spread: int,
-                  fps: float | None) -> None:
+                  fps: float | None, share: float = 0.5, stretch: float = 1.0) -> None:
     """Add the ramps of a junction with mismatch ``d`` (J, 3) at frame ``c`` to ``offset``
     (T, J, 3): over ``spread`` frames, the feet's over as many as keep their added speed
     ``1.875 |d| / 2 / (frames / fps)`` within :data:`JUNCTION_ADDED_SPEED` (at most
-    :data:`JUNCTION_FOOT_SPREAD_MAX` seconds) when ``fps`` is given."""
+    :data:`JUNCTION_FOOT_SPREAD_MAX` seconds) when ``fps`` is given; ``share`` of ``d``
+    on the outgoing side (:func:`_add_ramps`); both windows times ``stretch``."""
+    spread = round(spread * stretch)
     if fps is None:
-        _add_ramps(offset, c, d, spread)
+        _add_ramps(offset, c, d, spread, share)
         return
     feet = np.zeros(len(d), bool)
     feet[list(_FOOT_JOINTS)] = True
     d_feet = np.where(feet[:, None], d, 0.0)
-    _add_ramps(offset, c, d - d_feet, spread)
+    _add_ramps(offset, c, d - d_feet, spread, share)
     need = 1.875 * float(np.max(np.linalg.norm(d_feet, axis=-1))) / 2.0 / JUNCTION_ADDED_SPEED
-    frames = min(int(np.ceil(need * fps)), round(JUNCTION_FOOT_SPREAD_MAX * fps))
-    _add_ramps(offset, c, d_feet, max(spread, frames))
+    frames = min(int(np.ceil(need * fps * stretch)),
+                 round(JUNCTION_FOOT_SPREAD_MAX * fps * stretch))
+    _add_ramps(offset, c, d_feet, max(spread, frames), share)
 
 
-def _add_ramps(offset: np.ndarray, c: int, d: np.ndarray, spread: int) -> None:
+def _add_ramps(offset: np.ndarray, c: int, d: np.ndarray, spread: int,
+               share: float = 0.5) -> None:
     """Add the offset-blending correction of a jump ``d`` (J, 3) at frame ``c`` to
-    ``offset`` (T, J, 3): ``+d/2`` ramped in before ``c``, ``-d/2`` ramped out after."""
+    ``offset`` (T, J, 3): ``share * d`` ramped in before ``c``, ``-(1 - share) * d``
+    ramped out after, each over ``spread`` frames times twice its share (the same added
+    speed whatever the share; one half: ``spread``)."""
     from ltl_human_motion.motion.ik import min_jerk
     T = offset.shape[0]
-    lo = max(0, c - spread)
-    k = np.arange(lo, c)
-    offset[lo:c] += (0.5 * min_jerk((k - (c - spread)) / spread))[:, None, None] * d
-    hi = min(T, c + spread)
-    k = np.arange(c, hi)
-    offset[c:hi] -= (0.5 * (1.0 - min_jerk((k - c) / spread)))[:, None, None] * d
+    before = round(2.0 * share * spread)
+    if before > 0:
+        lo = max(0, c - before)
+        k = np.arange(lo, c)
+        offset[lo:c] += (share * min_jerk((k - (c - before)) / before))[:, None, None] * d
+    after = round(2.0 * (1.0 - share) * spread)
+    if after > 0:
+        hi = min(T, c + after)
+        k = np.arange(c, hi)
+        offset[c:hi] -= ((1.0 - share) * (1.0 - min_jerk((k - c) / after)))[:, None, None] * d

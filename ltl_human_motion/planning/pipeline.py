@@ -28,9 +28,15 @@ from ltl_human_motion.motion.realism import realism_summary
 from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
 from ltl_human_motion.motion.types import Motion
-from ltl_human_motion.planning.blend import JUNCTION_SPREAD, concatenate
+from ltl_human_motion.planning.blend import JUNCTION_SPREAD, concatenate, junction_frames
 from ltl_human_motion.planning.feasibility import check_steps
 from ltl_human_motion.planning.footlock import lock_feet
+from ltl_human_motion.planning.junction_repair import (
+    JUNCTION_REPAIRS,
+    JunctionRepairs,
+    repaired,
+    unlock_weights,
+)
 from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, failure_error, verify_motion
@@ -424,19 +430,27 @@ def _in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
 
 
 def _blended(plan: Plan, floor_cell, floor_z: float, library, realism: bool,
-             spec_text: str, sequence: list[str], seed: int, variant: int
+             spec_text: str, sequence: list[str], seed: int, variant: int,
+             repairs: JunctionRepairs | None = None
              ) -> tuple[SynthesizedMotion, dict[str, np.ndarray], list[tuple[int, int]]]:
-    """The plan's segments blended into one motion (with offset blending of junctions and
-    foot locking when ``realism``), its part tracks and task timeline, lifted from the
-    planner's floor at z = 0 (``floor_cell``) by ``floor_z``; the held masks (T,) and
-    the frame span of each segment."""
+    """The plan's segments blended into one motion (with offset blending of junctions,
+    as ``repairs`` changed them, and foot locking when ``realism``), its part tracks and
+    task timeline, lifted from the planner's floor at z = 0 (``floor_cell``) by
+    ``floor_z``; the held masks (T,) and the frame span of each segment."""
+    repairs = repairs or JunctionRepairs()
     positions, root_yaw, _labels, spans = concatenate(
         plan.segments, spread=round(JUNCTION_SPREAD * library.fps) if realism else 0,
-        fps=library.fps if realism else None)
+        fps=library.fps if realism else None, shares=repairs.shares,
+        stretch=repairs.stretch)
     # Linear blends of joint positions shorten bones between unlike poses; restore them.
     positions = enforce_bone_lengths(positions, library.skeleton, rigid_hips=False)
     if realism:
+        unlocked = positions
         positions = lock_feet(positions, library.fps, library.skeleton, 0.0)
+        if repairs.unlock:
+            w = unlock_weights(repairs.unlock, len(positions), library.fps)[:, None, None]
+            positions = enforce_bone_lengths(positions + w * (unlocked - positions),
+                                             library.skeleton, rigid_hips=False)
     tracks, held = _object_tracks(floor_cell, plan, spans, positions, library.overlap)
     targets = [step.target for step in plan.steps]
     if floor_z:
@@ -485,18 +499,28 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     attempts = [True, False] if options.foot_locking and not strict else [strict]
     t_blending = t_verify = 0.0
     for realism in attempts:
-        t0 = time.perf_counter()
-        synth, held, spans = _blended(plan, floor_cell, cell.floor_z, library, realism,
-                                      spec_text, [s.text for s in steps], seed, variant)
-        t_blending += time.perf_counter() - t0
-        checkpoint("blending")
+        repairs = JunctionRepairs()
+        for repair in range(JUNCTION_REPAIRS + 1):
+            t0 = time.perf_counter()
+            synth, held, spans = _blended(plan, floor_cell, cell.floor_z, library, realism,
+                                          spec_text, [s.text for s in steps], seed, variant,
+                                          repairs)
+            t_blending += time.perf_counter() - t0
+            checkpoint("blending")
 
-        t0 = time.perf_counter()
-        report = verify_motion(synth, cell, specification, seq, written,
-                               options.verification, held=held, stature=stature,
-                               blend_frames=library.overlap, raise_on_failure=False)
-        t_verify += time.perf_counter() - t0
-        checkpoint("verification")
+            t0 = time.perf_counter()
+            report = verify_motion(synth, cell, specification, seq, written,
+                                   options.verification, held=held, stature=stature,
+                                   blend_frames=library.overlap, raise_on_failure=False)
+            t_verify += time.perf_counter() - t0
+            checkpoint("verification")
+            if report["passed"] or not realism or repair == JUNCTION_REPAIRS:
+                break
+            moved = repaired(report, synth, cell, held, stature, junction_frames(spans),
+                             repairs, repair > 0, options.verification.limits)
+            if moved is None:
+                break
+            repairs = moved
         if report["passed"] or report["collision"]["passed"]:
             break
     if not report["passed"] and options.verify:

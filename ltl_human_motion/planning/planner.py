@@ -437,8 +437,9 @@ class SequencePlanner:
         stance before the goal primitive. They do, except under a low board that no
         place reaches from the carry stance while the hands are free (a short worker's
         floor grasp under a board at knee height reaches from the arms down). Under a low
-        board a place whose posture keeps the hips in their range of motion comes first,
-        from either stance; one that needs the pelvis tilted in full only after."""
+        board a place whose posture keeps the hips in their range of motion (a crouch
+        with the pelvis's tilt capped, or kneeling) comes first, from either stance; one
+        that needs the pelvis tilted in full only after."""
         hand = acting_hand(self.state, kind, args[0] if args else None)
         low = kind in LEVEL_PATH_TASKS \
             and low_board(self.ctx.cell, target, self.ctx.stature) is not None

@@ -209,20 +209,28 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
     return report
 
 
+def colliding_frames(synth, cell, held: dict[str, np.ndarray] | None,
+                     stature: float) -> np.ndarray:
+    """Whether each frame of ``synth`` collides (body capsules, and the objects carried
+    at the frames ``held`` gives), exact on every frame, shape (T,) of bool."""
+    from ltl_human_motion.scene.predicates import collision
+
+    pos = synth.motion.positions
+    if not cell.obstacles:
+        return np.zeros(len(pos), dtype=bool)
+    carried = {name: np.where(np.asarray(mask)[:, None], synth.objects[name], np.nan)
+               for name, mask in (held or {}).items() if np.any(mask)}
+    # The capsule test itself skips (frame, part) pairs whose bounding boxes are apart.
+    return collision(pos, cell, stature=stature, carried=carried)
+
+
 def _collision_check(synth, cell, held: dict[str, np.ndarray] | None,
                      stature: float) -> dict:
     """The ``collision`` entry of :func:`verify_motion`: exact on every frame."""
     from ltl_human_motion.scene.contacts import deepest_contact
-    from ltl_human_motion.scene.predicates import collision
 
     pos = synth.motion.positions
-    carried = {name: np.where(np.asarray(mask)[:, None], synth.objects[name], np.nan)
-               for name, mask in (held or {}).items() if np.any(mask)}
-    hits = np.zeros(len(pos), dtype=bool)
-    if cell.obstacles:
-        # Exact on every frame: the capsule test itself skips (frame, part) pairs whose
-        # bounding boxes are apart.
-        hits = collision(pos, cell, stature=stature, carried=carried)
+    hits = colliding_frames(synth, cell, held, stature)
     n_hit = int(np.sum(hits))
     if n_hit == 0:
         return _check(True, "no frame collides", frames=0)
