@@ -46,6 +46,29 @@ def test_region_entry_is_the_exact_predicate():
     assert not above.cells(np.array([[0.6, -1.0]]))[0]
 
 
+def test_a_walk_into_a_region_over_a_bench_arrives_from_the_side() -> None:
+    """under_shelf's R1 over the bench for a 1.95 m worker, walked to from beside the
+    low shelf (where the kneeling grasp of O1 leaves the worker): goal places from which
+    the body enters the region facing one heading only held the search 8,000 poses in
+    front of the bench; those it enters facing half the headings bring it in."""
+    from pathlib import Path
+
+    from ltl_human_motion.planning.planner import SequencePlanner
+    from ltl_human_motion.vocabulary import task_step
+    path = Path(__file__).resolve().parents[1] / "scenarios" / "cells" / "under_shelf.yaml"
+    cell = resolve_cell(str(path))
+    planner = SequencePlanner(cell, get_library(1.95), np.random.default_rng(0))
+    plan = planner.plan([task_step("walk", ("R1",), {})], (0.74, 0.14, 0.0))
+    assert plan.expanded < 2000
+    radius = float(capsule_radii(1.95).max())
+    lib = get_library(1.95)
+    entry = RegionEntry(cell.region("R1"), lib.standing_pose, lib.standing_height, 1.95,
+                        radius)
+    end = plan.segments[-1]
+    assert entry.enters(end.positions[-1:, 0, 0], end.positions[-1:, 0, 1],
+                        end.root_yaw[-1:])[0]
+
+
 @pytest.mark.parametrize("spec", ["F(standUp)", "F(kneel & X(standUp & X wait(3.0)))"])
 def test_stand_up_when_standing_is_a_standing_pause(spec):
     motion = _verified(spec, "paper_cell")
