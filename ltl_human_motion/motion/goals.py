@@ -905,7 +905,7 @@ def _contact_poses(skeleton: Skeleton, st: _Start, pitch: np.ndarray, drop: np.n
             elbow_pole[:, k] = _goal_elbow_pole(k)
         else:
             hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04])
-            if kneel is not None and np.any(kneel):
+            if kneel is not None and np.any(kneel) and _hangs(st, k):
                 prop = _prop_point(tr[:, _J[f"{s}_shoulder"]], skeleton.stature,
                                    _arm_length(skeleton))
                 hands[:, k] = np.where(np.asarray(kneel)[:, None], prop, hands[:, k])
@@ -1428,7 +1428,8 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
         hand_dir, elbow_pole = _hand_orientation(task, active, st, t, (t1, t2, total), rel_goal,
                                                  flat_palm or rise is not None)
         if kneel:
-            _prop_orientation(hand_dir, elbow_pole, lean, active)
+            _prop_orientation(hand_dir, elbow_pole, lean,
+                              tuple(k for k in range(2) if k in active or not _hangs(st, k)))
         world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, *legs,
                         trunk=tr)
         peak = max(_peak_hand_speed(world, active, fps),
@@ -1476,15 +1477,15 @@ def _free_hands(hands: np.ndarray, active: tuple[int, ...], st: _Start, pelvis: 
                 arm: float) -> None:
     """Set the hands (T, 2, 3) that are not ``active`` in place: by the hip while the
     trunk leans (they do not swing forward into the furniture the other hand reaches
-    over; ``sb`` (T,): the body's progress); kneeling (``lean`` (T,) given), down onto
-    the floor under the shoulder (``sh1`` (2, 3) in the posture) as the trunk leans, to
-    prop it (:func:`_prop_point`)."""
+    over; ``sb`` (T,): the body's progress); kneeling (``lean`` (T,) given), a hand that
+    hangs free (:func:`_hangs`) goes down onto the floor under the shoulder (``sh1``
+    (2, 3) in the posture) as the trunk leans, to prop it (:func:`_prop_point`)."""
     for k in range(2):
         if k in active:
             continue
         hands[:, k] = pelvis + (st.hands[k] - st.pelvis) + np.array([0.0, 0.0, 0.04]) * \
             sb[:, None]
-        if lean is not None:
+        if lean is not None and _hangs(st, k):
             hands[:, k] += lean[:, None] * (_prop_point(sh1[k], stature, arm) - hands[:, k])
 
 
@@ -1675,6 +1676,12 @@ _PROP_HEIGHT = 0.03
 _PROP_PALM = np.array([1.0, 0.0, -0.2]) / np.hypot(1.0, 0.2)
 
 
+def _hangs(st: _Start, k: int) -> bool:
+    """Whether hand ``k`` of the start pose hangs by the body (below the pelvis), free to
+    prop a kneeling worker; not in the carry stance, where it may hold a part."""
+    return bool(st.hands[k, 2] < st.pelvis[2])
+
+
 def _prop_point(shoulder: np.ndarray, stature: float, arm: float) -> np.ndarray:
     """Where the free palm of a kneeling worker props the trunk, below ``shoulder``
     (..., 3, start frame) and in from it (:data:`_PROP_AHEAD`, :data:`_PROP_IN`,
@@ -1687,13 +1694,13 @@ def _prop_point(shoulder: np.ndarray, stature: float, arm: float) -> np.ndarray:
 
 
 def _prop_orientation(hand_dir: np.ndarray, elbow_pole: np.ndarray, lean: np.ndarray,
-                      active: tuple[int, ...]) -> None:
-    """Turn the free hand's palm direction and elbow pole (each (T, 2, 3), in place) to
-    a palm flat on the floor, pointing forward, and the elbow out and back, with the
-    trunk's lean (T,) (:func:`_prop_point`)."""
+                      keep: tuple[int, ...]) -> None:
+    """Turn the palm direction and elbow pole (each (T, 2, 3), in place) of the hands
+    not in ``keep`` to a palm flat on the floor, pointing forward, and the elbow out and
+    back, with the trunk's lean (T,) (:func:`_prop_point`)."""
     w = lean[:, None]
     for k in range(2):
-        if k in active:
+        if k in keep:
             continue
         hd = (1.0 - w) * hand_dir[:, k] + w * _PROP_PALM
         hand_dir[:, k] = hd / np.linalg.norm(hd, axis=-1, keepdims=True)
