@@ -170,3 +170,28 @@ def test_settings_are_checked():
         ErgonomicsSettings(reba_coupling="great")
     with pytest.raises(ValueError, match="duration"):
         ErgonomicsSettings(duration="4h")
+
+
+def test_a_grasp_on_the_knees_is_coded_kneeling_by_owas():
+    """A reach deep under a low board kneels (under_shelf grasp(O3)): OWAS codes the legs
+    as kneeling (6) where a knee rests on the floor, though the task is a grasp."""
+    from pathlib import Path
+
+    from ltl_human_motion.assess import owas
+    from ltl_human_motion.planning import synthesize
+
+    cell = Path(__file__).resolve().parents[1] / "scenarios" / "cells" / "under_shelf.yaml"
+    m = synthesize("F grasp(O3)", str(cell), seed=0)[0]
+    rep = assess_motion(m)
+    seg = next(s for s in m.timeline if s.task == "grasp(O3)")
+    f = (seg.start_frame + seg.end_frame) // 2
+    assert m.positions[f, J["l_knee"], 2] < m.positions[f, J["l_ankle"], 2]
+    a = body_angles(m.positions[f:f + 1], m.motion.skeleton.stature)
+    legs = owas.legs_code(a.knee_flexion[:, 0], a.knee_flexion[:, 1], False, False, True,
+                          False)
+    assert int(legs[0]) == 6
+    want = owas.action_category(owas.back_code(a.trunk_flexion, a.trunk_twist),
+                                owas.arms_code(a.upper_arm_flexion[:, 0],
+                                               a.upper_arm_flexion[:, 1]), legs,
+                                owas.load_code(np.zeros(1)))
+    assert rep.owas[f] == int(want[0])

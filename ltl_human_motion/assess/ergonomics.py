@@ -218,6 +218,9 @@ def assess_motion(synth: SynthesizedMotion, masses: Mapping[str, float] | None =
     for seg, kind in zip(synth.timeline, kinds):
         if kind == "kneel":
             kneeling[seg.start_frame:seg.end_frame] = True
+    # a knee below its own ankle rests on the floor (a reach under a low board kneels)
+    for s in "lr":
+        kneeling |= pos[:, JOINT_INDEX[f"{s}_knee"], 2] < pos[:, JOINT_INDEX[f"{s}_ankle"], 2]
     owas_f = owas.action_category(
         owas.back_code(a.trunk_flexion, a.trunk_twist),
         owas.arms_code(a.upper_arm_flexion[:, 0], a.upper_arm_flexion[:, 1]),
