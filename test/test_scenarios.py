@@ -389,6 +389,9 @@ FIXED_FAMILY_RUNS = {
     ("aisle/job/aisle_carry_out", 1.95, 0): "carry:squeeze_square_up",
     # ... to the body's middle, where the most gait starts keep the swinging arms clear
     ("aisle/single/carry(O2, R2)", 1.95, 1): "walk:squeeze_body_middle",
+    # the last try for room round a target (goal_steps.motion_room) made while seated
+    # read the obstacles the goal model is given only standing (KeyError)
+    ("seats/job/fetch_then_sit", 1.55, 0): "crash:room_while_seated",
     # a hand swung into a crate between the search's samples
     ("cluttered/single/assemble(R2)", 1.95, 0): "walk:between_samples",
     ("cluttered/single/grasp(O1)", 1.95, 0): "walk:between_samples",

@@ -477,9 +477,11 @@ class GoalSteps:
                                                         or raised, None, grasped, part,
                                                         container)
                     kwargs["rng"] = np.random.default_rng(0)
-                    if not posture_clear(kind, local, self.ctx.library.skeleton,
-                                         kwargs["obstacles"], start_pose=stance,
-                                         hand=kwargs.get("hand", "auto")):
+                    # (no obstacles around, or seated: no posture to rule out)
+                    obstacles = kwargs.get("obstacles")
+                    if obstacles is not None and not posture_clear(
+                            kind, local, self.ctx.library.skeleton, obstacles,
+                            start_pose=stance, hand=kwargs.get("hand", "auto")):
                         continue
                     try:
                         mp = self.ctx.library.goal(kind, local, **kwargs)
