@@ -290,6 +290,10 @@ _KNEEL_PITCH_MAX = 1.6
 #: other), as long again to get up: kneeling down and getting up take about as long as
 #: a sit-to-stand, 1.5-3 s (issue 13's timing; Janssen et al. 2002 for sit-to-stand).
 KNEEL_DOWN_SECONDS = 2.0
+#: Height of a knee joint resting on the floor and of a kneeling leg's ankle (toes tucked
+#: under), fractions of stature (:func:`_kneel_legs`).
+_KNEE_ON_FLOOR = 0.026
+_KNEELING_ANKLE = 0.075
 
 _TRUNK = (("spine", "pelvis", 0.5), ("chest", "spine", 0.85), ("neck", "chest", 1.0),
           ("head", "neck", 1.0), ("l_clavicle", "chest", 1.0), ("l_shoulder", "l_clavicle", 1.0),
@@ -578,7 +582,7 @@ def _kneel_legs(skeleton: Skeleton, hips: np.ndarray
     H = skeleton.stature
     b = _bones(skeleton)
     thigh, shank, foot = b[_J["l_knee"]], b[_J["l_ankle"]], b[_J["l_toe"]]
-    knee_z, ankle_z = 0.026 * H, 0.075 * H
+    knee_z, ankle_z = _KNEE_ON_FLOOR * H, _KNEELING_ANKLE * H
     toe_z = skeleton.rest_positions()[_J["l_toe"], 2]
     above = hips[..., 2] - knee_z
     ok = np.all((above <= thigh) & (above > 0.0), axis=-1)
@@ -611,7 +615,7 @@ def _kneel_set(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
         thigh * np.cos(np.radians(np.linspace(0.0, 60.0, 13))),
         np.linspace(-0.1, 0.4, 6), indexing="ij"))
     pelvis = np.tile(st.pelvis, (P.size, 1))
-    pelvis[:, 2] = 0.026 * H + A - hip_z
+    pelvis[:, 2] = _KNEE_ON_FLOOR * H + A - hip_z
     pelvis[:, 0] = float(st.ankles[:, 0].mean()) + K - np.sqrt(thigh ** 2 - A ** 2)
     D, shift = st.pelvis[2] - pelvis[:, 2], pelvis[:, 0] - st.pelvis[0]
     tr = _trunk(skeleton, pelvis, P, False, kneel=True)
@@ -1620,23 +1624,14 @@ def _kneel_path(skeleton: Skeleton, st: _Start, hand: str, t: np.ndarray, s: np.
     ``times`` = (t1, t2, t_up, total). Moves the kneeling leg's ankle, toe and knee pole
     (each (T, 2, 3)) in place."""
     H = skeleton.stature
-    b = _bones(skeleton)
+    thigh = _bones(skeleton)[_J["l_knee"]]
     t1, t2, t_up, total = times
     k = 0 if hand in ("l_hand", "left", "l") else 1
     rest = skeleton.rest_positions()
-    thigh, shank, foot = b[_J["l_knee"]], b[_J["l_ankle"]], b[_J["l_toe"]]
-    knee_z = 0.026 * H
-    hip_above = 0.97 * thigh
-    hip_x = -0.6 * thigh
-    knee = np.array([hip_x + 0.24 * thigh, st.ankles[k, 1], knee_z])
-    hip = np.array([knee[0] - np.sqrt(thigh ** 2 - hip_above ** 2), knee[1],
-                    knee_z + hip_above])
-    ankle_z = 0.075 * H
-    ankle = np.array([knee[0] - np.sqrt(shank ** 2 - (ankle_z - knee_z) ** 2), knee[1],
-                      ankle_z])
-    toe_z = rest[_J["l_toe"], 2]
-    toe = ankle + np.array([np.sqrt(foot ** 2 - (ankle_z - toe_z) ** 2), 0.0,
-                            toe_z - ankle_z])
+    # the knee 0.36 thigh behind the start, the hip 0.97 thigh above it
+    hip = np.array([-0.36 * thigh - np.sqrt(thigh ** 2 - (0.97 * thigh) ** 2), st.ankles[k, 1],
+                    _KNEE_ON_FLOOR * H + 0.97 * thigh])
+    ankle, toe, pole = (v[0, 0] for v in _kneel_legs(skeleton, hip[None, None])[:3])
     pel1 = hip - (rest[_J[f"{_SIDES[k]}_hip"]] - rest[0])
     # the moving foot lifts while it steps back
     # it moves only once lifted and lands before it stops, so it never slides over
@@ -1650,7 +1645,7 @@ def _kneel_path(skeleton: Skeleton, st: _Start, hand: str, t: np.ndarray, s: np.
     ankles[:, k, 2] += lift
     toes[:, k] = st.toes[k] + s_foot[:, None] * (toe - st.toes[k])
     toes[:, k, 2] += lift
-    knee_pole[:, k] = np.array([0.35, 0.0, -1.0])
+    knee_pole[:, k] = pole
     pelvis = st.pelvis + s[:, None] * (pel1 - st.pelvis)
     pitch = 0.15 * s
     return pelvis, pitch

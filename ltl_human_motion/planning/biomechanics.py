@@ -476,16 +476,17 @@ def check_biomechanics(positions: np.ndarray, fps: float, *, stature: float = DE
     return out
 
 
-def _speed_ratio(p: np.ndarray, fps: float, labels: Sequence[str],
-                 limits: BiomechanicsLimits, scale: float) -> tuple[np.ndarray, np.ndarray]:
-    """Joint speeds (T-w, J) (:func:`joint_speeds`) and their ratio to the limits (an
-    interval is limited by the stricter of its two end frames' activities)."""
+def _speeds_and_limits(p: np.ndarray, fps: float, labels: Sequence[str],
+                       limits: BiomechanicsLimits, scale: float
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Joint speeds (T-w, J) (:func:`joint_speeds`) and their limits (T-w, J): an
+    interval is limited by the stricter of its two end frames' activities."""
     T = len(p)
     speed = joint_speeds(p, fps)
     w = T - len(speed)
     lim_a = _speed_limits(T - w, labels[:T - w], limits, scale)
     lim_b = _speed_limits(T - w, labels[w:], limits, scale)
-    return speed, speed / np.minimum(lim_a, lim_b)
+    return speed, np.minimum(lim_a, lim_b)
 
 
 def speed_excess(positions: np.ndarray, fps: float, labels: Sequence[str], *,
@@ -495,11 +496,11 @@ def speed_excess(positions: np.ndarray, fps: float, labels: Sequence[str], *,
     frame (the middle of each speed interval), shape (T,) of bool."""
     p = np.asarray(positions, dtype=np.float64)
     out = np.zeros(len(p), dtype=bool)
-    speed, ratio = _speed_ratio(p, fps, list(labels), limits,
-                                float(stature) / limits.reference_stature)
+    speed, lim = _speeds_and_limits(p, fps, list(labels), limits,
+                                    float(stature) / limits.reference_stature)
     if speed.size:
         w = len(p) - len(speed)
-        out[w // 2:w // 2 + len(speed)] = ratio.max(axis=1) > 1.0
+        out[w // 2:w // 2 + len(speed)] = np.any(speed > lim, axis=1)
     return out
 
 
@@ -507,11 +508,12 @@ def _speed_entry(p: np.ndarray, fps: float, labels: list[str], limits: Biomechan
                  scale: float) -> dict:
     """The ``joint_speed`` entry of :func:`check_biomechanics`; ``p`` is (T, J, 3)."""
     T = len(p)
-    speed, ratio = _speed_ratio(p, fps, labels, limits, scale)
+    speed, limit = _speeds_and_limits(p, fps, labels, limits, scale)
     if speed.size:
         w = T - len(speed)
+        ratio = speed / limit
         f0, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-        lim = float(speed[f0, j] / ratio[f0, j])
+        lim = float(limit[f0, j])
         ok = bool(ratio[f0, j] <= 1.0)
         jf = int(np.argmax(speed.max(axis=0)))
         f = int(f0) + w // 2

@@ -16,7 +16,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ltl_human_motion.motion.ik import min_jerk
+from ltl_human_motion.planning.biomechanics import (
+    BiomechanicsLimits,
+    frame_labels,
+    self_penetration,
+    speed_excess,
+)
 from ltl_human_motion.planning.blend import JUNCTION_FOOT_SPREAD_MAX
+from ltl_human_motion.planning.verify import colliding_frames
 
 #: Times a motion is blended again with repaired junctions.
 JUNCTION_REPAIRS = 3
@@ -45,7 +53,6 @@ def unlock_weights(frames: tuple[int, ...], n_frames: int, fps: float) -> np.nda
     """How much of the unlocked motion to take at each frame, shape (n_frames,): 1 within
     :data:`UNLOCK_HOLD` of one of ``frames``, fading to 0 over :data:`UNLOCK_RAMP`
     (minimum jerk)."""
-    from ltl_human_motion.motion.ik import min_jerk
     w = np.zeros(n_frames)
     if not frames:
         return w
@@ -56,7 +63,7 @@ def unlock_weights(frames: tuple[int, ...], n_frames: int, fps: float) -> np.nda
 
 def repaired(report: dict, synth, cell, held: dict[str, np.ndarray] | None, stature: float,
              junctions: list[int], repairs: JunctionRepairs, wide: bool,
-             limits=None) -> JunctionRepairs | None:
+             limits: BiomechanicsLimits | None = None) -> JunctionRepairs | None:
     """The repairs after ``repairs`` for a motion ``synth`` whose verification ``report``
     failed: the junctions (centre frames ``junctions``) near colliding or
     self-penetrating frames move their mismatch off that side (:func:`shares_off`;
@@ -64,14 +71,6 @@ def repaired(report: dict, synth, cell, held: dict[str, np.ndarray] | None, stat
     those frames; else the junctions near too fast frames are stretched. None when there
     is nothing left to change. ``limits``: the biomechanical limits verified against
     (default :class:`~ltl_human_motion.planning.biomechanics.BiomechanicsLimits`)."""
-    from ltl_human_motion.planning.biomechanics import (
-        BiomechanicsLimits,
-        frame_labels,
-        self_penetration,
-        speed_excess,
-    )
-    from ltl_human_motion.planning.verify import colliding_frames
-
     pos = synth.motion.positions
     fps = synth.motion.fps
     blocked = np.zeros(len(pos), dtype=bool)
