@@ -256,24 +256,40 @@ def _first_stop(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, near: np.n
     """The first successor ``m`` of ``near`` (indices into ``succ`` (M,) and ``ends``
     (M, 3), in order) after which a stop primitive may follow, is not ``forbidden``
     there, keeps clear and ends in the goal, with the first such stop: (m, the stop, its
-    end pose (3,)); None if there is none. The goal, floor and body tests of all the
-    candidates run in one call each."""
-    owners, ids, stop_ends, paths = [], [], [], []
-    for m in near.tolist():
-        at = (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2]))
-        stop_ids = _stop_candidates(index, int(succ[m]), at, allowed, forbidden, options)
-        if stop_ids.size:
-            owners.append(np.full(stop_ids.size, m))
-            ids.append(stop_ids)
-            stop_ends.append(_place(index, stop_ids, *at))
-            paths.append(_path_points(index, stop_ids, *at))
-    if not ids:
+    end pose (3,)); None if there is none. The floor, goal and body tests of all the
+    candidates left run in one call each."""
+    prims = succ[near]
+    first = index.indptr[prims]
+    counts = index.indptr[prims + 1] - first
+    total = int(counts.sum())
+    if total == 0:
         return None
-    owner, cand, cand_ends = np.concatenate(owners), np.concatenate(ids), np.concatenate(stop_ends)
-    path = np.concatenate(paths)                                     # (K, S, 2)
-    ok = goal.reached(cand_ends[:, 0], cand_ends[:, 1], cand_ends[:, 2])
-    ok &= clearance(path.reshape(-1, 2)).reshape(path.shape[:2]).min(axis=1) \
+    offsets = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+    cand = index.indices[np.repeat(first, counts) + offsets]
+    owner = np.repeat(near, counts)
+    keep = index.stops[cand] & allowed[cand]
+    if forbidden and keep.any():
+        for k in np.flatnonzero(keep).tolist():
+            at = ends[owner[k]]
+            there = placement_key(float(at[0]), float(at[1]), float(at[2]), options.grid,
+                                  options.yaw_bins)
+            keep[k] = (int(cand[k]), *there) not in forbidden
+    if not keep.any():
+        return None
+    owner, cand = owner[keep], cand[keep]
+    at = ends[owner]                                                 # (K, 3)
+    c, s = np.cos(at[:, 2]), np.sin(at[:, 2])
+    d = index.disp[cand]
+    cand_ends = np.stack([at[:, 0] + c * d[:, 0] - s * d[:, 1],
+                          at[:, 1] + s * d[:, 0] + c * d[:, 1], at[:, 2] + d[:, 2]], axis=-1)
+    p = index.path[cand]                                             # (K, S, 2)
+    path = np.stack([at[:, 0, None] + c[:, None] * p[..., 0] - s[:, None] * p[..., 1],
+                     at[:, 1, None] + s[:, None] * p[..., 0] + c[:, None] * p[..., 1]],
+                    axis=-1)
+    ok = clearance(path.reshape(-1, 2)).reshape(path.shape[:2]).min(axis=1) \
         > options.body_radius
+    if ok.any():
+        ok[ok] = goal.reached(cand_ends[ok, 0], cand_ends[ok, 1], cand_ends[ok, 2])
     if ok.any() and body_clear is not None and index.body.size:
         # The arms swing as the worker stops: check the whole body, as for every move.
         sel = np.flatnonzero(ok)
@@ -343,19 +359,6 @@ def _body_at(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float
     body[..., 0] += x
     body[..., 1] += y
     return body
-
-
-def _stop_candidates(index: GaitIndex, prim: int, at: Pose, allowed: np.ndarray,
-                     forbidden: frozenset[tuple[int, int, int, int]], options: SearchOptions
-                     ) -> np.ndarray:
-    """The stop primitives that may follow ``prim`` at pose ``at`` and are not
-    ``forbidden`` there, (K,)."""
-    stop_ids = index.successors(prim)
-    stop_ids = stop_ids[index.stops[stop_ids] & allowed[stop_ids]]
-    if forbidden and stop_ids.size:
-        there = placement_key(*at, options.grid, options.yaw_bins)
-        stop_ids = stop_ids[[(int(p), *there) not in forbidden for p in stop_ids.tolist()]]
-    return stop_ids
 
 
 def _step_costs(index: GaitIndex, options: SearchOptions, carry: bool,

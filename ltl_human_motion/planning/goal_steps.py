@@ -27,7 +27,7 @@ from ltl_human_motion.motion.goals import (
 )
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
-from ltl_human_motion.planning.astar import AT_GOAL_NODES, SearchBudget
+from ltl_human_motion.planning.astar import AT_GOAL_NODES, Goal, SearchBudget
 from ltl_human_motion.planning.plan_state import (
     OTHER_HAND,
     PlanContext,
@@ -535,10 +535,10 @@ class GoalSteps:
         desc = f"reach {text} at ({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})"
         goal, back = self.goals.reach(target, placement, desc, text, sector=sector,
                                       stand_yaw=stand_yaw)
-        if sector is None and stand_yaw is None and self.state.seat is None:
-            # (From a side or facing a board, the alternatives walk round instead.)
-            self.executor.step_towards(target, placement, back)
-        walked = self.executor.walk(goal, text, -1, carry=self.state.carrying, budget=budget)
+        if self.state.seat is None and sector is None and stand_yaw is None:
+            self.executor.step_towards(target, placement, back, goal=goal)
+        walked = self._walk_or_step_into(goal, text, budget, sector is not None
+                                         or stand_yaw is not None)
         if not self.executor.adjust_to(target, placement, text, back, stand_yaw):
             # No clear step from where the walk ended: walk on to a spot that needs
             # (almost) none.
@@ -548,6 +548,8 @@ class GoalSteps:
             final = budget or self.ctx.options.budget
             final = replace(final, max_nodes=min(final.max_nodes, FINAL_WALK_NODES),
                             at_goal_nodes=min(AT_GOAL_NODES, FINAL_WALK_NODES))
+            if self.state.seat is None:
+                self.executor.step_into(goal)
             try:
                 walked += self.executor.walk(goal, text, -1, carry=self.state.carrying,
                                              budget=final)
@@ -562,6 +564,23 @@ class GoalSteps:
                     "searched)", task=text, reason="blocked") from exc
             self.executor.adjust_to(target, placement, text, back, stand_yaw)
         return walked
+
+    def _walk_or_step_into(self, goal: Goal, text: str, budget: SearchBudget | None,
+                           step_after: bool) -> int:
+        """The walk to ``goal``; with ``step_after``, where its search ends without a
+        place to stop, model-made steps into the goal instead if it is that near
+        (:meth:`.steps.StepExecutor.step_into`; a side next to furniture can be smaller
+        than a tall worker's stop stride). Returns the gait primitives walked."""
+        mark = self.state.mark()
+        try:
+            return self.executor.walk(goal, text, -1, carry=self.state.carrying, budget=budget)
+        except PlanningError as exc:
+            if not step_after or self.state.seat is not None or exc.reason != "budget":
+                raise
+            self.state.restore(mark)
+            if not self.executor.step_into(goal):
+                raise
+            return 0
 
     def approach_under(self, target: np.ndarray, placement: tuple[float, float],
                        text: str) -> int | None:
@@ -690,4 +709,4 @@ class GoalSteps:
             return True
         # The part rests on its support until the hand lifts it; carried from then on.
         centre = hand[lift:] + (self.where(grasped) - hand[contact])
-        return not np.any(object_clearance(self.ctx.cell, grasped, centre) <= 0.0)
+        return not np.any(object_clearance(self.ctx.cell, grasped, centre, exact_below=0.0) <= 0.0)

@@ -127,6 +127,11 @@ ADJUST_STILL = (0.02, 0.05)
 #: model-made step towards it before walking (:meth:`StepExecutor.step_towards`): two
 #: steps reach it, where a 1.95 m worker's gait start and stop (0.5 m each) overshoot.
 STEP_TOWARDS_REACH = 2.0
+#: Spacing (m) of the spots a worker standing near a walk's goal tries to step into when
+#: no gait start and stop fits (:meth:`StepExecutor.step_into`), and how many of the
+#: nearest are tried.
+STEP_INTO_GRID = 0.05
+STEP_INTO_TRIES = 8
 #: The gait index's step straight back (metres ahead, left), the first step tried to
 #: get room in front (:meth:`StepExecutor.step_back`).
 GAIT_STEP_BACK = [-0.3, 0.0]
@@ -326,7 +331,7 @@ class StepExecutor:
         for name, joint in self.state.held.items():
             step = 1 if samples is None else 2
             centre = world[::step, JOINT_INDEX[joint]] + self.state.held_offset(name)
-            if np.any(object_clearance(self.ctx.cell, name, centre) <= 0.0):
+            if np.any(object_clearance(self.ctx.cell, name, centre, exact_below=0.0) <= 0.0):
                 return False
         return True
 
@@ -452,7 +457,7 @@ class StepExecutor:
                              exact_below=EXACT_BELOW) <= PLACED_MARGIN
         for name, joint in self.state.held.items():
             centre = world[:, JOINT_INDEX[joint]] + self.state.held_offset(name)
-            bad |= object_clearance(self.ctx.cell, name, centre) <= 0.0
+            bad |= object_clearance(self.ctx.cell, name, centre, exact_below=0.0) <= 0.0
         if not bad.any():
             return None
         return int(np.searchsorted(ends, int(np.argmax(bad)), side="right"))
@@ -572,12 +577,58 @@ class StepExecutor:
                 for di in (-1, 0, 1) for dj in (-1, 0, 1)}
 
     def step_towards(self, target: np.ndarray, placement: tuple[float, float],
-                     back_limit: float, stand_yaw: float | None = None) -> bool:
+                     back_limit: float, stand_yaw: float | None = None,
+                     goal: Goal | None = None) -> bool:
         """Where the ideal placement for ``target`` (:func:`.standing.ideal_placement`) is
         further than ``options.adjust_radius`` but within ``STEP_TOWARDS_REACH`` of it, a
         model-made step of ``adjust_radius`` straight towards it (no turn), if clear: the
         gait's shortest start and stop overshoot a spot this near (a 1.95 m worker's
-        stop strides 0.5 m). Returns whether it stepped."""
+        stop strides 0.5 m). Where that spot is blocked or the step is not clear, the
+        steps into ``goal`` (if given, :meth:`step_into`). Returns whether it stepped."""
+        if self._step_towards(target, placement, back_limit, stand_yaw):
+            return True
+        return goal is not None and self.step_into(goal)
+
+    def step_into(self, goal: Goal) -> bool:
+        """Up to ``STEP_TOWARDS_REACH`` model-made steps of at most
+        ``options.adjust_radius`` each, without turning, to the nearest spot within their
+        reach where ``goal.reached`` holds, if the worker is not there yet and every step
+        is clear (the nearest ``STEP_INTO_TRIES`` spots tried). A walk's goal next to
+        furniture may be smaller than the gait's shortest start and stop: a search from
+        close by floods the floor around it. Returns whether it stepped."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        x, y, yaw = self.state.pose
+        if bool(goal.reached(np.array([x]), np.array([y]), np.array([yaw]))[0]):
+            return False
+        reach = self.ctx.options.adjust_radius
+        most = STEP_TOWARDS_REACH * reach
+        g = np.arange(-most, most + 1e-9, STEP_INTO_GRID)
+        dx, dy = (v.ravel() for v in np.meshgrid(g, g))
+        far = np.hypot(dx, dy)
+        c, s = math.cos(yaw), math.sin(yaw)
+        wx, wy = x + c * dx - s * dy, y + s * dx + c * dy
+        ok = (far <= most) & (far > 0.0)
+        ok[ok] = goal.reached(wx[ok], wy[ok], np.full(int(ok.sum()), yaw))
+        lib = self.ctx.library
+        stance = self.ctx.stance(self.state.carrying)
+        task = "carry" if self.state.carrying else "walk"
+        for k in np.flatnonzero(ok)[np.argsort(far[ok], kind="stable")][:STEP_INTO_TRIES]:
+            n = math.ceil(far[k] / reach - 1e-9)
+            mp = make_step_primitive(stance, lib.standing_height, float(dx[k]) / n,
+                                     float(dy[k]) / n, 0.0, lib.skeleton, lib.fps, task)
+            poses = [self.state.pose]
+            for _ in range(n - 1):
+                poses.append(self.hand_over_pose(mp, poses[-1]))
+            if all(self.placed_clear(mp, pose) for pose in poses):
+                for pose in poses:
+                    self.add(mp, pose, -1, self.ctx.overlap)
+                self.state.pose = self.hand_over_pose(mp, poses[-1])
+                return True
+        return False
+
+    def _step_towards(self, target: np.ndarray, placement: tuple[float, float],
+                      back_limit: float, stand_yaw: float | None) -> bool:
+        """:meth:`step_towards`'s step towards the ideal placement."""
         from ltl_human_motion.planning.turns import make_step_primitive
         x, y, yaw = self.state.pose
         px, py, _, free = (float(v[0]) for v in ideal_placement(

@@ -182,7 +182,8 @@ def body_clearance(positions: np.ndarray, cell: Cell, *,
                                         bounds=point_bounds(np.asarray(positions)))
 
 
-def object_clearance(cell: Cell, name: str, trajectory: np.ndarray) -> np.ndarray:
+def object_clearance(cell: Cell, name: str, trajectory: np.ndarray,
+                     exact_below: float = 0.5) -> np.ndarray:
     """Distance between object ``name`` and the obstacles along a trajectory.
 
     Parameters
@@ -191,12 +192,14 @@ def object_clearance(cell: Cell, name: str, trajectory: np.ndarray) -> np.ndarra
     name : str
     trajectory : array-like, shape (T, 3) or (3,)
         Object positions; rows with NaN are skipped (clearance ``inf``).
+    exact_below : float
+        Metres: distances are exact up to this, a lower bound (the gap of the bounding
+        boxes) beyond. A collision test needs them exact only up to its margin.
 
     Returns
     -------
     clearance : ndarray, shape (T,) or ()
-        0 when touching or overlapping; exact up to 0.5 m, a lower bound (the gap of
-        the bounding boxes) beyond.
+        0 when touching or overlapping.
     """
     obj = cell.object(name)
     traj = np.asarray(trajectory, dtype=np.float64)
@@ -215,7 +218,7 @@ def object_clearance(cell: Cell, name: str, trajectory: np.ndarray) -> np.ndarra
         # the distance itself for two axis-aligned boxes.
         bound = box_gap((tv + rel_lo)[:, None], (tv + rel_hi)[:, None], ps.lo, ps.hi)
         obj_box = isinstance(obj.shape, Box) and obj.shape.axis_aligned
-        need = (bound <= 0.5) & ~(ps.is_box & obj_box)            # exact distance wanted
+        need = (bound <= exact_below) & ~(ps.is_box & obj_box)    # exact distance wanted
         best = np.where(need, np.inf, bound).min(axis=1)
         for k in np.flatnonzero(need.any(axis=0)):
             # Exact only where it could be the smallest (it is at least the bound).
@@ -256,6 +259,6 @@ def collision(positions: np.ndarray, cell: Cell, *, stature: float = DEFAULT_STA
         if traj.shape != (*pos.shape[:-2], 3):
             raise ValueError(f"carried[{name!r}] must have shape {(*pos.shape[:-2], 3)}, "
                              f"got {traj.shape}")
-        d = object_clearance(cell, name, traj)
+        d = object_clearance(cell, name, traj, exact_below=exact_below)
         hit = hit | (d <= margin)
     return hit
