@@ -1350,14 +1350,17 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     postures = _reach_postures(skeleton, st, targets, active, task, target, board, obstacles,
                                furniture)
     # the cheapest posture, swinging wider past the thigh where the arm would pass through
-    # it, then the next postures
-    tries = [(postures[0], w) for w in _WIDER_SWINGS] + [(p, 1.0) for p in postures[1:]]
+    # it, then the next postures; last the kneeling ones without the free hand's prop
+    # (on the way up its forearm can pass through the thigh coming forward)
+    tries = [(postures[0], w, True) for w in _WIDER_SWINGS] + \
+        [(p, 1.0, True) for p in postures[1:]] + [(p, 1.0, False) for p in postures if p[4]]
     draws = rng.bit_generator.state
-    for n, (posture, wide) in enumerate(tries):
+    for n, (posture, wide, prop) in enumerate(tries):
         rng.bit_generator.state = draws
         world, f1, f2, contact_t = _reach_motion(
             task, skeleton, st, targets, active, posture,
-            (level, travel, approach, board, support, flat_palm), rng, duration, fps, wide)
+            (level, travel, approach, board, support, flat_palm), rng, duration, fps, wide,
+            prop)
         if n + 1 == len(tries) or not _self_penetrates(world, H):
             break
     T = world.shape[0]
@@ -1379,12 +1382,13 @@ def _self_penetrates(world: np.ndarray, stature: float) -> bool:
 def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray,
                   active: tuple[int, ...], posture: tuple[float, float, float, bool],
                   path: tuple, rng: np.random.Generator, duration: float | None, fps: float,
-                  wide: float = 1.0) -> tuple[np.ndarray, int, int, float]:
+                  wide: float = 1.0, prop: bool = True) -> tuple[np.ndarray, int, int, float]:
     """Frames (T, J, 3) of a hand task's reach into ``posture`` (pitch, drop, shift,
     capped), its hold and its return; the first and last hold frame and the contact time
     (s). ``posture`` may kneel (:func:`_kneel_progress`). ``path``: (level, travel,
     approach (2, 3) or None, board, support, flat_palm) of :func:`_hand_task`; ``wide``
-    scales the low reach's swing outside the thigh (:func:`_hand_path`)."""
+    scales the low reach's swing outside the thigh (:func:`_hand_path`); ``prop``: a
+    kneeling worker's free hand props the trunk (:func:`_free_hands`)."""
     H = skeleton.stature
     arm = _arm_length(skeleton)
     level, travel, approach, board, support, flat_palm = path
@@ -1428,10 +1432,11 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
         if task in ("leftHand", "rightHand", "assemble") and hold > 0.4:
             _add_manipulation(rel, t, t1, t2, active, rng)
         hands = shoulders + rel
-        _free_hands(hands, active, st, pelvis, sb, lean if kneel else None, sh1, H, arm)
+        _free_hands(hands, active, st, pelvis, sb, lean if kneel and prop else None, sh1, H,
+                    arm)
         hand_dir, elbow_pole = _hand_orientation(task, active, st, t, (t1, t2, total), rel_goal,
                                                  flat_palm or rise is not None)
-        if kneel:
+        if kneel and prop:
             _prop_orientation(hand_dir, elbow_pole, lean,
                               tuple(k for k in range(2) if k in active or not _hangs(st, k)))
         world = _frames(skeleton, st, t, pelvis, pitch, hands, hand_dir, elbow_pole, *legs,
