@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ltl_human_motion.scene.cell import load_cell
-from ltl_human_motion.scene.predicates import object_clearance
+from ltl_human_motion.scene.predicates import object_clearance, object_collides
 
 CELLS = Path(__file__).resolve().parents[1] / "scenarios" / "cells"
 
@@ -64,6 +64,8 @@ def test_object_clearance_exact_below_keeps_the_collision_answer() -> None:
     quick = object_clearance(cell, "done", traj, exact_below=0.0)
     assert (full <= 0.0).any() and (full > 0.0).any()
     np.testing.assert_array_equal(full <= 0.0, quick <= 0.0)
+    np.testing.assert_array_equal(full <= 0.0, object_collides(cell, "done", traj))
+    np.testing.assert_array_equal(full <= 0.05, object_collides(cell, "done", traj, 0.05))
     assert np.all(quick <= full + 1e-12)
     some = object_clearance(cell, "done", traj, exact_below=0.1)
     close = full <= 0.1

@@ -166,18 +166,20 @@ def placement_key(x: float, y: float, yaw: float, grid: float = 0.08, yaw_bins: 
             round(yaw * yaw_bins / (2.0 * np.pi)) % yaw_bins)
 
 
-def _place(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float) -> np.ndarray:
-    """End poses of primitives ``ids`` started at (x, y, yaw), shape (M, 3)."""
+def _place(index: GaitIndex, ids: np.ndarray, x: float | np.ndarray, y: float | np.ndarray,
+           yaw: float | np.ndarray) -> np.ndarray:
+    """End poses of primitives ``ids`` (M,) started at (x, y, yaw) (each a float, or (M,)
+    per primitive), shape (M, 3)."""
     c, s = np.cos(yaw), np.sin(yaw)
     d = index.disp[ids]
     return np.stack([x + c * d[:, 0] - s * d[:, 1], y + s * d[:, 0] + c * d[:, 1],
                      yaw + d[:, 2]], axis=-1)
 
 
-def _path_points(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float
-                 ) -> np.ndarray:
-    """World floor points of the root paths of primitives ``ids`` started at (x, y, yaw),
-    shape (M, S, 2)."""
+def _path_points(index: GaitIndex, ids: np.ndarray, x: float | np.ndarray,
+                 y: float | np.ndarray, yaw: float | np.ndarray) -> np.ndarray:
+    """World floor points of the root paths of primitives ``ids`` (M,) started at
+    (x, y, yaw) (each a float, or (M, 1) per primitive), shape (M, S, 2)."""
     c, s = np.cos(yaw), np.sin(yaw)
     p = index.path[ids]                                    # (M, S, 2)
     wx = x + c * p[..., 0] - s * p[..., 1]
@@ -278,14 +280,8 @@ def _first_stop(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, near: np.n
         return None
     owner, cand = owner[keep], cand[keep]
     at = ends[owner]                                                 # (K, 3)
-    c, s = np.cos(at[:, 2]), np.sin(at[:, 2])
-    d = index.disp[cand]
-    cand_ends = np.stack([at[:, 0] + c * d[:, 0] - s * d[:, 1],
-                          at[:, 1] + s * d[:, 0] + c * d[:, 1], at[:, 2] + d[:, 2]], axis=-1)
-    p = index.path[cand]                                             # (K, S, 2)
-    path = np.stack([at[:, 0, None] + c[:, None] * p[..., 0] - s[:, None] * p[..., 1],
-                     at[:, 1, None] + s[:, None] * p[..., 0] + c[:, None] * p[..., 1]],
-                    axis=-1)
+    cand_ends = _place(index, cand, at[:, 0], at[:, 1], at[:, 2])
+    path = _path_points(index, cand, at[:, 0, None], at[:, 1, None], at[:, 2, None])
     ok = clearance(path.reshape(-1, 2)).reshape(path.shape[:2]).min(axis=1) \
         > options.body_radius
     if ok.any():

@@ -700,7 +700,7 @@ class GoalSteps:
             return False
         if grasped is None:
             return True
-        from ltl_human_motion.scene.predicates import object_clearance
+        from ltl_human_motion.scene.predicates import object_collides
         joint = holding_joint(mp.meta.get("hand"))
         hand = world[:, JOINT_INDEX[joint]]
         contact = int(mp.meta.get("contact_frame", 0))
@@ -709,4 +709,4 @@ class GoalSteps:
             return True
         # The part rests on its support until the hand lifts it; carried from then on.
         centre = hand[lift:] + (self.where(grasped) - hand[contact])
-        return not np.any(object_clearance(self.ctx.cell, grasped, centre, exact_below=0.0) <= 0.0)
+        return not np.any(object_collides(self.ctx.cell, grasped, centre))

@@ -311,7 +311,7 @@ class StepExecutor:
         hand offsets) clear of every obstacle, checked with the exact distances on
         ``samples`` frames (None: every frame, as the verifier checks). ``world``:
         ``world_positions(mp, *pose)`` if already made."""
-        from ltl_human_motion.scene.predicates import body_clearance, object_clearance
+        from ltl_human_motion.scene.predicates import body_clearance, object_collides
         if not self.ctx.cell.obstacles:
             return True
         stature = self.ctx.stature
@@ -331,7 +331,7 @@ class StepExecutor:
         for name, joint in self.state.held.items():
             step = 1 if samples is None else 2
             centre = world[::step, JOINT_INDEX[joint]] + self.state.held_offset(name)
-            if np.any(object_clearance(self.ctx.cell, name, centre, exact_below=0.0) <= 0.0):
+            if np.any(object_collides(self.ctx.cell, name, centre)):
                 return False
         return True
 
@@ -446,7 +446,7 @@ class StepExecutor:
         """Index of the first gait primitive of a path that comes within the planner's
         margin of an obstacle on any frame (body or held parts), or None; what
         :meth:`placed_clear` checks on every frame, in one pass over the whole path."""
-        from ltl_human_motion.scene.predicates import body_clearance, object_clearance
+        from ltl_human_motion.scene.predicates import body_clearance, object_collides
         if not self.ctx.cell.obstacles or not primitives:
             return None
         worlds = [world_positions(self.ctx.index.primitives[p], *pose)
@@ -457,7 +457,7 @@ class StepExecutor:
                              exact_below=EXACT_BELOW) <= PLACED_MARGIN
         for name, joint in self.state.held.items():
             centre = world[:, JOINT_INDEX[joint]] + self.state.held_offset(name)
-            bad |= object_clearance(self.ctx.cell, name, centre, exact_below=0.0) <= 0.0
+            bad |= object_collides(self.ctx.cell, name, centre)
         if not bad.any():
             return None
         return int(np.searchsorted(ends, int(np.argmax(bad)), side="right"))

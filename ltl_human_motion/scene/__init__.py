@@ -47,6 +47,7 @@ from ltl_human_motion.scene.predicates import (
     enter_object,
     ground_enter,
     object_clearance,
+    object_collides,
 )
 from ltl_human_motion.scene.shapes import (
     Box,
@@ -109,6 +110,7 @@ __all__ = [
     "knee_height",
     "load_cell",
     "object_clearance",
+    "object_collides",
     "occ",
     "parse_task",
     "part_indices",

@@ -44,6 +44,7 @@ __all__ = [
     "enter_object",
     "ground_enter",
     "object_clearance",
+    "object_collides",
 ]
 
 Target = Region | Shape | SceneObject
@@ -228,6 +229,15 @@ def object_clearance(cell: Cell, name: str, trajectory: np.ndarray,
     return out[0] if single else out
 
 
+def object_collides(cell: Cell, name: str, trajectory: np.ndarray, margin: float = 0.0
+                    ) -> np.ndarray:
+    """Whether object ``name`` is within ``margin`` of an obstacle at each position of
+    ``trajectory`` (T, 3) (:func:`object_clearance`, exact up to the margin), shape (T,)
+    of bool; rows with NaN never collide."""
+    exact_below = float(np.nextafter(margin, np.inf))
+    return object_clearance(cell, name, trajectory, exact_below=exact_below) <= margin
+
+
 def collision(positions: np.ndarray, cell: Cell, *, stature: float = DEFAULT_STATURE,
               carried: Mapping[str, np.ndarray] | None = None,
               margin: float = 0.0) -> np.ndarray:
@@ -259,6 +269,5 @@ def collision(positions: np.ndarray, cell: Cell, *, stature: float = DEFAULT_STA
         if traj.shape != (*pos.shape[:-2], 3):
             raise ValueError(f"carried[{name!r}] must have shape {(*pos.shape[:-2], 3)}, "
                              f"got {traj.shape}")
-        d = object_clearance(cell, name, traj, exact_below=exact_below)
-        hit = hit | (d <= margin)
+        hit = hit | object_collides(cell, name, traj, margin)
     return hit
