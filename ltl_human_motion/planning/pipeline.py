@@ -264,8 +264,21 @@ def _under_deadline(fn):
 
 
 @_under_deadline
+def _stature_of(library, stature: float | None) -> float:
+    """The worker's stature, metres: ``stature``, else the library's, else
+    ``DEFAULT_STATURE``; a ``ValueError`` where ``stature`` contradicts the library."""
+    if library is not None and stature is not None \
+            and abs(float(stature) - float(library.stature)) > 1e-6:
+        raise ValueError(f"stature {float(stature):.3f} m does not match the library's "
+                         f"{float(library.stature):.3f} m: pass one of them, or a library "
+                         "of that stature (get_library(stature))")
+    if stature is None:
+        return DEFAULT_STATURE if library is None else float(library.stature)
+    return float(stature)
+
+
 def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
-               cycles: int = 1, stature: float = DEFAULT_STATURE,
+               cycles: int = 1, stature: float | None = None,
                options: SynthesisOptions | None = None) -> list[SynthesizedMotion]:
     """Synthesize ``variants`` verified full-body motions satisfying ``spec`` in ``cell``.
 
@@ -277,7 +290,8 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     cell : Cell, str or Path
         The cell, its name (``config/<name>.yaml``), a YAML path or YAML text.
     library : MotionLibrary, optional
-        Default: the cached library for ``stature``.
+        Default: the cached library for ``stature``. Its skeleton's stature is the
+        worker's (feasibility, verification, realism).
     variants : int
         Number of motions. Different task sequences come first (from the LTL
         variations); further variants re-plan sequences with other seeds.
@@ -285,8 +299,9 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
         The same seed gives the same motions, byte for byte.
     cycles : int
         Repetitions of the accepting cycle.
-    stature : float
-        Body height in metres.
+    stature : float, optional
+        Body height in metres; default the library's, else ``DEFAULT_STATURE``. Given with
+        a library of another stature, a ``ValueError``.
     options : SynthesisOptions, optional
 
     Returns
@@ -313,6 +328,7 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
         raise ValueError(f"variants must be >= 1, got {variants}")
     if cycles < 1:
         raise ValueError(f"cycles must be >= 1, got {cycles}")
+    stature = _stature_of(library, stature)
     options = options or SynthesisOptions()
     t_all = time.perf_counter()
     cell = resolve_cell(cell)

@@ -73,6 +73,13 @@ SAME_SEAT_DISTANCE = 0.05
 
 #: Hand tasks a seated worker does from the seat (others make the worker stand up).
 SEATED_HAND_TASKS = ("leftHand", "rightHand", "assemble")
+#: How far inside a move's (or carry's) region, beyond the part's half-diagonal, the
+#: point in front of a worker already there must lie to be used instead of its centre,
+#: metres.
+REGION_POINT_MARGIN = 0.05
+#: How far from the point in front of the worker that region point may lie (a step
+#: adjusts the stance), metres.
+REGION_POINT_REACH = 0.25
 
 
 @dataclass(frozen=True)
@@ -372,6 +379,10 @@ class SequencePlanner:
         if target is not None and kind not in ("release", "standUp") and self.state.seat is None:
             # (Seated, the hands work from the seat.)
             placement, arms_up = self._placement(kind, target, text, args)
+            here = self._region_point_here(kind, args, target, placement)
+            if here is not None:
+                target = here
+                placement, arms_up = self._placement(kind, target, text, args)
             walked, approach_failed = self._first_approach(kind, target, placement, text,
                                                            facing)
         carrying_before = self.state.carrying
@@ -407,6 +418,39 @@ class SequencePlanner:
                         lift_frame=lift, hand=hand, expanded=self.state.expanded - expanded0,
                         primitive=mp.name,
                         objects_effect=effect, sub_steps=subs)
+
+    def _region_point_here(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                           placement: tuple[float, float]) -> np.ndarray | None:
+        """For a move (or carry) into a region, the hand's point (3,) that puts the part
+        at the point of the region nearest the one in front of the worker (``placement``
+        from where they stand, at the height of ``target``: the region's centre less the
+        part's held offset), ``REGION_POINT_MARGIN`` inside it and clear of obstacles,
+        when that is within ``REGION_POINT_REACH`` of it: a worker already at the region
+        puts the part down in front of them instead of walking to a spot facing its centre
+        (in an aisle 0.8 m wide, a turn with the part in hand). None otherwise."""
+        if kind != "move" or self.state.seat is not None \
+                or args[0] not in self.state.held_offsets:
+            return None
+        region = self.ctx.cell.region(args[1])
+        x, y, yaw = self.state.pose
+        c, s = np.cos(yaw), np.sin(yaw)
+        d, lat = placement
+        here = np.array([x + c * d - s * lat, y + s * d + c * lat, float(target[2])])
+        point = here + self.state.held_offsets[args[0]]
+        lo, hi = self.ctx.cell.object(args[0]).shape.aabb()
+        room = float(np.linalg.norm((np.asarray(hi) - np.asarray(lo))[:2]) / 2.0) \
+            + REGION_POINT_MARGIN
+        lo, hi = np.asarray(region.lo, dtype=float), np.asarray(region.hi, dtype=float)
+        if np.any(lo[:2] + room > hi[:2] - room):
+            return None
+        inside = point.copy()
+        inside[:2] = np.clip(point[:2], lo[:2] + room, hi[:2] - room)
+        if np.linalg.norm(inside[:2] - point[:2]) > REGION_POINT_REACH \
+                or np.linalg.norm(inside[:2] - (lo[:2] + hi[:2]) / 2.0) < REGION_POINT_MARGIN:
+            return None
+        if float(self.ctx.obstacle_field.distance(inside[None])[0]) <= room:
+            return None
+        return here + (inside - point)
 
     def _first_approach(self, kind: str, target: np.ndarray, placement: tuple[float, float],
                         text: str, facing: np.ndarray | None

@@ -587,18 +587,22 @@ class StepExecutor:
         steps into ``goal`` (if given, :meth:`step_into`). Returns whether it stepped."""
         if self._step_towards(target, placement, back_limit, stand_yaw):
             return True
-        return goal is not None and self.step_into(goal)
+        return goal is not None and (self.step_into(goal) or self.step_into(goal, turn=True))
 
-    def step_into(self, goal: Goal) -> bool:
+    def step_into(self, goal: Goal, turn: bool = False) -> bool:
         """Up to ``STEP_TOWARDS_REACH`` model-made steps of at most
         ``options.adjust_radius`` each, without turning, to the nearest spot within their
         reach where ``goal.reached`` holds, if the worker is not there yet and every step
         is clear (the nearest ``STEP_INTO_TRIES`` spots tried). A walk's goal next to
         furniture may be smaller than the gait's shortest start and stop: a search from
-        close by floods the floor around it. Returns whether it stepped."""
+        close by floods the floor around it. With ``turn``, the worker first turns on the
+        spot to the goal's heading there (``goal.heading``; where the goal needs the worker
+        facing its target, e.g. in an aisle too narrow to turn in at the spot, the gait's
+        turns take a search of thousands of nodes). Returns whether it stepped."""
         from ltl_human_motion.planning.turns import make_step_primitive
         x, y, yaw = self.state.pose
-        if bool(goal.reached(np.array([x]), np.array([y]), np.array([yaw]))[0]):
+        if (turn and goal.heading is None) \
+                or bool(goal.reached(np.array([x]), np.array([y]), np.array([yaw]))[0]):
             return False
         reach = self.ctx.options.adjust_radius
         most = STEP_TOWARDS_REACH * reach
@@ -607,22 +611,38 @@ class StepExecutor:
         far = np.hypot(dx, dy)
         c, s = math.cos(yaw), math.sin(yaw)
         wx, wy = x + c * dx - s * dy, y + s * dx + c * dy
-        ok = (far <= most) & (far > 0.0)
-        ok[ok] = goal.reached(wx[ok], wy[ok], np.full(int(ok.sum()), yaw))
+        ok = (far <= most) & ((far > 0.0) | turn)
+        heading = np.full(len(far), yaw)
+        if turn:
+            heading[ok] = goal.heading(wx[ok], wy[ok])
+            ok &= np.abs(wrap_angle(heading - yaw)) > self.ctx.options.heading_tolerance
+        ok[ok] = goal.reached(wx[ok], wy[ok], heading[ok])
         lib = self.ctx.library
         stance = self.ctx.stance(self.state.carrying)
         task = "carry" if self.state.carrying else "walk"
+
+        def step(ddx: float, ddy: float, dyaw: float) -> MotionPrimitive:
+            return make_step_primitive(stance, lib.standing_height, ddx, ddy, dyaw,
+                                       lib.skeleton, lib.fps, task)
+
         for k in np.flatnonzero(ok)[np.argsort(far[ok], kind="stable")][:STEP_INTO_TRIES]:
+            moves: list[MotionPrimitive] = []
+            ddx, ddy = float(dx[k]), float(dy[k])
+            if turn:
+                dyaw = float(wrap_angle(heading[k] - yaw))
+                moves.append(step(0.0, 0.0, dyaw))
+                cy, sy = math.cos(dyaw), math.sin(dyaw)
+                ddx, ddy = cy * ddx + sy * ddy, -sy * ddx + cy * ddy
             n = math.ceil(far[k] / reach - 1e-9)
-            mp = make_step_primitive(stance, lib.standing_height, float(dx[k]) / n,
-                                     float(dy[k]) / n, 0.0, lib.skeleton, lib.fps, task)
+            if n:
+                moves += [step(ddx / n, ddy / n, 0.0)] * n
             poses = [self.state.pose]
-            for _ in range(n - 1):
+            for mp in moves[:-1]:
                 poses.append(self.hand_over_pose(mp, poses[-1]))
-            if all(self.placed_clear(mp, pose) for pose in poses):
-                for pose in poses:
+            if all(self.placed_clear(mp, pose) for mp, pose in zip(moves, poses)):
+                for mp, pose in zip(moves, poses):
                     self.add(mp, pose, -1, self.ctx.overlap)
-                self.state.pose = self.hand_over_pose(mp, poses[-1])
+                self.state.pose = self.hand_over_pose(moves[-1], poses[-1])
                 return True
         return False
 
