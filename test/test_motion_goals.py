@@ -257,6 +257,31 @@ def test_two_bone_ik_reaches_and_keeps_lengths() -> None:
     np.testing.assert_allclose(end[ok], target[ok], atol=1e-9)
 
 
+def test_two_bone_ik_folds_no_further_than_max_flexion() -> None:
+    """A target nearer the base than the fold allows is pushed out along the
+    base-target line; the others are reached as without the limit."""
+    rng = np.random.default_rng(6)
+    base = rng.normal(size=(300, 3))
+    target = base + rng.normal(size=(300, 3)) * 0.15
+    pole = rng.normal(size=(300, 3))
+    limit = np.radians(147.0)
+    mid, end = two_bone_ik(base, target, 0.3, 0.25, pole, max_flexion=limit)
+    free_mid, free_end = two_bone_ik(base, target, 0.3, 0.25, pole)
+    upper, lower = mid - base, end - mid
+    cos = np.sum(upper * lower, axis=1) / (0.3 * 0.25)
+    flexion = np.arccos(np.clip(cos, -1.0, 1.0))
+    assert flexion.max() <= limit + 1e-9
+    free_flexion = np.arccos(np.clip(np.sum((free_mid - base) * (free_end - free_mid), axis=1)
+                                     / (0.3 * 0.25), -1.0, 1.0))
+    folded = free_flexion > limit
+    assert folded.any() and (~folded).any()
+    np.testing.assert_allclose(end[~folded], free_end[~folded], atol=1e-12)
+    out = (end - base)[folded]
+    along = (target - base)[folded]
+    cross = np.linalg.norm(np.cross(out, along), axis=1)
+    np.testing.assert_allclose(cross, 0.0, atol=1e-9)
+
+
 def test_reach_onto_a_table_keeps_the_knees_out_of_it() -> None:
     # A 1.95 m worker standing obliquely at a 0.75 m table reaches a part 10 cm in from
     # its edge: the unconstrained posture bends a knee into the table; with the table as

@@ -232,3 +232,12 @@ def test_a_batch_folder_killed_during_start_up_resumes(tmp_path: Path) -> None:
     (out / "dataset.json").unlink()
     with pytest.raises(Exception, match="is not a dataset"):
         DatasetStore(tmp_path / "out", {"fingerprint": "f" * 64, "count": 2, "shard_size": 1})
+
+
+def test_synthesize_honours_its_time_budget_without_ros() -> None:
+    """``SynthesisOptions(max_seconds=)`` makes synthesize itself stop at its first check
+    (the deadline wraps the public function), naming the stage."""
+    from ltl_human_motion.planning.pipeline import SynthesisOptions, synthesize
+    options = SynthesisOptions.from_dict({"max_seconds": 1e-4})
+    with pytest.raises(BudgetExhaustedError, match=r"time budget of 0\.0001 s exhausted in "):
+        synthesize("S2", "paper_cell", seed=11, options=options)

@@ -350,6 +350,11 @@ BIOMECHANICS_RUNS = {
     # (the ramps near it twice as long)
     ("stations/single/grasp(O1)", 1.55): "joint_speed:junction_ramp",
     ("wall_gap/single/grasp(O1)", 1.75): "joint_speed:junction_ramp",
+    # a 1.55 m worker's hand rising over the wall shelf's edge close to the shoulder
+    # folded the elbow to 151-164 deg; fixed by goals._ELBOW_MAX_FLEXION (the arm's IK
+    # keeps the wrist that far from the shoulder)
+    ("shelf_heights/job/overhead_down", 1.55): "range_of_motion:elbow_over_edge",
+    ("shelf_heights/single/move(O_over, R1)", 1.55): "range_of_motion:elbow_over_edge",
 }
 
 

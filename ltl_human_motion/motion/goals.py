@@ -173,6 +173,10 @@ _SUPPORT_FREE_PARTS: tuple[str, ...] = (
 #: Degrees the posture search keeps inside the hip and knee ranges of motion of
 #: planning.biomechanics (blending and foot locking move the legs by a degree or two).
 _ROM_MARGIN = 3.0
+#: The elbow folds at most this far, radians: the range of motion's 150 deg less
+#: ``_ROM_MARGIN`` (a hand path rising over a shelf's edge close to the shoulder folded a
+#: 1.55 m worker's elbow to 151-164 deg; the wrist stays that far from the shoulder).
+_ELBOW_MAX_FLEXION = float(np.radians(150.0 - _ROM_MARGIN))
 #: The obstacles around a worker as the posture search sees them
 #: (:func:`make_goal_primitive`'s ``obstacles``): ``clearance(poses, parts)`` is the
 #: smallest clearance (m) of the capsules ``parts`` (names of
@@ -365,7 +369,8 @@ def _body(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, ankles: np.
         sh, el, wr, ha = (_J[f"{s}_{n}"] for n in ("shoulder", "elbow", "wrist", "hand"))
         hd = hand_dir[:, k] / np.linalg.norm(hand_dir[:, k], axis=-1, keepdims=True)
         elbow, wrist = two_bone_ik(out[:, sh], hands[:, k] - b[ha] * hd, b[el], b[wr],
-                                   elbow_pole[:, k], max_stretch=1.0)
+                                   elbow_pole[:, k], max_stretch=1.0,
+                                   max_flexion=_ELBOW_MAX_FLEXION)
         out[:, el], out[:, wr], out[:, ha] = elbow, wrist, wrist + b[ha] * hd
     return out
 
@@ -561,7 +566,8 @@ def _legs_in_range(skeleton: Skeleton, st: _Start, pelvis: np.ndarray, pitch: np
     poses = _body(skeleton, pelvis, pitch, *legs,
                   shoulders + st.hand_rel, np.broadcast_to(st.hand_dir, (C, 2, 3)),
                   np.broadcast_to(st.elbow_pole, (C, 2, 3)), trunk)
-    angles = joint_angles(poses)
+    angles = joint_angles(poses, [f"{s}_{n}" for s in _SIDES
+                                  for n in ("hip_flexion", "knee_flexion")])
     rom = BiomechanicsLimits().rom
     ok = np.ones(C, bool)
     for s in _SIDES:

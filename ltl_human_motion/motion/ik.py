@@ -10,7 +10,8 @@ __all__ = ["SEGMENT_MASS", "center_of_mass", "min_jerk", "two_bone_ik"]
 
 
 def two_bone_ik(base: np.ndarray, target: np.ndarray, l1: float, l2: float,
-                pole: np.ndarray, max_stretch: float = 0.999) -> tuple[np.ndarray, np.ndarray]:
+                pole: np.ndarray, max_stretch: float = 0.999,
+                max_flexion: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Place the middle joint of a two-bone chain (arm or leg) analytically.
 
     Parameters
@@ -26,6 +27,9 @@ def two_bone_ik(base: np.ndarray, target: np.ndarray, l1: float, l2: float,
     max_stretch : float
         The chain is never straighter than this fraction of ``l1 + l2``; a target further
         away is pulled in along the base-target line.
+    max_flexion : float, optional
+        The chain never folds further than this angle between its bones (radians; 0 is
+        straight); a target nearer the base is pushed out along the base-target line.
 
     Returns
     -------
@@ -40,6 +44,8 @@ def two_bone_ik(base: np.ndarray, target: np.ndarray, l1: float, l2: float,
     dist = np.linalg.norm(v, axis=-1, keepdims=True)
     u = v / np.maximum(dist, 1e-9)
     dmin = abs(l1 - l2) + 1e-6
+    if max_flexion is not None:
+        dmin = max(dmin, float(np.sqrt(l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * np.cos(max_flexion))))
     d = np.clip(dist, dmin, max_stretch * (l1 + l2))
     end = base + u * d
     # distance along u of the middle joint, and its offset from the line

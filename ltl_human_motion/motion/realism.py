@@ -44,6 +44,9 @@ _UNITS = {"hand_speed": "m/s", "knee_speed": "m/s", "foot_speed": "m/s", "knee_a
           "hip_angle": "deg", "elbow_angle": "deg", "trunk_angle": "deg",
           "hand_jerk": "m/s^3", "step_length": "m", "cadence": "steps/min",
           "foot_skate": "m/s"}
+#: The joint angles the metrics sample (:func:`motion_samples`).
+_ANGLES = ("l_knee_flexion", "r_knee_flexion", "l_hip_flexion", "r_hip_flexion",
+           "l_elbow_flexion", "r_elbow_flexion", "trunk_flexion")
 #: Shortest time between two strikes of opposite feet counted as steps, s (cadences over
 #: 200 steps/min are running).
 _MIN_STEP = 0.3
@@ -94,7 +97,7 @@ def motion_samples(positions: np.ndarray, fps: float, stature: float = DEFAULT_S
     out["hand_speed"] = vs[:, [_J["l_hand"], _J["r_hand"]]].ravel()
     out["knee_speed"] = vs[:, [_J["l_knee"], _J["r_knee"]]].ravel()
     out["foot_speed"] = vs[:, [_J["l_ankle"], _J["r_ankle"]]].ravel()
-    ang = joint_angles(p)
+    ang = joint_angles(p, _ANGLES)
     out["knee_angle"] = np.concatenate([ang["l_knee_flexion"][sel], ang["r_knee_flexion"][sel]])
     out["hip_angle"] = np.concatenate([ang["l_hip_flexion"][sel], ang["r_hip_flexion"][sel]])
     out["elbow_angle"] = np.concatenate([ang["l_elbow_flexion"][sel],

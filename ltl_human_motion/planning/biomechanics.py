@@ -54,7 +54,7 @@ Limits and where they come from (:class:`BiomechanicsLimits`):
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -180,7 +180,13 @@ def _frame(lateral: np.ndarray, up: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return cross3(left, u), left, u
 
 
-def joint_angles(positions: np.ndarray) -> dict[str, np.ndarray]:
+#: The angles of :func:`joint_angles` measured in the chest's frame.
+_CHEST_ANGLES = ("l_shoulder_extension", "r_shoulder_extension", "trunk_flexion",
+                 "trunk_lateral", "trunk_rotation", "neck_flexion", "neck_lateral")
+
+
+def joint_angles(positions: np.ndarray, names: Collection[str] | None = None
+                 ) -> dict[str, np.ndarray]:
     """Anatomical joint angles of every frame, degrees.
 
     Keys (each an array of shape (T,)): ``{l,r}_knee_flexion`` (signed about the knee's
@@ -193,33 +199,50 @@ def joint_angles(positions: np.ndarray) -> dict[str, np.ndarray]:
     Parameters
     ----------
     positions : array-like, shape (T, J, 3)
+    names : collection of str, optional
+        Only these keys (the same values); default all.
     """
     p = np.asarray(positions, dtype=np.float64)
+    want = (lambda key: True) if names is None else frozenset(names).__contains__
     deg = np.degrees
     out: dict[str, np.ndarray] = {}
     fwd, left, up = _frame(p[:, _J["l_hip"]] - p[:, _J["r_hip"]],
                            p[:, _J["spine"]] - p[:, _J["pelvis"]])
-    cf, cl, cu = _frame(p[:, _J["l_shoulder"]] - p[:, _J["r_shoulder"]],
-                        p[:, _J["neck"]] - p[:, _J["chest"]])
+    if any(want(k) for k in _CHEST_ANGLES):
+        cf, cl, cu = _frame(p[:, _J["l_shoulder"]] - p[:, _J["r_shoulder"]],
+                            p[:, _J["neck"]] - p[:, _J["chest"]])
     for s, side in (("l", 1.0), ("r", -1.0)):
         hip, knee, ank, toe = (p[:, _J[f"{s}_{n}"]] for n in ("hip", "knee", "ankle", "toe"))
         thigh, shank, foot = knee - hip, ank - knee, toe - ank
-        axis = _unit(-cross3(shank, foot))
-        cr = dot3(cross3(thigh, shank), axis)
-        out[f"{s}_knee_flexion"] = deg(np.arctan2(cr, dot3(thigh, shank)))
+        if want(f"{s}_knee_flexion"):
+            axis = _unit(-cross3(shank, foot))
+            cr = dot3(cross3(thigh, shank), axis)
+            out[f"{s}_knee_flexion"] = deg(np.arctan2(cr, dot3(thigh, shank)))
         t = _unit(thigh)
-        out[f"{s}_hip_flexion"] = deg(np.arctan2(dot3(t, fwd), -dot3(t, up)))
-        out[f"{s}_hip_abduction"] = deg(np.arcsin(np.clip(side * dot3(t, left), -1, 1)))
+        if want(f"{s}_hip_flexion"):
+            out[f"{s}_hip_flexion"] = deg(np.arctan2(dot3(t, fwd), -dot3(t, up)))
+        if want(f"{s}_hip_abduction"):
+            out[f"{s}_hip_abduction"] = deg(np.arcsin(np.clip(side * dot3(t, left), -1, 1)))
+        if not (want(f"{s}_elbow_flexion") or want(f"{s}_shoulder_extension")):
+            continue
         sh, el, wr = (p[:, _J[f"{s}_{n}"]] for n in ("shoulder", "elbow", "wrist"))
         ua, fa = _unit(el - sh), _unit(wr - el)
-        out[f"{s}_elbow_flexion"] = deg(np.arccos(np.clip(dot3(ua, fa), -1, 1)))
-        out[f"{s}_shoulder_extension"] = deg(np.arcsin(np.clip(-dot3(ua, cf), -1, 1)))
-    out["trunk_flexion"] = deg(np.arctan2(dot3(cu, fwd), dot3(cu, up)))
-    out["trunk_lateral"] = deg(np.arcsin(np.clip(dot3(cu, left), -1, 1)))
-    out["trunk_rotation"] = deg(np.arctan2(dot3(cl, -fwd), dot3(cl, left)))
-    h = _unit(p[:, _J["head"]] - p[:, _J["neck"]])
-    out["neck_flexion"] = deg(np.arctan2(dot3(h, cf), dot3(h, cu)))
-    out["neck_lateral"] = deg(np.arcsin(np.clip(dot3(h, cl), -1, 1)))
+        if want(f"{s}_elbow_flexion"):
+            out[f"{s}_elbow_flexion"] = deg(np.arccos(np.clip(dot3(ua, fa), -1, 1)))
+        if want(f"{s}_shoulder_extension"):
+            out[f"{s}_shoulder_extension"] = deg(np.arcsin(np.clip(-dot3(ua, cf), -1, 1)))
+    if want("trunk_flexion"):
+        out["trunk_flexion"] = deg(np.arctan2(dot3(cu, fwd), dot3(cu, up)))
+    if want("trunk_lateral"):
+        out["trunk_lateral"] = deg(np.arcsin(np.clip(dot3(cu, left), -1, 1)))
+    if want("trunk_rotation"):
+        out["trunk_rotation"] = deg(np.arctan2(dot3(cl, -fwd), dot3(cl, left)))
+    if want("neck_flexion") or want("neck_lateral"):
+        h = _unit(p[:, _J["head"]] - p[:, _J["neck"]])
+        if want("neck_flexion"):
+            out["neck_flexion"] = deg(np.arctan2(dot3(h, cf), dot3(h, cu)))
+        if want("neck_lateral"):
+            out["neck_lateral"] = deg(np.arcsin(np.clip(dot3(h, cl), -1, 1)))
     return out
 
 

@@ -263,7 +263,6 @@ def _under_deadline(fn):
     return wrapper
 
 
-@_under_deadline
 def _stature_of(library, stature: float | None) -> float:
     """The worker's stature, metres: ``stature``, else the library's, else
     ``DEFAULT_STATURE``; a ``ValueError`` where ``stature`` contradicts the library."""
@@ -277,6 +276,7 @@ def _stature_of(library, stature: float | None) -> float:
     return float(stature)
 
 
+@_under_deadline
 def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
                cycles: int = 1, stature: float | None = None,
                options: SynthesisOptions | None = None) -> list[SynthesizedMotion]:

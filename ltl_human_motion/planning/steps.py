@@ -606,6 +606,12 @@ class StepExecutor:
             return False
         reach = self.ctx.options.adjust_radius
         most = STEP_TOWARDS_REACH * reach
+        left = float(goal.distance(np.array([x]), np.array([y]))[0])
+        if np.isfinite(left) and left > most + reach + 2.0 * self.ctx.options.grid_resolution:
+            # The spots the goal accepts stand within ``reach`` of its floor cells (the
+            # ideal placements): none within the steps' reach (the walk's own field,
+            # path lengths at least the straight distance, a cell off).
+            return False
         g = np.arange(-most, most + 1e-9, STEP_INTO_GRID)
         dx, dy = (v.ravel() for v in np.meshgrid(g, g))
         far = np.hypot(dx, dy)
