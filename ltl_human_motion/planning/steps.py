@@ -587,7 +587,7 @@ class StepExecutor:
         steps into ``goal`` (if given, :meth:`step_into`). Returns whether it stepped."""
         if self._step_towards(target, placement, back_limit, stand_yaw):
             return True
-        return goal is not None and (self.step_into(goal) or self.step_into(goal, turn=True))
+        return goal is not None and self.step_into(goal, turn=True)
 
     def step_into(self, goal: Goal, turn: bool = False) -> bool:
         """Up to ``STEP_TOWARDS_REACH`` model-made steps of at most
@@ -595,14 +595,13 @@ class StepExecutor:
         reach where ``goal.reached`` holds, if the worker is not there yet and every step
         is clear (the nearest ``STEP_INTO_TRIES`` spots tried). A walk's goal next to
         furniture may be smaller than the gait's shortest start and stop: a search from
-        close by floods the floor around it. With ``turn``, the worker first turns on the
-        spot to the goal's heading there (``goal.heading``; where the goal needs the worker
-        facing its target, e.g. in an aisle too narrow to turn in at the spot, the gait's
-        turns take a search of thousands of nodes). Returns whether it stepped."""
-        from ltl_human_motion.planning.turns import make_step_primitive
+        close by floods the floor around it. With ``turn``, where no such steps are clear,
+        the worker turns on the spot to the goal's heading (``goal.heading``) and then
+        steps (where the goal needs the worker facing its target, e.g. in an aisle too
+        narrow to turn in at the spot, the gait's turns take a search of thousands of
+        nodes). Returns whether it stepped."""
         x, y, yaw = self.state.pose
-        if (turn and goal.heading is None) \
-                or bool(goal.reached(np.array([x]), np.array([y]), np.array([yaw]))[0]):
+        if bool(goal.reached(np.array([x]), np.array([y]), np.array([yaw]))[0]):
             return False
         reach = self.ctx.options.adjust_radius
         most = STEP_TOWARDS_REACH * reach
@@ -617,30 +616,46 @@ class StepExecutor:
         far = np.hypot(dx, dy)
         c, s = math.cos(yaw), math.sin(yaw)
         wx, wy = x + c * dx - s * dy, y + s * dx + c * dy
-        ok = (far <= most) & ((far > 0.0) | turn)
+        near = far <= most
+        plain = near & (far > 0.0)
+        plain[plain] = goal.reached(wx[plain], wy[plain], np.full(int(plain.sum()), yaw))
+        if self._steps_into(plain, dx, dy, far, None):
+            return True
+        if not turn or goal.heading is None:
+            return False
         heading = np.full(len(far), yaw)
-        if turn:
-            heading[ok] = goal.heading(wx[ok], wy[ok])
-            ok &= np.abs(wrap_angle(heading - yaw)) > self.ctx.options.heading_tolerance
-        ok[ok] = goal.reached(wx[ok], wy[ok], heading[ok])
+        heading[near] = goal.heading(wx[near], wy[near])
+        turns = wrap_angle(heading - yaw)
+        turned = near & (np.abs(turns) > self.ctx.options.heading_tolerance)
+        turned[turned] = goal.reached(wx[turned], wy[turned], heading[turned])
+        return self._steps_into(turned, dx, dy, far, turns)
+
+    def _steps_into(self, spots: np.ndarray, dx: np.ndarray, dy: np.ndarray,
+                    far: np.ndarray, turns: np.ndarray | None) -> bool:
+        """:meth:`step_into`'s steps to the nearest of ``spots`` (bool (G,) over the grid
+        offsets ``dx``, ``dy`` (G,) in the worker's frame, ``far`` (G,) their lengths),
+        after a turn on the spot by ``turns`` (G,) radians if given, the first
+        ``STEP_INTO_TRIES`` tried; the first whose moves are all clear is taken."""
+        from ltl_human_motion.planning.turns import make_step_primitive
         lib = self.ctx.library
         stance = self.ctx.stance(self.state.carrying)
         task = "carry" if self.state.carrying else "walk"
+        reach = self.ctx.options.adjust_radius
 
         def step(ddx: float, ddy: float, dyaw: float) -> MotionPrimitive:
             return make_step_primitive(stance, lib.standing_height, ddx, ddy, dyaw,
                                        lib.skeleton, lib.fps, task)
 
-        for k in np.flatnonzero(ok)[np.argsort(far[ok], kind="stable")][:STEP_INTO_TRIES]:
+        for k in np.flatnonzero(spots)[np.argsort(far[spots], kind="stable")][:STEP_INTO_TRIES]:
             moves: list[MotionPrimitive] = []
             ddx, ddy = float(dx[k]), float(dy[k])
-            if turn:
-                dyaw = float(wrap_angle(heading[k] - yaw))
+            if turns is not None:
+                dyaw = float(turns[k])
                 moves.append(step(0.0, 0.0, dyaw))
                 cy, sy = math.cos(dyaw), math.sin(dyaw)
                 ddx, ddy = cy * ddx + sy * ddy, -sy * ddx + cy * ddy
             n = math.ceil(far[k] / reach - 1e-9)
-            if n:
+            if n:                                    # (none for a turn where it stands)
                 moves += [step(ddx / n, ddy / n, 0.0)] * n
             poses = [self.state.pose]
             for mp in moves[:-1]:
