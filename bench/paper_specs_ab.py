@@ -6,9 +6,10 @@ commit before the scenario-corpus work, whose S1/S2 times issue 11 says must not
 more than 20 %) into a git worktree under ``.build/ab/``, then alternates runs of the two
 trees in fresh processes: each run synthesizes S1 and S2 with seeds 0-8, twice, after a
 warm-up, and reports the median CPU time per motion. The ratio this tree / base is taken
-per pair of neighbouring runs; their median is the result. ``--biomechanics`` times this
-tree with the biomechanical checks (and foot locking) against the base's default.
-Prints a table and writes ``bench/results/paper_specs_ab.json``.
+per pair of neighbouring runs; their median is the result. This tree runs with its
+default, the biomechanical checks (and foot locking) on; ``--no-biomechanics`` times it
+without them, as the base verifies. Prints a table and writes
+``bench/results/paper_specs_ab.json`` (``paper_specs_ab_without_biomechanics.json``).
 Not a test: run ``python bench/paper_specs_ab.py``.
 """
 
@@ -31,15 +32,15 @@ DEFAULT_BASE = "a6ece0b^"
 
 _CHILD = r"""
 import json, sys, time, statistics
-tree, bio = sys.argv[1], sys.argv[2] == "1"
+tree, mode = sys.argv[1], sys.argv[2]
 sys.path.insert(0, tree)
 from ltl_human_motion.planning import pipeline
 from ltl_human_motion.planning.pipeline import get_library, resolve_cell, synthesize
 kw = {}
-if bio:
+if mode != "default":
     from ltl_human_motion.planning.pipeline import SynthesisOptions
     from ltl_human_motion.planning.verify import VerificationOptions
-    kw["options"] = SynthesisOptions(verification=VerificationOptions(biomechanics=True))
+    kw["options"] = SynthesisOptions(verification=VerificationOptions(biomechanics=mode == "on"))
 cell, lib = resolve_cell("paper_cell"), get_library()
 out = {}
 for name in ("S1", "S2"):
@@ -68,9 +69,11 @@ def worktree(ref: str) -> Path:
     return path
 
 
-def run(tree: Path, bio: bool) -> dict[str, float]:
-    """Median CPU seconds per S1 and S2 motion of one fresh process on ``tree``."""
-    res = subprocess.run([sys.executable, "-c", _CHILD, str(tree), "1" if bio else "0"],
+def run(tree: Path, mode: str) -> dict[str, float]:
+    """Median CPU seconds per S1 and S2 motion of one fresh process on ``tree``, with its
+    default verification (``mode`` "default") or the biomechanical checks "on" or
+    "off"."""
+    res = subprocess.run([sys.executable, "-c", _CHILD, str(tree), mode],
                          check=True, capture_output=True, text=True)
     return json.loads(res.stdout.strip().splitlines()[-1])
 
@@ -79,14 +82,14 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--base", default=DEFAULT_BASE, help="git ref to compare against")
     parser.add_argument("--pairs", type=int, default=6)
-    parser.add_argument("--biomechanics", action="store_true",
-                        help="this tree with the biomechanical checks")
+    parser.add_argument("--no-biomechanics", action="store_true",
+                        help="this tree without the biomechanical checks")
     parser.add_argument("--out", type=Path, default=None)
     args = parser.parse_args(argv)
     base = worktree(args.base)
     pairs = []
     for k in range(args.pairs):
-        b, h = run(base, False), run(ROOT, args.biomechanics)
+        b, h = run(base, "default"), run(ROOT, "off" if args.no_biomechanics else "on")
         pairs.append({"base": b, "head": h})
         print(f"pair {k + 1}: base S1 {b['S1'] * 1e3:.1f} ms, S2 {b['S2'] * 1e3:.1f} ms; "
               f"this tree S1 {h['S1'] * 1e3:.1f} ms, S2 {h['S2'] * 1e3:.1f} ms", flush=True)
@@ -95,12 +98,14 @@ def main(argv: list[str] | None = None) -> int:
     head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
                           capture_output=True, text=True).stdout.strip()
     report = {"benchmark": "paper_specs_ab", "base": args.base, "base_tree": base.name,
-              "head": head, "biomechanics": args.biomechanics, "pairs": pairs,
+              "head": head, "biomechanics": not args.no_biomechanics, "pairs": pairs,
               "ratio_median": ratio, "limit": 1.2}
     print(f"this tree / {args.base}: S1 {ratio['S1']:.3f}x, S2 {ratio['S2']:.3f}x "
-          f"(issue 11 allows 1.2x){' with the biomechanical checks' if args.biomechanics else ''}")
+          f"(issue 11 allows 1.2x), "
+          f"{'without' if args.no_biomechanics else 'with'} the biomechanical checks")
     out = args.out or ROOT / "bench" / "results" / (
-        "paper_specs_ab_biomechanics.json" if args.biomechanics else "paper_specs_ab.json")
+        "paper_specs_ab_without_biomechanics.json" if args.no_biomechanics
+        else "paper_specs_ab.json")
     out.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out, json.dumps(report, indent=1))
     print(f"wrote {out}")

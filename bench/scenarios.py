@@ -12,7 +12,8 @@ writes ``bench/results/scenarios.json``:
 * a short table per cell.
 
 Not a test: run ``python bench/scenarios.py`` (``--quick`` for a short look,
-``--cells shelf_heights bins``, ``--limit 50``).
+``--cells shelf_heights bins``, ``--limit 50``; ``--no-biomechanics`` verifies without
+the biomechanical checks, which are on by default).
 """
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ def _job(item: dict) -> dict:
     """Run one (pair, stature, seed) in a worker; returns the item with its outcome."""
     cell = item["cell_yaml"] if item.get("cell_yaml") else item["cell_file"]
     outcome = run_pair(item["spec"], cell, item["stature"], item["seed"], item["timeout"],
-                       biomechanics=item.get("biomechanics", False))
+                       biomechanics=item.get("biomechanics", True))
     ok, family = judge(item["expect"], item.get("reason"), outcome)
     out = {k: v for k, v in item.items() if k != "cell_yaml"}
     out.update(outcome=outcome.as_dict(), ok=ok, family=family)
@@ -93,7 +94,7 @@ def _items(args) -> list[dict]:
                               "cell_file": p.cell_file, "spec": p.spec, "expect": p.expect,
                               "reason": p.reason, "family_label": p.family,
                               "stature": stature, "seed": seed, "timeout": args.timeout,
-                              "biomechanics": args.biomechanics})
+                              "biomechanics": not args.no_biomechanics})
     if args.generated > 0:
         from ltl_human_motion.scenarios.generator import generate_scenarios
         for scen in generate_scenarios(args.generated, seed=args.generator_seed):
@@ -103,7 +104,7 @@ def _items(args) -> list[dict]:
                               "spec": gp.spec, "expect": gp.expect, "reason": gp.reason,
                               "family_label": gp.family, "stature": scen.stature,
                               "seed": 0, "timeout": args.timeout,
-                              "biomechanics": args.biomechanics})
+                              "biomechanics": not args.no_biomechanics})
     return items
 
 
@@ -224,13 +225,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT,
                         help="seconds per pair")
     parser.add_argument("--workers", type=int, default=MAX_WORKERS)
-    parser.add_argument("--biomechanics", action="store_true",
-                        help="verify with the biomechanical checks (and their motion work)")
+    parser.add_argument("--no-biomechanics", action="store_true",
+                        help="verify without the biomechanical checks (and their motion "
+                             "work: foot locking), as before they were on by default")
     parser.add_argument("--quick", action="store_true",
                         help="one stature (1.75 m), one seed, 60 pairs, 3 generated cells")
-    parser.add_argument("--out", type=Path,
-                        default=ROOT / "bench" / "results" / "scenarios.json")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="default bench/results/scenarios.json, with --no-biomechanics "
+                             "bench/results/scenarios_without_biomechanics.json")
     args = parser.parse_args(argv)
+    args.out = args.out or ROOT / "bench" / "results" / (
+        "scenarios_without_biomechanics.json" if args.no_biomechanics else "scenarios.json")
     if args.quick:
         args.statures, args.seeds = [1.75], 1
         args.limit = args.limit or 60
@@ -265,7 +270,7 @@ def main(argv: list[str] | None = None) -> int:
     report = {"benchmark": "scenarios", "machine": machine(), "commit": _commit(),
               "load_average": list(os.getloadavg()), "statures": args.statures,
               "seeds": args.seeds, "timeout_s": args.timeout, "workers": workers,
-              "biomechanics": bool(args.biomechanics),
+              "biomechanics": not args.no_biomechanics,
               "wall_time_s": wall, "specs": str(args.specs.relative_to(ROOT))
               if args.specs.resolve().is_relative_to(ROOT) else str(args.specs),
               "cells_selected": args.cells, "limit": args.limit,

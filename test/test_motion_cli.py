@@ -1,4 +1,5 @@
-"""``ltl-human-motion library``: builds the library, writes the report and the plot."""
+"""``ltl-human-motion library`` (builds the library, writes the report and the plot) and
+``ltl-human-motion synthesize``."""
 
 from __future__ import annotations
 
@@ -49,3 +50,20 @@ def test_library_parser_has_options() -> None:
     assert args.stature == 1.6 and args.delta == 0.3
     with pytest.raises(SystemExit):
         build_parser().parse_args(["library", "--stature", "tall"])
+
+
+def test_synthesize_command_verifies_with_the_biomechanical_checks_unless_told(
+        tmp_path: Path, capsys) -> None:
+    rc = main(["synthesize", "--cell", "paper_cell", "--spec", "S1", "--out",
+               str(tmp_path / "on")])
+    assert rc == 0
+    out = capsys.readouterr().out
+    assert "verified: yes" in out
+    checks = json.loads(out[out.index("{"):])["motions"][0]["verification"]
+    assert checks["foot_skate"] and checks["joint_speed"] and checks["self_penetration"]
+    assert (tmp_path / "on" / "motion_000.npz").is_file()
+    rc = main(["synthesize", "--cell", "paper_cell", "--spec", "S1", "--out",
+               str(tmp_path / "off"), "--no-biomechanics"])
+    out = capsys.readouterr().out
+    checks = json.loads(out[out.index("{"):])["motions"][0]["verification"]
+    assert rc == 0 and checks["collision"] and "foot_skate" not in checks

@@ -6,6 +6,7 @@ a gap only the footprints leave (the aisle's planning:*:blocked)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from ltl_human_motion.planning.astar import placement_key
 from ltl_human_motion.planning.navigation import (
@@ -255,3 +256,39 @@ def test_field_leads_from_the_floor_beside_the_lanes() -> None:
         - goal.distance(np.array([-0.5]), np.array([0.0]))[0]
     assert abs(along) < 0.2 * (1.0 + LANE_NARROW_COST)
     assert 0.1 < away <= 0.2 + 0.05
+
+
+def test_the_reach_goals_band_holds_every_spot_ideal_placement_can_pick() -> None:
+    # the goal test of a reach skips poses outside this band: every spot of
+    # standing.ideal_placement (target - R(yaw) (d + b, lat), b in [0, back]) within
+    # ``adjust`` of a pose puts that pose inside it
+    from ltl_human_motion.planning.walk_goals import _spot_band
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        d, lat = rng.uniform(-0.2, 0.7), rng.uniform(-0.4, 0.4)
+        back, adjust = rng.uniform(0.0, 0.4), rng.uniform(0.05, 0.4)
+        lo, hi = _spot_band((d, lat), back, adjust)
+        b = rng.uniform(0.0, back, 50)
+        spots = np.hypot(d + b, lat)                      # distance of each spot
+        r = spots + rng.uniform(-adjust, adjust, 50)      # poses within adjust of it
+        assert np.all((r >= lo) & (r <= hi))
+
+
+def test_compiled_successor_poses_and_clearances_equal_the_numpy_ones() -> None:
+    # astar's one compiled call per expansion (ClearanceMap.placed_paths) gives the
+    # numbers of _place and _path_clearance, bit for bit
+    from ltl_human_motion.planning.astar import _path_clearance, _place
+    from ltl_human_motion.planning.gait_index import gait_index
+    from ltl_human_motion.planning.pipeline import get_library
+    index = gait_index(get_library())
+    cmap = ClearanceMap(cell_from_yaml(CELL), resolution=0.04)
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        ids = rng.choice(len(index.disp), 40)
+        pose = (rng.uniform(-2.2, 2.2), rng.uniform(-2.2, 2.2), rng.uniform(-7, 7))
+        placed = cmap.placed_paths(index.disp, index.path, ids, pose)
+        if placed is None:
+            pytest.skip("the compiled kernels are not in use")
+        ends, gap = placed
+        np.testing.assert_array_equal(ends, _place(index, ids, *pose))
+        np.testing.assert_array_equal(gap, _path_clearance(index, ids, *pose, cmap))

@@ -84,3 +84,28 @@ def test_a_limit_of_the_cell_is_not_tried_in_another_order(kitting) -> None:
     with pytest.raises(PlanningError) as err:
         _in_another_order(one, seqs[0], failure, lambda: seqs, cell, 1.75)
     assert err.value is failure
+
+
+def test_an_order_that_fails_like_one_tried_before_is_skipped(kitting) -> None:
+    cell, seqs = kitting
+    first = seqs[0]
+    failure = PlanningError("task grasp(gear): blocked", task="grasp(gear)", reason="blocked")
+    failure.step_index = 1
+    gear_first = [s for s in seqs if _texts(s)[0] == "grasp(gear)"]
+    assert len(gear_first) >= 2              # the same situation comes up more than once
+    tried = []
+
+    def one(seq):
+        texts = _texts(seq)
+        at = texts.index("grasp(gear)")
+        tried.append(frozenset(texts[:at]))
+        exc = PlanningError("task grasp(gear): still blocked", task="grasp(gear)",
+                            reason="blocked")
+        exc.step_index = at
+        raise exc
+
+    with pytest.raises(PlanningError) as err:
+        _in_another_order(one, first, failure, lambda: [first, *gear_first], cell, 1.75)
+    # the second order that grasps the gear first would fail as the first one did
+    assert tried == [frozenset()]
+    assert "1 other order(s) of the tasks failed too" in str(err.value)

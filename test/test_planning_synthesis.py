@@ -23,10 +23,10 @@ from ltl_human_motion.planning.result import SynthesizedMotion
 from ltl_human_motion.planning.verify import verify_motion
 from ltl_human_motion.scene.predicates import collision
 
-# The checks verify_motion runs by default; the biomechanical ones (joint_speed,
-# range_of_motion, self_penetration, balance, foot_skate) are opt-in for now and tested
-# in test_biomechanics.py.
-CHECKS = ("start", "collision", "termination", "ltl", "smoothness", "feet")
+# The checks verify_motion runs by default, the biomechanical ones (tested one by one in
+# test_biomechanics.py) included.
+CHECKS = ("start", "collision", "termination", "ltl", "smoothness", "feet",
+          "joint_speed", "range_of_motion", "self_penetration", "balance", "foot_skate")
 
 
 @pytest.fixture(scope="module")
@@ -196,6 +196,12 @@ def test_options_from_service_json_are_checked() -> None:
     assert opts.sequence_mode == "coverage" and opts.planner.budget.max_nodes == 500
     with pytest.raises(ValueError, match="unknown synthesis options"):
         SynthesisOptions.from_dict({"speed": 3})
+    # the biomechanical checks are on unless the request turns them off, with a boolean
+    assert SynthesisOptions.from_dict({}).verification.biomechanics is True
+    assert SynthesisOptions.from_dict({"biomechanics": False}).verification.biomechanics \
+        is False
+    with pytest.raises(ValueError, match="'biomechanics' must be true or false"):
+        SynthesisOptions.from_dict({"biomechanics": "no"})
 
 
 TASK_CELL = """

@@ -31,6 +31,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="output formats (repeatable; default npz and json)")
     parser.add_argument("--no-verify", action="store_true",
                         help="return motions even if a verification check fails")
+    parser.add_argument("--no-biomechanics", action="store_true",
+                        help="verify without the biomechanical checks (joint speed limits, "
+                             "range of motion, self-penetration, balance, foot skate)")
     parser.add_argument("--out", type=Path, default=Path("out/motions"),
                         help="output folder (default out/motions)")
 
@@ -39,12 +42,15 @@ def run(args: argparse.Namespace) -> int:
     """Synthesize, write each motion, print one line per motion and a JSON summary."""
     from ltl_human_motion.planning import exports
     from ltl_human_motion.planning.pipeline import SynthesisOptions, synthesize
+    from ltl_human_motion.planning.verify import VerificationOptions
 
     if args.variants < 1 or args.cycles < 1:
         print("ltl-human-motion synthesize: error: --variants and --cycles must be >= 1",
               file=sys.stderr)
         return 2
-    options = SynthesisOptions(sequence_mode=args.mode, verify=not args.no_verify)
+    options = SynthesisOptions(
+        sequence_mode=args.mode, verify=not args.no_verify,
+        verification=VerificationOptions(biomechanics=not args.no_biomechanics))
     motions = synthesize(args.spec, args.cell, variants=args.variants, seed=args.seed,
                          cycles=args.cycles, stature=args.stature, options=options)
     savers = {"npz": exports.save_npz, "json": exports.save_json, "csv": exports.save_csv,

@@ -134,6 +134,12 @@ _RISE_BELOW = 0.25
 #: Least horizontal distance (m) of such a rise from the shoulder: a board edge nearer
 #: than this and ``_RISE_FRONT`` leaves no room to raise the hand in front of it.
 _RISE_LEAST = 0.12
+#: Least horizontal distance of such a rise from the neck and head joints at the reach's
+#: end, m at 1.75 m, scaled by stature: the head capsule's radius (0.105 m) and 5 cm. A rise
+#: towards a target in front of the face (a short worker close to a wall shelf) took
+#: the hand down past the face, through the head capsule; it moves along the edge to
+#: the hand's own side instead, and the palm goes over the board to the target.
+_RISE_HEAD_CLEAR = 0.155
 #: A board over a part this close above its grasp point (m) leaves no room for a palm
 #: that points down as the arm does (the wrist a hand's length above it, in the board):
 #: the palm comes in level (:func:`_goal_hand_dir`; a part in a shelf compartment).
@@ -1117,12 +1123,32 @@ def _level_keys(targets: np.ndarray, active: tuple, sh1: np.ndarray, rel_home: n
             (total, rel_home)], frozenset()
 
 
+def _head_clear_shift(sh1: np.ndarray, k: int, rise: np.ndarray, normal: tuple[float, float],
+                      head: np.ndarray, clear: float) -> np.ndarray:
+    """Horizontal shift (2,) along a furniture edge (inward normal ``normal``) that takes
+    hand ``k``'s rise point ``rise`` (shoulder-relative, (2,)) ``clear`` metres from the
+    neck and the head (``head`` (2, 3), their positions at the reach's end; the
+    shoulders there ``sh1`` (2, 3)), towards that hand's side; zero where it is that far
+    already."""
+    e = np.array([-normal[1], normal[0]])
+    if float(e @ (sh1[k, :2] - sh1.mean(axis=0)[:2])) < 0.0:
+        e = -e
+    shift = 0.0
+    for point in head[:, :2]:
+        v = sh1[k, :2] + rise - point
+        ve = float(v @ e)
+        shift = max(shift, -ve + np.sqrt(max(ve * ve - float(v @ v) + clear * clear, 0.0)))
+    return shift * e
+
+
 def _rise_points(targets: np.ndarray, active: tuple, sh1: np.ndarray,
-                 support: tuple[float, float, float, float] | None, arm: float
+                 support: tuple[float, float, float, float] | None, arm: float,
+                 stature: float = DEFAULT_STATURE, head: np.ndarray | None = None
                  ) -> np.ndarray | None:
     """Shoulder-to-palm points (2, 3) in front of the edge of the furniture under the
     targets (``support`` (nx, ny, offset, top), start frame, :func:`_slab_depth`),
-    towards each active hand's target: where the level path's palms rise before they
+    towards each active hand's target (along the edge to the hand's own side where that
+    passes the face, ``_RISE_HEAD_CLEAR``): where the level path's palms rise before they
     come straight up and in over the furniture. Each is as high above the shoulder as
     keeps it ``_LEVEL_MIN_EXTENSION`` of ``arm`` from it (the elbow not folded on the
     way up), and no higher than ``_RISE_BELOW`` under the furniture's top. None unless
@@ -1142,6 +1168,9 @@ def _rise_points(targets: np.ndarray, active: tuple, sh1: np.ndarray,
         if ahead < _RISE_LEAST:
             return None
         rise[k, :2] = flat / dh * min(ahead, dh)
+        if head is not None:
+            rise[k, :2] += _head_clear_shift(sh1, k, rise[k, :2], (nx, ny), head,
+                                             _RISE_HEAD_CLEAR * stature / DEFAULT_STATURE)
         least = _LEVEL_MIN_EXTENSION * arm
         rise[k, 2] = min(np.sqrt(max(least ** 2 - float(np.sum(rise[k, :2] ** 2)), 0.0)),
                          top - sh1[k, 2] - _RISE_BELOW)
@@ -1361,19 +1390,20 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     tries = [(postures[0], w, True) for w in _WIDER_SWINGS] + \
         [(p, 1.0, True) for p in postures[1:]] + [(p, 1.0, False) for p in postures if p[4]]
     draws = rng.bit_generator.state
-    for n, (posture, wide, prop) in enumerate(tries):
+    for posture, wide, prop in tries:
         rng.bit_generator.state = draws
         world, f1, f2, contact_t = _reach_motion(
             task, skeleton, st, targets, active, posture,
             (level, travel, approach, board, support, flat_palm), rng, duration, fps, wide,
             prop)
-        if n + 1 == len(tries) or not _self_penetrates(world, H):
+        penetrates = _self_penetrates(world, H)
+        if not penetrates:
             break
     T = world.shape[0]
     contact = min(round(contact_t * fps), T - 1)
     meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
             "hold_frames": [f1, f2], "trunk_flexion": posture[0], "pelvis_drop": posture[1],
-            "posture": _posture_name(world[f1], skeleton)}
+            "posture": _posture_name(world[f1], skeleton), "self_penetrating": penetrates}
     return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
                    f"goals.make_goal_primitive({task!r}, target={_fmt(target)})", meta)
 
@@ -1428,8 +1458,8 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
         for k in active:
             rel_goal[k] = targets[k] - sh1[k]
             rel_pre[k] = targets[k] - travel * approach - sh1[k]
-        rise = _rise_points(targets, active, sh1, support, arm) if level and board is None \
-            else None
+        rise = _rise_points(targets, active, sh1, support, arm, H,
+                            tr[f1, [_J["neck"], _J["head"]]]) if level and board is None else None
         keys, contact_t, straight = _hand_keys(task, targets, active, sh1, rel_home, rel_goal,
                                                rel_pre, (t1, t2, total), level, board, H, arm,
                                                rise)

@@ -28,24 +28,28 @@ def _cell(grid, v):
 
 
 @_jit
+def _bilinear_at(xs, ys, values, in_lo, in_hi, x, y):
+    """The clearance at (x, y) on the grid values (nx, ny) at xs (nx,), ys (ny,); -1
+    outside the box in_lo, in_hi (2,)."""
+    if not (x >= in_lo[0] and x <= in_hi[0] and y >= in_lo[1] and y <= in_hi[1]):
+        return -1.0
+    i, j = _cell(xs, x), _cell(ys, y)
+    x0, y0 = xs[i], ys[j]
+    tx = (x - x0) / (xs[i + 1] - x0)
+    ty = (y - y0) / (ys[j + 1] - y0)
+    sx, sy = 1 - tx, 1 - ty
+    v = 0.0 + values[i, j] * sx * sy
+    v = v + values[i, j + 1] * sx * ty
+    v = v + values[i + 1, j] * tx * sy
+    return v + values[i + 1, j + 1] * tx * ty
+
+
+@_jit
 def bilinear(xs, ys, values, in_lo, in_hi, xy, out) -> None:
     """out[n] = clearance at xy[n] (N, 2) on the grid values (nx, ny) at xs (nx,), ys
     (ny,); -1 outside the box in_lo, in_hi (2,)."""
     for n in range(xy.shape[0]):
-        x, y = xy[n, 0], xy[n, 1]
-        if not (x >= in_lo[0] and x <= in_hi[0] and y >= in_lo[1] and y <= in_hi[1]):
-            out[n] = -1.0
-            continue
-        i, j = _cell(xs, x), _cell(ys, y)
-        x0, y0 = xs[i], ys[j]
-        tx = (x - x0) / (xs[i + 1] - x0)
-        ty = (y - y0) / (ys[j + 1] - y0)
-        sx, sy = 1 - tx, 1 - ty
-        v = 0.0 + values[i, j] * sx * sy
-        v = v + values[i, j + 1] * sx * ty
-        v = v + values[i + 1, j] * tx * sy
-        v = v + values[i + 1, j + 1] * tx * ty
-        out[n] = v
+        out[n] = _bilinear_at(xs, ys, values, in_lo, in_hi, xy[n, 0], xy[n, 1])
 
 
 @_jit
@@ -170,3 +174,25 @@ def body_samples_clear(grid, lo, res, far, pos, cand, samples, ia, ib, long, nee
             if not ok:
                 break
         out[n] = ok
+
+
+@_jit
+def placed_paths(disp, path, ids, x, y, yaw, c, s, xs, ys, values, in_lo, in_hi, ends, gap
+                 ) -> None:
+    """The search's successor poses and root-path clearances in one call: for primitive
+    ids[m] started at (x, y, yaw) (c, s: its cosine and sine), ends[m] (3,) its end pose
+    (``astar._place``'s arithmetic) and gap[m] the least :func:`bilinear` clearance of
+    its root path's points path[ids[m]] (S, 2) placed there (``astar._path_points``)."""
+    for m in range(ids.shape[0]):
+        p = ids[m]
+        ends[m, 0] = x + c * disp[p, 0] - s * disp[p, 1]
+        ends[m, 1] = y + s * disp[p, 0] + c * disp[p, 1]
+        ends[m, 2] = yaw + disp[p, 2]
+        least = np.inf
+        for k in range(path.shape[1]):
+            v = _bilinear_at(xs, ys, values, in_lo, in_hi,
+                             x + c * path[p, k, 0] - s * path[p, k, 1],
+                             y + s * path[p, k, 0] + c * path[p, k, 1])
+            if v < least or k == 0:
+                least = v
+        gap[m] = least

@@ -17,6 +17,7 @@ import numpy as np
 
 from ltl_human_motion.deadline import checkpoint
 from ltl_human_motion.planning.gait_index import GaitIndex
+from ltl_human_motion.planning.navigation import ClearanceMap
 
 Pose = tuple[float, float, float]
 
@@ -209,8 +210,13 @@ def _clear_successors(index: GaitIndex, prim: int, pose: Pose, allowed: np.ndarr
         succ = succ[[(int(p), *here) not in forbidden for p in succ.tolist()]]
     if succ.size == 0:
         return None
-    ends = _place(index, succ, px, py, pyaw)
-    gap = _path_clearance(index, succ, px, py, pyaw, clearance)
+    placed = (clearance.placed_paths(index.disp, index.path, succ, pose)
+              if isinstance(clearance, ClearanceMap) else None)
+    if placed is None:
+        ends = _place(index, succ, px, py, pyaw)
+        gap = _path_clearance(index, succ, px, py, pyaw, clearance)
+    else:
+        ends, gap = placed
     clear = gap > options.body_radius
     if not clear.any():
         return None
@@ -300,14 +306,15 @@ def _first_stop(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, near: np.n
 
 
 def _heuristic(goal: Goal, options: SearchOptions, x: np.ndarray, y: np.ndarray,
-               yaw: np.ndarray) -> np.ndarray:
+               yaw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Relaxed time (M,) to the goal from poses (M,): distance at the heuristic speed plus
-    the heading error at the turn rate."""
-    h = goal.distance(x, y) * (1.0 / options.heuristic_speed)
+    the heading error at the turn rate; and that distance, metres (M,)."""
+    left = goal.distance(x, y)
+    h = left * (1.0 / options.heuristic_speed)
     if goal.heading is not None:
         off = np.abs((goal.heading(x, y) - yaw + np.pi) % (2.0 * np.pi) - np.pi)
         h = h + off / options.turn_rate
-    return h
+    return h, left
 
 
 def _over_budget(budget: SearchBudget, t0: float, expanded: int, stall_nodes: int | None,
@@ -351,7 +358,8 @@ def _body_at(index: GaitIndex, ids: np.ndarray, x: float, y: float, yaw: float
     """Sampled body poses of primitives ``ids`` placed at (x, y, yaw), shape (M, B, J, 3)."""
     c, s = np.cos(yaw), np.sin(yaw)
     rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    body = index.body[ids] @ rot.T
+    local = index.body[ids]
+    body = (local.reshape(-1, 3) @ rot.T).reshape(local.shape)
     body[..., 0] += x
     body[..., 1] += y
     return body
@@ -485,7 +493,7 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
     if bool(goal.reached(np.array([sx]), np.array([sy]), np.array([syaw]))[0]):
         return SearchResult([], [], start, 0, time.perf_counter() - t0)
     allowed, step_cost = _step_costs(index, options, carry, rng)
-    h0 = float(_heuristic(goal, options, np.array([sx]), np.array([sy]), np.array([syaw]))[0])
+    h0 = float(_heuristic(goal, options, np.array([sx]), np.array([sy]), np.array([syaw]))[0][0])
     tree = _Tree(start, -1 if start_primitive is None else start_primitive, h0)
     expanded = 0
     near = _Closest(float(goal.distance(np.array([sx]), np.array([sy]))[0]), (sx, sy))
@@ -511,10 +519,10 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
             chain, chain_poses = tree.chain(node, int(succ[best]), tail)
             return SearchResult(chain, chain_poses, tuple(float(v) for v in ends[best]),
                                 expanded, time.perf_counter() - t0)
-        h_new = _heuristic(goal, options, ends[:, 0], ends[:, 1], ends[:, 2])
+        h_new, left = _heuristic(goal, options, ends[:, 0], ends[:, 1], ends[:, 2])
         keep = np.isfinite(h_new)
         if not keep.any():
             continue
-        near.update(goal.distance(ends[keep, 0], ends[keep, 1]), ends[keep], expanded)
+        near.update(left[keep], ends[keep], expanded)
         tree.push(node, succ[keep], ends[keep], g_new[keep], g_new[keep] + h_new[keep])
     return near.failure("blocked", expanded, t0)

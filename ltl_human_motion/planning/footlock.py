@@ -61,6 +61,13 @@ MAX_LOCK_BALL = 0.02
 #: or slides throughout.
 STILL_SPEED = 0.005
 STILL_TIME = 0.25
+#: Least time (s) a foot that shuffled on after its stance's pin reached ``MAX_LOCK``
+#: must then stand still (``STILL_SPEED``) for that to be pinned as a stance of its own
+#: (:func:`_next_stance`): the 0.07-0.1 s a stop's last flat shuffle stands before the
+#: next step (S1 at 1.95 m, seed 4), not a slow moment of a walk (0.12 s let a
+#: 0.5 m/s shuffle of a 1.95 m worker slide; a walk's extra stance took a 1.55 m
+#: worker's knee 0.3 % over its limit).
+SHUFFLE_STILL_TIME = 0.05
 #: Time the foot takes to return to its own path after a stance, s.
 RELEASE = 0.15
 #: Height above its rest height a moving, unplanted foot is lifted to, m: just above the
@@ -243,6 +250,25 @@ def _trim_to_anchor(run_off: np.ndarray, stance: np.ndarray, a: int, b: int, k: 
     return run_off, a, b
 
 
+def _next_stance(hc: np.ndarray, vc: np.ndarray, a: int, b: int, fps: float
+                 ) -> tuple[int, int] | None:
+    """Where the frames [a, b) left over after a stance's pin reached its limit plant the
+    foot again, standing: from the first frame slower than ``STANCE_SPEED`` to ``b``,
+    where a still part (``STILL_SPEED``, ``SHUFFLE_STILL_TIME``) follows; else None.
+    A flat foot shuffled forward a few centimetres without leaving the contact height
+    (a stop's last small step) is one run of low frames: its first standing part is
+    pinned, and the second would otherwise slide with nothing holding it. The caller
+    starts ``a`` a release time after the first stance, so the correction passes
+    between the two pins (:func:`_bridge_stances`) while the foot is lifted clear."""
+    if b - a < SHUFFLE_STILL_TIME * fps:
+        return None
+    still = vc[a:b] <= STILL_SPEED
+    if not any(e - s >= SHUFFLE_STILL_TIME * fps for s, e in _runs(still)):
+        return None
+    enter = np.flatnonzero((hc[a:b] <= CONTACT_HEIGHT) & (vc[a:b] <= STANCE_SPEED))
+    return a + int(enter[0]), b
+
+
 def _bridge_stances(disp: np.ndarray, weight: np.ndarray, n_rel: int) -> None:
     """Between two held stances closer than two release times (``n_rel`` frames each),
     pass the displacement ``disp`` (T, 2, 2) from the one to the other along the
@@ -307,12 +333,19 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     weight = np.zeros(T)
     n_rel = max(1, round(RELEASE * fps))
     ramp = min_jerk(np.arange(1, n_rel + 1) / (n_rel + 1))
-    for a, b in _runs(stance):
+    runs = _runs(stance)
+    while runs:
+        a, b = runs.pop(0)
         k = a + _anchor(held[np.arange(a, b), contact[a:b], :2], fps)
         run_off = _pin_offsets(held, h, a, b, k)
         ball = _roll_weight(h[a:b]) >= 1.0
+        end = b
         run_off, a, b = _trim_to_anchor(run_off, stance, a, b, k,
                                         np.where(ball, MAX_LOCK_BALL, MAX_LOCK))
+        tail = _next_stance(hc, v[np.arange(T), contact], b + n_rel, end, fps)
+        if tail is not None:
+            stance[tail[0]:tail[1]] = True
+            runs.insert(0, tail)
         # continuous where the contact passes from heel to ball (the pin continues, the
         # heading's pivot slides), and not smoothed: it cancels the motion's slide exactly
         disp[a:b] = held[a:b, :, :2] - joints[a:b, :, :2] + run_off[:, None]
@@ -446,8 +479,8 @@ def _segment_gaps(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
 def _pass_clear(p: np.ndarray, s: str, o: str, fps: float, stature: float,
                 rest_h: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
     """Ankle and toe targets (T, 3) each that keep foot ``s`` ("l"/"r") of ``p`` (T, J, 3)
-    clear of the other leg's (``o``) shank while the foot swings past it, or (None, None)
-    where it already is.
+    clear of the other leg's (``o``) shank and foot while the foot swings past them, or
+    (None, None) where it already is.
 
     The gait clips' narrow steps and turns, and the blends of their junctions, take a
     swinging foot through the standing leg's shank (self-penetration, issue 13): where
@@ -460,14 +493,23 @@ def _pass_clear(p: np.ndarray, s: str, o: str, fps: float, stature: float,
     foot's ankle and toe standing on the floor.
     """
     names = [c[0] for c in BODY_CAPSULES]
-    need = float(capsule_radii(stature)[names.index(f"{o}_shank")]) + FOOT_PASS_MARGIN
+    radii = capsule_radii(stature)
     ank, toe = p[:, _J[f"{s}_ankle"]], p[:, _J[f"{s}_toe"]]
-    gap, dist = _segment_gaps(ank, toe, p[:, _J[f"{o}_knee"]], p[:, _J[f"{o}_ankle"]])
+    # the other leg's shank, and its foot (a foot crossing in front of the planted one
+    # in a turn): whichever the foot lacks more room from
+    lack, gap = np.zeros(len(p)), np.zeros((len(p), 3))
+    for part, (a, b) in ((f"{o}_shank", ("knee", "ankle")), (f"{o}_foot", ("ankle", "toe"))):
+        need = max(float(radii[names.index(part)]), float(radii[names.index(f"{s}_foot")])) \
+            + FOOT_PASS_MARGIN
+        g, dist = _segment_gaps(ank, toe, p[:, _J[f"{o}_{a}"]], p[:, _J[f"{o}_{b}"]])
+        more = need - dist > lack
+        lack = np.where(more, need - dist, lack)
+        gap[more] = g[more]
     # swinging: heel and ball both move (a push-off's ankle moves about a planted ball)
     speed = np.zeros(len(p))
     speed[1:] = np.min(np.linalg.norm(np.diff(np.stack([ank, toe], 1)[:, :, :2], axis=0),
                                       axis=-1), axis=1) * fps
-    lack = np.where((dist < need) & (speed > STANCE_SPEED), need - dist, 0.0)
+    lack = np.where(speed > STANCE_SPEED, lack, 0.0)
     if not np.any(lack > 0):
         return None, None
     # the sideways direction of each pass: away from the shank, horizontally, held over

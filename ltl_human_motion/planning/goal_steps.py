@@ -189,7 +189,7 @@ class GoalSteps:
         seated = self.state.seat is not None and kind != "standUp"
         hand_fixed = "hand" in kwargs
         mp = None
-        kept_in = 0
+        kept_in = self_hits = 0
         blocked: list[MotionPrimitive] = []
         switched = None          # the hand tried first, after switching to the other one
         attempts = self.ctx.options.goal_attempts if attempts is None else attempts
@@ -212,6 +212,12 @@ class GoalSteps:
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
             clear = self.goal_clear(candidate, grasped)
+            through_body = clear and self.ctx.options.refuse_self_penetration \
+                and bool(candidate.meta.get("self_penetrating"))
+            if through_body:
+                # a limb through the body (the verifier's self-penetration check)
+                self_hits += 1
+                clear = False
             if clear and kind == "extract" and part is not None and container is not None \
                     and not self.pulls_out(candidate, part, container):
                 kept_in += 1
@@ -219,14 +225,15 @@ class GoalSteps:
             if clear:
                 mp = candidate
                 break
-            blocked.append(candidate)
+            if not through_body:
+                blocked.append(candidate)
             if attempt == 1 and kind in ("grasp", "release") and not hand_fixed \
                     and board is None:
                 other = OTHER_HAND.get(candidate.meta.get("hand"))
                 if other:
                     kwargs["hand"], switched = other, candidate.meta.get("hand")
         if mp is None:
-            raise self.refusal(text, kind, attempts, blocked, grasped, kept_in,
+            raise self.refusal(text, kind, attempts, blocked, grasped, (kept_in, self_hits),
                                part, container)
         seg = self.executor.add(mp, self.state.pose, label, self.ctx.overlap)
         self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
@@ -664,16 +671,25 @@ class GoalSteps:
                    for p in hand[contact::EXTRACT_CHECK_STRIDE])
 
     def refusal(self, text: str, kind: str, attempts: int, blocked: list[MotionPrimitive],
-                grasped: str | None, kept_in: int, part: str | None,
+                grasped: str | None, counts: tuple[int, int], part: str | None,
                 container: str | None) -> PlanningError:
-        """The error of a goal primitive none of whose ``attempts`` tries was clear."""
+        """The error of a goal primitive none of whose ``attempts`` tries was clear;
+        ``counts``: how many kept the part in its container, and how many took a limb
+        through the body, of those clear of obstacles."""
+        kept_in, self_hits = counts
+        if not blocked:
+            return PlanningError(f"task {text}: every {kind} motion tried ({attempts}) "
+                                 "takes a limb through the body from where the worker "
+                                 "stands", task=text, reason="blocked")
+        into = (f"{len(blocked)} of the {kind} motions tried ({attempts}) run into an "
+                f"obstacle, {self_hits} take a limb through the body" if self_hits
+                else f"every {kind} motion tried ({attempts}) runs into an obstacle")
         if kept_in:
             return PlanningError(f"task {text}: {kept_in} of the {attempts} {kind} motions "
                                  f"tried keep {part} in {container} (the hand does not take "
                                  "it out far enough from where the worker stands), the "
                                  "others run into an obstacle", task=text, reason="blocked")
-        return PlanningError(f"task {text}: every {kind} motion tried ({attempts}) runs "
-                             f"into an obstacle; {self.what_blocks(blocked, grasped)}",
+        return PlanningError(f"task {text}: {into}; {self.what_blocks(blocked, grasped)}",
                              task=text, reason="blocked")
 
     def what_blocks(self, blocked: list[MotionPrimitive], grasped: str | None) -> str:

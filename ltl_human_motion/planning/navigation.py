@@ -268,6 +268,23 @@ class ClearanceMap:
                   & (y >= self._in_lo[1]) & (y <= self._in_hi[1]))
         return np.where(inside, out, -1.0)
 
+    def placed_paths(self, disp: np.ndarray, path: np.ndarray, ids: np.ndarray,
+                     pose: tuple[float, float, float]
+                     ) -> tuple[np.ndarray, np.ndarray] | None:
+        """Where gait primitives ``ids`` (M,) started at ``pose`` (x, y, yaw) end, (M, 3),
+        and the least clearance along their root paths, (M,), in one compiled call
+        (``disp`` (P, 3) and ``path`` (P, S, 2): every primitive's displacement and root
+        path in its start frame); None where the compiled kernel is not in use."""
+        nb = _compiled_loops()
+        if nb is None:
+            return None
+        x, y, yaw = (float(v) for v in pose)
+        ends = np.empty((len(ids), 3))
+        gap = np.empty(len(ids))
+        nb.placed_paths(disp, path, ids, x, y, yaw, float(np.cos(yaw)), float(np.sin(yaw)),
+                        self._xs, self._ys, self._values, self._in_lo, self._in_hi, ends, gap)
+        return ends, gap
+
 
 def _trilinear(grid: np.ndarray, u: np.ndarray) -> np.ndarray:
     """Trilinear interpolation of ``grid`` (nx, ny, nz) at index coordinates ``u`` (N, 3).

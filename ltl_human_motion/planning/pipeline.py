@@ -71,11 +71,12 @@ class SynthesisOptions:
         can cancel, e.g. a node shutting down); overrides ``max_seconds``.
     foot_locking : bool
         Join the primitives by offset blending and pin the planted feet
-        (:mod:`~ltl_human_motion.planning.footlock`) before verification (always with the
-        biomechanical checks): whole-motion foot skate of S1/S2 0.0001 m/s instead of
-        0.06-0.09 m/s. If that moves a pose into an obstacle, the motion is blended again
-        without it (``stats["foot_locking"]`` says which). Default off for now: it changes
-        the motions other components' tests were measured on.
+        (:mod:`~ltl_human_motion.planning.footlock`) before verification: whole-motion
+        foot skate of S1/S2 0.0001 m/s instead of 0.06-0.09 m/s. Always done with the
+        biomechanical checks (``VerificationOptions.biomechanics``, the default), which
+        refuse a skating foot; this option is for verification without them, where a
+        motion whose locked feet moved a pose into an obstacle is blended again without
+        it (``stats["foot_locking"]`` says which).
     """
 
     sequence_mode: str = "all"
@@ -94,12 +95,14 @@ class SynthesisOptions:
 
         Keys: ``sequence_mode``, ``backend``, ``verify``, ``library_source``,
         ``heuristic_speed``, ``max_nodes``, ``max_seconds`` (the time budget of each
-        call, and of each search), ``cost_noise``, ``eps``, ``max_joint_speed``.
+        call, and of each search), ``cost_noise``, ``eps``, ``max_joint_speed``,
+        ``biomechanics`` (false: without the biomechanical checks).
         Unknown keys raise ValueError naming them.
         """
         from ltl_human_motion.planning.astar import SearchBudget
         known = {"sequence_mode", "backend", "verify", "library_source", "heuristic_speed",
-                 "max_nodes", "max_seconds", "cost_noise", "eps", "max_joint_speed"}
+                 "max_nodes", "max_seconds", "cost_noise", "eps", "max_joint_speed",
+                 "biomechanics"}
         unknown = sorted(set(data) - known)
         if unknown:
             raise ValueError(f"unknown synthesis options {unknown}; expected some of "
@@ -122,6 +125,11 @@ class SynthesisOptions:
         if "eps" in data or "max_joint_speed" in data:
             ver = replace(ver, eps=float(data.get("eps", ver.eps)),
                           max_joint_speed=float(data.get("max_joint_speed", ver.max_joint_speed)))
+        if "biomechanics" in data:
+            if not isinstance(data["biomechanics"], bool):
+                raise ValueError(f"synthesis option 'biomechanics' must be true or false, "
+                                 f"got {data['biomechanics']!r}")
+            ver = replace(ver, biomechanics=data["biomechanics"])
         return cls(sequence_mode=str(data.get("sequence_mode", base.sequence_mode)),
                    backend=str(data.get("backend", base.backend)),
                    planner=planner, verification=ver, verify=bool(data.get("verify", True)),
@@ -412,6 +420,15 @@ def _same_situation(other, seq, at: int, failed: set[str]) -> bool:
     return False
 
 
+def _failed_situation(seq, failure: PlanningError) -> tuple[int, set[str]] | None:
+    """Where ``failure`` (raised planning ``seq``) happened, for :func:`_same_situation`:
+    its step index and the texts of the task that failed; None if it does not say."""
+    at = failure.step_index
+    if at is None:
+        return None
+    return at, {_task_text(seq.tasks[at])} | ({failure.task} if failure.task else set())
+
+
 def _in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
                       failure: PlanningError, others: Callable[[], list], cell,
                       stature: float) -> SynthesizedMotion:
@@ -420,15 +437,17 @@ def _in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
     situation (:func:`_same_situation`); the first that plans. Raises ``failure``
     (saying how many orders were tried) if none does, or if its reason is not one
     another order can change."""
-    at = failure.step_index
-    if failure.reason not in _ORDER_REASONS or at is None:
+    where = _failed_situation(seq, failure)
+    if failure.reason not in _ORDER_REASONS or where is None:
         raise failure
-    failed = {_task_text(seq.tasks[at])} | ({failure.task} if failure.task else set())
+    # every situation a step failed in so far: an order that comes to one of them again
+    # is not tried (it would fail the same way)
+    situations = [(seq, *where)]
     tried = 0
     for other in others():
         if tried >= OTHER_ORDERS:
             break
-        if _same_situation(other, seq, at, failed):
+        if any(_same_situation(other, s, at, failed) for s, at, failed in situations):
             continue
         try:
             check_steps(cell, [(t.name, tuple(t.args)) for t in other.tasks], stature)
@@ -437,8 +456,10 @@ def _in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
         tried += 1
         try:
             return one(other)
-        except PlanningError:
-            continue
+        except PlanningError as exc:
+            where = _failed_situation(other, exc)
+            if where is not None:
+                situations.append((other, *where))
     if tried:
         raise PlanningError(f"{failure}; {tried} other order(s) of the tasks failed too",
                             task=failure.task, reason=failure.reason) from failure
@@ -501,7 +522,8 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     # Planned on a floor at z = 0; the motion, the parts and the targets are lifted back
     # (_blended) and verified in the user's own cell.
     floor_cell = cell.floor_at_zero()
-    planner = SequencePlanner(floor_cell, library, rng, options.planner)
+    planner = SequencePlanner(floor_cell, library, rng, replace(
+        options.planner, refuse_self_penetration=options.verification.biomechanics))
     start = _start_pose(floor_cell, planner.target_of(steps[0].kind, steps[0].args), rng)
     t0 = time.perf_counter()
     plan = planner.plan(steps, start)

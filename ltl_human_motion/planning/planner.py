@@ -120,6 +120,10 @@ class PlannerOptions:
     max_step_back : float
         How much further from the target than the preferred reach the worker may stand
         when an obstacle (a bench) is in the way; the goal primitive leans further.
+    refuse_self_penetration : bool
+        Take a goal primitive that takes a limb through the body (the biomechanical
+        self-penetration check) as blocked, so that other placements are tried.
+        Synthesis sets it from ``VerificationOptions.biomechanics``.
     """
 
     heuristic_speed: float = SearchOptions.heuristic_speed
@@ -135,6 +139,7 @@ class PlannerOptions:
     stand_clearance: float = 0.22
     max_step_back: float = 0.35
     grid_resolution: float = 0.05
+    refuse_self_penetration: bool = True
 
     @property
     def search(self) -> SearchOptions:

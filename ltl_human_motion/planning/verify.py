@@ -15,7 +15,7 @@ Checks (each a key of the report):
                  limits by body part and activity, anatomical range of motion, no body
                  part through another, static balance, foot skate): see
                  :mod:`~ltl_human_motion.planning.biomechanics` for the limits and their
-                 sources. Opt-in for now (``VerificationOptions.biomechanics``).
+                 sources. On by default (``VerificationOptions.biomechanics``).
 """
 
 from __future__ import annotations
@@ -55,7 +55,8 @@ class VerificationOptions:
         Longest time both feet may be more than ``flight_height`` above the floor, s.
     flight_height : float
     biomechanics : bool
-        Run the biomechanical checks (default off for now: README, "Human
+        Run the biomechanical checks (default on; off measures or reproduces the
+        motions of the looser verification of earlier releases: README, "Human
         plausibility").
     limits : BiomechanicsLimits
         Their limits (:mod:`~ltl_human_motion.planning.biomechanics`).
@@ -66,7 +67,7 @@ class VerificationOptions:
     floor_tolerance: float = 0.02
     max_flight: float = 0.15
     flight_height: float = 0.12
-    biomechanics: bool = False
+    biomechanics: bool = True
     limits: BiomechanicsLimits = field(default_factory=BiomechanicsLimits)
 
 

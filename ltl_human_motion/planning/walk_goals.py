@@ -12,6 +12,7 @@ the footprint map (the squeeze through a narrow aisle).
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -96,6 +97,25 @@ def _ring_stands(ctx: PlanContext, target: np.ndarray, placement: tuple[float, f
     on = side(x, y) & (ctx.stand_map(np.stack([x, y], axis=-1)) > ctx.stand_room)
     return bool(on.any()) and bool(ideal_placement(ctx, target, placement, x[on], y[on], tol,
                                                    stand_yaw=stand_yaw)[3].any())
+
+
+#: Metres the band of :func:`_spot_band` is widened by (rounding only).
+_BAND_SLACK = 1e-6
+
+
+def _spot_band(placement: tuple[float, float], back: float, adjust: float
+               ) -> tuple[float, float]:
+    """The distances from the target within which a root may pass a reach goal: every
+    spot :func:`.standing.ideal_placement` picks lies ``hypot(d + b, lat)`` from the
+    target for a ``b`` in [0, ``back``] (``placement`` = (d, lat)), and the goal needs
+    the root within ``adjust`` of it. A prefilter: the goal test of the search's many
+    far poses is skipped."""
+    d, lat = float(placement[0]), float(placement[1])
+    lo_b, hi_b = min(0.0, back), max(0.0, back)
+    nearest = min(max(-d, lo_b), hi_b)
+    inner = math.hypot(d + nearest, lat)
+    outer = max(math.hypot(d + lo_b, lat), math.hypot(d + hi_b, lat))
+    return inner - adjust - _BAND_SLACK, outer + adjust + _BAND_SLACK
 
 
 def _towards(led: NavigationField, target: tuple[float, float], near: float, offset: float
@@ -267,11 +287,18 @@ class WalkGoals:
             return field, limit[0]
 
         field, back = self.led(solve)
-        walk_map = field.grid.clearance
+        band = _spot_band(placement, back, adjust)
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+            r = np.hypot(tx - x, ty - y)
+            out = (r >= band[0]) & (r <= band[1])
+            if out.any():
+                out[out] = reached_in_band(x[out], y[out], yaw[out])
+            return out
+
+        def reached_in_band(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             px, py, pyaw, free, here = ideal_placement(self.ctx, target, placement, x, y, back,
-                                                         room=True, walk_map=walk_map,
+                                                         room=True, walk_map=field.grid.clearance,
                                                          stand_yaw=stand_yaw)
             # Turning on the spot needs room for the hips; facing nearly right needs none.
             room = here > self.ctx.turn_room

@@ -380,7 +380,13 @@ class SynthesisNode(Node):
                 msg.task_sequences.append(info.task_sequence)
                 msg.durations.append(info.duration)
             msg.store_dir = str(self.store.directory or "")
-            self._catalog_pub.publish(msg)
+            try:
+                self._catalog_pub.publish(msg)
+            except Exception:      # rclpy's RCLError: the context is gone
+                if self.context.ok() and not self._stopping.is_set():
+                    raise
+                # a synthesis that finished as the node shut down (SIGINT): nobody is
+                # left to tell, and its answer goes out (or is dropped) as any other's
 
 
 #: Seconds destroy_node waits for the workers (issue 17: exit within 2 s of SIGINT); a

@@ -69,7 +69,7 @@ def _on_alarm(signum, frame) -> None:
 
 
 def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None = None,
-             biomechanics: bool = False) -> Outcome:
+             biomechanics: bool = True) -> Outcome:
     """Synthesize one motion for ``spec`` in ``cell`` and classify the result.
 
     Parameters
@@ -82,12 +82,12 @@ def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None =
     timeout : float, optional
         Seconds; uses SIGALRM, so only in a process's main thread.
     biomechanics : bool
-        Verify with the biomechanical checks too (``VerificationOptions.biomechanics``).
+        Verify with the biomechanical checks (``VerificationOptions.biomechanics``, the
+        default); False without them.
     """
     from ltl_human_motion.planning.pipeline import SynthesisOptions, get_library, synthesize
     from ltl_human_motion.planning.verify import VerificationOptions
-    options = SynthesisOptions(verification=VerificationOptions(biomechanics=True)) \
-        if biomechanics else None
+    options = SynthesisOptions(verification=VerificationOptions(biomechanics=biomechanics))
     get_library(float(stature))                      # loaded before timing
     use_alarm = timeout is not None and timeout > 0
     if use_alarm:
