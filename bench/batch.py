@@ -132,9 +132,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=3, help="runs per setting (default 3)")
     parser.add_argument("--profile-items", type=int, default=10)
     parser.add_argument("--top", type=int, default=15)
-    parser.add_argument("--out", default=str(ROOT / "bench" / "results" / "batch.json"))
+    parser.add_argument("--no-biomechanics", action="store_true",
+                        help="verify without the biomechanical checks (on by default)")
+    parser.add_argument("--out", default=None,
+                        help="default bench/results/batch.json, with --no-biomechanics "
+                             "bench/results/batch_without_biomechanics.json")
     args = parser.parse_args(argv)
-    specs = specs_from_yaml(SPECS, "bench/batch.py:SPECS")
+    args.out = args.out or str(ROOT / "bench" / "results" / (
+        "batch_without_biomechanics.json" if args.no_biomechanics else "batch.json"))
+    specs = specs_from_yaml(SPECS + ("options: {biomechanics: false}\n"
+                                     if args.no_biomechanics else ""), "bench/batch.py:SPECS")
     load_before = list(os.getloadavg())
     spin = [_spin_efficiency()]
     runs: dict[int, list[dict]] = {1: [], 2: []}
@@ -155,6 +162,7 @@ def main(argv: list[str] | None = None) -> int:
                             if r["mean_cpu_s"])
     result = {
         "benchmark": "batch", "spec": "S2 (sequence_mode all: grasp O1, grasp O2, assemble)",
+        "biomechanics": not args.no_biomechanics,
         "cell": "paper_cell", "count_per_run": args.count, "repeat": args.repeat,
         "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                     "platform": platform.platform(),
