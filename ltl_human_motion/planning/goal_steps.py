@@ -677,18 +677,18 @@ class GoalSteps:
         ``counts``: how many kept the part in its container, and how many took a limb
         through the body, of those clear of obstacles."""
         kept_in, self_hits = counts
-        if not blocked:
+        if self_hits and not blocked:
             return PlanningError(f"task {text}: every {kind} motion tried ({attempts}) "
                                  "takes a limb through the body from where the worker "
                                  "stands", task=text, reason="blocked")
-        into = (f"{len(blocked)} of the {kind} motions tried ({attempts}) run into an "
-                f"obstacle, {self_hits} take a limb through the body" if self_hits
-                else f"every {kind} motion tried ({attempts}) runs into an obstacle")
         if kept_in:
             return PlanningError(f"task {text}: {kept_in} of the {attempts} {kind} motions "
                                  f"tried keep {part} in {container} (the hand does not take "
                                  "it out far enough from where the worker stands), the "
                                  "others run into an obstacle", task=text, reason="blocked")
+        into = (f"{len(blocked)} of the {kind} motions tried ({attempts}) run into an "
+                f"obstacle, {self_hits} take a limb through the body" if self_hits
+                else f"every {kind} motion tried ({attempts}) runs into an obstacle")
         return PlanningError(f"task {text}: {into}; {self.what_blocks(blocked, grasped)}",
                              task=text, reason="blocked")
 
