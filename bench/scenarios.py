@@ -233,6 +233,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=None,
                         help="default bench/results/scenarios.json, with --no-biomechanics "
                              "bench/results/scenarios_without_biomechanics.json")
+    parser.add_argument("--runs-out", type=Path, default=None,
+                        help="also write every run's outcome (id, stature, seed, seconds, "
+                             "ok, family) to this JSON file, to compare two trees run by run")
     args = parser.parse_args(argv)
     args.out = args.out or ROOT / "bench" / "results" / (
         "scenarios_without_biomechanics.json" if args.no_biomechanics else "scenarios.json")
@@ -283,6 +286,11 @@ def main(argv: list[str] | None = None) -> int:
                             "message": r["outcome"]["message"][:240]}
                            for r in results if not r["ok"]]}
     atomic_write_text(args.out, json.dumps(report, indent=1) + "\n")
+    if args.runs_out is not None:
+        atomic_write_text(args.runs_out, json.dumps(
+            [{"id": r["id"], "source": r["source"], "stature": r["stature"], "seed": r["seed"],
+              "seconds": round(r["outcome"]["seconds"], 3), "ok": r["ok"],
+              "family": r["family"]} for r in results], indent=0) + "\n")
     _print(summary, wall)
     print(f"written to {args.out}")
     return 0

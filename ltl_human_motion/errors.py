@@ -50,12 +50,18 @@ class PlanningError(LtlHumanMotionError):
     """Motion planning failed; the message names the task and the reason.
 
     ``step_index``: the position of the failed step in the task sequence being planned
-    (None where the failure is not a step's, or before any step)."""
+    (None where the failure is not a step's, or before any step). ``search``: how the
+    walk's search ended where a walk failed (``"budget"``, ``"no_stop"``, ...), else
+    None. ``situation``: what the planner held the failed step's situation to be
+    (:meth:`~ltl_human_motion.planning.planner.SequencePlanner.situation`), or None."""
 
-    def __init__(self, message: str, task: str | None = None, reason: str | None = None) -> None:
+    def __init__(self, message: str, task: str | None = None, reason: str | None = None,
+                 search: str | None = None) -> None:
         self.task = task
         self.reason = reason
+        self.search = search
         self.step_index: int | None = None
+        self.situation: tuple | None = None
         super().__init__(message)
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.errors import PlanningError, VerificationError
 from ltl_human_motion.ltl.spec import build_specification
 from ltl_human_motion.planning.pipeline import (
     OTHER_ORDERS,
@@ -17,6 +17,7 @@ from ltl_human_motion.planning.pipeline import (
     _other_sequences,
     _same_situation,
     _task_text,
+    _verified_in_another_order,
     resolve_cell,
 )
 
@@ -56,7 +57,7 @@ def test_other_orders_are_planned_in_turn_and_the_first_failure_is_kept(kitting)
     failure.step_index = 1
     tried = []
 
-    def one(seq):
+    def one(seq, failed=None):
         tried.append(_texts(seq))
         raise PlanningError("still blocked", task="x", reason="blocked")
 
@@ -67,7 +68,7 @@ def test_other_orders_are_planned_in_turn_and_the_first_failure_is_kept(kitting)
     assert err.value.reason == "blocked" and err.value.task == "grasp(gear)"
     assert str(err.value).startswith("task grasp(gear): blocked; 2 other order(s)")
 
-    def works(seq):
+    def works(seq, failed=None):
         return _texts(seq)
 
     assert _in_another_order(works, first, failure, lambda: seqs, cell, 1.75) == tried[0]
@@ -78,7 +79,7 @@ def test_a_limit_of_the_cell_is_not_tried_in_another_order(kitting) -> None:
     failure = PlanningError("out of reach", task="grasp(gear)", reason="reach")
     failure.step_index = 0
 
-    def one(seq):
+    def one(seq, failed=None):
         raise AssertionError("no other order may be planned")
 
     with pytest.raises(PlanningError) as err:
@@ -95,7 +96,7 @@ def test_an_order_that_fails_like_one_tried_before_is_skipped(kitting) -> None:
     assert len(gear_first) >= 2              # the same situation comes up more than once
     tried = []
 
-    def one(seq):
+    def one(seq, failed=None):
         texts = _texts(seq)
         at = texts.index("grasp(gear)")
         tried.append(frozenset(texts[:at]))
@@ -109,3 +110,84 @@ def test_an_order_that_fails_like_one_tried_before_is_skipped(kitting) -> None:
     # the second order that grasps the gear first would fail as the first one did
     assert tried == [frozenset()]
     assert "1 other order(s) of the tasks failed too" in str(err.value)
+
+
+AISLE = Path(__file__).resolve().parents[1] / "scenarios" / "cells" / "aisle.yaml"
+
+
+def _aisle_planner(failed: dict | None = None):
+    import numpy as np
+
+    from ltl_human_motion.planning.pipeline import get_library
+    from ltl_human_motion.planning.planner import PlannerOptions, SequencePlanner
+
+    cell = resolve_cell(AISLE)
+    planner = SequencePlanner(cell.floor_at_zero(), get_library(1.75),
+                              np.random.default_rng([0, 0]),
+                              PlannerOptions(refuse_self_penetration=True))
+    planner.failed_before = failed or {}
+    return cell, planner
+
+
+def _steps(cell, texts: list[tuple[str, tuple[str, ...]]]):
+    from ltl_human_motion.vocabulary import task_step
+    return [task_step(name, args, cell.shorthands) for name, args in texts]
+
+
+def test_a_step_that_failed_in_the_same_situation_fails_without_a_search() -> None:
+    """Holding O1 in the right hand, a 1.75 m worker coming from the aisle's end finds no
+    grasp of O2 on the knee board (every motion hits the rack above); another order
+    that comes to it the same way fails the same way at once, its earlier steps planned
+    as before. The hand that holds O1 is part of the situation."""
+    tail = [("grasp", ("O1",)), ("walk", ("R1",)), ("grasp", ("O2",))]
+    cell, first = _aisle_planner()
+    with pytest.raises(PlanningError) as err:
+        first.plan(_steps(cell, [("wait", ("1.0",)), *tail]), (0.0, 0.0, 0.0))
+    failure = err.value
+    assert failure.step_index == 3
+    assert failure.situation[:3] == ("grasp(O2)", "walk(R1)", frozenset({("O1", "r_hand")}))
+
+    again = [("assemble", ("R2",)), *tail]
+    cell, before = _aisle_planner()
+    before.plan(_steps(cell, again[:-1]), (0.0, 0.0, 0.0))      # the steps before it plan
+    cell, second = _aisle_planner({failure.situation: failure})
+    with pytest.raises(PlanningError) as err:
+        second.plan(_steps(cell, again), (0.0, 0.0, 0.0))
+    assert err.value.step_index == 3 and str(err.value) == str(failure)
+    assert err.value.reason == failure.reason
+    assert second.state.expanded == before.state.expanded    # no node searched for it
+
+    # with O1 in the left hand (straight from the start) it is another situation
+    cell, third = _aisle_planner({failure.situation: failure})
+    with pytest.raises(PlanningError) as err:
+        third.plan(_steps(cell, tail), (0.0, 0.0, 0.0))
+    assert err.value.situation[2] == frozenset({("O1", "l_hand")})
+    assert str(err.value) != str(failure)                    # planned, not replayed
+
+
+def test_a_motion_that_fails_verification_is_made_in_another_order(kitting) -> None:
+    cell, seqs = kitting
+    first = seqs[0]
+    failure = VerificationError("verification failed (joint_speed): l_toe", "joint_speed")
+    tried = []
+
+    def one(seq, failed=None):
+        tried.append(_texts(seq))
+        raise VerificationError("verification failed (foot_skate): left foot", "foot_skate")
+
+    with pytest.raises(VerificationError) as err:
+        _verified_in_another_order(one, first, failure, lambda: seqs, cell, 1.75)
+    assert len(tried) == OTHER_ORDERS and _texts(first) not in tried
+    assert err.value.check == "joint_speed"
+    assert str(err.value) == ("verification failed (joint_speed): l_toe; 2 other order(s) "
+                              "of the tasks failed too")
+
+    def works(seq, failed=None):
+        return _texts(seq)
+
+    assert _verified_in_another_order(works, first, failure, lambda: seqs, cell,
+                                      1.75) == tried[0]
+    # no other order: the failure as it was
+    with pytest.raises(VerificationError) as err:
+        _verified_in_another_order(works, first, failure, lambda: [first], cell, 1.75)
+    assert err.value is failure

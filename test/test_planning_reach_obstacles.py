@@ -116,3 +116,40 @@ def test_a_checked_approach_finds_a_clear_reach(cell: str, spec: str, stature: f
     from ltl_human_motion.scenarios.run import run_pair
     outcome = run_pair(spec, cell, stature, 0, timeout=30.0)
     assert outcome.status == "verified", outcome.message[:300]
+
+
+def test_the_posture_clearance_answers_as_the_exact_one_at_the_search_threshold() -> None:
+    """The posture search's clearance is exact only below ``POSTURE_EXACT_BELOW`` (a
+    bound above): on random postures beside the kitting shelf every answer to 'nearer
+    than 1 cm' is the one of the clearance exact to 25 cm, and the values below
+    ``POSTURE_EXACT_BELOW`` are those values."""
+    from pathlib import Path
+
+    from ltl_human_motion.motion.goals import _OBSTACLE_CLEARANCE
+    from ltl_human_motion.planning.pipeline import get_library, resolve_cell
+    from ltl_human_motion.planning.planner import SequencePlanner
+    from ltl_human_motion.planning.standing import POSTURE_EXACT_BELOW, posture_clearance
+    from ltl_human_motion.scene.geometry import point_bounds
+    from ltl_human_motion.scene.occupancy import BODY_PARTS
+    from ltl_human_motion.scene.shapes import EXACT_BELOW
+
+    cell = resolve_cell(Path(__file__).resolve().parents[1] / "scenarios" / "cells"
+                        / "kitting.yaml").floor_at_zero()
+    lib = get_library(1.75)
+    planner = SequencePlanner(cell, lib, np.random.default_rng(0))
+    rng = np.random.default_rng(3)
+    stance = planner.ctx.stance(False)
+    # the standing stance at spots in front of the shelf, shaken by up to 25 cm per joint
+    poses = stance[None] + rng.uniform(-0.25, 0.25, (400, *stance.shape))
+    pose = (1.25, -0.3, 0.0)
+    fast = posture_clearance(planner.ctx, pose)(poses, BODY_PARTS)
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    world = poses @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T \
+        + np.array([pose[0], pose[1], 0.0])
+    seg, rad = capsules_from_positions(world, planner.ctx.stature, BODY_PARTS)
+    exact = cell.part_set.body_clearance(seg, rad, EXACT_BELOW, bounds=point_bounds(world))
+    assert np.any(exact <= _OBSTACLE_CLEARANCE) and np.any(exact > _OBSTACLE_CLEARANCE)
+    np.testing.assert_array_equal(fast <= _OBSTACLE_CLEARANCE, exact <= _OBSTACLE_CLEARANCE)
+    low = exact < POSTURE_EXACT_BELOW
+    np.testing.assert_array_equal(fast[low], exact[low])
+    assert np.all(fast <= exact + 1e-12)                        # a lower bound elsewhere

@@ -186,7 +186,8 @@ _ELBOW_MAX_FLEXION = float(np.radians(150.0 - _ROM_MARGIN))
 #: The obstacles around a worker as the posture search sees them
 #: (:func:`make_goal_primitive`'s ``obstacles``): ``clearance(poses, parts)`` is the
 #: smallest clearance (m) of the capsules ``parts`` (names of
-#: ``scene.occupancy.BODY_PARTS``) of start-frame poses (C, J, 3) to any obstacle, (C,).
+#: ``scene.occupancy.BODY_PARTS``) of start-frame poses (C, J, 3) to any obstacle, (C,);
+#: only compared with ``_OBSTACLE_CLEARANCE``, so above it a lower bound will do.
 ObstacleClearance = Callable[[np.ndarray, tuple[str, ...]], np.ndarray]
 #: Clearance (m) a reaching posture keeps from the obstacles around the worker, at
 #: contact and on the trunk's and legs' way there: over the planner's 3 mm

@@ -111,6 +111,10 @@ class Goal:
     reroute : callable or None
         ``reroute((x, y)) -> Goal | None``: the same goal with a heuristic that avoids the
         floor around (x, y), where a search stalled (None: no other way).
+    possible : callable or None
+        ``possible() -> bool``: False where no floor pose at all passes ``reached`` (a
+        test on a grid fine enough not to miss the goal's spots), so no search can end
+        there; None where the goal does not say.
     """
 
     reached: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
@@ -119,6 +123,7 @@ class Goal:
     description: str = ""
     clearance: Callable[[np.ndarray], np.ndarray] | None = None
     reroute: Callable[[tuple[float, float]], Goal | None] | None = None
+    possible: Callable[[], bool] | None = None
 
 
 @dataclass

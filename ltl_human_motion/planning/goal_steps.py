@@ -107,6 +107,11 @@ MOTION_ROOM_NODES = 1000
 #: Node budget of the walk to an alternative approach (most are a few steps round the
 #: target; a side that needs a long way round is not worth the search).
 ALTERNATIVE_NODES = 500
+#: Nodes such a walk may expand after it first came to the goal's floor cells without a
+#: place to stop there (a side whose spots are all in the furniture: the search floods
+#: them); where it ends so, the model-made steps into the goal are tried as after its
+#: budget (:meth:`GoalSteps._walk_or_step_into`).
+ALTERNATIVE_AT_GOAL_NODES = 100
 
 #: Node budget of the walk to the side of a seat that faces the seated work (without
 #: it the worker sits facing whichever way the walk arrives).
@@ -382,13 +387,14 @@ class GoalSteps:
                 kind, args, (stood + back, placement[1], target[2]), raised)
 
         def walk_there(spot: tuple[float, float], sector: tuple[float, float], nodes: int,
-                       stand_yaw: float | None = None) -> int:
+                       stand_yaw: float | None = None, at_goal: int | None = None) -> int:
             lowered = raised and not self.state.held
             if lowered:
                 self.executor.arm_transition(True, -1)
             self.executor.step_out()            # the first try may have left the worker at a rack
             walked = self.approach(target, spot, text, sector=sector,
-                                   budget=SearchBudget(nodes), stand_yaw=stand_yaw)
+                                   budget=SearchBudget(nodes, at_goal_nodes=at_goal),
+                                   stand_yaw=stand_yaw)
             if lowered:
                 self.executor.arm_transition(False, -1)
             return walked
@@ -402,10 +408,12 @@ class GoalSteps:
                                     "that side", task=text, reason="blocked")
             d, lat = mirrored() if other else placement
             return walk_there((d + back if ahead is None else ahead, lat),
-                              (first + turn, APPROACH_HALF_WIDTH), ALTERNATIVE_NODES)
+                              (first + turn, APPROACH_HALF_WIDTH), ALTERNATIVE_NODES,
+                              at_goal=ALTERNATIVE_AT_GOAL_NODES)
 
         def room() -> int:
-            # Last: the side where the goal primitive itself was clear (made there first).
+            # Last: the side where the goal primitive itself was clear (made there first;
+            # its walk may take long to find the spot: no limit at the goal).
             found = self.motion_room(kind, args, target, first, [placement] + (
                 [mirrored()] if mirrored() is not None else []), raised)
             if found is None:
@@ -542,6 +550,7 @@ class GoalSteps:
         desc = f"reach {text} at ({target[0]:.2f}, {target[1]:.2f}, {target[2]:.2f})"
         goal, back = self.goals.reach(target, placement, desc, text, sector=sector,
                                       stand_yaw=stand_yaw)
+        self._possible(goal, text, desc)
         if self.state.seat is None and sector is None and stand_yaw is None:
             self.executor.step_towards(target, placement, back, goal=goal)
         walked = self._walk_or_step_into(goal, text, budget, sector is not None
@@ -552,14 +561,17 @@ class GoalSteps:
             goal, back = self.goals.reach(target, placement, desc, text,
                                           adjust=FINAL_ADJUST_RADIUS, sector=sector,
                                           stand_yaw=stand_yaw)
+            self._possible(goal, text, desc)
             final = budget or self.ctx.options.budget
             final = replace(final, max_nodes=min(final.max_nodes, FINAL_WALK_NODES),
                             at_goal_nodes=min(AT_GOAL_NODES, FINAL_WALK_NODES))
             if self.state.seat is None:
                 self.executor.step_into(goal)
             try:
+                # (an alternative's spot, where the squeeze search ran out next to it:
+                # squaring up to the gap and searching again did not find one either)
                 walked += self.executor.walk(goal, text, -1, carry=self.state.carrying,
-                                             budget=final)
+                                             budget=final, square_up=budget is None)
             except PlanningError as exc:
                 if exc.reason != "budget":
                     raise
@@ -572,6 +584,13 @@ class GoalSteps:
             self.executor.adjust_to(target, placement, text, back, stand_yaw)
         return walked
 
+    def _possible(self, goal: Goal, text: str, desc: str) -> None:
+        """Raise a blocked :class:`PlanningError` where no floor pose passes ``goal``'s
+        test (:attr:`.astar.Goal.possible`): no search could end there."""
+        if goal.possible is not None and not goal.possible():
+            raise PlanningError(f"task {text}: {desc}: no place to stand there keeps the "
+                                "body clear", task=text, reason="blocked")
+
     def _walk_or_step_into(self, goal: Goal, text: str, budget: SearchBudget | None,
                            step_after: bool) -> int:
         """The walk to ``goal``; with ``step_after``, where its search ends without a
@@ -582,7 +601,8 @@ class GoalSteps:
         try:
             return self.executor.walk(goal, text, -1, carry=self.state.carrying, budget=budget)
         except PlanningError as exc:
-            if not step_after or self.state.seat is not None or exc.reason != "budget":
+            if not step_after or self.state.seat is not None \
+                    or exc.search not in ("budget", "no_stop"):
                 raise
             self.state.restore(mark)
             if not self.executor.step_into(goal):

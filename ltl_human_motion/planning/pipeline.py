@@ -15,7 +15,7 @@ import functools
 import inspect
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -23,7 +23,7 @@ import numpy as np
 
 from ltl_human_motion.deadline import Deadline, checkpoint
 from ltl_human_motion.deadline import active as active_deadline
-from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.errors import PlanningError, VerificationError
 from ltl_human_motion.motion.realism import realism_summary
 from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
@@ -328,7 +328,9 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
         fails in the order of the tasks chosen first, up to ``OTHER_ORDERS`` other
         orders are planned before this is raised (the message says how many).
     VerificationError
-        A motion failed a check (the message names it).
+        A motion failed a check (the message names it). Where the motion of the order of
+        the tasks chosen first fails, up to ``OTHER_ORDERS`` other orders are made before
+        this is raised (the message says how many).
     """
     from ltl_human_motion.ltl.spec import build_specification
 
@@ -353,10 +355,11 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
         t_library = 0.0
     checkpoint("library")
 
-    def one(seq, v: int) -> SynthesizedMotion:
+    def one(seq, v: int, failed: dict | None = None) -> SynthesizedMotion:
         rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, v])
         return _synthesize_one(spec, specification, seq, cell, library, rng, seed, v,
-                               options, t_automaton, t_sequence, t_library, float(stature))
+                               options, t_automaton, t_sequence, t_library, float(stature),
+                               failed)
     others = functools.partial(_other_sequences, specification, cell,
                                variants + ORDER_CANDIDATES, seed, options, cycles)
     results = [_variant(one, sequences[v % len(sequences)], v, others, cell, float(stature))
@@ -394,6 +397,9 @@ def _variant(one: Callable[[Any, int], SynthesizedMotion], seq, v: int,
     except PlanningError as exc:
         return _in_another_order(functools.partial(one, v=v), seq, exc, others, cell,
                                  stature)
+    except VerificationError as exc:
+        return _verified_in_another_order(functools.partial(one, v=v), seq, exc, others,
+                                          cell, stature)
 
 
 def _other_sequences(specification, cell, n: int, seed: int, options: SynthesisOptions,
@@ -432,38 +438,76 @@ def _failed_situation(seq, failure: PlanningError) -> tuple[int, set[str]] | Non
 def _in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
                       failure: PlanningError, others: Callable[[], list], cell,
                       stature: float) -> SynthesizedMotion:
-    """``one(sequence)`` for the next sequences of ``others()`` (up to ``OTHER_ORDERS``)
-    that do not come to the task ``failure`` (raised by ``one(seq)``) names in the same
-    situation (:func:`_same_situation`); the first that plans. Raises ``failure``
-    (saying how many orders were tried) if none does, or if its reason is not one
-    another order can change."""
+    """``one(sequence, failed=...)`` for the next sequences of ``others()`` (up to
+    ``OTHER_ORDERS``) that do not come to the task ``failure`` (raised by ``one(seq)``)
+    names in the same situation (:func:`_same_situation`); the first that plans. A step
+    that failed in one order fails at once in another that comes to it holding the same
+    parts with the same parts moved (``failed``: by
+    :meth:`.planner.SequencePlanner.situation`). Raises ``failure`` (saying how many
+    orders were tried) if none does, or if its reason is not one another order can
+    change."""
     where = _failed_situation(seq, failure)
     if failure.reason not in _ORDER_REASONS or where is None:
         raise failure
     # every situation a step failed in so far: an order that comes to one of them again
     # is not tried (it would fail the same way)
     situations = [(seq, *where)]
+    known = {} if failure.situation is None else {failure.situation: failure}
+    tried = 0
+    for other in _orders(others, cell, stature, lambda other: any(
+            _same_situation(other, s, at, texts) for s, at, texts in situations)):
+        tried += 1
+        try:
+            return one(other, failed=known)
+        except PlanningError as exc:
+            where = _failed_situation(other, exc)
+            if where is not None:
+                situations.append((other, *where))
+            if exc.situation is not None:
+                known.setdefault(exc.situation, exc)
+    if tried:
+        raise PlanningError(f"{failure}; {tried} other order(s) of the tasks failed too",
+                            task=failure.task, reason=failure.reason) from failure
+    raise failure
+
+
+def _verified_in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
+                               failure: VerificationError, others: Callable[[], list],
+                               cell, stature: float) -> SynthesizedMotion:
+    """``one(sequence)`` for the next sequences of ``others()`` other than ``seq`` (see
+    :func:`_orders`), where the motion of ``seq`` failed verification (``failure``,
+    after the junction repairs): the first whose motion verifies. Raises ``failure``
+    (saying how many orders were tried) if none does."""
+    tried = 0
+    for other in _orders(others, cell, stature, lambda other: other.tasks == seq.tasks):
+        tried += 1
+        try:
+            return one(other)
+        except (PlanningError, VerificationError):
+            continue
+    if tried:
+        raise VerificationError(f"{failure}; {tried} other order(s) of the tasks failed "
+                                "too", failure.check) from failure
+    raise failure
+
+
+def _orders(others: Callable[[], list], cell, stature: float, skip: Callable[[Any], bool]
+            ) -> Iterator[Any]:
+    """The next sequences of ``others()`` that ``skip`` (asked as each comes) does not
+    rule out and a worker of this stature can do (:func:`.feasibility.check_steps`), at
+    most ``OTHER_ORDERS``."""
     tried = 0
     for other in others():
         if tried >= OTHER_ORDERS:
-            break
-        if any(_same_situation(other, s, at, failed) for s, at, failed in situations):
+            return
+        if skip(other):
             continue
         try:
             check_steps(cell, [(t.name, tuple(t.args)) for t in other.tasks], stature)
         except PlanningError:
             continue
         tried += 1
-        try:
-            return one(other)
-        except PlanningError as exc:
-            where = _failed_situation(other, exc)
-            if where is not None:
-                situations.append((other, *where))
-    if tried:
-        raise PlanningError(f"{failure}; {tried} other order(s) of the tasks failed too",
-                            task=failure.task, reason=failure.reason) from failure
-    raise failure
+        yield other
 
 
 def _blended(plan: Plan, floor_cell, floor_z: float, library, realism: bool,
@@ -514,7 +558,7 @@ def _blended(plan: Plan, floor_cell, floor_z: float, library, realism: bool,
 
 
 def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, variant,
-                    options, t_automaton, t_sequence, t_library, stature
+                    options, t_automaton, t_sequence, t_library, stature, failed=None
                     ) -> SynthesizedMotion:
     t_start = time.perf_counter()
     written = [(t.name, tuple(t.args)) for t in seq.tasks]        # as verification reads them
@@ -524,6 +568,7 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     floor_cell = cell.floor_at_zero()
     planner = SequencePlanner(floor_cell, library, rng, replace(
         options.planner, refuse_self_penetration=options.verification.biomechanics))
+    planner.failed_before = failed or {}
     start = _start_pose(floor_cell, planner.target_of(steps[0].kind, steps[0].args), rng)
     t0 = time.perf_counter()
     plan = planner.plan(steps, start)

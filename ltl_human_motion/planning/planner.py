@@ -226,6 +226,22 @@ class SequencePlanner:
         self.goals = WalkGoals(self.ctx, self.state)
         self.goal_steps = GoalSteps(self.ctx, self.state, self.executor, self.goals)
         self.steps: list[StepPlan] = []
+        #: Steps that failed in an earlier order of the tasks, by :meth:`situation`: the
+        #: same step in the same situation fails the same way here, without a search.
+        self.failed_before: dict[tuple, PlanningError] = {}
+
+    def situation(self, text: str, after: str | None) -> tuple:
+        """Step ``text`` done after step ``after`` (None: first) in what the tasks so far
+        left: which hand holds which part, where parts were put down, the parts used up
+        and, seated, the seat and how the worker sits on it (the hands work from there).
+        (A walk from another place to the same reach can end elsewhere: in an aisle,
+        coming from its far end or from the other rack.)"""
+        st = self.state
+        return (text, after, frozenset(st.held.items()),
+                frozenset((k, tuple(np.round(v, 4).tolist())) for k, v in st.object_at.items()),
+                frozenset(st.consumed),
+                None if st.seat is None
+                else (*np.round(st.seat, 4).tolist(), *np.round(st.pose, 4).tolist()))
 
     def target_of(self, kind: str, args: tuple[str, ...]) -> np.ndarray | None:
         """Where a step acts, shape (3,): grasp point, region or object centre, seat; the
@@ -256,10 +272,17 @@ class SequencePlanner:
         for i, task in enumerate(tasks):
             first = len(self.state.segments)
             facing = self._seated_work(tasks[i + 1:]) if task.kind == "sit" else None
+            situation = self.situation(task.text, tasks[i - 1].text if i else None)
             try:
+                known = self.failed_before.get(situation)
+                if known is not None:
+                    raise PlanningError(str(known), task=known.task, reason=known.reason,
+                                        search=known.search)
                 step = self._plan_step(i, task.text, task.kind, task.args, facing=facing)
             except PlanningError as exc:
                 exc.step_index = i              # where the order of the tasks failed
+                if task.kind not in ("walk", "carry"):   # (a walk depends on where from)
+                    exc.situation = situation
                 raise
             step.first_segment = first
             step.last_segment = len(self.state.segments) - 1

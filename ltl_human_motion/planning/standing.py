@@ -105,16 +105,23 @@ def board_local(cell, target: np.ndarray, local: np.ndarray, yaw: float, stature
     return _edge_local(low[0], low[3], local, yaw), low[1], low[2]
 
 
+#: Metres below which the posture search's clearances are exact (above, the bounding
+#: boxes' gap: a lower bound). The search only asks whether a posture keeps
+#: ``motion.goals._OBSTACLE_CLEARANCE`` (1 cm): any bound above that answers the same,
+#: and the exact capsule-box distances of every pair within 25 cm took most of its time
+#: beside shelves.
+POSTURE_EXACT_BELOW = 0.05
+
+
 def posture_clearance(ctx: PlanContext, pose: Pose
                       ) -> Callable[[np.ndarray, tuple[str, ...]], np.ndarray]:
     """The obstacles of the cell around a worker standing at ``pose`` (x, y, yaw) as the
     goal models' posture search takes them (``motion.goals.ObstacleClearance``):
-    ``clearance(poses, parts)``, the smallest exact clearance (m, below
-    ``EXACT_BELOW``) of the capsules ``parts`` of start-frame poses (C, J, 3) to any
-    obstacle part, (C,)."""
+    ``clearance(poses, parts)``, the smallest clearance (m) of the capsules ``parts`` of
+    start-frame poses (C, J, 3) to any obstacle part, (C,): exact below
+    ``POSTURE_EXACT_BELOW``, a lower bound above it."""
     from ltl_human_motion.scene.geometry import point_bounds
     from ltl_human_motion.scene.occupancy import capsules_from_positions
-    from ltl_human_motion.scene.shapes import EXACT_BELOW
     cell, stature = ctx.cell, ctx.stature
     x, y, yaw = (float(v) for v in pose)
     rot = np.array([[math.cos(yaw), -math.sin(yaw), 0.0],
@@ -124,7 +131,8 @@ def posture_clearance(ctx: PlanContext, pose: Pose
     def clearance(poses: np.ndarray, parts: tuple[str, ...]) -> np.ndarray:
         world = np.asarray(poses, dtype=np.float64) @ rot.T + shift
         seg, rad = capsules_from_positions(world, stature, parts)
-        return cell.part_set.body_clearance(seg, rad, EXACT_BELOW, bounds=point_bounds(world))
+        return cell.part_set.body_clearance(seg, rad, POSTURE_EXACT_BELOW,
+                                            bounds=point_bounds(world))
 
     return clearance
 

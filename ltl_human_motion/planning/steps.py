@@ -491,13 +491,15 @@ class StepExecutor:
         return False
 
     def walk(self, goal: Goal, task: str, label: int, carry: bool,
-             budget: SearchBudget | None = None) -> int:
+             budget: SearchBudget | None = None, square_up: bool = True) -> int:
         """A* from the current pose; appends the gait segments; returns their count.
 
         The search checks the body on sampled frames of a distance grid; every frame of
         the path it returns is then checked as the verifier does (exact capsules, held
         parts). A primitive that collides is forbidden from its pose and the search runs
-        again (at most ``WALK_REPAIRS`` times)."""
+        again (at most ``WALK_REPAIRS`` times). A squeeze search (on the footprint map)
+        out of budget in a narrow gap squares up to it and searches again
+        (:meth:`square_up`), unless not ``square_up``."""
         # A step of the same task (a grasp at a rack, then the step back its arms needed)
         # may have left the worker where no walk may start.
         if self.state.seat is None:
@@ -537,7 +539,7 @@ class StepExecutor:
                 raise PlanningError(f"task {task}: {goal.description}: every path found "
                                     f"({WALK_REPAIRS + 1}) collides on a frame the search "
                                     "did not sample", task=task, reason="blocked")
-        if isinstance(res, SearchFailure) and res.reason == "budget" and \
+        if isinstance(res, SearchFailure) and res.reason == "budget" and square_up and \
                 goal.clearance is self.ctx.stand_map and self.square_up(goal, carry):
             return self.walk(goal, task, label, carry, budget)    # square to the gap
         if isinstance(res, SearchFailure):
@@ -552,7 +554,8 @@ class StepExecutor:
                        f"placements; closest approach {res.closest:.2f} m)")
             # No stop at the goal is a blocked goal (the caller may try other placements).
             raise PlanningError(f"task {task}: {goal.description}: {why}", task=task,
-                                reason="blocked" if res.reason == "no_stop" else res.reason)
+                                reason="blocked" if res.reason == "no_stop" else res.reason,
+                                search=res.reason)
         for prim_id, pose in zip(res.primitives, res.poses):
             self.add(self.ctx.index.primitives[prim_id], pose, label, self.ctx.overlap)
         if res.primitives:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -98,6 +99,10 @@ def _ring_stands(ctx: PlanContext, target: np.ndarray, placement: tuple[float, f
     return bool(on.any()) and bool(ideal_placement(ctx, target, placement, x[on], y[on], tol,
                                                    stand_yaw=stand_yaw)[3].any())
 
+
+#: Largest spacing, metres, of the grid on which a reach goal tells whether any floor
+#: point passes its test (:attr:`.astar.Goal.possible`).
+POSSIBLE_SPACING = 0.04
 
 #: Metres the band of :func:`_spot_band` is widened by (rounding only).
 _BAND_SLACK = 1e-6
@@ -296,23 +301,42 @@ class WalkGoals:
                 out[out] = reached_in_band(x[out], y[out], yaw[out])
             return out
 
-        def reached_in_band(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+        def reached_in_band(x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None
+                            ) -> np.ndarray:
+            # (yaw None: facing the spot's way, as a walk may arrive)
             px, py, pyaw, free, here = ideal_placement(self.ctx, target, placement, x, y, back,
                                                          room=True, walk_map=field.grid.clearance,
                                                          stand_yaw=stand_yaw)
-            # Turning on the spot needs room for the hips; facing nearly right needs none.
-            room = here > self.ctx.turn_room
-            facing = np.abs(wrap_angle(pyaw - yaw)) <= self.ctx.options.heading_tolerance
-            out = free & (np.hypot(px - x, py - y) <= adjust) & (room | facing) & side(x, y)
+            out = free & (np.hypot(px - x, py - y) <= adjust) & side(x, y)
+            if yaw is not None:
+                # Turning on the spot needs room for the hips; facing nearly right needs none.
+                out &= (here > self.ctx.turn_room) \
+                    | (np.abs(wrap_angle(pyaw - yaw)) <= self.ctx.options.heading_tolerance)
             if stand_yaw is not None:
                 # The spot is fixed: a walk must still end on the ring, not nearer (under
                 # the board the standing step would have to back out of).
                 out &= np.hypot(tx - x, ty - y) >= dist - tol
             return out
 
+        def possible() -> bool:
+            # Every floor point of the band on a polar grid no coarser than
+            # POSSIBLE_SPACING and 0.7 of ``adjust`` (a spot's disc of radius ``adjust``
+            # holds one), facing the way its spot does.
+            step = min(POSSIBLE_SPACING, 0.7 * adjust)
+            r = np.arange(max(band[0], 0.0), band[1] + step, step)
+            if sector is None:
+                a = np.arange(-np.pi, np.pi, step / max(band[1], step))
+            else:
+                a = sector[0] + np.arange(-sector[1], sector[1] + 1e-9,
+                                          step / max(band[1], step))
+            x = (tx + np.outer(r, np.cos(a))).ravel()
+            y = (ty + np.outer(r, np.sin(a))).ravel()
+            return bool(reached_in_band(x, y, None).any())
+
         heading = functools.partial(_towards, target=(tx, ty), near=dist + 2 * tol,
                                     offset=offset)
-        return self.from_field(field, reached, desc, task, heading), back
+        return replace(self.from_field(field, reached, desc, task, heading),
+                       possible=possible), back
 
     def region(self, region, desc: str, task: str) -> Goal:
         """Walk until the standing body enters ``region`` (the verifier's predicate).
