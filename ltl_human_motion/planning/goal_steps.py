@@ -103,6 +103,9 @@ MOTION_ROOM_HALF_WIDTH = 2 * math.pi / MOTION_ROOM_SIDES
 #: Node budget of the walk to a spot :meth:`GoalSteps.motion_room` found (the walk
 #: from the front of a cart round to the 30 degree side beside it took 816 nodes).
 MOTION_ROOM_NODES = 1000
+#: ... and the nodes it may expand after it first came to the goal's floor cells
+#: without a place to stop (a spot that a search found took 212 after it came there).
+MOTION_ROOM_AT_GOAL_NODES = 300
 
 #: Node budget of the walk to an alternative approach (most are a few steps round the
 #: target; a side that needs a long way round is not worth the search).
@@ -413,7 +416,7 @@ class GoalSteps:
 
         def room() -> int:
             # Last: the side where the goal primitive itself was clear (made there first;
-            # its walk may take long to find the spot: no limit at the goal).
+            # its walk may take longer to find the spot).
             found = self.motion_room(kind, args, target, first, [placement] + (
                 [mirrored()] if mirrored() is not None else []), raised)
             if found is None:
@@ -421,7 +424,8 @@ class GoalSteps:
                                     "motion keeps clear of the obstacles", task=text,
                                     reason="blocked")
             side, yaw, spot = found
-            return walk_there(spot, (side, MOTION_ROOM_HALF_WIDTH), MOTION_ROOM_NODES, yaw)
+            return walk_there(spot, (side, MOTION_ROOM_HALF_WIDTH), MOTION_ROOM_NODES, yaw,
+                              at_goal=MOTION_ROOM_AT_GOAL_NODES)
 
         return [(target, None)] + [
             (target, functools.partial(approach, turn, back, other))
@@ -551,6 +555,7 @@ class GoalSteps:
         goal, back = self.goals.reach(target, placement, desc, text, sector=sector,
                                       stand_yaw=stand_yaw)
         self._possible(goal, text, desc)
+        expanded0 = self.state.expanded
         if self.state.seat is None and sector is None and stand_yaw is None:
             self.executor.step_towards(target, placement, back, goal=goal)
         walked = self._walk_or_step_into(goal, text, budget, sector is not None
@@ -563,8 +568,16 @@ class GoalSteps:
                                           stand_yaw=stand_yaw)
             self._possible(goal, text, desc)
             final = budget or self.ctx.options.budget
-            final = replace(final, max_nodes=min(final.max_nodes, FINAL_WALK_NODES),
-                            at_goal_nodes=min(AT_GOAL_NODES, FINAL_WALK_NODES))
+            # (a given budget is the whole walk's: what the first walk left of it)
+            left = final.max_nodes - (self.state.expanded - expanded0 if budget else 0)
+            final = replace(final, max_nodes=min(left, FINAL_WALK_NODES),
+                            at_goal_nodes=min(final.at_goal_nodes or AT_GOAL_NODES,
+                                              FINAL_WALK_NODES))
+            if final.max_nodes <= 0:
+                raise PlanningError(
+                    f"task {text}: {desc}: no place to stop within {FINAL_ADJUST_RADIUS:.2f}"
+                    f" m of the reach spot keeps the body clear (the walk's {budget.max_nodes}"
+                    " nodes spent)", task=text, reason="blocked")
             if self.state.seat is None:
                 self.executor.step_into(goal)
             try:
