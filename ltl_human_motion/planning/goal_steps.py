@@ -106,6 +106,7 @@ MOTION_ROOM_NODES = 1000
 #: ... and the nodes it may expand after it first came to the goal's floor cells
 #: without a place to stop (a spot that a search found took 212 after it came there).
 MOTION_ROOM_AT_GOAL_NODES = 300
+MOTION_ROOM_BUDGET = SearchBudget(MOTION_ROOM_NODES, at_goal_nodes=MOTION_ROOM_AT_GOAL_NODES)
 
 #: Node budget of the walk to an alternative approach (most are a few steps round the
 #: target; a side that needs a long way round is not worth the search).
@@ -115,6 +116,7 @@ ALTERNATIVE_NODES = 500
 #: them); where it ends so, the model-made steps into the goal are tried as after its
 #: budget (:meth:`GoalSteps._walk_or_step_into`).
 ALTERNATIVE_AT_GOAL_NODES = 100
+ALTERNATIVE_BUDGET = SearchBudget(ALTERNATIVE_NODES, at_goal_nodes=ALTERNATIVE_AT_GOAL_NODES)
 
 #: Node budget of the walk to the side of a seat that faces the seated work (without
 #: it the worker sits facing whichever way the walk arrives).
@@ -389,14 +391,13 @@ class GoalSteps:
             return stood > placement[0] + back and self.reaches(
                 kind, args, (stood + back, placement[1], target[2]), raised)
 
-        def walk_there(spot: tuple[float, float], sector: tuple[float, float], nodes: int,
-                       stand_yaw: float | None = None, at_goal: int | None = None) -> int:
+        def walk_there(spot: tuple[float, float], sector: tuple[float, float],
+                       budget: SearchBudget, stand_yaw: float | None = None) -> int:
             lowered = raised and not self.state.held
             if lowered:
                 self.executor.arm_transition(True, -1)
             self.executor.step_out()            # the first try may have left the worker at a rack
-            walked = self.approach(target, spot, text, sector=sector,
-                                   budget=SearchBudget(nodes, at_goal_nodes=at_goal),
+            walked = self.approach(target, spot, text, sector=sector, budget=budget,
                                    stand_yaw=stand_yaw)
             if lowered:
                 self.executor.arm_transition(False, -1)
@@ -411,12 +412,10 @@ class GoalSteps:
                                     "that side", task=text, reason="blocked")
             d, lat = mirrored() if other else placement
             return walk_there((d + back if ahead is None else ahead, lat),
-                              (first + turn, APPROACH_HALF_WIDTH), ALTERNATIVE_NODES,
-                              at_goal=ALTERNATIVE_AT_GOAL_NODES)
+                              (first + turn, APPROACH_HALF_WIDTH), ALTERNATIVE_BUDGET)
 
         def room() -> int:
-            # Last: the side where the goal primitive itself was clear (made there first;
-            # its walk may take longer to find the spot).
+            # Last: the side where the goal primitive itself was clear (made there first).
             found = self.motion_room(kind, args, target, first, [placement] + (
                 [mirrored()] if mirrored() is not None else []), raised)
             if found is None:
@@ -424,8 +423,7 @@ class GoalSteps:
                                     "motion keeps clear of the obstacles", task=text,
                                     reason="blocked")
             side, yaw, spot = found
-            return walk_there(spot, (side, MOTION_ROOM_HALF_WIDTH), MOTION_ROOM_NODES, yaw,
-                              at_goal=MOTION_ROOM_AT_GOAL_NODES)
+            return walk_there(spot, (side, MOTION_ROOM_HALF_WIDTH), MOTION_ROOM_BUDGET, yaw)
 
         return [(target, None)] + [
             (target, functools.partial(approach, turn, back, other))
@@ -569,7 +567,8 @@ class GoalSteps:
             self._possible(goal, text, desc)
             final = budget or self.ctx.options.budget
             # (a given budget is the whole walk's: what the first walk left of it)
-            left = final.max_nodes - (self.state.expanded - expanded0 if budget else 0)
+            left = final.max_nodes - (self.state.expanded - expanded0 if budget is not None
+                                      else 0)
             final = replace(final, max_nodes=min(left, FINAL_WALK_NODES),
                             at_goal_nodes=min(final.at_goal_nodes or AT_GOAL_NODES,
                                               FINAL_WALK_NODES))

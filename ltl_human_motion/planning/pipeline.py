@@ -324,13 +324,10 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     CellError
         Malformed cell.
     PlanningError
-        A task could not be planned (the message names the task and why). Where a step
-        fails in the order of the tasks chosen first, up to ``OTHER_ORDERS`` other
-        orders are planned before this is raised (the message says how many).
+        A task could not be planned (the message names the task and why).
     VerificationError
-        A motion failed a check (the message names it). Where the motion of the order of
-        the tasks chosen first fails, up to ``OTHER_ORDERS`` other orders are made before
-        this is raised (the message says how many).
+        A motion failed a check (the message names it). Before either is raised, up to
+        ``OTHER_ORDERS`` other orders of the tasks are tried (the message says how many).
     """
     from ltl_human_motion.ltl.spec import build_specification
 

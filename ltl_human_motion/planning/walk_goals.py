@@ -123,6 +123,45 @@ def _spot_band(placement: tuple[float, float], back: float, adjust: float
     return inner - adjust - _BAND_SLACK, outer + adjust + _BAND_SLACK
 
 
+def _stands_to_reach(ctx: PlanContext, target: np.ndarray, placement: tuple[float, float],
+                     back: float, adjust: float,
+                     side: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                     walk_map: Callable[[np.ndarray], np.ndarray], stand_yaw: float | None,
+                     inner: float, x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None
+                     ) -> np.ndarray:
+    """The goal test of :meth:`WalkGoals.reach` for root poses (x, y, yaw) (M,) in its
+    band: the ideal spot (:func:`.standing.ideal_placement`, up to ``back`` further back;
+    room on ``walk_map``) is free, within ``adjust`` and on ``side``, and the worker
+    faces its way or has room to turn there (any heading where ``yaw`` is None); with
+    ``stand_yaw``, the root at least ``inner`` from the target. Bool (M,)."""
+    px, py, pyaw, free, here = ideal_placement(ctx, target, placement, x, y, back, room=True,
+                                               walk_map=walk_map, stand_yaw=stand_yaw)
+    out = free & (np.hypot(px - x, py - y) <= adjust) & side(x, y)
+    if yaw is not None:
+        # Turning on the spot needs room for the hips; facing nearly right needs none.
+        out &= (here > ctx.turn_room) \
+            | (np.abs(wrap_angle(pyaw - yaw)) <= ctx.options.heading_tolerance)
+    if stand_yaw is not None:
+        # The spot is fixed: a walk must still end on the ring, not nearer (under the
+        # board the standing step would have to back out of).
+        out &= np.hypot(target[0] - x, target[1] - y) >= inner
+    return out
+
+
+def _band_points(target: np.ndarray, band: tuple[float, float],
+                 sector: tuple[float, float] | None, step: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Floor points (x, y), each (N,), of the ring ``band`` (metres from ``target``) within
+    ``sector`` (all round without one) on a polar grid no coarser than ``step``: a disc of
+    radius ``step / 0.7`` in it holds one."""
+    r = np.arange(max(band[0], 0.0), band[1] + step, step)
+    da = step / max(band[1], step)
+    a = np.arange(-np.pi, np.pi, da) if sector is None \
+        else sector[0] + np.arange(-sector[1], sector[1] + 1e-9, da)
+    return ((float(target[0]) + np.outer(r, np.cos(a))).ravel(),
+            (float(target[1]) + np.outer(r, np.sin(a))).ravel())
+
+
 def _towards(led: NavigationField, target: tuple[float, float], near: float, offset: float
              ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """The heuristic's heading for a reach: the field's way, and within ``near`` of the
@@ -294,6 +333,10 @@ class WalkGoals:
         field, back = self.led(solve)
         band = _spot_band(placement, back, adjust)
 
+        reached_in_band = functools.partial(
+            _stands_to_reach, self.ctx, target, placement, back, adjust, side,
+            field.grid.clearance, stand_yaw, dist - tol)
+
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             r = np.hypot(tx - x, ty - y)
             out = (r >= band[0]) & (r <= band[1])
@@ -301,36 +344,9 @@ class WalkGoals:
                 out[out] = reached_in_band(x[out], y[out], yaw[out])
             return out
 
-        def reached_in_band(x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None
-                            ) -> np.ndarray:
-            # (yaw None: facing the spot's way, as a walk may arrive)
-            px, py, pyaw, free, here = ideal_placement(self.ctx, target, placement, x, y, back,
-                                                         room=True, walk_map=field.grid.clearance,
-                                                         stand_yaw=stand_yaw)
-            out = free & (np.hypot(px - x, py - y) <= adjust) & side(x, y)
-            if yaw is not None:
-                # Turning on the spot needs room for the hips; facing nearly right needs none.
-                out &= (here > self.ctx.turn_room) \
-                    | (np.abs(wrap_angle(pyaw - yaw)) <= self.ctx.options.heading_tolerance)
-            if stand_yaw is not None:
-                # The spot is fixed: a walk must still end on the ring, not nearer (under
-                # the board the standing step would have to back out of).
-                out &= np.hypot(tx - x, ty - y) >= dist - tol
-            return out
-
         def possible() -> bool:
-            # Every floor point of the band on a polar grid no coarser than
-            # POSSIBLE_SPACING and 0.7 of ``adjust`` (a spot's disc of radius ``adjust``
-            # holds one), facing the way its spot does.
-            step = min(POSSIBLE_SPACING, 0.7 * adjust)
-            r = np.arange(max(band[0], 0.0), band[1] + step, step)
-            if sector is None:
-                a = np.arange(-np.pi, np.pi, step / max(band[1], step))
-            else:
-                a = sector[0] + np.arange(-sector[1], sector[1] + 1e-9,
-                                          step / max(band[1], step))
-            x = (tx + np.outer(r, np.cos(a))).ravel()
-            y = (ty + np.outer(r, np.sin(a))).ravel()
+            # facing the way each spot does, as a walk may arrive
+            x, y = _band_points(target, band, sector, min(POSSIBLE_SPACING, 0.7 * adjust))
             return bool(reached_in_band(x, y, None).any())
 
         heading = functools.partial(_towards, target=(tx, ty), near=dist + 2 * tol,
