@@ -103,6 +103,8 @@ def _ring_stands(ctx: PlanContext, target: np.ndarray, placement: tuple[float, f
 #: Largest spacing, metres, of the grid on which a reach goal tells whether any floor
 #: point passes its test (:attr:`.astar.Goal.possible`).
 POSSIBLE_SPACING = 0.04
+#: Points of that grid tested at a time (the test stops at the first chunk that passes).
+POSSIBLE_CHUNK = 256
 
 #: Metres the band of :func:`_spot_band` is widened by (rounding only).
 _BAND_SLACK = 1e-6
@@ -149,17 +151,19 @@ def _stands_to_reach(ctx: PlanContext, target: np.ndarray, placement: tuple[floa
 
 
 def _band_points(target: np.ndarray, band: tuple[float, float],
-                 sector: tuple[float, float] | None, step: float
+                 sector: tuple[float, float] | None, step: float, toward: float
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Floor points (x, y), each (N,), of the ring ``band`` (metres from ``target``) within
-    ``sector`` (all round without one) on a polar grid no coarser than ``step``: a disc of
-    radius ``step / 0.7`` in it holds one."""
+    ``sector`` (all round without one) on a polar grid no coarser than ``step`` (a disc
+    of radius ``step / 0.7`` in it holds one), those nearest the direction ``toward``
+    (rad, from the target) first."""
     r = np.arange(max(band[0], 0.0), band[1] + step, step)
     da = step / max(band[1], step)
     a = np.arange(-np.pi, np.pi, da) if sector is None \
         else sector[0] + np.arange(-sector[1], sector[1] + 1e-9, da)
-    return ((float(target[0]) + np.outer(r, np.cos(a))).ravel(),
-            (float(target[1]) + np.outer(r, np.sin(a))).ravel())
+    a = a[np.argsort(np.abs(wrap_angle(a - toward)), kind="stable")]
+    return ((float(target[0]) + np.outer(np.cos(a), r)).ravel(),
+            (float(target[1]) + np.outer(np.sin(a), r)).ravel())
 
 
 def _towards(led: NavigationField, target: tuple[float, float], near: float, offset: float
@@ -345,9 +349,13 @@ class WalkGoals:
             return out
 
         def possible() -> bool:
-            # facing the way each spot does, as a walk may arrive
-            x, y = _band_points(target, band, sector, min(POSSIBLE_SPACING, 0.7 * adjust))
-            return bool(reached_in_band(x, y, None).any())
+            # facing the way each spot does, as a walk may arrive; the side the worker
+            # comes from first, in chunks (most goals pass in the first)
+            toward = math.atan2(self.state.pose[1] - ty, self.state.pose[0] - tx)
+            x, y = _band_points(target, band, sector, min(POSSIBLE_SPACING, 0.7 * adjust),
+                                toward)
+            return any(reached_in_band(x[k:k + POSSIBLE_CHUNK], y[k:k + POSSIBLE_CHUNK],
+                                       None).any() for k in range(0, len(x), POSSIBLE_CHUNK))
 
         heading = functools.partial(_towards, target=(tx, ty), near=dist + 2 * tol,
                                     offset=offset)
