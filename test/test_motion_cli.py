@@ -67,3 +67,22 @@ def test_synthesize_command_verifies_with_the_biomechanical_checks_unless_told(
     out = capsys.readouterr().out
     checks = json.loads(out[out.index("{"):])["motions"][0]["verification"]
     assert rc == 0 and checks["collision"] and "foot_skate" not in checks
+
+
+def test_synthesize_command_says_when_the_motion_was_made_in_another_order(
+        tmp_path: Path, capsys) -> None:
+    """A 1.95 m worker in the bins cell: the first order's motion slides a foot 0.16 m/s
+    (foot_skate); the next order's verifies, and the command says so."""
+    cell = Path(__file__).resolve().parents[1] / "scenarios" / "cells" / "bins.yaml"
+    spec = ("F((grasp(O1)) & F (assemble(R2))) & F (extract(O2, bin_b)) & "
+            "G(((grasp(O1)) & !(assemble(R2)) & F (assemble(R2))) -> "
+            "(!(extract(O2, bin_b)) U (assemble(R2))))")
+    rc = main(["synthesize", "--cell", str(cell), "--spec", spec, "--stature", "1.95",
+               "--out", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert rc == 0 and "verified: yes" in out
+    assert "(made in another order of the tasks: 1 failed before it, the first: " \
+           "verification failed (foot_skate)" in out
+    stats = json.loads(out[out.index("{"):])["motions"][0]["stats"]
+    assert stats["orders_failed"] == 1 and stats["first_failure"].startswith(
+        "verification failed (foot_skate): foot_skate: left foot slides")

@@ -36,6 +36,17 @@ def _texts(seq) -> list[str]:
     return [_task_text(t) for t in seq.tasks]
 
 
+class _Made:
+    """What a stand-in for the synthesis of one order returns: its tasks and stats."""
+
+    def __init__(self, texts: list[str]) -> None:
+        self.texts, self.stats = texts, {}
+
+
+def _works(seq, failed=None) -> _Made:
+    return _Made(_texts(seq))
+
+
 def test_the_same_situation_is_the_same_set_of_tasks_before(kitting) -> None:
     _, seqs = kitting
     first = seqs[0]
@@ -68,10 +79,9 @@ def test_other_orders_are_planned_in_turn_and_the_first_failure_is_kept(kitting)
     assert err.value.reason == "blocked" and err.value.task == "grasp(gear)"
     assert str(err.value).startswith("task grasp(gear): blocked; 2 other order(s)")
 
-    def works(seq, failed=None):
-        return _texts(seq)
-
-    assert _in_another_order(works, first, failure, lambda: seqs, cell, 1.75) == tried[0]
+    made = _in_another_order(_works, first, failure, lambda: seqs, cell, 1.75)
+    assert made.texts == tried[0]
+    assert made.stats == {"orders_failed": 1, "first_failure": "task grasp(gear): blocked"}
 
 
 def test_a_limit_of_the_cell_is_not_tried_in_another_order(kitting) -> None:
@@ -182,12 +192,10 @@ def test_a_motion_that_fails_verification_is_made_in_another_order(kitting) -> N
     assert str(err.value) == ("verification failed (joint_speed): l_toe; 2 other order(s) "
                               "of the tasks failed too")
 
-    def works(seq, failed=None):
-        return _texts(seq)
-
-    assert _verified_in_another_order(works, first, failure, lambda: seqs, cell,
-                                      1.75) == tried[0]
+    made = _verified_in_another_order(_works, first, failure, lambda: seqs, cell, 1.75)
+    assert made.texts == tried[0] and made.stats["orders_failed"] == 1
+    assert made.stats["first_failure"] == str(failure)
     # no other order: the failure as it was
     with pytest.raises(VerificationError) as err:
-        _verified_in_another_order(works, first, failure, lambda: [first], cell, 1.75)
+        _verified_in_another_order(_works, first, failure, lambda: [first], cell, 1.75)
     assert err.value is failure

@@ -70,11 +70,14 @@ def run(args: argparse.Namespace) -> int:
                    f"(compiled kernels, gait index, the cell's fields), "
                    f"{(st['total_time'] - stages) * 1000:.0f} ms"
                    if i == 0 and st["total_time"] - stages > 0.2 else "")
+        before = (f"\n  (made in another order of the tasks: {st['orders_failed']} failed "
+                  f"before it, the first: {st['first_failure'][:200]})"
+                  if st.get("orders_failed") else "")
         print(f"motion {i}: {' ; '.join(synth.sequence)}  ({synth.motion.duration:.1f} s of "
               f"motion in {st['total_time'] * 1000:.0f} ms: planning "
               f"{st['planning_time'] * 1000:.0f} ms, blending {st['blending_time'] * 1000:.0f} "
               f"ms, verification {st['verification_time'] * 1000:.0f} ms{loading}; verified: "
-              f"{'yes' if all(checks.values()) else 'NO'})")
+              f"{'yes' if all(checks.values()) else 'NO'}){before}")
         summary.append({"files": written, "sequence": synth.sequence,
                         "duration": synth.motion.duration, "verification": checks,
                         "stats": {k: v for k, v in synth.stats.items()

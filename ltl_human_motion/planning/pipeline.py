@@ -455,7 +455,7 @@ def _in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
             _same_situation(other, s, at, texts) for s, at, texts in situations)):
         tried += 1
         try:
-            return one(other, failed=known)
+            return _after_failures(one(other, failed=known), tried, failure)
         except PlanningError as exc:
             where = _failed_situation(other, exc)
             if where is not None:
@@ -479,13 +479,22 @@ def _verified_in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
     for other in _orders(others, cell, stature, lambda other: other.tasks == seq.tasks):
         tried += 1
         try:
-            return one(other)
+            return _after_failures(one(other), tried, failure)
         except (PlanningError, VerificationError):
             continue
     if tried:
         raise VerificationError(f"{failure}; {tried} other order(s) of the tasks failed "
                                 "too", failure.check) from failure
     raise failure
+
+
+def _after_failures(synth: SynthesizedMotion, failed: int, first: Exception
+                    ) -> SynthesizedMotion:
+    """``synth`` with ``stats["orders_failed"]`` (orders of the tasks that failed before
+    its own) and ``stats["first_failure"]`` (why the first did)."""
+    synth.stats["orders_failed"] = failed
+    synth.stats["first_failure"] = str(first)
+    return synth
 
 
 def _orders(others: Callable[[], list], cell, stature: float, skip: Callable[[Any], bool]
