@@ -134,8 +134,7 @@ def _aisle_planner(failed: dict | None = None):
     cell = resolve_cell(AISLE)
     planner = SequencePlanner(cell.floor_at_zero(), get_library(1.75),
                               np.random.default_rng([0, 0]),
-                              PlannerOptions(refuse_self_penetration=True))
-    planner.failed_before = failed or {}
+                              PlannerOptions(refuse_self_penetration=True), failed_before=failed)
     return cell, planner
 
 

@@ -572,11 +572,16 @@ class GoalSteps:
             final = replace(final, max_nodes=min(left, FINAL_WALK_NODES),
                             at_goal_nodes=min(final.at_goal_nodes or AT_GOAL_NODES,
                                               FINAL_WALK_NODES))
+            # Next to the spot and no stop there keeps the body clear: a blocked spot (the
+            # caller tries the other placements).
+            no_stop = PlanningError(
+                f"task {text}: {desc}: no place to stop within {FINAL_ADJUST_RADIUS:.2f} m "
+                "of the reach spot keeps the body clear ("
+                + (f"{final.max_nodes} nodes searched)" if final.max_nodes > 0
+                   else f"the walk's {budget.max_nodes} nodes spent)"),
+                task=text, reason="blocked")
             if final.max_nodes <= 0:
-                raise PlanningError(
-                    f"task {text}: {desc}: no place to stop within {FINAL_ADJUST_RADIUS:.2f}"
-                    f" m of the reach spot keeps the body clear (the walk's {budget.max_nodes}"
-                    " nodes spent)", task=text, reason="blocked")
+                raise no_stop
             if self.state.seat is None:
                 self.executor.step_into(goal)
             try:
@@ -587,12 +592,7 @@ class GoalSteps:
             except PlanningError as exc:
                 if exc.reason != "budget":
                     raise
-                # Next to the spot: no stop there keeps the body clear (a blocked spot,
-                # the caller tries the other placements).
-                raise PlanningError(
-                    f"task {text}: {desc}: no place to stop within {FINAL_ADJUST_RADIUS:.2f}"
-                    f" m of the reach spot keeps the body clear ({final.max_nodes} nodes "
-                    "searched)", task=text, reason="blocked") from exc
+                raise no_stop from exc
             self.executor.adjust_to(target, placement, text, back, stand_yaw)
         return walked
 

@@ -573,8 +573,8 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     # (_blended) and verified in the user's own cell.
     floor_cell = cell.floor_at_zero()
     planner = SequencePlanner(floor_cell, library, rng, replace(
-        options.planner, refuse_self_penetration=options.verification.biomechanics))
-    planner.failed_before = failed or {}
+        options.planner, refuse_self_penetration=options.verification.biomechanics),
+        failed_before=failed)
     start = _start_pose(floor_cell, planner.target_of(steps[0].kind, steps[0].args), rng)
     t0 = time.perf_counter()
     plan = planner.plan(steps, start)

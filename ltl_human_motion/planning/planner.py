@@ -216,10 +216,13 @@ class SequencePlanner:
     library : MotionLibrary
     rng : numpy.random.Generator
     options : PlannerOptions
+    failed_before : dict, optional
+        Steps that failed in an earlier order of the tasks (:attr:`failed_before`).
     """
 
     def __init__(self, cell, library, rng: np.random.Generator,
-                 options: PlannerOptions = PlannerOptions()) -> None:
+                 options: PlannerOptions = PlannerOptions(),
+                 failed_before: dict[tuple, PlanningError] | None = None) -> None:
         self.ctx = PlanContext.build(cell, library, rng, options)
         self.state = WorkerState()
         self.executor = StepExecutor(self.ctx, self.state)
@@ -228,7 +231,7 @@ class SequencePlanner:
         self.steps: list[StepPlan] = []
         #: Steps that failed in an earlier order of the tasks, by :meth:`situation`: the
         #: same step in the same situation fails the same way here, without a search.
-        self.failed_before: dict[tuple, PlanningError] = {}
+        self.failed_before: dict[tuple, PlanningError] = failed_before or {}
 
     def situation(self, text: str, after: str | None) -> tuple:
         """Step ``text`` done after step ``after`` (None: first) in what the tasks so far
