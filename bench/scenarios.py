@@ -266,6 +266,12 @@ def main(argv: list[str] | None = None) -> int:
         items = _items(args)
     except (OSError, ValueError) as exc:      # unknown cell, unreadable or broken specs
         parser.error(str(exc))
+    for out in (args.out, args.runs_out):      # a bad output folder: before the run
+        try:
+            if out is not None:
+                out.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            parser.error(f"cannot write {out}: {exc.strerror}: {exc.filename}")
     print(f"{len(items)} runs on {workers} worker(s), {args.timeout:.0f} s limit per pair")
     t0 = time.perf_counter()
     results: list[dict] = []
