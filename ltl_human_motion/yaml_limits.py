@@ -9,14 +9,19 @@ graph first, refuses it beyond the limits below, then constructs the value.
 
 from __future__ import annotations
 
+import os
+import stat
+from pathlib import Path
 from typing import Any
 
-__all__ = ["MAX_YAML_CHARS", "MAX_YAML_DEPTH", "MAX_YAML_EXPANDED_NODES", "YamlLimitError",
-           "load_yaml_limited", "short_repr"]
+__all__ = ["MAX_YAML_BYTES", "MAX_YAML_CHARS", "MAX_YAML_DEPTH", "MAX_YAML_EXPANDED_NODES",
+           "TextFileError", "YamlLimitError", "load_yaml_limited", "read_text_file", "short_repr"]
 
 #: Characters of one YAML document (a detailed cell is ~100 kB; 10,000 tiny obstacles
 #: were 1.4 MB).
 MAX_YAML_CHARS = 5_000_000
+#: Bytes read from a YAML file: MAX_YAML_CHARS characters of up to 4 UTF-8 bytes each.
+MAX_YAML_BYTES = 4 * MAX_YAML_CHARS
 #: Nesting depth of mappings and sequences (a cell nests 4-5 deep).
 MAX_YAML_DEPTH = 64
 #: Nodes of the document with every alias expanded (a cell has a few thousand).
@@ -27,6 +32,54 @@ SHORT_REPR_CHARS = 80
 
 class YamlLimitError(ValueError):
     """A YAML document beyond a named limit (or not YAML); the message says which."""
+
+
+class TextFileError(ValueError):
+    """A text file that cannot be read: missing, not a regular file, too big or not UTF-8;
+    the message names the file and the cause."""
+
+
+_FILE_KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+               (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"),
+               (stat.S_ISDIR, "a folder"))
+
+
+def read_text_file(path: str | os.PathLike[str], what: str,
+                   max_bytes: int = MAX_YAML_BYTES) -> str:
+    """The UTF-8 text of the regular file ``path`` (symlinks followed), at most ``max_bytes``.
+
+    A FIFO, device, socket or folder is refused without reading (issue 34: a FIFO blocked
+    forever, ``/dev/zero`` was read until memory ran out). The open does not block on a
+    FIFO with no writer. ``what`` names the file in messages, e.g. ``"cell file"``.
+
+    Raises
+    ------
+    TextFileError
+        e.g. "cell file c.yaml is not a regular file (a FIFO)".
+    """
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as exc:
+        raise TextFileError(f"{path}: cannot read {what}: {exc.strerror or exc}") from None
+    mode = os.fstat(fd).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        kind = next((name for test, name in _FILE_KINDS if test(mode)), "a special file")
+        raise TextFileError(f"{what} {path} is not a regular file ({kind})")
+    with os.fdopen(fd, "rb") as fh:
+        try:
+            data = fh.read(max_bytes + 1)
+        except OSError as exc:
+            raise TextFileError(f"{path}: cannot read {what}: {exc.strerror or exc}") from None
+    if len(data) > max_bytes:
+        raise TextFileError(f"{what} {path} has more than {max_bytes:,} bytes; at most "
+                            f"{max_bytes:,} are read (MAX_YAML_BYTES)")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise TextFileError(f"{path}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at "
+                            f"offset {exc.start}); save the {what} as UTF-8") from None
 
 
 def short_repr(value: Any, limit: int = SHORT_REPR_CHARS) -> str:

@@ -162,6 +162,30 @@ def test_deep_inline_cell_is_a_clean_error(served: tuple[SynthesisNode, ClientSe
     assert "internal error" not in response.error_message, response.error_message
 
 
+def test_cells_that_are_not_regular_files_never_hold_a_worker(
+        served: tuple[SynthesisNode, ClientSession], tmp_path: Path) -> None:
+    """Issue 34: each FIFO request held one of the 4 workers for good; now each is refused
+    at once and a normal request behind them is answered."""
+    _, session = served
+    fifo = tmp_path / "c.yaml"
+    os.mkfifo(fifo)
+    (tmp_path / "zero.yaml").symlink_to("/dev/zero")
+    bad = [str(fifo)] * 5 + [str(tmp_path / "zero.yaml")] * 2
+    requests = [SynthesizeMotion.Request(spec="S1", cell=c, seed=40 + i)
+                for i, c in enumerate(bad)]
+    requests.append(SynthesizeMotion.Request(spec="S1", cell="paper_cell", seed=50))
+    started = time.monotonic()
+    answers = _answers(session, requests, None, timeout=60.0)
+    assert all(a is not None for a in answers), answers
+    for cell, answer in zip(bad, answers, strict=False):
+        kind = "a FIFO" if cell == str(fifo) else "a character device"
+        assert not answer.success
+        assert answer.error_message.endswith(f"cell file {cell} is not a regular file ({kind})"), \
+            answer.error_message
+    assert answers[-1].success, answers[-1].error_message
+    assert time.monotonic() - started < 30.0
+
+
 SERVER_CODE = textwrap.dedent("""
     import sys
     from ltl_human_motion.ros.entry_points import synthesis_node

@@ -33,6 +33,7 @@ from ltl_human_motion.batch.worker import (
     prepare_worker,
     run_item,
 )
+from ltl_human_motion.yaml_limits import TextFileError, read_text_file
 
 if TYPE_CHECKING:
     from ltl_human_motion.scene.cell import Cell
@@ -106,7 +107,10 @@ def make_job(cell: str | os.PathLike[str], specs: BatchSpecs, dtype: str = "floa
     if not source.is_file():
         raise BatchConfigError(f"cell {cell!r}: a batch needs a cell file (got source "
                                f"{resolved.source!r})")
-    text = source.read_text(encoding="utf-8")
+    try:
+        text = read_text_file(source, "cell file")
+    except TextFileError as exc:
+        raise BatchConfigError(str(exc)) from None
     parsed = cell_from_yaml(text, source=str(source), base_dir=source.parent)
     validate_against_cell(specs, parsed)
     job = BatchJob(cell_yaml=text, cell_source=str(source), cell_base_dir=str(source.parent),

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from ltl_human_motion.errors import LtlHumanMotionError
+from ltl_human_motion.yaml_limits import TextFileError, read_text_file
 
 __all__ = [
     "BatchConfigError", "BatchSpecs", "Jitter", "SpecEntry", "load_specs", "specs_from_yaml",
@@ -312,8 +313,7 @@ def load_specs(path: str | os.PathLike[str]) -> BatchSpecs:
     """Read and check a specs file (see the module docstring for the format)."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise BatchConfigError(f"{path}: cannot read specs file: {exc.strerror or exc}") \
-            from exc
+        text = read_text_file(path, "specs file")
+    except TextFileError as exc:
+        raise BatchConfigError(str(exc)) from None
     return specs_from_yaml(text, source=str(path))

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 from ltl_human_motion.ltl import (
     BACKENDS,
@@ -23,6 +22,7 @@ from ltl_human_motion.ltl.automaton import degeneralize
 from ltl_human_motion.ltl.formula import And, Globally
 from ltl_human_motion.ltl.spec import Specification
 from ltl_human_motion.tasks import has_geometry, plan_sequences
+from ltl_human_motion.yaml_limits import TextFileError, read_text_file
 
 NAME = "tasks"
 HELP = "Print task sequences (or the Büchi automaton) satisfying an LTL specification."
@@ -142,7 +142,7 @@ def always_on_lines(spec: Specification) -> list[str]:
 
 def _read_hoa(path: str) -> Automaton:
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise HoaError(f"cannot read HOA file {path}: {exc}") from None
+        text = read_text_file(path, "HOA file")
+    except TextFileError as exc:
+        raise HoaError(str(exc)) from None
     return automaton_from_hoa(text)

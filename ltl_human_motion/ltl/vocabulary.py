@@ -138,14 +138,21 @@ def load_vocabulary(path: str | Path) -> Vocabulary:
         If the file is missing, too large or deep for
         :func:`~ltl_human_motion.yaml_limits.load_yaml_limited`, or malformed.
     """
-    from ltl_human_motion.yaml_limits import YamlLimitError, load_yaml_limited
+    from ltl_human_motion.yaml_limits import (
+        TextFileError,
+        YamlLimitError,
+        load_yaml_limited,
+        read_text_file,
+    )
 
     path = Path(path)
-    if not path.is_file():
-        raise CellError(f"cell file not found: {path}")
     try:
-        data = load_yaml_limited(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, YamlLimitError) as exc:
+        text = read_text_file(path, "cell file")
+    except TextFileError as exc:
+        raise CellError(str(exc)) from None
+    try:
+        data = load_yaml_limited(text)
+    except YamlLimitError as exc:
         raise CellError(f"{path}: cannot read cell description: {exc}") from None
     if not isinstance(data, Mapping):
         raise CellError(f"{path}: a cell description must be a YAML mapping")

@@ -25,7 +25,12 @@ from ltl_human_motion.scene.cell import Cell, Obstacle, Region, SceneObject
 from ltl_human_motion.scene.frames import ZUP_FROM_YUP, extents_zup_from_yup, zup_from_yup
 from ltl_human_motion.scene.shapes import Box, Cylinder, MeshShape, Shape, Sphere
 from ltl_human_motion.vocabulary import TASK_ARGUMENTS, shorthand_conjuncts
-from ltl_human_motion.yaml_limits import YamlLimitError, load_yaml_limited
+from ltl_human_motion.yaml_limits import (
+    TextFileError,
+    YamlLimitError,
+    load_yaml_limited,
+    read_text_file,
+)
 from ltl_human_motion.yaml_limits import short_repr as _r
 
 __all__ = [
@@ -423,12 +428,9 @@ def load_cell(path: str | os.PathLike[str]) -> Cell:
     """Load a cell from a YAML file; mesh paths are relative to the file."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise CellError(f"{path}: cannot read cell file: {exc.strerror or exc}") from exc
-    except UnicodeDecodeError as exc:
-        raise CellError(f"{path}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at "
-                        f"offset {exc.start}); save the cell file as UTF-8") from None
+        text = read_text_file(path, "cell file")
+    except TextFileError as exc:
+        raise CellError(str(exc)) from None
     return cell_from_yaml(text, source=str(path), base_dir=path.parent)
 
 
@@ -472,9 +474,15 @@ def cell_by_name(name: str) -> Cell:
             return load_cell(candidate)
         if folder.is_dir():
             # Other YAML files live there too (bringup parameters, batch specs, robots).
-            found.update(p.stem for p in folder.glob("*.yaml")
-                         if "start_region:" in p.read_text(encoding="utf-8", errors="replace"))
+            found.update(p.stem for p in folder.glob("*.yaml") if _is_cell_file(p))
     raise CellError(f"no cell named {stem!r}; known cells: {', '.join(sorted(found)) or '(none)'}")
+
+
+def _is_cell_file(path: Path) -> bool:
+    try:
+        return "start_region:" in read_text_file(path, "cell file")
+    except TextFileError:
+        return False
 
 
 def looks_like_yaml(text: str) -> bool:
