@@ -572,7 +572,15 @@ class CoexistenceController:
         return steps
 
     def close(self) -> None:
-        """Disconnect; a broken interface is kept alive (see the module docstring)."""
+        """Disconnect the working interfaces; a broken one is neither disconnected nor
+        destroyed but kept alive (see the module docstring), and the loss is logged.
+
+        Issue 34: after the controller went away, destroying the broken
+        ``RTDEIOInterface`` (held by a wrapper, so not recognised by its type) made its
+        destructor write to the closed socket: "write: Broken pipe", std::terminate."""
+        if self._recv is not None:
+            self._check_receive_alive()
+        lost = []
         for attr, ok in (("_io", self._io_ok), ("_recv", self._recv_ok)):
             obj = getattr(self, attr)
             if obj is None:
@@ -582,11 +590,24 @@ class CoexistenceController:
                 try:
                     obj.disconnect()
                     continue
-                except (RuntimeError, OSError):
-                    pass
-            if attr == "_io" and type(obj).__module__ == "rtde_io":
-                _keep_alive_forever(obj)
+                except (RuntimeError, OSError) as exc:
+                    log.warning("RTDE %s: disconnect failed (%s)", attr[1:], exc)
+            lost.append(attr[1:])
+            _keep_alive_forever(obj)
+        if lost:
+            log.warning("robot connection lost before the stop (RTDE %s); not disconnected",
+                        " and ".join(lost))
         self._recv_ok = self._io_ok = False
+
+    def _check_receive_alive(self) -> None:
+        """Mark both interfaces lost when the receive side says its connection is gone
+        (the io side talks to the same controller)."""
+        try:
+            alive = bool(self._recv.isConnected())
+        except (RuntimeError, OSError):
+            alive = False
+        if not alive:
+            self._recv_ok = self._io_ok = False
 
     def __enter__(self) -> CoexistenceController:
         return self
