@@ -221,6 +221,7 @@ def test_a_low_reach_from_the_carry_stance_keeps_the_forearm_out_of_the_thigh(
     swings the hand wider past the thigh where the usual swing passes the forearm through
     it (the thigh rises towards the flexed trunk; at the contact pose the arm is clear)."""
     from ltl_human_motion.motion import goals
+    from ltl_human_motion.motion.goals import hand_tasks, postures
     from ltl_human_motion.planning.pipeline import get_library
     sk = Skeleton(1.85)
     carry = get_library(1.85).carry_standing_pose
@@ -231,6 +232,6 @@ def test_a_low_reach_from_the_carry_stance_keeps_the_forearm_out_of_the_thigh(
         return float(self_penetration(mp.poses + mp.root[:, None, :3], 1.85)[0].max())
 
     assert deepest() <= 0.0
-    monkeypatch.setattr(goals, "_WIDER_SWINGS", (1.0,))
-    monkeypatch.setattr(goals, "_POSTURE_TRIES", 1)
+    monkeypatch.setattr(hand_tasks, "_WIDER_SWINGS", (1.0,))
+    monkeypatch.setattr(postures, "_POSTURE_TRIES", 1)
     assert deepest() > 0.0

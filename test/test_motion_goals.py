@@ -320,11 +320,12 @@ def test_a_retimed_reach_is_slower_along_the_same_path(monkeypatch, z: float,
     from scipy.spatial.distance import cdist
 
     from ltl_human_motion.motion import goals
+    from ltl_human_motion.motion.goals import hand_tasks
     x, y = goals.reach_placement("grasp", z, SK)
     target = np.array([x, y, z])
 
     def made(limit: float) -> np.ndarray:
-        monkeypatch.setattr(goals, "HAND_RETIME_SPEED", limit)
+        monkeypatch.setattr(hand_tasks, "HAND_RETIME_SPEED", limit)
         mp = goals.make_goal_primitive("grasp", target, SK, rng=np.random.default_rng(seed))
         return mp.poses + mp.root[:, None, :3]
 
@@ -453,6 +454,7 @@ def test_without_kneeling_the_reach_under_the_low_board_folds_the_hips(monkeypat
     the pelvis tilted in full, whose hips fold past their 125 degree range of motion
     (the failure the kneel replaces)."""
     from ltl_human_motion.motion import goals
+    from ltl_human_motion.motion.goals import postures
     from ltl_human_motion.planning.biomechanics import joint_angles
     sk = Skeleton(1.75)
     start = standing_pose(sk)[0]
@@ -464,8 +466,8 @@ def test_without_kneeling_the_reach_under_the_low_board_folds_the_hips(monkeypat
         out[5] = np.zeros_like(out[5])                 # none feasible
         return tuple(out)
 
-    monkeypatch.setattr(goals, "_kneel_set", no_kneel)
-    monkeypatch.setattr(goals, "_GRID_CACHE", {})
+    monkeypatch.setattr(postures, "_kneel_set", no_kneel)
+    monkeypatch.setattr(postures, "_GRID_CACHE", {})
     goals._placement.cache_clear()
     try:
         x, y = reach_placement("grasp", 0.10, sk, board=(0.17, 0.44, 0.46), start_pose=start)

@@ -304,8 +304,8 @@ def library_key(stature: float, files: list[Path], delta: float, k_comp: int,
                          "delta": float(delta), "k_comp": int(k_comp),
                          "phase_step": int(phase_step), "fps": _gait.LIBRARY_FPS,
                          "default": bool(include_default)}, sort_keys=True).encode())
-    for code in sorted(_MOTION_DIR.glob("*.py")):
-        h.update(code.name.encode())
+    for code in sorted(_MOTION_DIR.rglob("*.py")):
+        h.update(code.relative_to(_MOTION_DIR).as_posix().encode())
         h.update(code.read_bytes())
     for f in files:
         h.update(str(f.name).encode())
