@@ -9,6 +9,8 @@ where an arm passes through the body.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ltl_human_motion.motion.goals.body import _frames, _Start, _trunk
@@ -28,7 +30,7 @@ from ltl_human_motion.motion.goals.kneeling import (
     _prop_point,
 )
 from ltl_human_motion.motion.goals.posture_checks import ObstacleClearance
-from ltl_human_motion.motion.goals.postures import _reach_postures
+from ltl_human_motion.motion.goals.postures import ReachPosture, _reach_postures
 from ltl_human_motion.motion.goals.tasks import (
     _INSERT_TRAVEL,
     _J,
@@ -110,6 +112,22 @@ def _push_direction(task: str, target: np.ndarray, st: _Start, active: tuple[int
     return a / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
 
 
+@dataclass(frozen=True)
+class _ReachPath:
+    """How the palm of a hand task goes (:func:`_hand_task`): on the ``level`` path (else
+    the arc); insert's push and extract's pull ``travel`` (m) along ``approach`` (3,)
+    (:func:`_push_direction`); the low ``board`` (edge, bottom, top) over the target, the
+    furniture under it, ``support`` (nx, ny, offset, top), or None; and whether the palm
+    comes in level (``flat_palm``, a board close over the target)."""
+
+    level: bool
+    travel: float
+    approach: np.ndarray
+    board: tuple[float, float, float] | None
+    support: tuple[float, float, float, float] | None
+    flat_palm: bool
+
+
 def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
                rng: np.random.Generator, duration: float | None, hand: str,
                fps: float, path: str = "arc", travel: float | None = None,
@@ -138,21 +156,21 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     # it, then the next postures; last the kneeling ones without the free hand's prop
     # (on the way up its forearm can pass through the thigh coming forward)
     tries = [(postures[0], w, True) for w in _WIDER_SWINGS] + \
-        [(p, 1.0, True) for p in postures[1:]] + [(p, 1.0, False) for p in postures if p[4]]
+        [(p, 1.0, True) for p in postures[1:]] + [(p, 1.0, False) for p in postures if p.kneel]
     draws = rng.bit_generator.state
     for posture, wide, prop in tries:
         rng.bit_generator.state = draws
         world, f1, f2, contact_t = _reach_motion(
             task, skeleton, st, targets, active, posture,
-            (level, travel, approach, board, support, flat_palm), rng, duration, fps, wide,
-            prop)
+            _ReachPath(level, travel, approach, board, support, flat_palm), rng, duration, fps,
+            wide, prop)
         penetrates = _self_penetrates(world, H)
         if not penetrates:
             break
     T = world.shape[0]
     contact = min(round(contact_t * fps), T - 1)
     meta = {"contact_frame": contact, "hand": hand_name, "target": target.tolist(),
-            "hold_frames": [f1, f2], "trunk_flexion": posture[0], "pelvis_drop": posture[1],
+            "hold_frames": [f1, f2], "trunk_flexion": posture.pitch, "pelvis_drop": posture.drop,
             "posture": _posture_name(world[f1], skeleton), "self_penetrating": penetrates}
     return _finish(f"{task}_{_fmt(target)}", task, world, st, fps,
                    f"goals.make_goal_primitive({task!r}, target={_fmt(target)})", meta)
@@ -166,19 +184,19 @@ def _self_penetrates(world: np.ndarray, stature: float) -> bool:
 
 
 def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray,
-                  active: tuple[int, ...], posture: tuple[float, float, float, bool],
-                  path: tuple, rng: np.random.Generator, duration: float | None, fps: float,
+                  active: tuple[int, ...], posture: ReachPosture,
+                  path: _ReachPath, rng: np.random.Generator, duration: float | None, fps: float,
                   wide: float = 1.0, prop: bool = True) -> tuple[np.ndarray, int, int, float]:
-    """Frames (T, J, 3) of a hand task's reach into ``posture`` (pitch, drop, shift,
-    capped), its hold and its return; the first and last hold frame and the contact time
-    (s). ``posture`` may kneel (:func:`_kneel_progress`). ``path``: (level, travel,
-    approach (2, 3) or None, board, support, flat_palm) of :func:`_hand_task`; ``wide``
+    """Frames (T, J, 3) of a hand task's reach into ``posture``, its hold and its return;
+    the first and last hold frame and the contact time (s). ``posture`` may kneel
+    (:func:`_kneel_progress`). ``path``: how the palm goes (:func:`_hand_task`); ``wide``
     scales the low reach's swing outside the thigh (:func:`_hand_path`); ``prop``: a
     kneeling worker's free hand props the trunk (:func:`_free_hands`)."""
     H = skeleton.stature
     arm = _arm_length(skeleton)
-    level, travel, approach, board, support, flat_palm = path
-    pitch1, drop1, kneel = posture[0], posture[1], posture[4]
+    level, travel, approach = path.level, path.travel, path.approach
+    board, support, flat_palm = path.board, path.support, path.flat_palm
+    pitch1, drop1, kneel = posture.pitch, posture.drop, posture.kneel
     dist = max(np.linalg.norm(targets[k] - st.hands[k]) for k in active)
     t_reach, hold, t_ret = _reach_times(task, dist, pitch1, drop1, H, level, duration, rng)
     if kneel:       # the body is down at half the reach time and up again as long after
@@ -239,7 +257,8 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
 
 
 def _body_path(skeleton: Skeleton, st: _Start, t: np.ndarray,
-               times: tuple[float, float, float], posture: tuple, level: bool, first: int
+               times: tuple[float, float, float], posture: ReachPosture, level: bool,
+               first: int
                ) -> tuple[np.ndarray, ...]:
     """The body of a hand task at times ``t`` (T,) (``times`` = reach end, hold end,
     total; ``posture`` as :func:`_reach_motion`'s): the pelvis's progress to the posture
@@ -250,7 +269,8 @@ def _body_path(skeleton: Skeleton, st: _Start, t: np.ndarray,
     one kneels down in that time (:func:`_kneel_progress`, ``first`` the foot stepping
     back first)."""
     t1, t2, total = times
-    pitch1, drop1, shift1, capped, kneel = posture
+    pitch1, drop1, shift1 = posture.pitch, posture.drop, posture.shift
+    capped, kneel = posture.capped, posture.kneel
     t_ret = total - t2
     body_keys = ([(0.0, 0.0), (0.5 * t1, 1.0), (t2 + 0.5 * t_ret, 1.0), (total, 0.0)] if level
                  else [(0.0, 0.0), (0.85 * t1, 1.0), (t2 + 0.15 * t_ret, 1.0), (total, 0.0)])

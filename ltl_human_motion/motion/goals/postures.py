@@ -10,6 +10,8 @@ low board the search also kneels (:func:`_kneel_set`) and, last, tilts the pelvi
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ltl_human_motion.motion.goals.body import (
@@ -298,15 +300,27 @@ def _contact_poses(skeleton: Skeleton, st: _Start, pitch: np.ndarray, drop: np.n
 _POSTURE_TRIES = 4
 
 
+@dataclass(frozen=True)
+class ReachPosture:
+    """One posture of the search (:func:`_grid`): trunk flexion ``pitch`` (rad), pelvis
+    ``drop`` below standing and forward ``shift`` (m), whether the pelvis tilt is
+    ``capped`` (:func:`.body._trunk`) and whether it kneels on both knees."""
+
+    pitch: float
+    drop: float
+    shift: float
+    capped: bool
+    kneel: bool
+
+
 def _reach_postures(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple,
                     task: str, target: np.ndarray,
                     board: tuple[float, float, float] | None = None,
                     obstacles: ObstacleClearance | None = None,
                     furniture: tuple | None = None
-                    ) -> list[tuple[float, float, float, bool, bool]]:
-    """Trunk flexion, pelvis drop and shift of the cheapest feasible postures
-    (:func:`_grid`, at most :data:`_POSTURE_TRIES`, cheapest first), whether each one's
-    pelvis tilt is capped and whether it kneels; ValueError where none reaches."""
+                    ) -> list[ReachPosture]:
+    """The cheapest feasible postures (:func:`_grid`, at most :data:`_POSTURE_TRIES`,
+    cheapest first); ValueError where none reaches."""
     P, D, S, cost, capped, kneel = _grid(skeleton, st, targets, active, task, board, obstacles,
                                   furniture=furniture)
     order = np.argsort(cost, kind="stable")[:_POSTURE_TRIES]
@@ -315,5 +329,5 @@ def _reach_postures(skeleton: Skeleton, st: _Start, targets: np.ndarray, active:
         raise ValueError(
             f"{task}: target {np.round(target, 3).tolist()} (start frame) is out of reach for a "
             f"{skeleton.stature:.2f} m worker; place the worker with reach_placement()")
-    return [(float(P[i]), float(D[i]), float(S[i]), bool(capped[i]), bool(kneel[i]))
-            for i in order]
+    return [ReachPosture(float(P[i]), float(D[i]), float(S[i]), bool(capped[i]),
+                         bool(kneel[i])) for i in order]
