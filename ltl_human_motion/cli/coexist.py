@@ -76,9 +76,32 @@ def run(args: argparse.Namespace) -> int:
     for mode, r in summary["runs"].items():
         print(f"{mode:>10}: min separation {_fmt(r['min_separation'], ' m')} "
               f"(S_p {r['protective_distance']:.2f} m), reduced speed "
-              f"{r['time_reduced_speed']:.1f} s, at minimum {r['time_min_speed']:.1f} s, "
-              f"{r['violations']} violation(s) ({r['violation_time']:.2f} s), mean slider "
-              f"{_fmt(r['mean_slider_1s_before'])} in the 1 s before S_p, effective cycle "
-              f"{_fmt(r['effective_cycle_time'], ' s')}, loop {_fmt(r['loop_rate_hz'], ' Hz', 1)}")
+              f"{r['time_reduced_speed']:.1f} s, at minimum {r['time_min_speed']:.1f} s, mean "
+              f"slider {_fmt(r['mean_slider_1s_before'])} in the 1 s before S_p, effective "
+              f"cycle {_fmt(r['effective_cycle_time'], ' s')}, loop "
+              f"{_fmt(r['loop_rate_hz'], ' Hz', 1)}")
+        for line in _breaches(r):
+            print(f"{'':>12}{line}")
     print(f"metrics: {args.out}/coexistence_*.json, .png; total {summary['wall_time']:.0f} s")
     return 0
+
+
+def _breaches(r: dict) -> list[str]:
+    """The times the worker came closer than the protective separation distance S_p, in a
+    commissioning engineer's words: when, how close, and what the robot did meanwhile."""
+    sp = r["protective_distance"]
+    intervals = r.get("violation_intervals") or []
+    if not intervals:
+        return [f"the worker never came closer than S_p = {sp:.2f} m"]
+    out = [f"the worker was closer than S_p = {sp:.2f} m {len(intervals)} time(s), "
+           f"{r['violation_time']:.1f} s in all:"]
+    for v in intervals:
+        if v["slowed_to_min"]:
+            did = ("the robot stood still throughout (speed slider at its "
+                   f"{v['max_slider']:.0%} minimum, which stands for stop: docs/robot.md)")
+        else:
+            did = (f"the robot was not stopped: it moved at up to {v['max_slider']:.0%} of "
+                   "its programmed speed")
+        out.append(f"  t = {v['start']:.1f}-{v['end']:.1f} s: down to "
+                   f"{v['min_separation']:.2f} m from the arm; {did}")
+    return out

@@ -148,10 +148,7 @@ def run(args: argparse.Namespace) -> int:
         for kind in ("gait", "goal"):
             q = quality.get(kind, {})
             if q:
-                w = q["worst"]
-                print(f"  quality {kind:5s}    {q['passed']:4d}/{q['count']:<4d} pass  worst: "
-                      f"bone {w['bone_length']:.1e} m, floor {w['floor']:+.3f} m, skate "
-                      f"{w['foot_skate']:.2f} m/s, speed {w['joint_speed']:.2f} m/s")
+                _print_quality(kind, q)
         if args.report is not None:
             print(f"  realism          ours ({report['realism']['ours']}) vs "
                   f"{len(report['realism']['real'])} real clips: median ours / real, "
@@ -168,3 +165,21 @@ def run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 1
     return 0
+
+
+def _print_quality(kind: str, q: dict) -> None:
+    """One kind's quality line: how many primitives keep the per-primitive limits, and the
+    worst value of each check beside its limit."""
+    from dataclasses import asdict
+
+    from ltl_human_motion.motion.quality import QualityThresholds
+    from ltl_human_motion.planning.biomechanics import BiomechanicsLimits
+    t = {**asdict(QualityThresholds()), **q.get("thresholds", {})}
+    w = q["worst"]
+    print(f"  quality {kind:5s}    {q['passed']:4d}/{q['count']:<4d} primitives within the "
+          f"per-primitive limits; worst (limit): bone {w['bone_length']:.1e} m "
+          f"({t['bone_length']:.0e}), floor {w['floor']:+.3f} m (>= {-t['floor_tolerance']:+.3f}),"
+          f" speed {w['joint_speed']:.2f} m/s ({t['joint_speed']:.1f})")
+    print(f"                   foot skate {w['foot_skate']:.2f} m/s ({t['foot_skate']:.2f}: a "
+          f"primitive alone; a synthesized motion's feet are pinned and its skate held to "
+          f"{BiomechanicsLimits().skate_mean:.2f} m/s)")

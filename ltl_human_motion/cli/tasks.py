@@ -22,6 +22,7 @@ from ltl_human_motion.ltl.automaton import degeneralize
 from ltl_human_motion.ltl.formula import And, Globally
 from ltl_human_motion.ltl.spec import Specification
 from ltl_human_motion.tasks import has_geometry, plan_sequences
+from ltl_human_motion.tasks.model import TIME_CALIBRATION, CellModel, estimated_duration
 from ltl_human_motion.yaml_limits import TextFileError, read_text_file
 
 NAME = "tasks"
@@ -89,12 +90,15 @@ def run(args: argparse.Namespace) -> int:
         return 0
     n = args.n if args.n is not None else (5 if args.mode == "random" else None)
     costs: list[float] = []
+    lengths: list[float | None] = []
     if given is None and has_geometry(cell):
         # the cell model: cost-optimal, physically possible sequences first
         seqs, stats = plan_sequences(spec, cell, n=n, seed=args.seed, mode=args.mode,
                                      cycles=args.cycles, min_steps=args.min_steps,
                                      backend=args.backend)
         costs = stats.costs
+        model = CellModel.from_cell(cell)
+        lengths = [estimated_duration(model, s.tasks) for s in seqs]
     else:
         seqs = synthesize_sequences(spec, n=n, seed=args.seed, mode=args.mode,
                                     cycles=args.cycles, min_steps=args.min_steps,
@@ -104,19 +108,27 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps({"spec": spec.text, "formula": str(spec.formula), "sequences": [
             {"prefix": list(map(str, s.prefix)), "cycle": list(map(str, s.cycle)),
              "repetitions": s.repetitions, "tasks": list(map(str, s.tasks)),
-             **({"estimated_seconds": round(costs[i], 3)} if i < len(costs) else {})}
+             **({"estimated_seconds": _round(lengths[i]), "search_cost": round(costs[i], 3)}
+                if i < len(costs) else {})}
             for i, s in enumerate(seqs)]}, indent=2))
         return 0
     print(f"# specification: {spec.text}")
     for line in always_on_lines(spec):
         print(f"# always on: {line}")
+    if lengths:
+        print(f"# estimated time of the motion: {TIME_CALIBRATION.describe()}")
     for i, seq in enumerate(seqs, 1):
         print(f"{i}: {' -> '.join(map(str, seq.tasks))}")
-        if i - 1 < len(costs):
-            print(f"   estimated time {costs[i - 1]:.1f} s (walking and nominal task times)")
+        if i - 1 < len(costs) and lengths[i - 1] is not None:
+            print(f"   estimated time of the motion {lengths[i - 1]:.0f} s (the search's "
+                  f"cost {costs[i - 1]:.1f})")
         print(f"   prefix [{', '.join(map(str, seq.prefix))}] cycle "
               f"[{', '.join(map(str, seq.cycle))}] x{seq.repetitions}")
     return 0
+
+
+def _round(value: float | None) -> float | None:
+    return None if value is None else round(value, 2)
 
 
 #: Up to this many exclusivity clauses are printed in full; more are summarised.

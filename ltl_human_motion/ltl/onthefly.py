@@ -21,6 +21,7 @@ touches a few hundred of them.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 
 from ltl_human_motion.ltl.automaton import lasso_accepted
@@ -127,6 +128,8 @@ class LetterTableau:
         self._next_ids: dict[frozenset[Formula], int] = {}
         self._formula_names: dict[Formula, frozenset[str]] = {}
         self.initial = self._intern(_state_key(frozenset({self.formula})))
+        #: Seconds spent making edges (the automaton's share of a product search).
+        self.build_seconds = 0.0
 
     def _intern(self, state: frozenset[Formula]) -> int:
         q = self._ids.get(state)
@@ -187,6 +190,7 @@ class LetterTableau:
         hit = self._succ.get(key)
         if hit is not None:
             return hit
+        t0 = time.perf_counter()
         if len(self.states[q]) < SPLIT_MIN_FORMULAS:
             terms = self._plain_terms(q, i)
         else:
@@ -202,6 +206,7 @@ class LetterTableau:
             out.append((q2, self.full & ~promised))
         result = tuple(sorted(set(out)))
         self._succ[key] = result
+        self.build_seconds += time.perf_counter() - t0
         return result
 
     def _plain_terms(self, q: int, i: int) -> list[_Term]:

@@ -544,14 +544,13 @@ class StepExecutor:
             return self.walk(goal, task, label, carry, budget)    # square to the gap
         if isinstance(res, SearchFailure):
             if res.reason == "budget":
-                why = (f"the search budget ran out ({used} nodes; closest approach "
-                       f"{res.closest:.2f} m)")
+                why = f"the search budget ran out ({used} nodes; {_approach(res.closest)})"
             elif res.reason == "no_stop":
                 why = (f"the search reached the goal's neighbourhood but no place to stop "
                        f"there keeps the body clear and passes the goal test ({used} nodes)")
             else:
                 why = (f"obstacles block every way to the target (searched {res.expanded} "
-                       f"placements; closest approach {res.closest:.2f} m)")
+                       f"placements; {_approach(res.closest)})")
             # No stop at the goal is a blocked goal (the caller may try other placements).
             raise PlanningError(f"task {task}: {goal.description}: {why}", task=task,
                                 reason="blocked" if res.reason == "no_stop" else res.reason,
@@ -745,3 +744,12 @@ class StepExecutor:
                         self.state.pose = self.hand_over_pose(mp, self.state.pose)
                     return True
         return False
+
+
+def _approach(closest: float) -> str:
+    """How near a failed walk came to its goal, in words (``closest``: the search's
+    field distance to the goal's floor cells, m; 0 once it stood on them)."""
+    if closest <= 0.005:
+        return ("it reached the goal's floor area but found no place there to stop at "
+                "that the goal test and the body's clearance accept")
+    return f"it came no nearer than {closest:.2f} m to the goal's floor area"

@@ -216,6 +216,7 @@ def _mode_summary(m: dict[str, Any]) -> dict[str, Any]:
         "violations": len(violations),
         "violation_time": float(sum(v["end"] - v["start"] for v in violations)),
         "violations_not_slowed_to_min": sum(not v["slowed_to_min"] for v in violations),
+        "violation_intervals": violations,
         "effective_cycle_time": m["extra"]["progress"]["effective_cycle_time"],
         "stop_lead_time": m["extra"]["progress"]["stop_lead_time"],
         "mean_slider_1s_before": m["extra"]["progress"]["mean_slider_1s_before"],

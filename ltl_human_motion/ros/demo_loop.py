@@ -59,7 +59,9 @@ def run_ros_demo(spec: str, cell: str, out_dir: str | Path, duration: float | No
         ``success``, ``error``, ``motion_ids``, ``task_sequence``, ``motion_duration``,
         ``synthesis_wall_time``, ``stats``, ``played_seconds``, ``received`` (per topic:
         count and rate as seen by the client), ``occupancy_rate_hz``, ``tf_frames``,
-        ``markers_namespaces``, ``recorded`` (per topic: count and rate) and ``mcap``.
+        ``markers_namespaces``, ``recorded`` (per topic: count and rate) and ``mcap``;
+        ``occupancy_messages``, ``occupancy_deadlines_missed`` (ticks skipped because the
+        stream started a period or more late) and ``occupancy_worst_late_ms``.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -108,6 +110,11 @@ def run_ros_demo(spec: str, cell: str, out_dir: str | Path, duration: float | No
         summary["played_seconds"] = round(time.monotonic() - t0, 3)
         summary["received"] = session.watcher.summary()
         summary["occupancy_rate_hz"] = round(occ_log.rate(skip=5), 2)
+        streams = [n for n in node_set.nodes if hasattr(n, "deadlines_missed")]
+        summary["occupancy_messages"] = occ_log.count
+        summary["occupancy_deadlines_missed"] = sum(n.deadlines_missed for n in streams)
+        summary["occupancy_worst_late_ms"] = round(
+            1e3 * max((n.worst_late for n in streams), default=0.0), 1)
         summary["tf_frames"] = sorted({t.child_frame_id for t in tf_log.last.transforms}) \
             if tf_log.last is not None else []
         summary["markers_namespaces"] = sorted({m.ns for a in marker_log.messages

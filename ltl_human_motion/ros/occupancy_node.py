@@ -179,6 +179,8 @@ class OccupancyNode(Node):
         self._group = MutuallyExclusiveCallbackGroup()
         self._names = cv.capsule_part_names()
         self.deadlines_missed = 0
+        #: The latest a tick has started so far, s (0 when none was late).
+        self.worst_late = 0.0
         self._timer = None
         self._schedule: WallSchedule | None = None
         if self.param("use_sim_time"):
@@ -221,6 +223,7 @@ class OccupancyNode(Node):
 
     def _on_miss(self, skipped: int, late: float) -> None:
         self.deadlines_missed += skipped
+        self.worst_late = max(self.worst_late, late)
         self.get_logger().warning(
             f"occupancy stream of human {self.human_id} missed {self.deadlines_missed} "
             f"deadline(s) so far (this tick {late * 1e3:.1f} ms late, "

@@ -23,8 +23,11 @@ Preconditions and effects follow Table I of the paper and what the planner does:
   ``standUp`` stands up (a no-op when standing); ``kneel`` kneels. Tasks that walk or
   work away from a seat stand up first, as the planner does.
 
-The cost of a step estimates its time: the straight-line walking distance on the floor
-over :data:`WALK_SPEED`, plus the task's nominal duration (:data:`NOMINAL_DURATION`).
+The cost of a step, which the search minimizes, is the straight-line walking distance on
+the floor over :data:`WALK_SPEED`, plus the task's nominal duration
+(:data:`NOMINAL_DURATION`). It orders sequences; it is not the length of the motion.
+:func:`estimated_duration` estimates that length with constants fitted to synthesized
+motions (:data:`TIME_CALIBRATION`, ``bench/time_estimate.py``).
 """
 
 from __future__ import annotations
@@ -38,7 +41,8 @@ from ltl_human_motion.ltl.formula import Atom
 from ltl_human_motion.vocabulary import two_hand_region
 
 __all__ = ["DONE", "IMPLICIT_FETCH_PENALTY", "IN_PLACE_WALK_PENALTY", "NOMINAL_DURATION",
-           "WALK_SPEED", "CellModel", "CellState", "Limits"]
+           "TIME_CALIBRATION", "WALK_SPEED", "CellModel", "CellState", "Limits",
+           "TimeCalibration", "estimated_duration"]
 
 #: Walking speed of the cost estimate, m/s. Slower than free walking (about 1.3 m/s,
 #: Bohannon 1997) because walks in a cell are short and start and stop.
@@ -51,6 +55,59 @@ NOMINAL_DURATION: Mapping[str, float] = {
     "leftHand": 1.4, "rightHand": 1.4, "assemble": 2.0, "walk": 0.4, "carry": 0.4,
     "sit": 2.0, "standUp": 1.8, "kneel": 2.0, "bend": 1.8, "stoop": 1.8, "wait": 0.0,
 }
+
+
+@dataclass(frozen=True)
+class TimeCalibration:
+    """Constants of the motion-length estimate (:func:`estimated_duration`), fitted by
+    least squares (non-negative) to synthesized motions.
+
+    Attributes
+    ----------
+    walk_speed : float
+        m/s over the straight-line distance between the model's locations.
+    walk_overhead : float
+        s per walk of non-zero length (starting, stopping, turning, the adjusting step).
+    start : float
+        s once per motion (the first stance and the last stop).
+    durations : mapping
+        Task name -> s of its goal primitive (``wait(t)`` adds t on top).
+    motions : int
+        Motions the constants were fitted to.
+    median_error, p90_error, max_error : float
+        Relative error |estimate - motion| / motion on motions not used for the fit
+        (other statures and seeds): median, 90th percentile, largest.
+    """
+
+    walk_speed: float
+    walk_overhead: float
+    start: float
+    durations: Mapping[str, float]
+    motions: int = 0
+    median_error: float = 0.0
+    p90_error: float = 0.0
+    max_error: float = 0.0
+
+    def describe(self) -> str:
+        """The estimate's error in words, for reports and the CLI."""
+        return (f"fitted to {self.motions} synthesized motions; on others off by "
+                f"{self.median_error:.0%} (median), {self.p90_error:.0%} (9 in 10), "
+                f"at most {self.max_error:.0%}")
+
+
+#: The estimate's constants, fitted by ``python bench/time_estimate.py`` (which writes
+#: ``bench/results/time_estimate.json``; 2026-12-07, commit 6ea2cf8): see
+#: :class:`TimeCalibration`. Walks are slow against the straight line between locations
+#: (starting, stopping, turning and going round furniture at short gait steps); insert and
+#: extract keep their nominal values (no motion of the fit had them).
+TIME_CALIBRATION = TimeCalibration(
+    walk_speed=0.292, walk_overhead=0.0, start=1.02,
+    durations={"grasp": 2.04, "release": 2.04, "move": 1.95, "insert": 2.2, "extract": 2.2,
+               "leftHand": 2.00, "rightHand": 1.02, "assemble": 3.01, "walk": 0.54,
+               "carry": 1.89, "sit": 1.13, "standUp": 0.04, "kneel": 4.89, "bend": 4.72,
+               "stoop": 4.80, "wait": 0.0},
+    motions=98, median_error=0.106, p90_error=0.257, max_error=0.743)
+
 
 #: Posture codes of :class:`CellState`.
 STANDING, SITTING, KNEELING = 0, 1, 2
@@ -136,6 +193,9 @@ class CellModel:
         Task name -> nominal duration, s (default :data:`NOMINAL_DURATION`).
     inside : tuple of (int or None)
         Per part (default none): the index of the container part it starts inside.
+    timing : TimeCalibration, optional
+        When given, step costs are the calibrated estimate of the motion's length (walks
+        and durations from it, no search penalties) instead of the search's cost.
     """
 
     points: np.ndarray
@@ -147,6 +207,7 @@ class CellModel:
     limits: Limits = field(default_factory=Limits)
     durations: Mapping[str, float] = field(default_factory=lambda: dict(NOMINAL_DURATION))
     inside: tuple[int | None, ...] = ()
+    timing: TimeCalibration | None = None
 
     def __post_init__(self) -> None:
         pts = np.asarray(self.points, dtype=np.float64)
@@ -159,7 +220,14 @@ class CellModel:
         self.part_index = {n: i for i, n in enumerate(self.part_names)}
         self.region_index = {n: i for i, n in enumerate(self.region_names)}
         diff = pts[:, None, :] - pts[None, :, :]
-        self.walk_time = np.sqrt((diff ** 2).sum(-1)) / WALK_SPEED
+        dist = np.sqrt((diff ** 2).sum(-1))
+        self.walk_time = dist / WALK_SPEED
+        self._fetch_penalty, self._in_place_penalty = IMPLICIT_FETCH_PENALTY, IN_PLACE_WALK_PENALTY
+        if self.timing is not None:
+            self.walk_time = dist / self.timing.walk_speed \
+                + np.where(dist > 1e-9, self.timing.walk_overhead, 0.0)
+            self.durations = dict(self.timing.durations)
+            self._fetch_penalty = self._in_place_penalty = 0.0
         self._walk = self.walk_time.tolist()
         if not self.movable:
             self.movable = (True,) * len(self.part_names)
@@ -199,7 +267,14 @@ class CellModel:
     def with_limits(self, limits: Limits) -> CellModel:
         """The same cell with other physical limits."""
         return CellModel(self.points, self.part_names, self.region_names, self.two_handed,
-                         self.movable, self.shorthands, limits, self.durations, self.inside)
+                         self.movable, self.shorthands, limits, self.durations, self.inside,
+                         self.timing)
+
+    def with_timing(self, timing: TimeCalibration) -> CellModel:
+        """The same cell whose step costs estimate the motion's length (see ``timing``)."""
+        return CellModel(self.points, self.part_names, self.region_names, self.two_handed,
+                         self.movable, self.shorthands, self.limits, self.durations,
+                         self.inside, timing)
 
     # ---------------------------------------------------------------- locations
     def supply(self, part: int) -> int:
@@ -329,7 +404,7 @@ class CellModel:
                 at = self._fetch_place(p, state, held)
                 if at is None:
                     return None
-                cost += self._walk[loc][at] + self.durations["grasp"] + IMPLICIT_FETCH_PENALTY
+                cost += self._walk[loc][at] + self.durations["grasp"] + self._fetch_penalty
                 loc = at
                 held.append(p)
             held.remove(p)
@@ -369,7 +444,7 @@ class CellModel:
         else:
             dest = self.target(task, state)
             if kind == "walk" and dest == loc:
-                cost += IN_PLACE_WALK_PENALTY   # already there: stands still in R
+                cost += self._in_place_penalty   # already there: stands still in R
             if dest is not None:
                 cost += self._walk[loc][dest]
                 loc = dest
@@ -409,3 +484,20 @@ def _containers(objects: Mapping[str, object], parts: Sequence[str]) -> tuple[in
                     if c != i and np.all(pos >= lo) and np.all(pos <= hi)), None)
         out.append(hit)
     return tuple(out)
+
+
+def estimated_duration(model: CellModel, tasks: Sequence[Atom],
+                       timing: TimeCalibration | None = None) -> float | None:
+    """Estimated length (s) of the motion of ``tasks`` done in order from the start, with
+    ``timing`` (default :data:`TIME_CALIBRATION`; its error says how far off it is), or
+    None when a step is impossible in the model."""
+    timing = timing or TIME_CALIBRATION
+    timed = model.with_timing(timing)
+    state, total = timed.initial_state(), timing.start
+    for task in tasks:
+        nxt = timed.step(state, task)
+        if nxt is None:
+            return None
+        state, cost = nxt
+        total += cost
+    return total
