@@ -11,11 +11,18 @@ clone the kernels compile then). Prints and writes ``bench/results/scenarios.jso
 * the verified rate on feasible pairs and the correct-refusal rate on infeasible ones;
 * failures by family (planning: which task and why; verification: which check);
 * median and maximum time per pair;
-* a short table per cell.
+* a short table per cell;
+* the unseen-style family (:mod:`ltl_human_motion.scenarios.unseen`: machine chambers,
+  boards, desks, conveyors, aisles, two-handed parts at three statures, labelled from
+  geometry) in its own section: per family the verified and refusal rates, CPU time per
+  run (median, max, runs over 2 s) and the failures grouped by cause (the first words
+  of the refusal or verification message, :func:`~ltl_human_motion.scenarios.run.
+  failure_cause`).
 
 Not a test: run ``python bench/scenarios.py`` (``--quick`` for a short look,
 ``--cells shelf_heights bins``, ``--limit 50``; ``--no-biomechanics`` verifies without
-the biomechanical checks, which are on by default).
+the biomechanical checks, which are on by default; ``--family unseen`` only the unseen
+family, ``--unseen-cells 0`` without it).
 """
 
 from __future__ import annotations
@@ -35,7 +42,12 @@ sys.path.insert(0, str(ROOT))
 
 from ltl_human_motion.atomic import atomic_write_text  # noqa: E402
 from ltl_human_motion.scenarios.corpus import default_specs_path, load_corpus  # noqa: E402
-from ltl_human_motion.scenarios.run import judge, prepare_cell, run_pair  # noqa: E402
+from ltl_human_motion.scenarios.run import (  # noqa: E402
+    failure_cause,
+    judge,
+    prepare_cell,
+    run_pair,
+)
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from paper_specs import machine  # noqa: E402
@@ -48,6 +60,9 @@ GENERATED_CELLS = 30
 #: Seconds a pair may take before it counts as a timeout (the target is 2 s per pair;
 #: the limit only keeps a hopeless search from stalling the benchmark).
 DEFAULT_TIMEOUT = 10.0
+#: Cells of each unseen-style family in a default run (each at the three statures with
+#: about 8 labelled pairs: some 270 runs).
+UNSEEN_CELLS = 2
 
 
 def _job(item: dict) -> dict:
@@ -57,7 +72,8 @@ def _job(item: dict) -> dict:
                        biomechanics=item.get("biomechanics", True))
     ok, family = judge(item["expect"], item.get("reason"), outcome)
     out = {k: v for k, v in item.items() if k != "cell_yaml"}
-    out.update(outcome=outcome.as_dict(), ok=ok, family=family)
+    out.update(outcome=outcome.as_dict(), ok=ok, family=family,
+               cause=None if ok else failure_cause(outcome.message, family))
     return out
 
 
@@ -123,6 +139,31 @@ def _items(args) -> list[dict]:
                               "family_label": gp.family, "stature": scen.stature,
                               "seed": 0, "timeout": args.timeout,
                               "biomechanics": not args.no_biomechanics})
+    if args.unseen_cells > 0:
+        items.extend(_unseen_items(args))
+    return items
+
+
+def _unseen_items(args) -> list[dict]:
+    """The unseen-style family's runs: every labelled pair of every cell at each stature
+    (the labels differ by stature) and each seed in ``range(--unseen-seeds)``."""
+    from ltl_human_motion.scenarios.unseen import FAMILIES, generate_unseen
+    families = tuple(args.unseen_families or FAMILIES)
+    unknown = sorted(set(families) - set(FAMILIES))
+    if unknown:
+        raise ValueError(f"unknown unseen families {unknown}; expected {', '.join(FAMILIES)}")
+    items = []
+    for scen in generate_unseen(args.unseen_cells, seed=args.generator_seed,
+                                families=families, statures=tuple(args.statures)):
+        for gp in scen.pairs:
+            for seed in range(args.unseen_seeds):
+                items.append({"source": "unseen", "id": f"{scen.name}/{gp.spec}",
+                              "cell": scen.name, "cell_file": None, "cell_yaml": scen.yaml,
+                              "spec": gp.spec, "expect": gp.expect, "reason": gp.reason,
+                              "why": gp.why, "family_label": gp.kind,
+                              "unseen_family": scen.family, "stature": scen.stature,
+                              "seed": seed, "timeout": args.timeout,
+                              "biomechanics": not args.no_biomechanics})
     return items
 
 
@@ -146,6 +187,7 @@ def summarize(results: list[dict]) -> dict:
         feas = [r for r in rows if r["expect"] == "feasible"]
         infeas = [r for r in rows if r["expect"] != "feasible"]
         times = [r["outcome"]["seconds"] for r in rows]
+        cpu = [r["outcome"].get("cpu_seconds", 0.0) for r in rows]
         fam: dict[str, dict] = {}
         for r in rows:
             if r["ok"]:
@@ -167,6 +209,9 @@ def summarize(results: list[dict]) -> dict:
             "median_time_s": statistics.median(times) if times else None,
             "max_time_s": max(times) if times else None,
             "over_2s": sum(t > 2.0 for t in times),
+            "median_cpu_s": statistics.median(cpu) if cpu else None,
+            "max_cpu_s": max(cpu) if cpu else None,
+            "over_2s_cpu": sum(t > 2.0 for t in cpu),
             "slowest": [{"id": r["id"], "stature": r["stature"], "seed": r["seed"],
                          "seconds": round(r["outcome"]["seconds"], 3), "ok": r["ok"]}
                         for r in sorted(rows, key=lambda r: -r["outcome"]["seconds"])
@@ -188,16 +233,72 @@ def summarize(results: list[dict]) -> dict:
     for name in sorted({r["family_label"] for r in corpus}):
         rows = [r for r in corpus if r["family_label"] == name]
         pair_families[name] = {"runs": len(rows), "ok": sum(r["ok"] for r in rows)}
+    unseen = [r for r in results if r["source"] == "unseen"]
     return {"corpus": block(corpus), "generated": block(generated), "cells": cells,
-            "pair_families": pair_families}
+            "pair_families": pair_families, "unseen": block(unseen),
+            **_unseen_summary(unseen, block)}
+
+
+def _causes(rows: list[dict], limit: int = 12) -> list[dict]:
+    """The failures of ``rows`` grouped by cause, most frequent first, with an example."""
+    groups: dict[str, list[dict]] = defaultdict(list)
+    for r in rows:
+        if not r["ok"]:
+            groups[r.get("cause") or r["family"]].append(r)
+    return [{"cause": cause, "count": len(g), "families": dict(Counter(
+                r.get("unseen_family", r["source"]) for r in g).most_common()),
+             "example": {"id": g[0]["id"], "stature": g[0]["stature"],
+                         "message": g[0]["outcome"]["message"][:300]}}
+            for cause, g in sorted(groups.items(), key=lambda kv: -len(kv[1]))[:limit]]
+
+
+def _unseen_summary(rows: list[dict], block) -> dict:
+    """Per unseen family: the block's rates and times, and the failures by cause."""
+    if not rows:
+        return {}
+    keys = ("runs", "feasible_runs", "verified", "verified_rate", "infeasible_runs",
+            "refused_correctly", "refusal_rate", "median_time_s", "max_time_s", "over_2s",
+            "median_cpu_s", "max_cpu_s", "over_2s_cpu")
+    families = {}
+    for name in sorted({r["unseen_family"] for r in rows}):
+        sub = [r for r in rows if r["unseen_family"] == name]
+        b = block(sub)
+        families[name] = {**{k: b[k] for k in keys}, "by_stature": {
+            str(h): {"feasible_runs": sum(r["expect"] == "feasible" for r in sub
+                                          if r["stature"] == h),
+                     "verified": sum(r["ok"] for r in sub if r["stature"] == h
+                                     and r["expect"] == "feasible")}
+            for h in sorted({r["stature"] for r in sub})},
+            "failures_by_cause": _causes(sub)}
+    return {"unseen_families": families, "unseen_failures_by_cause": _causes(rows, 25)}
 
 
 def _pct(x: float | None) -> str:
     return "-" if x is None else f"{100 * x:.1f} %"
 
 
+def _print_unseen(summary: dict) -> None:
+    """The unseen family's section: a row per family, then the causes of failures."""
+    fams = summary.get("unseen_families") or {}
+    if not fams:
+        return
+    print(f"\n{'unseen family':14s} {'verified':>14s} {'refused':>10s} {'cpu med':>8s} "
+          f"{'cpu max':>8s} {'>2 s':>5s}  top cause")
+    for name, f in fams.items():
+        top = f["failures_by_cause"][0] if f["failures_by_cause"] else None
+        verified = f"{f['verified']}/{f['feasible_runs']} {_pct(f['verified_rate'])}"
+        refused = f"{f['refused_correctly']}/{f['infeasible_runs']}"
+        print(f"{name:14s} {verified:>14s} {refused:>10s} {f['median_cpu_s']:8.2f} "
+              f"{f['max_cpu_s']:8.2f} {f['over_2s_cpu']:5d}  "
+              + (f"{top['count']} x {top['cause']}" if top else ""))
+    print("  failures by cause (families):")
+    for c in summary["unseen_failures_by_cause"]:
+        fam = ", ".join(f"{k} {v}" for k, v in c["families"].items())
+        print(f"    {c['count']:4d}  {c['cause'][:70]:70s} ({fam})")
+
+
 def _print(summary: dict, wall: float) -> None:
-    for name in ("corpus", "generated"):
+    for name in ("corpus", "generated", "unseen"):
         b = summary[name]
         if not b["runs"]:
             continue
@@ -224,6 +325,7 @@ def _print(summary: dict, wall: float) -> None:
             print(f"{name:18s} {c['verified']:5d}/{c['feasible_runs']:<6d} "
                   f"{c['refused_correctly']:3d}/{c['infeasible_runs']:<5d} "
                   f"{c['median_time_s']:9.2f} {c['max_time_s']:7.2f}  {top}")
+    _print_unseen(summary)
     print(f"\nwall time {wall:.0f} s (measured under load on a shared 2-core machine)")
 
 
@@ -240,6 +342,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--generated", type=int, default=GENERATED_CELLS,
                         help="random cells of the generator (each with its pairs)")
     parser.add_argument("--generator-seed", type=int, default=0)
+    parser.add_argument("--family", choices=("all", "corpus", "generated", "unseen"),
+                        default="all", help="run only this part (default all three)")
+    parser.add_argument("--unseen-cells", type=int, default=UNSEEN_CELLS,
+                        help="cells of each unseen-style family (0: none)")
+    parser.add_argument("--unseen-families", nargs="+", default=None,
+                        help="only these unseen families (chamber boards desk conveyor "
+                             "aisle twohanded)")
+    parser.add_argument("--unseen-seeds", type=int, default=1,
+                        help="synthesis seeds per unseen pair and stature")
     parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT,
                         help="seconds per pair")
     parser.add_argument("--workers", type=int, default=MAX_WORKERS)
@@ -256,11 +367,17 @@ def main(argv: list[str] | None = None) -> int:
                              "ok, family) to this JSON file, to compare two trees run by run")
     args = parser.parse_args(argv)
     args.out = args.out or ROOT / "bench" / "results" / (
-        "scenarios_without_biomechanics.json" if args.no_biomechanics else "scenarios.json")
+        "scenarios_without_biomechanics.json" if args.no_biomechanics
+        else "scenarios.json" if args.family == "all" else f"scenarios_{args.family}.json")
     if args.quick:
         args.statures, args.seeds = [1.75], 1
         args.limit = args.limit or 60
         args.generated = min(args.generated, 3)
+        args.unseen_cells = min(args.unseen_cells, 1)
+    if args.family != "all":
+        args.no_corpus = args.no_corpus or args.family != "corpus"
+        args.generated = args.generated if args.family == "generated" else 0
+        args.unseen_cells = args.unseen_cells if args.family == "unseen" else 0
     workers = max(1, min(args.workers, MAX_WORKERS))
     try:
         items = _items(args)
@@ -306,12 +423,18 @@ def main(argv: list[str] | None = None) -> int:
               if args.specs.resolve().is_relative_to(ROOT) else str(args.specs),
               "cells_selected": args.cells, "limit": args.limit,
               "generated_cells": args.generated, "generator_seed": args.generator_seed,
+              "family": args.family, "unseen_cells": args.unseen_cells,
+              "unseen_seeds": args.unseen_seeds,
               "workers_ready_s": round(ready, 1),
               "cell_preparation_s": {k: round(v, 3) for k, v in sorted(preparation.items())},
               **summary,
               "failures": [{"id": r["id"], "source": r["source"], "stature": r["stature"],
                             "seed": r["seed"], "family": r["family"],
                             "seconds": round(r["outcome"]["seconds"], 3),
+                            "cpu_seconds": round(r["outcome"].get("cpu_seconds", 0.0), 3),
+                            "cause": r.get("cause"),
+                            **({"unseen_family": r["unseen_family"], "expect": r["expect"],
+                                "why": r.get("why", "")} if r["source"] == "unseen" else {}),
                             "message": r["outcome"]["message"][:240]}
                            for r in results if not r["ok"]]}
     atomic_write_text(args.out, json.dumps(report, indent=1) + "\n")

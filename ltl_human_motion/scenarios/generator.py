@@ -447,23 +447,11 @@ def _to_paper_yup(d: dict) -> dict:
 
 def _accessible(cell_yaml: str, targets) -> bool:
     """Whether every target box has comfortable floor near it, connected to R0."""
-    from scipy.sparse.csgraph import connected_components
-
-    from ltl_human_motion.planning.navigation import FloorGrid
+    from ltl_human_motion.scenarios.labels import floor_components
     from ltl_human_motion.scene.cell import cell_from_yaml
     cell = cell_from_yaml(cell_yaml, source="<generated>")
-    fps = [p.footprint() for ob in cell.obstacles for p in ob.parts]
-    lo, hi = cell.workspace_lo[:2], cell.workspace_hi[:2]
-
-    def free(xy):
-        ok = np.all((xy >= lo + COMFORT_RADIUS) & (xy <= hi - COMFORT_RADIUS), axis=-1)
-        for fp in fps:
-            ok &= fp.signed_distance(xy) > COMFORT_RADIUS
-        return ok
-
-    grid = FloorGrid(lo, hi, free, COMFORT_RESOLUTION)
+    grid, labels = floor_components(cell, COMFORT_RADIUS, COMFORT_RESOLUTION)
     flat = grid.free.ravel()
-    _, labels = connected_components(grid.graph, directed=False)
     start = flat & (np.abs(grid.centres) <= 0.3).all(axis=-1)
     if not start.any():
         return False

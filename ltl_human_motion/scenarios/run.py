@@ -7,6 +7,7 @@ classifies what happened (verified, refused with which error, timed out);
 
 from __future__ import annotations
 
+import re
 import signal
 import time
 from dataclasses import asdict, dataclass
@@ -19,7 +20,7 @@ from ltl_human_motion.errors import (
     VerificationError,
 )
 
-__all__ = ["Outcome", "judge", "prepare_cell", "run_pair"]
+__all__ = ["Outcome", "failure_cause", "judge", "prepare_cell", "run_pair"]
 
 
 class _PairTimeoutError(Exception):
@@ -46,6 +47,8 @@ class Outcome:
     task : str or None
         The task a PlanningError names.
     message : str
+    cpu_seconds : float
+        Processor time of the synthesize call (this process, all its threads).
     """
 
     status: str
@@ -53,6 +56,7 @@ class Outcome:
     reason: str | None = None
     task: str | None = None
     message: str = ""
+    cpu_seconds: float = 0.0
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -93,7 +97,7 @@ def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None =
     if use_alarm:
         previous = signal.signal(signal.SIGALRM, _on_alarm)
         signal.setitimer(signal.ITIMER_REAL, float(timeout))
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         motions = synthesize(spec, cell, stature=float(stature), seed=int(seed),
                              options=options)
@@ -125,6 +129,7 @@ def run_pair(spec: str, cell, stature: float, seed: int, timeout: float | None =
             signal.setitimer(signal.ITIMER_REAL, 0.0)
             signal.signal(signal.SIGALRM, previous)
     out.seconds = time.perf_counter() - t0
+    out.cpu_seconds = time.process_time() - c0
     return out
 
 
@@ -177,3 +182,55 @@ def judge(expect: str, expected_reason: str | None, outcome: Outcome) -> tuple[b
     right = (o.status == "planning" and o.reason == expected_reason) or (
         o.status == "spec" and o.reason == "unsatisfiable" == expected_reason)
     return (True, "ok") if right else (False, f"wrong_reason:{expected_reason}<-{got}")
+
+
+_NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?")
+
+
+def _verification_cause(text: str) -> str:
+    """``"verification collision: right hand enters cnc"``, ``"verification joint_speed:
+    r_toe"`` from a verification message."""
+    m = re.match(r"verification failed \((\w+)[^)]*\): (?:\w+: )?(.*)", text)
+    if not m:
+        return "verification"
+    check, detail = m.groups()
+    deepest = re.search(r"deepest: (?:the )?(.+?) by [-\d.]+ ?cm", detail)
+    if deepest:
+        detail = deepest.group(1)
+    elif "carried part meets an obstacle" in detail:
+        detail = "a carried part meets an obstacle"
+    else:
+        detail = re.split(r" at | moves | is |[,;:(]", detail, maxsplit=1)[0]
+    return f"verification {check}: {_NUMBER.sub('#', detail).strip()}"
+
+
+def failure_cause(message: str, family: str = "") -> str:
+    """A short cause of a failed run, the same for runs that failed alike.
+
+    The first words of the refusal or verification message without its numbers: for a
+    motion that ran into an obstacle the closest try (``"insert: right upper arm enters
+    cnc"``), for a verification the check and the joint or body part
+    (``"verification joint_speed: r_toe"``), else the message up to its first clause
+    with numbers as ``#`` (``"grasp: no place to stop within # m of the reach spot"``).
+    ``family`` (:func:`judge`'s) names runs without a message (``"false_verified"``).
+    """
+    text = " ".join(message.split())
+    if not text:
+        return family or "?"
+    m = re.match(r"task (\w+)(?:\([^)]*\))?: (.*)", text)
+    task, rest = (m.group(1), m.group(2)) if m else ("", text)
+    closest = re.search(r"closest try: (?:the )?(.+?) by [-\d.]+ ?cm", rest)
+    if closest:
+        cause = closest.group(1)
+    elif rest.startswith("verification failed"):
+        return _verification_cause(rest)
+    elif rest.startswith("no answer within"):
+        planning = re.search(r"\(planning (\w+)", rest)
+        return f"timeout {planning.group(1)}" if planning else "timeout"
+    else:
+        rest = re.sub(r"^reach \w+\([^)]*\) at \([^)]*\): ", "", rest)
+        rest = re.sub(r"^cannot make an? \w+ motion for the target: (?:\w+: )?", "", rest)
+        rest = re.sub(r"\[[^\]]*\]|\([-\d.,\s]+\)|\(start frame\)|'[^']*' ", "", rest)
+        cause = _NUMBER.sub("#", re.split(r"[;:(]", rest, maxsplit=1)[0])
+        cause = " ".join(cause.split()[:16])
+    return f"{task}: {cause}" if task else cause
