@@ -19,8 +19,8 @@ from ltl_human_motion.cli import interrupts
 from ltl_human_motion.errors import LtlHumanMotionError
 
 SUBCOMMAND_MODULES: tuple[str, ...] = (
-    "tasks", "library", "synthesize", "paper", "batch", "bringup", "ur_sim", "coexist", "demo",
-    "study",
+    "tasks", "library", "synthesize", "render", "paper", "batch", "bringup", "call", "ur_sim",
+    "coexist", "demo", "study",
 )
 
 

@@ -7,6 +7,14 @@ import json
 import sys
 from pathlib import Path
 
+from ltl_human_motion.cli.render import (
+    PictureOptions,
+    add_picture_arguments,
+    picture_options,
+    write_gif,
+    write_sheet,
+)
+
 NAME = "synthesize"
 HELP = "synthesize verified full-body motions for an LTL specification in a cell"
 
@@ -36,6 +44,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "range of motion, self-penetration, balance, foot skate)")
     parser.add_argument("--out", type=Path, default=Path("out/motions"),
                         help="output folder (default out/motions)")
+    parser.add_argument("--render", action="store_true",
+                        help="also draw each motion: motion_NNN.gif (animation) and "
+                             "motion_NNN.png (snapshots titled with the tasks) in --out")
+    add_picture_arguments(parser, "; with --render")
+
+
+def _render(synth, cell: str, stem: Path, pictures: PictureOptions) -> list[str]:
+    from ltl_human_motion.scene.cell_yaml import resolve_cell
+    the_cell = resolve_cell(cell)
+    gif, png = stem.with_suffix(".gif"), stem.with_suffix(".png")
+    write_gif(synth, the_cell, gif, pictures)
+    write_sheet(synth, the_cell, png, pictures)
+    return [str(gif), str(png)]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -47,6 +68,10 @@ def run(args: argparse.Namespace) -> int:
     if args.variants < 1 or args.cycles < 1:
         print("ltl-human-motion synthesize: error: --variants and --cycles must be >= 1",
               file=sys.stderr)
+        return 2
+    pictures = picture_options(args)
+    if isinstance(pictures, str):
+        print(f"ltl-human-motion synthesize: error: {pictures}", file=sys.stderr)
         return 2
     options = SynthesisOptions(
         sequence_mode=args.mode, verify=not args.no_verify,
@@ -63,6 +88,8 @@ def run(args: argparse.Namespace) -> int:
             path = stem.with_suffix(f".{fmt}")
             savers[fmt](synth, path)
             written.append(str(path))
+        if args.render:
+            written += _render(synth, args.cell, stem, pictures)
         checks = {k: v["passed"] for k, v in synth.verification.items() if isinstance(v, dict)}
         st = synth.stats
         stages = st["planning_time"] + st["blending_time"] + st["verification_time"]

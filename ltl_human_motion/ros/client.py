@@ -162,14 +162,22 @@ class ClientSession:
         """Log what ``topic`` delivers (see :class:`TopicWatcher`)."""
         return self.watcher.watch(msg_type, topic, keep, qos)
 
+    def _client(self, srv_type: Any, name: str) -> Client:
+        key = (srv_type, name)
+        if key not in self._clients:
+            self._clients[key] = self.node.create_client(srv_type, name)
+        return self._clients[key]
+
+    def service_ready(self, srv_type: Any, name: str, wait: float) -> bool:
+        """Whether service ``name`` is offered within ``wait`` seconds."""
+        return self._client(srv_type, name).wait_for_service(timeout_sec=wait)
+
     def call(self, srv_type: Any, name: str, request: Any, timeout: float = 10.0,
              resend_after: float | None = None) -> Any:
         """Call service ``name`` (the client is made once per name and type); see
         :func:`call_service` for ``resend_after``."""
-        key = (srv_type, name)
-        if key not in self._clients:
-            self._clients[key] = self.node.create_client(srv_type, name)
-        return call_service(self._clients[key], request, timeout, resend_after=resend_after)
+        return call_service(self._client(srv_type, name), request, timeout,
+                            resend_after=resend_after)
 
     def close(self) -> None:
         """Stop spinning, destroy the node, shut the context down."""

@@ -20,7 +20,7 @@ import numpy as np
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, N_JOINTS
 from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
-__all__ = ["BODY_COLORS", "body_mesh", "body_part_names"]
+__all__ = ["BODY_COLORS", "BODY_DISPLAY_SCALE", "body_mesh", "body_part_names"]
 
 #: Colours (RGB, 0-1) of the parts: skin, a work shirt, trousers and safety shoes.
 BODY_COLORS: dict[str, tuple[float, float, float]] = {
@@ -34,7 +34,7 @@ _SHOES = ("l_foot", "r_foot")
 _SKIPPED = ("l_palm", "r_palm", "l_knee", "r_knee")
 #: Display radius / occupancy radius: the occupancy adds about 1 cm for clothing and
 #: margin (:mod:`~ltl_human_motion.scene.occupancy`), the picture shows the body.
-_DISPLAY_SCALE = 0.9
+BODY_DISPLAY_SCALE = 0.9
 
 
 def body_part_names() -> tuple[str, ...]:
@@ -90,7 +90,7 @@ def body_mesh(positions: np.ndarray, stature: float = DEFAULT_STATURE,
     if p.shape != (N_JOINTS, 3):
         raise ValueError(f"positions must have shape ({N_JOINTS}, 3), got {p.shape}")
     tv, tf, upper = _template(tuple(int(c) for c in detail))
-    radii = capsule_radii(stature) * _DISPLAY_SCALE
+    radii = capsule_radii(stature) * BODY_DISPLAY_SCALE
     verts, faces, colors = [], [], []
     for k, (part, ja, jb, _) in enumerate(BODY_CAPSULES):
         if part in _SKIPPED:

@@ -6,11 +6,16 @@ package. Every file is written atomically.
 """
 
 from ltl_human_motion.viz.plots import plot_cell, plot_hand_trajectory
-from ltl_human_motion.viz.render import render_animation, render_snapshots
+from ltl_human_motion.viz.render import (
+    render_animation,
+    render_snapshots,
+    task_snapshot_times,
+)
 
 __all__ = [
     "plot_cell",
     "plot_hand_trajectory",
     "render_animation",
     "render_snapshots",
+    "task_snapshot_times",
 ]

@@ -16,6 +16,7 @@ from ltl_human_motion.errors import MissingDependencyError
 from ltl_human_motion.motion.skeleton import PARENTS
 from ltl_human_motion.scene.cell import Cell
 from ltl_human_motion.scene.occupancy import capsules_from_positions
+from ltl_human_motion.viz.lines import LINE_ZORDER, CellLines
 
 PathLike = str | os.PathLike[str]
 
@@ -163,12 +164,12 @@ def cell_bounds(cell: Cell, extra: np.ndarray | None = None, margin: float = 0.3
 
 
 def setup_axes3d(ax, lo: np.ndarray, hi: np.ndarray, elev: float = 20.0,
-                 azim: float = -125.0) -> None:
+                 azim: float = -125.0, zoom: float = 1.15) -> None:
     """Equal-scale 3D axes over ``[lo, hi]`` with z up."""
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(tuple(np.maximum(hi - lo, 1e-3)), zoom=1.15)
+    ax.set_box_aspect(tuple(np.maximum(hi - lo, 1e-3)), zoom=zoom)
     ax.view_init(elev=elev, azim=azim)
     ax.set_xlabel("x [m]", labelpad=-8)
     ax.set_ylabel("y [m]", labelpad=-8)
@@ -176,43 +177,91 @@ def setup_axes3d(ax, lo: np.ndarray, hi: np.ndarray, elev: float = 20.0,
     ax.tick_params(labelsize=6, pad=-3)
 
 
+#: An object whose bottom is this far (m) above what lies under it gets a drawn support.
+SUPPORT_GAP = 0.03
+SUPPORT_COLOR = "#c8c8c8"
+
+
+def object_supports(cell: Cell) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Boxes ``(lo (3,), hi (3,))`` to draw under objects that would float in the picture.
+
+    A cell often leaves out what a part rests on (a tray, a cart: not an obstacle to the
+    planner). Under every object whose bottom lies more than :data:`SUPPORT_GAP` above
+    the highest surface beneath its centre (an obstacle part's top, another object's
+    top, the floor), a pedestal of 60 % of its footprint reaches down to that surface.
+    Drawing only: the planner does not know these pedestals.
+    """
+    tops = [p.aabb() for ob in cell.obstacles for p in ob.parts]
+    tops += [o.shape.aabb() for o in cell.objects.values()]
+    out = []
+    for obj in cell.objects.values():
+        lo, hi = (np.asarray(v, dtype=np.float64) for v in obj.shape.aabb())
+        c = 0.5 * (lo + hi)
+        under = [b[1][2] for b in tops
+                 if b[0][0] <= c[0] <= b[1][0] and b[0][1] <= c[1] <= b[1][1]
+                 and b[1][2] <= lo[2] + 1e-3 and not np.allclose(b[0], lo)]
+        base = max([cell.floor_z, *under])
+        if lo[2] - base > SUPPORT_GAP:
+            half = 0.3 * (hi - lo)
+            out.append((np.array([c[0] - half[0], c[1] - half[1], base]),
+                        np.array([c[0] + half[0], c[1] + half[1], lo[2]])))
+    return out
+
+
+def box_triangles(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The 12 triangles of an axis-aligned box, shape (12, 3, 3)."""
+    import trimesh
+    box = trimesh.creation.box(bounds=np.array([lo, hi], dtype=np.float64))
+    return np.asarray(box.triangles)
+
+
 def draw_static_cell(ax, cell: Cell, lo: np.ndarray, hi: np.ndarray, labels: bool = True,
-                     grid: float | None = None) -> None:
-    """Floor, obstacles (solid), regions (wire boxes) of ``cell`` on 3D axes ``ax``.
+                     grid: float | None = None) -> CellLines:
+    """Floor, obstacles (solid), supports, regions (wire boxes) of ``cell`` on 3D axes ``ax``.
 
     ``grid``: spacing of floor grid lines in metres (for axes drawn without ticks).
+    The line work (floor outline, grid, region edges) is returned as a
+    :class:`~ltl_human_motion.viz.lines.CellLines`: add more lines to it (a path), then
+    call its ``update`` with the worker before the figure is drawn, so that no line is
+    painted across a solid in front of it.
     """
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
     z = cell.floor_z
+    solids = []
+    for ob in cell.obstacles:
+        tri = np.asarray(ob.to_trimesh().triangles)
+        solids.append(tri)
+        ax.add_collection3d(Poly3DCollection(tri, facecolors=shaded(tri, ob.color or "0.5"),
+                                             edgecolors="none", alpha=0.9))
+    for s_lo, s_hi in object_supports(cell):
+        tri = box_triangles(s_lo, s_hi)
+        solids.append(tri)
+        ax.add_collection3d(Poly3DCollection(tri, facecolors=shaded(tri, SUPPORT_COLOR),
+                                             edgecolors="none"))
+    lines = CellLines(ax, np.concatenate(solids) if solids else np.zeros((0, 3, 3)))
     # The floor is an outline, not a filled polygon: mplot3d sorts whole collections by
-    # depth, and a big translucent floor would be painted over the worker's legs.
-    outline = [(lo[0], lo[1], z), (hi[0], lo[1], z), (hi[0], hi[1], z), (lo[0], hi[1], z)]
-    ax.add_collection3d(Line3DCollection([outline[i:i + 2] if i < 3 else [outline[3],
-                                                                          outline[0]]
-                                          for i in range(4)], colors="#b0b0b0",
-                                         linewidths=0.8))
+    # depth, and a big floor would be painted over the worker's legs.
+    corners = np.array([(lo[0], lo[1], z), (hi[0], lo[1], z), (hi[0], hi[1], z),
+                        (lo[0], hi[1], z)])
+    lines.add(np.stack([corners, np.roll(corners, -1, axis=0)], axis=1), "#b0b0b0", 0.8)
     if grid:
         xs = np.arange(np.ceil(lo[0] / grid), np.floor(hi[0] / grid) + 1) * grid
         ys = np.arange(np.ceil(lo[1] / grid), np.floor(hi[1] / grid) + 1) * grid
-        lines = [[(x, lo[1], z), (x, hi[1], z)] for x in xs]
-        lines += [[(lo[0], y, z), (hi[0], y, z)] for y in ys]
-        ax.add_collection3d(Line3DCollection(lines, colors="#d0d0d0", linewidths=0.5))
-    for ob in cell.obstacles:
-        mesh = ob.to_trimesh()
-        tri = np.asarray(mesh.triangles)
-        ax.add_collection3d(Poly3DCollection(tri, facecolors=shaded(tri, ob.color or "0.5"),
-                                             edgecolors="none", alpha=0.9))
+        segs = [[(x, lo[1], z), (x, hi[1], z)] for x in xs]
+        segs += [[(lo[0], y, z), (hi[0], y, z)] for y in ys]
+        lines.add(np.array(segs), "#d0d0d0", 0.5)
     for i, (name, reg) in enumerate(cell.regions.items()):
         color = REGION_COLORS[i % len(REGION_COLORS)]
         if reg.is_box:
-            ax.add_collection3d(Line3DCollection(box_edges(reg.lo, reg.hi), colors=color,
-                                                 linewidths=1.0, linestyles="--"))
+            lines.add(box_edges(reg.lo, reg.hi), color, 1.0, "--")
         else:
             ax.add_collection3d(Poly3DCollection(reg.shape.triangles, facecolors=color,
                                                  alpha=0.15, edgecolors="none"))
         if labels:
             c = reg.center
-            ax.text(c[0], c[1], reg.hi[2] + 0.05, name, color=color, fontsize=7)
+            ax.text(c[0], c[1], reg.hi[2] + 0.05, name, color=color, fontsize=7,
+                    zorder=LINE_ZORDER)
+    return lines
 
 
 def object_polys(cell: Cell, positions: dict[str, np.ndarray] | None = None

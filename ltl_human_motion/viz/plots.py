@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
+
 from ltl_human_motion.planning.result import SynthesizedMotion
 from ltl_human_motion.scene.cell import Cell
 from ltl_human_motion.viz._common import (
@@ -98,8 +100,10 @@ def plot_cell(cell: Cell, path: PathLike, elev: float = 25.0, azim: float = -125
     ax = fig.add_subplot(1, 2, 1, projection="3d")
     lo, hi = cell_bounds(cell)
     setup_axes3d(ax, lo, hi, elev, azim)
-    draw_static_cell(ax, cell, lo, hi)
-    for name, tri in object_polys(cell).items():
+    lines = draw_static_cell(ax, cell, lo, hi)
+    polys = object_polys(cell)
+    lines.update(triangles=np.concatenate(list(polys.values())) if polys else None)
+    for name, tri in polys.items():
         obj = cell.objects[name]
         ax.add_collection3d(Poly3DCollection(tri, facecolors=obj.color or "tab:orange",
                                              edgecolors="k", linewidths=0.2))

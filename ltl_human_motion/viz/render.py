@@ -16,7 +16,9 @@ import numpy as np
 from ltl_human_motion.atomic import atomic_path
 from ltl_human_motion.errors import MissingDependencyError
 from ltl_human_motion.planning.result import SynthesizedMotion
+from ltl_human_motion.scene.body_mesh import BODY_DISPLAY_SCALE
 from ltl_human_motion.scene.cell import Cell
+from ltl_human_motion.scene.occupancy import capsules_from_positions
 from ltl_human_motion.viz._common import (
     PathLike,
     body_quads,
@@ -31,7 +33,7 @@ from ltl_human_motion.viz._common import (
     shaded,
 )
 
-__all__ = ["render_animation", "render_snapshots"]
+__all__ = ["render_animation", "render_snapshots", "task_snapshot_times"]
 
 
 def _frame_title(synth: SynthesizedMotion, frame: int) -> str:
@@ -43,11 +45,29 @@ BODY_STYLES = ("shaded", "stick")
 #: Capsule tessellation of the animated body (latitudes, longitudes): coarser than the
 #: snapshots' so that a GIF frame draws in about 0.1 s.
 _GIF_DETAIL = (5, 8)
+#: Zoom of the animation's axes: without ticks and panes the cell can fill more of it.
+_GIF_ZOOM = 1.35
 
 
 def _check_body(body: str) -> None:
     if body not in BODY_STYLES:
         raise ValueError(f"body must be one of {', '.join(BODY_STYLES)}, got {body!r}")
+
+
+def _occluding_capsules(synth: SynthesizedMotion, frame: int, body: str
+                        ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The capsules that hide lines behind the worker (the shaded body's), or None."""
+    if body != "shaded":
+        return None
+    seg, rad = capsules_from_positions(synth.positions[frame], synth.motion.skeleton.stature)
+    return seg, rad * BODY_DISPLAY_SCALE
+
+
+def _path_segments(synth: SynthesizedMotion, z: float) -> np.ndarray:
+    """The pelvis path on the floor as segments, shape (T - 1, 2, 3)."""
+    root = synth.positions[:, 0].copy()
+    root[:, 2] = z
+    return np.stack([root[:-1], root[1:]], axis=1)
 
 
 def _draw_worker(ax, synth: SynthesizedMotion, frame: int, capsules: bool,
@@ -67,10 +87,31 @@ def _draw_worker(ax, synth: SynthesizedMotion, frame: int, capsules: bool,
     ax.add_collection3d(Line3DCollection(bone_segments(pose), colors="#1f3b73", linewidths=1.5))
 
 
+def task_snapshot_times(synth: SynthesizedMotion, max_panels: int = 9) -> list[float]:
+    """Times (s) for a sheet of snapshots: the start, then the middle of each task.
+
+    With more tasks than ``max_panels - 1``, tasks evenly spread over the motion are
+    kept (always the first and the last).
+    """
+    if max_panels < 1:
+        raise ValueError(f"max_panels must be positive, got {max_panels}")
+    mids = [(seg.start_frame + seg.end_frame) / 2 / synth.fps for seg in synth.timeline]
+    if len(mids) > max_panels - 1:
+        keep = np.unique(np.round(np.linspace(0, len(mids) - 1, max_panels - 1)).astype(int))
+        mids = [mids[i] for i in keep] if max_panels > 1 else []
+    return sorted({0.0, *(round(t, 2) for t in mids)})[:max_panels]
+
+
+def _stack(polys: dict[str, np.ndarray]) -> np.ndarray:
+    """All objects' triangles in one array, shape (F, 3, 3)."""
+    return np.concatenate(list(polys.values())) if polys else np.zeros((0, 3, 3))
+
+
 def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float],
                      path: PathLike, ncols: int = 3, capsules: bool = True,
                      elev: float = 20.0, azim: float = -125.0, dpi: float = 110.0,
-                     body: str = "shaded") -> None:
+                     body: str = "shaded", panel_size: tuple[float, float] = (4.0, 3.6),
+                     title: str | None = None) -> None:
     """Several 3D panels of the worker in the cell at the given times (paper Fig. 2).
 
     Parameters
@@ -90,6 +131,10 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
     dpi : float
     body : {"shaded", "stick"}
         A shaded body (default) or the stick figure.
+    panel_size : (float, float)
+        Width and height of one panel in inches (pixels = inches * ``dpi``).
+    title : str, optional
+        A line above the panels (e.g. the specification and the task sequence).
     """
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
     _check_body(body)
@@ -100,28 +145,35 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
         raise ValueError(f"ncols must be positive, got {ncols}")
     ncols = min(ncols, len(times))
     nrows = -(-len(times) // ncols)
-    fig = new_figure(4.0 * ncols, 3.6 * nrows, dpi)
-    root = synth.positions[:, 0]
+    if panel_size[0] <= 0 or panel_size[1] <= 0:
+        raise ValueError(f"panel_size must be positive, got {panel_size}")
+    fig = new_figure(panel_size[0] * ncols, panel_size[1] * nrows, dpi)
     lo, hi = cell_bounds(cell, synth.positions[:, [0, 4, 9, 14]].reshape(-1, 3))
+    path_segments = _path_segments(synth, cell.floor_z + 0.005)
     for k, time in enumerate(times):
         frame = synth.frame_at(time)
         ax = fig.add_subplot(nrows, ncols, k + 1, projection="3d")
         setup_axes3d(ax, lo, hi, elev, azim)
-        draw_static_cell(ax, cell, lo, hi)
-        ax.plot(root[:, 0], root[:, 1], np.full(len(root), cell.floor_z + 0.005), color="0.55",
-                lw=0.6, ls=":")
-        for name, tri in object_polys(cell, synth.objects_at(frame)).items():
+        lines = draw_static_cell(ax, cell, lo, hi)
+        lines.add(path_segments, "0.55", 0.6, ":")
+        polys = object_polys(cell, synth.objects_at(frame))
+        for name, tri in polys.items():
             color = cell.objects[name].color or "tab:orange"
             ax.add_collection3d(Poly3DCollection(tri, facecolors=shaded(tri, color),
                                                  edgecolors="k", linewidths=0.2))
         _draw_worker(ax, synth, frame, capsules, body)
+        lines.update(_occluding_capsules(synth, frame, body), _stack(polys))
         ax.set_title(_frame_title(synth, frame), fontsize=8)
-    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.02, top=0.95, wspace=0.0, hspace=0.08)
+    top = 0.95
+    if title:
+        top -= 0.3 / (panel_size[1] * nrows)
+        fig.suptitle(title, fontsize=9, y=0.995, va="top")
+    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.02, top=top, wspace=0.0, hspace=0.08)
     save_figure(fig, path)
 
 
 def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: float = 15.0,
-                     capsules: bool = False, size: tuple[float, float] = (6.4, 4.8),
+                     capsules: bool = False, size: tuple[float, float] = (10.0, 7.5),
                      dpi: float = 80.0, elev: float = 20.0, azim: float = -125.0,
                      max_frames: int | None = None, body: str = "shaded") -> int:
     """Write an animated GIF of the motion (offscreen, no display needed).
@@ -141,7 +193,7 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
     capsules : bool
         With ``body="stick"``: also draw the occupancy capsules (slower).
     size : (float, float)
-        Figure size in inches.
+        Figure size in inches (the default, at ``dpi`` 80, makes 800 x 600 pixels).
     dpi : float
     elev, azim : float
     max_frames : int, optional
@@ -176,10 +228,11 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
     fig = new_figure(size[0], size[1], dpi)
     ax = fig.add_subplot(1, 1, 1, projection="3d")
     lo, hi = cell_bounds(cell, synth.positions[:, [0, 4, 9, 14]].reshape(-1, 3))
-    setup_axes3d(ax, lo, hi, elev, azim)
+    setup_axes3d(ax, lo, hi, elev, azim, zoom=_GIF_ZOOM)
     ax.set_axis_off()                  # ticks and panes cost most of the drawing time
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.94)
-    draw_static_cell(ax, cell, lo, hi, grid=0.5)
+    lines = draw_static_cell(ax, cell, lo, hi, grid=0.5)
+    lines.add(_path_segments(synth, cell.floor_z + 0.005), "0.55", 0.6, ":")
     stature = synth.motion.skeleton.stature
     bones = shell = None
     if body == "shaded":
@@ -218,10 +271,13 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
             bones.set_segments(bone_segments(pose))
         if caps is not None:
             caps.set_verts(body_quads(pose, stature))
+        moved = dict(base)
         for name, art in obj_artists.items():
             if name in synth.objects:
                 shift = synth.objects[name][frame] - cell.objects[name].position
-                art.set_verts(base[name] + shift)
+                moved[name] = base[name] + shift
+                art.set_verts(moved[name])
+        lines.update(_occluding_capsules(synth, int(frame), body), _stack(moved))
         title.set_text(_frame_title(synth, int(frame)))
         canvas.draw()
         rgb = Image.fromarray(np.asarray(canvas.buffer_rgba())[..., :3].copy())
