@@ -30,7 +30,8 @@ from contextlib import contextmanager
 
 from ltl_human_motion.errors import LtlHumanMotionError
 
-__all__ = ["DEFAULT_MAX_SECONDS", "BudgetExhaustedError", "Deadline", "active", "checkpoint"]
+__all__ = ["DEFAULT_MAX_SECONDS", "BudgetExhaustedError", "Deadline", "active", "checkpoint",
+           "current"]
 
 #: Default per-request budget of the synthesis service (s); issue 17 asks for 30 s.
 #: S1 and S2 take 1-5 s on a loaded 2-core machine, so 30 s leaves a wide margin.
@@ -122,3 +123,8 @@ def checkpoint(stage: str) -> None:
     deadline = _ACTIVE.get()
     if deadline is not None:
         deadline.check(stage)
+
+
+def current() -> Deadline | None:
+    """The active deadline (None outside :func:`active`)."""
+    return _ACTIVE.get()

@@ -9,6 +9,10 @@ RecursionError). The translator also checks the active time budget in its main l
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+from ltl_human_motion.deadline import BudgetExhaustedError, Deadline, active, current
 from ltl_human_motion.errors import SpecError
 from ltl_human_motion.ltl.formula import (
     Finally,
@@ -21,8 +25,9 @@ from ltl_human_motion.ltl.formula import (
     WeakUntil,
 )
 
-__all__ = ["MAX_NESTING", "MAX_SPEC_CHARS", "MAX_TEMPORAL_OPERATORS", "check_formula_limits",
-           "nesting_depth", "temporal_operators"]
+__all__ = ["MAX_NESTING", "MAX_SPEC_CHARS", "MAX_TEMPORAL_OPERATORS",
+           "MAX_TRANSLATION_SECONDS", "check_formula_limits", "nesting_depth",
+           "temporal_operators", "translation_budget"]
 
 #: Characters of specification text. Table I's and the batch corpus's longest specs are
 #: under 400 characters; 20,000 leaves room for generated ones.
@@ -38,6 +43,12 @@ MAX_NESTING = 100
 #: also has its time budget. 64 admits 20-part kitting with a response rule per part
 #: (``G(grasp(Pi) -> F insert(Pi, kit))``: 40) and refuses machine-made formulas.
 MAX_TEMPORAL_OPERATORS = 64
+#: Seconds that building a specification's whole automaton may take (the explicit
+#: translation of :func:`~ltl_human_motion.ltl.sequences.synthesize_sequences` and
+#: ``tasks --automaton``). Table I's specifications take under 0.05 s; 12 ``G F`` terms
+#: took over 90 s and a 49-deep ``U`` chain 40 s (issue 34), where the on-the-fly search
+#: of a cell with geometry answers or refuses within its work budget.
+MAX_TRANSLATION_SECONDS = 2.0
 
 _TEMPORAL = (Next, Finally, Globally, Until, Release, WeakUntil, StrongRelease)
 
@@ -80,3 +91,31 @@ def check_formula_limits(f: Formula, text: str = "") -> None:
                         "beyond which translation takes minutes; split the task or "
                         "remove repeated terms", text=text)
 
+
+@contextmanager
+def translation_budget() -> Iterator[None]:
+    """Run the block (a translation) under :data:`MAX_TRANSLATION_SECONDS`, or under the
+    active deadline when that one ends sooner (a request's budget, or an enclosing
+    translation budget).
+
+    Raises
+    ------
+    SpecError
+        When the block's own budget is spent; the message names the limit.
+    """
+    outer = current()
+    if outer is not None and outer.remaining() <= MAX_TRANSLATION_SECONDS:
+        yield
+        return
+    own = Deadline(MAX_TRANSLATION_SECONDS)
+    try:
+        with active(own):
+            yield
+    except BudgetExhaustedError:
+        if not own.expired:
+            raise
+        raise SpecError(
+            "the specification is too complex to translate into an automaton within "
+            f"{MAX_TRANSLATION_SECONDS:g} s (MAX_TRANSLATION_SECONDS); split it into smaller "
+            "specifications, or plan with a cell that has geometry (e.g. --cell "
+            "paper_cell), whose search builds only the states it visits") from None

@@ -37,6 +37,7 @@ from ltl_human_motion.ltl.automaton import Automaton, accepting_components
 from ltl_human_motion.ltl.automaton import strongly_connected_components as _sccs
 from ltl_human_motion.ltl.evaluator import evaluate_lasso
 from ltl_human_motion.ltl.formula import Atom, Formula, conj
+from ltl_human_motion.ltl.limits import translation_budget
 from ltl_human_motion.ltl.spec import Specification, build_specification, letter_of
 from ltl_human_motion.ltl.translate import translate
 
@@ -223,8 +224,11 @@ def _canonical(prefix: list[int], cycle: list[int]) -> tuple[tuple[int, ...], tu
 
 
 def task_automaton(spec: Specification, backend: str = "auto") -> Automaton:
-    """The automaton of the full specification (user formula and always-on conjuncts)."""
-    return translate(spec.formula, backend=backend)
+    """The automaton of the full specification (user formula and always-on conjuncts),
+    built within :data:`~ltl_human_motion.ltl.limits.MAX_TRANSLATION_SECONDS` (a
+    SpecError beyond)."""
+    with translation_budget():
+        return translate(spec.formula, backend=backend)
 
 
 def _graph_for(formula: Formula, spec: Specification, backend: str,
@@ -236,8 +240,15 @@ def unsat_core(spec: Specification, backend: str = "auto",
                allow_empty: bool = True, limit: int = 16) -> list[str]:
     """A minimal set of labelled conjuncts that admits no task sequence (deletion-based).
 
-    Returns all conjunct labels if there are more than ``limit`` of them.
+    Returns all conjunct labels if there are more than ``limit`` of them. Within
+    :data:`~ltl_human_motion.ltl.limits.MAX_TRANSLATION_SECONDS` (a SpecError beyond).
     """
+    with translation_budget():
+        return _unsat_core(spec, backend, allow_empty, limit)
+
+
+def _unsat_core(spec: Specification, backend: str, allow_empty: bool, limit: int
+                ) -> list[str]:
     parts = spec.labelled_conjuncts()
     if len(parts) > limit:
         return [label for label, _ in parts]
@@ -556,7 +567,9 @@ def synthesize_sequences(spec: str | Specification, cell: object = None, n: int 
     Raises
     ------
     SpecError
-        Malformed, ill-typed or unsatisfiable specification (naming conflicting conjuncts).
+        Malformed, ill-typed or unsatisfiable specification (naming conflicting conjuncts),
+        or one whose automaton takes longer than
+        :data:`~ltl_human_motion.ltl.limits.MAX_TRANSLATION_SECONDS` to build.
     ValueError
         Bad ``mode``, ``n``, ``cycles``.
     """
@@ -570,6 +583,14 @@ def synthesize_sequences(spec: str | Specification, cell: object = None, n: int 
         raise ValueError("mode='random' needs a number of sequences n")
     if not isinstance(spec, Specification):
         spec = build_specification(spec, cell, free_atoms=free_atoms)
+    with translation_budget():
+        return _synthesize(spec, n, seed, mode, cycles, min_steps, backend, max_length,
+                           automaton)
+
+
+def _synthesize(spec: Specification, n: int | None, seed: int, mode: str, cycles: int,
+                min_steps: int, backend: str, max_length: int | None,
+                automaton: Automaton | None) -> list[TaskSequence]:
     aut = automaton if automaton is not None else task_automaton(spec, backend)
     graph = _LetterGraph(aut, spec.letters, allow_empty=False)
     if not graph.nonempty():

@@ -71,6 +71,7 @@ def _prune(terms: list[_Term]) -> list[_Term]:
                                                _names(t[1]), _names(t[2])))
     kept: list[_Term] = []
     for t in unique:
+        checkpoint("translation")                 # quadratic: 4,096 terms of 12 G F
         c, nx, pr = t
         if not any(k[0].pos <= c.pos and k[0].neg <= c.neg and k[1] <= nx and k[2] <= pr
                    for k in kept):

@@ -146,6 +146,8 @@ def load_vocabulary(path: str | Path) -> Vocabulary:
     )
 
     path = Path(path)
+    if not path.exists():
+        raise CellError(f"cell file not found: {path}")
     try:
         text = read_text_file(path, "cell file")
     except TextFileError as exc:
