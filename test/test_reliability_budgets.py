@@ -17,8 +17,7 @@ import pytest
 
 from ltl_human_motion.deadline import BudgetExhaustedError, Deadline, active
 from ltl_human_motion.errors import SpecError
-from ltl_human_motion.ltl import build_specification, synthesize_sequences, task_automaton
-from ltl_human_motion.ltl import limits
+from ltl_human_motion.ltl import build_specification, limits, synthesize_sequences, task_automaton
 from ltl_human_motion.ltl.limits import MAX_TEMPORAL_OPERATORS, temporal_operators
 from ltl_human_motion.ltl.sequences import unsat_core
 
@@ -75,7 +74,7 @@ def test_the_budget_is_the_named_constant(monkeypatch: pytest.MonkeyPatch) -> No
 def test_a_shorter_request_deadline_still_wins() -> None:
     spec = build_specification(HARD["49-deep U chain"], CELL)
     with active(Deadline(0.2)), pytest.raises(BudgetExhaustedError,
-                                              match="time budget of 0.2 s exhausted in "
+                                              match=r"time budget of 0\.2 s exhausted in "
                                                     "translation"):
         synthesize_sequences(spec, n=1)
 
