@@ -1,10 +1,12 @@
 """The study report: JSON with every item's figures, PNG plots and one HTML page.
 
-Plots: distributions of cycle time, worst REBA, lifting index and minimum separation
-(layouts overlaid), the cycle-time breakdown, and per layout a floor "spaghetti" plot of
-the worker's paths and a heat map of floor occupancy. The HTML page embeds the PNGs
-(base64) and, with two layouts, shows them side by side with the differences and their
-95 % confidence intervals (Welch's t interval on the difference of means).
+Plots: a top view of the layouts with what differs between them
+(:mod:`ltl_human_motion.study.layout`), distributions of cycle time, worst REBA, lifting
+index and minimum separation (layouts overlaid), the cycle-time breakdown, and per layout a
+floor "spaghetti" plot of the worker's paths and a heat map of floor occupancy. The HTML
+page embeds the PNGs (base64), says which items moved and by how much, gives the reason of
+every failed item and, with two layouts, shows them side by side with the differences and
+their 95 % confidence intervals (Welch's t interval on the difference of means).
 """
 
 from __future__ import annotations
@@ -20,6 +22,12 @@ from typing import Any
 import numpy as np
 
 from ltl_human_motion.atomic import atomic_write_text
+from ltl_human_motion.study.layout import (
+    draw_floor_plan,
+    floor_axes,
+    layout_changes,
+    plot_layouts,
+)
 from ltl_human_motion.viz._common import new_figure, save_figure
 
 __all__ = ["METRICS", "compare", "item_metrics", "summarize", "write_report"]
@@ -117,34 +125,6 @@ def compare(a: Sequence[dict[str, Any]], b: Sequence[dict[str, Any]]
 
 # ------------------------------------------------------------------------------ plots
 
-def _floor_plan(ax, cell) -> None:
-    from matplotlib.patches import Rectangle
-    for ob in cell.obstacles:
-        for part in ob.parts:
-            lo, hi = part.aabb()
-            ax.add_patch(Rectangle(lo[:2], *(hi[:2] - lo[:2]), color=ob.color or "grey",
-                                   alpha=0.55, lw=0, zorder=3))
-        lo, hi = ob.aabb()
-        ax.text(0.5 * (lo[0] + hi[0]), hi[1] + 0.04, ob.name, ha="center", fontsize=8,
-                zorder=5)
-    for name, reg in cell.regions.items():
-        ax.add_patch(Rectangle(reg.lo[:2], *(reg.hi[:2] - reg.lo[:2]), fill=False,
-                               ls="--", ec="black", lw=0.8, zorder=4))
-        ax.text(reg.lo[0], reg.lo[1] - 0.12, name, fontsize=8, zorder=5)
-    for name, obj in cell.objects.items():
-        # A black edge keeps a part's square apart from the heat map's cells.
-        ax.plot(*obj.position[:2], "s", color=obj.color or "black", ms=7, mec="black",
-                mew=1.2, zorder=5)
-        ax.text(obj.position[0] + 0.06, obj.position[1] + 0.06, name, fontsize=8, zorder=5)
-
-
-def _robot_base(ax, robot: dict[str, Any] | None) -> None:
-    if robot:
-        x, y = robot["base_xyz"][:2]
-        ax.plot(x, y, "k^", ms=9, zorder=6)
-        ax.text(x + 0.06, y - 0.15, "robot", fontsize=8, zorder=6)
-
-
 def _extent(cell, paths: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     from ltl_human_motion.viz._common import cell_bounds
     pts = np.concatenate([np.c_[p, np.zeros(len(p))] for p in paths]) if paths else None
@@ -173,18 +153,12 @@ def plot_spaghetti(cell, paths: Sequence[np.ndarray], path: Path, title: str,
     floor (lo (2,), hi (2,)), shared by the layouts of a comparison)."""
     fig = new_figure(6.0, 5.6, dpi=110)
     ax = fig.add_subplot(111)
-    _floor_plan(ax, cell)
-    _robot_base(ax, robot)
+    draw_floor_plan(ax, cell, robot)
     alpha = float(np.clip(8.0 / max(len(paths), 1), 0.05, 0.6))
     for p in paths:
         ax.plot(p[:, 0], p[:, 1], color="tab:blue", lw=0.8, alpha=alpha, zorder=2)
     lo, hi = bounds if bounds is not None else _extent(cell, paths)
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title(f"{title}: worker paths ({len(paths)} motions)")
+    floor_axes(ax, lo, hi, f"{title}: worker paths ({len(paths)} motions)")
     fig.tight_layout()
     save_figure(fig, path)
     return path
@@ -205,14 +179,8 @@ def plot_heatmap(cell, paths: Sequence[np.ndarray], path: Path, title: str,
                    vmin=0.0, vmax=vmax)
     fig.colorbar(im, ax=ax, label=f"s per motion in {cell_size * 100:.0f} cm squares",
                  shrink=0.85)
-    _floor_plan(ax, cell)
-    _robot_base(ax, robot)
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title(f"{title}: floor occupancy")
+    draw_floor_plan(ax, cell, robot)
+    floor_axes(ax, lo, hi, f"{title}: floor occupancy")
     fig.tight_layout()
     save_figure(fig, path)
     return path
@@ -341,12 +309,42 @@ def _compare_table(cmp: dict[str, dict[str, Any]], a: str, b: str) -> str:
             f"<th>differs</th></tr>{''.join(rows)}</table>")
 
 
+def _changes_section(changes: Sequence[Any], labels: Sequence[str], png: Path) -> str:
+    if len(labels) < 2:
+        return "<h2>Layout</h2>" + _img(png, "top view of the layout")
+    a, b = html.escape(labels[0]), html.escape(labels[1])
+    items = "".join(f"<li>{html.escape(c.describe())}</li>" for c in changes) \
+        or "<li>nothing: the two cells are the same</li>"
+    return (f"<h2>What differs between layouts {a} and {b}</h2><ul>{items}</ul>"
+            f'<p class="note">Shifts are {b} minus {a} in the cells\' frame (x, y on the '
+            "floor, z up; metres). Everything else is the same.</p>"
+            + _img(png, f"top view of layouts {a} and {b}"))
+
+
+def _failed_section(layouts: Sequence[dict[str, Any]]) -> str:
+    rows = []
+    for lay in layouts:
+        for f in lay["failed"].get("items", []):
+            where = f.get("task") or f.get("check") or "–"
+            rows.append(f"<tr><td>{html.escape(lay['label'])}</td><td>{f['index']}</td>"
+                        f"<td>{_fmt(f['stature'])}</td><td>{f['seed']}</td>"
+                        f"<td>{html.escape(str(where))}</td><td class='why'>"
+                        f"{html.escape(str(f.get('message') or f.get('type') or '?'))}"
+                        f"</td></tr>")
+    if not rows:
+        return "<h2>Failed items</h2><p>None: every item was synthesized and verified.</p>"
+    return ("<h2>Failed items</h2><p>Items whose motion could not be made or did not pass "
+            "verification; they are left out of every figure above.</p><table><tr>"
+            "<th>layout</th><th>item</th><th>stature [m]</th><th>seed</th><th>task or check"
+            f"</th><th>reason</th></tr>{''.join(rows)}</table>")
+
+
 _CSS = """body{font-family:sans-serif;margin:24px;max-width:1400px;color:#222}
 table{border-collapse:collapse;margin:8px 0 20px}td,th{border:1px solid #bbb;padding:4px 8px;
 font-size:14px;text-align:right}td:first-child,th:first-child{text-align:left}
 tr.sig td{background:#fff3cd}.row{display:flex;gap:16px;flex-wrap:wrap}
 .row>div{flex:1;min-width:420px}img{max-width:100%}h2{border-bottom:1px solid #ccc}
-.note{color:#555;font-size:13px}"""
+.note{color:#555;font-size:13px}td.why{text-align:left;max-width:900px}"""
 
 
 def write_report(layouts: Sequence[dict[str, Any]], out: Path, meta: dict[str, Any]
@@ -374,6 +372,9 @@ def write_report(layouts: Sequence[dict[str, Any]], out: Path, meta: dict[str, A
     bounds = (np.min([e[0] for e in ext], axis=0), np.max([e[1] for e in ext], axis=0))
     vmax = max((float(_occupancy(lay["paths"], bounds, 0.1, 10.0)[0].max(initial=0.0))
                 for lay in layouts), default=0.0) or None
+    changes = layout_changes(cells[labels[0]], cells[labels[1]]) if len(layouts) > 1 else []
+    pngs["layouts"] = plot_layouts([cells[lb] for lb in labels], labels, out / "layouts.png",
+                                   changes, robot, bounds)
     for lay in layouts:
         lb = lay["label"]
         pngs[f"spaghetti_{lb}"] = plot_spaghetti(cells[lb], lay["paths"],
@@ -390,6 +391,7 @@ def write_report(layouts: Sequence[dict[str, Any]], out: Path, meta: dict[str, A
                                        "summary": summaries[lay["label"]]}
                         for lay in layouts},
             "comparison": comparison,
+            "layout_changes": [c.to_dict() for c in changes],
             "report": {"html": str(out / "study.html"),
                        "plots": {k: str(v) for k, v in pngs.items()}}}
     atomic_write_text(out / "study.json", json.dumps(data, indent=1, allow_nan=False,
@@ -403,7 +405,8 @@ def write_report(layouts: Sequence[dict[str, Any]], out: Path, meta: dict[str, A
              f"{html.escape(str(meta.get('robot') or 'none'))}; seed {meta['seed']}.</p>",
              "<p>" + "; ".join(f"layout {html.escape(lay['label'])}: {len(lay['items'])} "
                                f"verified motions, {lay['failed']['count']} failed"
-                               for lay in layouts) + ".</p>"]
+                               for lay in layouts) + " (reasons at the end).</p>",
+             _changes_section(changes, labels, pngs["layouts"])]
     if comparison:
         parts += [f"<h2>{html.escape(labels[1])} against {html.escape(labels[0])}</h2>",
                   _compare_table(comparison, labels[0], labels[1]),
@@ -418,6 +421,7 @@ def write_report(layouts: Sequence[dict[str, Any]], out: Path, meta: dict[str, A
               "<h2>Floor occupancy</h2>", '<div class="row">'
               + "".join(f"<div>{_img(pngs[f'heatmap_{lb}'], f'heat map {lb}')}</div>"
                         for lb in labels) + "</div>",
+              _failed_section(layouts),
               '<p class="note">REBA: Hignett &amp; McAtamney (2000); RULA: McAtamney &amp; '
               "Corlett (1993); lifting index: revised NIOSH equation (Waters et al. 1994), "
               "every lift from grasp to release; separation: the live SSM controller's "

@@ -114,8 +114,9 @@ def collect_layout(folder: Path, label: str, cell: str) -> dict[str, Any]:
     -------
     dict
         ``label``, ``cell``, ``items`` (one dict per verified item: index, stature,
-        sequence, duration and the ``study`` figures), ``failed`` (count and first
-        errors), ``paths`` (list of (N, 2) pelvis paths at :data:`PATH_RATE`).
+        sequence, duration and the ``study`` figures), ``failed`` (count, first errors,
+        and per failed item its index, stature, seed and error: type, message, check,
+        task), ``paths`` (list of (N, 2) pelvis paths at :data:`PATH_RATE`).
     """
     from ltl_human_motion.batch.reader import open_dataset
     from ltl_human_motion.motion.skeleton import JOINT_INDEX
@@ -134,7 +135,10 @@ def collect_layout(folder: Path, label: str, cell: str) -> dict[str, Any]:
     failed = ds.failed()
     return {"label": label, "cell": cell, "items": items,
             "failed": {"count": len(failed),
-                       "errors": [f.get("error") for f in failed[:5]]},
+                       "errors": [f.get("error") for f in failed[:5]],
+                       "items": [{"index": f["index"], "stature": f["params"]["stature"],
+                                  "seed": f["seed"], "sequence": f.get("sequence"),
+                                  **(f.get("error") or {})} for f in failed]},
             "paths": paths}
 
 
