@@ -6,6 +6,23 @@ the ROS nodes can turn it into a message without a traceback.
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
+
+
+def did_you_mean(name: object, known: Iterable[str]) -> str:
+    """``"did you mean 'X'? "`` for the known name closest to a misspelt ``name``, or "".
+
+    A name that differs only in case is always suggested; otherwise the closest by
+    :func:`difflib.get_close_matches` (similarity 0.6 or more).
+    """
+    if not isinstance(name, str) or not name:
+        return ""
+    names = [k for k in known if isinstance(k, str)]
+    same_case = [k for k in names if k.lower() == name.lower() and k != name]
+    close = same_case or difflib.get_close_matches(name, names, n=1, cutoff=0.6)
+    return f"did you mean '{close[0]}'? " if close and close[0] != name else ""
+
 
 class LtlHumanMotionError(Exception):
     """Base class of all errors caused by user input or unmet requirements."""

@@ -23,7 +23,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``coexist``."""
     parser.add_argument("--spec", default="S1",
                         help="worker's LTL spec: a paper name (S1..) or formula (default S1)")
-    parser.add_argument("--cell", default="paper_cell", help="cell name or YAML path")
+    parser.add_argument("--cell", default="paper_cell",
+                        help="cell name or YAML path (default paper_cell)")
     parser.add_argument("--out", type=Path, default=Path("out/coexist"),
                         help="output folder (default out/coexist)")
     parser.add_argument("--robot-host", default=None, metavar="IP",

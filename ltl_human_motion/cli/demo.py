@@ -27,17 +27,20 @@ from pathlib import Path
 from ltl_human_motion.atomic import atomic_write_text
 
 NAME = "demo"
-HELP = "run the main job: paper reproduction, ROS 2 loop with MCAP recording, robot coexistence"
+HELP = ("run the main job: paper reproduction, ROS 2 loop with MCAP recording, robot "
+        "coexistence, and a study of two layouts of the paper cell")
 
 PARTS = ("paper", "ros", "robot", "study")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``ltl-human-motion demo``."""
-    parser.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder")
+    parser.add_argument("--out", type=Path, default=Path("out/demo"),
+                        help="output folder (default out/demo)")
     parser.add_argument("--only", choices=PARTS, action="append",
                         help="run only this part (repeatable)")
-    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--seed", type=int, default=1,
+                        help="random seed of the syntheses and the study (default 1)")
     parser.add_argument("--no-animation", action="store_true",
                         help="skip the GIF animations of the paper part")
     parser.add_argument("--playback-rate", type=float, default=2.0,

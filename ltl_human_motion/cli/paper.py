@@ -14,7 +14,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``ltl-human-motion paper``."""
     parser.add_argument("--out", type=Path, default=Path("out/paper"),
                         help="output folder (default out/paper)")
-    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--seed", type=int, default=1,
+                        help="random seed of the syntheses (default 1)")
     parser.add_argument("--cycles", type=int, default=2,
                         help="assembly cycles per specification (default 2)")
     parser.add_argument("--no-animation", action="store_true", help="skip the GIF animations")

@@ -52,7 +52,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="x/y offsets of the parts' positions per variant, uniform in "
                              "+-M metres (default 0.05)")
     parser.add_argument("--out", type=Path, default=Path("out/study"),
-                        help="output folder (an interrupted study in it is resumed)")
+                        help="output folder (default out/study; an interrupted study in it is "
+                             "resumed)")
     parser.add_argument("--seed", type=int, default=0, help="global seed (default 0)")
     parser.add_argument("--workers", type=int, default=None,
                         help="worker processes (default: CPU count; 0 = this process)")

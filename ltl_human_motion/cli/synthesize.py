@@ -7,6 +7,7 @@ import json
 import sys
 from pathlib import Path
 
+from ltl_human_motion.cli._types import stature
 from ltl_human_motion.cli.render import (
     PictureOptions,
     add_picture_arguments,
@@ -31,7 +32,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument("--cycles", type=int, default=1,
                         help="passes through the accepting cycle (default 1)")
-    parser.add_argument("--stature", type=float, default=1.75, help="body height in m")
+    parser.add_argument("--stature", type=stature, default=1.75,
+                        help="body height in m, 1.55 to 1.95 (default 1.75)")
     parser.add_argument("--mode", choices=("all", "coverage", "random"), default="all",
                         help="how task-sequence variations are chosen (default all: "
                              "shortest first)")

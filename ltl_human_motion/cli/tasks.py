@@ -26,7 +26,7 @@ from ltl_human_motion.tasks.model import TIME_CALIBRATION, CellModel, estimated_
 from ltl_human_motion.yaml_limits import TextFileError, read_text_file
 
 NAME = "tasks"
-HELP = "Print task sequences (or the Büchi automaton) satisfying an LTL specification."
+HELP = "print task sequences (or the Büchi automaton) satisfying an LTL specification"
 
 
 def _positive(text: str) -> int:
@@ -47,18 +47,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "YAML file naming objects, regions, shorthands and the final region")
     parser.add_argument("-n", type=_positive, default=None,
                         help="number of sequences (default 5; coverage/all: the full set)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of --mode random")
+    parser.add_argument("--seed", type=int, default=0, help="seed of --mode random (default 0)")
     parser.add_argument("--mode", choices=MODES, default="random",
-                        help="variations: seeded random walks, transition coverage, or all "
-                        "distinct sequences by length")
+                        help="variations: seeded random walks (default), transition "
+                        "coverage, or all distinct sequences by length")
     parser.add_argument("--cycles", type=_positive, default=1,
                         help="passes through the accepting cycle (default 1)")
     parser.add_argument("--min-steps", type=int, default=0,
-                        help="repeat the cycle until a sequence has this many steps")
+                        help="repeat the cycle until a sequence has this many steps "
+                        "(default 0: once)")
     parser.add_argument("--max-length", type=_positive, default=None,
                         help="bound on prefix+cycle length for --mode all")
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
-                        help="LTL translator (auto: Spot if installed, else built-in)")
+                        help="LTL translator (default auto: Spot if installed, else built-in)")
     parser.add_argument("--hoa", metavar="FILE",
                         help="take the automaton from a HOA file (e.g. from Spot's ltl2tgba) "
                         "instead of translating; sequences are still checked against the spec")

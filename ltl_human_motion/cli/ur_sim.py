@@ -8,8 +8,8 @@ import signal
 import sys
 
 NAME = "ur-sim"
-HELP = ("Run a simulated UR e-Series controller (RTDE on TCP 30004, dashboard on 29999) "
-        "looping a pick-and-place trajectory until Ctrl-C.")
+HELP = ("run a simulated UR e-Series controller (RTDE on TCP 30004, dashboard on 29999) "
+        "looping a pick-and-place trajectory until Ctrl-C")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -21,12 +21,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(default: built-in pick-and-place cycle)")
     parser.add_argument("--host", default="127.0.0.1", help="bind address (default loopback)")
     parser.add_argument("--rtde-port", type=int, default=30004,
-                        help="RTDE port (ur_rtde clients always use 30004)")
+                        help="RTDE port (default 30004, which ur_rtde clients always use)")
     parser.add_argument("--dashboard-port", type=int, default=29999,
-                        help="dashboard port; -1 disables the dashboard server")
-    parser.add_argument("--rate", type=float, default=500.0, help="controller rate in Hz")
+                        help="dashboard port (default 29999; -1 disables the dashboard server)")
+    parser.add_argument("--rate", type=float, default=500.0,
+                        help="controller rate in Hz (default 500)")
     parser.add_argument("--speed-slider", type=float, default=1.0,
-                        help="initial speed slider fraction in [0, 1]")
+                        help="initial speed slider fraction in [0, 1] (default 1)")
     parser.add_argument("-v", "--verbose", action="store_true", help="log client activity")
 
 

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ltl_human_motion.errors import SpecError
+from ltl_human_motion.errors import SpecError, did_you_mean
 from ltl_human_motion.ltl.formula import (
     FALSE,
     TRUE,
@@ -384,8 +384,8 @@ class _Parser:
         if self.free_atoms:
             return Atom(name, tuple(args))
         known = sorted(set(TASK_ARGUMENTS) | {REGION_ATOM} | set(self.vocab.shorthands))
-        raise self.error(f"unknown task '{name}'; expected one of: {', '.join(known)}",
-                         tok.pos)
+        raise self.error(f"unknown task '{name}'; {did_you_mean(name, known)}expected one of: "
+                         f"{', '.join(known)}", tok.pos)
 
     def check_arg(self, value: str, tok: _Token, kind: str, task: str) -> str:
         if kind == "duration":
@@ -404,8 +404,9 @@ class _Parser:
         names = self.vocab.objects if kind == "object" else self.vocab.regions
         if names is not None and value not in names:
             listed = ", ".join(sorted(names)) or "(none)"
-            raise self.error(f"unknown {kind} '{value}' in task '{task}'; expected one of "
-                             f"the cell's {kind}s: {listed}", tok.pos)
+            raise self.error(f"unknown {kind} '{value}' in task '{task}'; "
+                             f"{did_you_mean(value, names)}expected one of the cell's {kind}s: "
+                             f"{listed}", tok.pos)
         return value
 
     def shorthand(self, tok: _Token, args: list[str], arg_toks: list[_Token]) -> Formula:

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ltl_human_motion.errors import CellError
+from ltl_human_motion.errors import CellError, did_you_mean
 from ltl_human_motion.scene.cell import Cell, Obstacle, Region, SceneObject
 from ltl_human_motion.scene.frames import ZUP_FROM_YUP, extents_zup_from_yup, zup_from_yup
 from ltl_human_motion.scene.shapes import Box, Cylinder, MeshShape, Shape, Sphere
@@ -87,7 +87,8 @@ class _Parser:
                 raise self.error(key, f"keys must be strings, got {_r(k)}")
             if k not in allowed:
                 raise self.error(f"{key}.{k}" if key else k,
-                                 f"unknown key; expected one of {', '.join(sorted(allowed))}")
+                                 f"unknown key; {did_you_mean(k, allowed)}expected one of "
+                                 f"{', '.join(sorted(allowed))}")
         for k in required:
             if k not in value:
                 raise self.error(key, f"missing required key {_r(k)}")
@@ -345,8 +346,8 @@ def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Ce
                 raise p.error(key, "missing")
             return None
         if not isinstance(value, str) or value not in regions:
-            raise p.error(key, f"unknown region {_r(value)}; expected a region name: "
-                               f"{', '.join(regions)}")
+            raise p.error(key, f"unknown region {_r(value)}; {did_you_mean(value, regions)}"
+                               f"expected a region name: {', '.join(regions)}")
         return regions[value]
 
     start = region_ref("start_region", True)
@@ -382,7 +383,9 @@ def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Ce
             raise p.error(key, str(exc)) from None
         for task, args in atoms:
             if task not in TASK_ARGUMENTS and task not in shorthands:
-                raise p.error(key, f"unknown task {_r(task)} in body {_r(body)}")
+                hint = did_you_mean(task, [*TASK_ARGUMENTS, *shorthands]).strip()
+                raise p.error(key, f"unknown task {_r(task)} in body {_r(body)}"
+                                   + (f"; {hint}" if hint else ""))
             for arg in args:
                 if arg not in params and arg not in objects and arg not in regions:
                     try:
@@ -475,7 +478,8 @@ def cell_by_name(name: str) -> Cell:
         if folder.is_dir():
             # Other YAML files live there too (bringup parameters, batch specs, robots).
             found.update(p.stem for p in folder.glob("*.yaml") if _is_cell_file(p))
-    raise CellError(f"no cell named {stem!r}; known cells: {', '.join(sorted(found)) or '(none)'}")
+    raise CellError(f"no cell named {stem!r}; {did_you_mean(stem, found)}known cells: "
+                    f"{', '.join(sorted(found)) or '(none)'}")
 
 
 def _is_cell_file(path: Path) -> bool:
