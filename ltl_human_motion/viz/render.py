@@ -168,7 +168,7 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
     if title:
         top -= 0.3 / (panel_size[1] * nrows)
         fig.suptitle(title, fontsize=9, y=0.995, va="top")
-    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.02, top=top, wspace=0.0, hspace=0.08)
+    fig.subplots_adjust(left=0.03, right=1.0, bottom=0.02, top=top, wspace=0.0, hspace=0.08)
     save_figure(fig, path)
 
 
