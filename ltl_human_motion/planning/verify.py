@@ -56,8 +56,8 @@ class VerificationOptions:
     flight_height : float
     biomechanics : bool
         Run the biomechanical checks (default on; off measures or reproduces the
-        motions of the looser verification of earlier releases: README, "Human
-        plausibility").
+        motions of the looser verification of earlier releases: docs/design-notes.md,
+        "Human plausibility").
     limits : BiomechanicsLimits
         Their limits (:mod:`~ltl_human_motion.planning.biomechanics`).
     """
