@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -72,10 +73,12 @@ def _ros(args: argparse.Namespace) -> dict:
                            playback_rate=args.playback_rate)
     missed = summary.get("occupancy_deadlines_missed", 0)
     if missed:
+        load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
         summary["warning"] = (
             f"the occupancy stream missed {missed} of its 10 ms deadlines (those messages "
             f"were skipped; worst {summary.get('occupancy_worst_late_ms', 0.0):.1f} ms late): "
-            "a robot reading it would have seen stale occupancy; the cores were busy")
+            "a robot reading it would have seen stale occupancy; the stream's thread did not "
+            f"get a core in time (load average {load:.1f} on {os.cpu_count()} cores)")
     return {"ok": bool(summary.get("success")), **summary}
 
 
