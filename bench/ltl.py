@@ -115,8 +115,8 @@ def main(argv: list[str] | None = None) -> int:
         paper[name]["cell_model"] = _cell_model_stage(name, args.repeat)
         cm = paper[name]["cell_model"]
         print(f"{name} with the cell model (config/paper_cell.yaml): first sequence "
-              f"{cm['first_sequence']} ({cm['estimated_seconds']:.1f} s of work), LTL stage "
-              f"{cm['ltl_stage_ms_median']:.1f} ms (translation + sequence, n=1) vs "
+              f"{cm['first_sequence']} (the search's cost {cm['estimated_seconds']:.1f}), "
+              f"LTL stage {cm['ltl_stage_ms_median']:.1f} ms (translation + sequence, n=1) vs "
               f"{cm['previous_ltl_stage_ms_median']:.1f} ms before (translate + sequences)")
     ratios = [r["ba_ratio"] for r in results]
     summary = {

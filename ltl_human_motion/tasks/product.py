@@ -2,8 +2,8 @@
 
 A product node is ``(automaton state, cell state)``; an edge does one task step: the
 automaton reads the task's letter and the cell model (:class:`~.model.CellModel`) does
-the task, at its estimated time. Nothing is built in full: nodes are made when the
-search reaches them.
+the task, at its cost (the cost model's seconds). Nothing is built in full: nodes are
+made when the search reaches them.
 
 A task sequence is a lasso ``prefix . cycle`` whose infinite word ``prefix cycle^w``
 the automaton accepts. As in the paper, the worker performs ``prefix`` and the cycle
@@ -125,7 +125,7 @@ class ExplicitView:
 
 @dataclass(frozen=True)
 class Lasso:
-    """A lasso of task indices with its estimated time.
+    """A lasso of task indices with its cost (the cost model's seconds).
 
     Attributes
     ----------

@@ -82,7 +82,9 @@ class PlanStats:
     weight : float
         A* weight of the first sequence (1.0: cost-optimal).
     costs : list of float
-        Estimated seconds of each sequence (prefix and cycle repetitions).
+        The search's cost of each sequence (prefix and cycle repetitions; seconds of the
+        cost model, which orders sequences: :func:`~ltl_human_motion.tasks.model.
+        estimated_duration` estimates the motion's length).
     """
 
     automaton_seconds: float = 0.0
