@@ -27,7 +27,9 @@ Six families, each its own name in the results:
     region smaller than the carton (``size``).
 
 Every cell is built in a local frame (its main furniture at the +x wall) and turned by a
-random multiple of 90 degrees. Cells are the same for every stature; each
+random multiple of 90 degrees; a family's even and odd cells alternate its two kinds
+(hinged or sliding door, seated or standing desk, aisle with a dead end or open, carton
+on a pallet or a table). Cells are the same for every stature; each
 :class:`UnseenScenario` carries the labels of one stature, computed from geometry by
 :mod:`ltl_human_motion.scenarios.labels` (tasks whose label is ambiguous for a stature
 are left out and counted in ``dropped``). Deterministic in the seed; the generator of
@@ -103,9 +105,10 @@ def _r(x: float) -> float:
 class _Layout:
     """A cell in its local frame: obstacles, objects and regions as boxes (lo, hi)."""
 
-    def __init__(self, rng: np.random.Generator, name: str) -> None:
+    def __init__(self, rng: np.random.Generator, name: str, index: int = 0) -> None:
         self.rng = rng
         self.name = name
+        self.even = index % 2 == 0     # alternates a family's two kinds (door, seat, ...)
         self.half = np.array([rng.uniform(2.4, 3.0), rng.uniform(2.4, 3.0)])
         self.obstacles: dict[str, tuple[str, list[tuple[np.ndarray, np.ndarray]]]] = {}
         self.objects: dict[str, dict] = {}
@@ -252,7 +255,7 @@ def _chamber(lay: _Layout) -> None:
     if h_in > oh + 0.005:                                                    # header
         lay.solid("cnc", "steelblue", ([xf, ym - ow / 2, ob + oh], [xf + _WALL, ym + ow / 2, top]))
     s = 1 if lay.rng.random() < 0.5 else -1
-    if lay.rng.random() < 0.5:                       # hinged door, swung open 90 degrees
+    if lay.even:                                     # hinged door, swung open 90 degrees
         y = ym + s * (wo + 0.015)
         lay.solid("cnc", "steelblue", ([xf - ow - 0.1, y - 0.015, ob], [xf, y + 0.015, ob + oh]))
     else:                                            # sliding door parked beside the opening
@@ -342,7 +345,7 @@ def _boards(lay: _Layout) -> None:
 def _desk(lay: _Layout) -> None:
     """A desk for seated or standing work with a bin, a jig, a riser and a small tray."""
     u, hx = lay.u, lay.half[0]
-    seated = lay.rng.random() < 0.5
+    seated = lay.even
     dd, dw, yd = u(0.7, 0.8), u(1.2, 1.6), u(-0.6, 0.6)
     top = u(0.70, 0.76) if seated else u(0.9, 1.0)
     xw = hx - 0.02
@@ -435,7 +438,7 @@ def _aisle(lay: _Layout) -> None:
     aw, rd, ya = u(0.8, 1.0), u(0.4, 0.5), u(-0.3, 0.3)
     x0 = u(0.9, 1.3)
     x1 = x0 + u(1.6, 2.2)
-    lay.half[0] = x1 + (0.02 if lay.rng.random() < 0.5 else u(1.0, 1.3))   # a dead end or not
+    lay.half[0] = x1 + (0.02 if lay.even else u(1.0, 1.3))     # a dead end or open
     ztop = u(2.3, 2.45)
     names = []
     for side, rack in ((1, "rack_left"), (-1, "rack_right")):
@@ -478,7 +481,7 @@ def _twohanded(lay: _Layout) -> None:
     cw, cd, ch = u(0.3, 0.45), u(0.25, 0.35), u(0.2, 0.35)
     xw = hx - 0.02
     yc = u(-0.8, 0.8)
-    if lay.rng.random() < 0.5:
+    if lay.even:
         base = 0.14
         lay.solid("pallet", "burlywood", ([xw - 0.8, yc - 0.6, 0.0], [xw, yc + 0.6, base]))
     else:
@@ -519,7 +522,7 @@ def build_cell(family: str, seed: int = 0, index: int = 0) -> UnseenCell:
     rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, int(index),
                                  FAMILIES.index(family) + 1000])
     name = f"unseen_{family}_{seed}_{index}"
-    lay = _Layout(rng, name)
+    lay = _Layout(rng, name, index)
     _BUILDERS[family](lay)
     cell, openings = _emit(lay, int(rng.integers(4)))
     text = yaml.safe_dump(cell, sort_keys=False, default_flow_style=None)
