@@ -144,7 +144,10 @@ def run(args: argparse.Namespace) -> int:
                      for mode, r in runs.items()]
             line += f"  -> {args.out / 'coexistence'} ({'; '.join(parts)})"
         elif name == "study" and res["ok"]:
-            counts = ", ".join(f"{k}: {n} motions" for k, n in res["motions"].items())
+            counts = ", ".join(f"{k}: {n} motions" + (f" ({res['failed'][k]} failed: "
+                                                         "the report says why)"
+                                                         if res["failed"].get(k) else "")
+                               for k, n in res["motions"].items())
             line += (f"  -> {res['html']} ({counts}; {len(res['comparison'])} figure(s) "
                      "differ)")
         elif not res["ok"]:
