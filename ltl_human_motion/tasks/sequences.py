@@ -360,6 +360,7 @@ def plan_sequences(spec: str | Specification, cell: object, n: int | None = 5, s
         _coverage(search, emit, want)
     stats.search_seconds += time.perf_counter() - t0
     stats.automaton_seconds = stats._automaton_time()
+    stats._views.clear()                    # the searches' automata are not kept alive
     stats.search_seconds = max(stats.search_seconds - stats.automaton_seconds, 0.0)
     return emit.out[:want], stats
 
