@@ -21,7 +21,8 @@ setup(
         ("share/ament_index/resource_index/packages", [f"resource/{package_name}"]),
         (f"share/{package_name}", ["package.xml"]),
     ],
-    install_requires=["numpy>=1.24", "scipy>=1.10", "PyYAML>=6", "trimesh>=4"],
+    install_requires=["numpy>=1.24", "scipy>=1.10", "PyYAML>=6", "trimesh>=4",
+                      "pin>=3.0", "pin-pink>=3.4", "qpsolvers[daqp]>=4.0"],
     extras_require={
         "collision": ["python-fcl>=0.7"],
         "fast": ["numba>=0.60"],

@@ -15,6 +15,7 @@ import functools
 import math
 from collections.abc import Callable
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -59,6 +60,15 @@ from ltl_human_motion.vocabulary import HAND_TASKS
 WAIT_EXTRA_FRAMES = 6
 #: How long a seated wait without a duration lasts, seconds (the wait model's default).
 SEATED_WAIT_SECONDS = 2.0
+
+if TYPE_CHECKING:
+    from ltl_human_motion.motion.goals.kinematics import HeldPart
+
+#: Blocked goal primitives of a step that the whole-body program remakes, at most.
+WHOLE_BODY_TRIES = 1
+#: Whole-body programs one plan runs at most (about 0.3 s each): a step that every
+#: placement blocks would otherwise run one per placement.
+WHOLE_BODY_BUDGET = 6
 
 #: Seeded primitives tried at each alternative (release place, approach) after the first
 #: (the first gets ``PlannerOptions.goal_attempts``).
@@ -175,6 +185,7 @@ class GoalSteps:
         self.state = state
         self.executor = executor
         self.goals = goals
+        self.programs_left = WHOLE_BODY_BUDGET
 
     def where(self, name: str) -> np.ndarray:
         """Where part ``name`` rests now (3,) (:func:`.plan_state.object_position`)."""
@@ -242,6 +253,8 @@ class GoalSteps:
                 other = OTHER_HAND.get(candidate.meta.get("hand"))
                 if other:
                     kwargs["hand"], switched = other, candidate.meta.get("hand")
+        if mp is None and blocked and self.ctx.options.whole_body:
+            mp = self.whole_body(blocked, kind, grasped, part, container)
         if mp is None:
             raise self.refusal(text, kind, attempts, blocked, grasped, (kept_in, self_hits),
                                part, container)
@@ -739,6 +752,72 @@ class GoalSteps:
         least = min(found, key=lambda c: c.depth)
         return f"closest try: {least.describe(self.ctx.library.fps)}"
 
+    def whole_body(self, blocked: list[MotionPrimitive], kind: str, grasped: str | None,
+                   part: str | None, container: str | None) -> MotionPrimitive | None:
+        """The first of ``blocked`` (hand goal primitives that met an obstacle) that the
+        whole-body program (:mod:`.constrained_goals`) remakes clear of every obstacle,
+        still reaching the target and passing the checks of :meth:`segment`; None if
+        none does."""
+        from ltl_human_motion.planning.constrained_goals import constrained_primitive
+        for candidate in blocked[:WHOLE_BODY_TRIES]:
+            if candidate.meta.get("hand") in (None, "none") or self.programs_left <= 0 \
+                    or not self.palm_clear(candidate):
+                continue
+            self.programs_left -= 1
+            held, held_from = self.held_part(candidate, kind, grasped, part)
+            made, _, _ = constrained_primitive(candidate, self.ctx.cell.part_set,
+                                            self.state.pose, self.ctx.stature, held, held_from)
+            if made is None or not self.goal_clear(made, grasped):
+                continue
+            if self.ctx.options.refuse_self_penetration and not body_sound(made, kind,
+                                                                          self.ctx.stature):
+                continue
+            if kind == "extract" and part is not None and container is not None \
+                    and not self.pulls_out(made, part, container):
+                continue
+            return made
+        return None
+
+    def palm_clear(self, mp: MotionPrimitive) -> bool:
+        """Whether the acting palms of goal primitive ``mp`` keep clear of the obstacles
+        where the task holds them (contact and hold frames): the whole-body program
+        tracks them there, so it cannot help where they are inside an obstacle."""
+        from ltl_human_motion.scene.occupancy import capsules_from_positions
+        frames = sorted({int(mp.meta.get("contact_frame", 0)),
+                         *(int(f) for f in mp.meta.get("hold_frames", []))})
+        world = world_positions(mp, *self.state.pose, frames=np.array(frames))
+        hand = mp.meta.get("hand")
+        palms = ("l_palm", "r_palm") if hand == "both" else (f"{hand[0]}_palm",)
+        seg, rad = capsules_from_positions(world, self.ctx.stature, palms)
+        return bool(np.all(self.ctx.cell.part_set.capsule_clearance(seg, rad) > 0.0))
+
+    def held_part(self, mp: MotionPrimitive, kind: str, grasped: str | None,
+                  part: str | None) -> tuple[HeldPart | None, int]:
+        """The part the acting hand of ``mp`` carries, as the whole-body program keeps it
+        clear (edges relative to the hand joint, start frame), and the frame from which
+        it is carried: a held part from the start, the part being grasped or extracted
+        from the frame the hand lifts it; (None, 0) for an empty hand."""
+        from ltl_human_motion.motion.goals.kinematics import HeldPart
+        taken = grasped if grasped is not None else part if kind == "extract" else None
+        name = taken if taken is not None else part if part in self.state.held else None
+        if name is None:
+            return None, 0
+        joint = holding_joint(mp.meta.get("hand"))
+        hand = world_positions(mp, *self.state.pose)[:, JOINT_INDEX[joint]]
+        if taken is not None:
+            contact = int(mp.meta.get("contact_frame", 0))
+            start, at = lift_frame(mp, hand), hand[contact]
+        else:
+            start, at = 0, hand[0]
+        obj = self.ctx.cell.objects[name]
+        lo, hi = obj.shape.aabb()
+        centre = self.where(name) + (lo + hi) / 2 - obj.position - at
+        yaw = float(self.state.pose[2])
+        c, s = math.cos(yaw), math.sin(yaw)
+        to_local = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+        return HeldPart.box(JOINT_INDEX[joint], to_local @ centre, (hi - lo) / 2,
+                            rotation=to_local), start
+
     def goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
         """Whether the body, the objects already in the hands and the part being grasped
         (``grasped``, from the frame the hand lifts it, :func:`lift_frame`) keep clear of
@@ -758,3 +837,13 @@ class GoalSteps:
         # The part rests on its support until the hand lifts it; carried from then on.
         centre = hand[lift:] + (self.where(grasped) - hand[contact])
         return not np.any(object_collides(self.ctx.cell, grasped, centre))
+
+
+def body_sound(mp: MotionPrimitive, kind: str, stature: float) -> bool:
+    """Whether goal primitive ``mp`` of task ``kind`` passes the verifier's biomechanical
+    checks on its own (speeds, ranges of motion, self-penetration, balance, planted
+    feet)."""
+    from ltl_human_motion.planning.biomechanics import check_biomechanics
+    world = world_positions(mp)
+    checks = check_biomechanics(world, mp.fps, stature=stature, labels=[kind] * len(world))
+    return all(entry["passed"] for entry in checks.values())

@@ -124,6 +124,11 @@ class PlannerOptions:
         Take a goal primitive that takes a limb through the body (the biomechanical
         self-penetration check) as blocked, so that other placements are tried.
         Synthesis sets it from ``VerificationOptions.biomechanics``.
+    whole_body : bool
+        Where every seeded goal primitive of a hand task meets an obstacle, remake the
+        first of them with the whole-body program (clearance, range of motion and
+        planted feet as constraints of every frame; :mod:`.constrained_goals`) before
+        other placements are tried.
     """
 
     heuristic_speed: float = SearchOptions.heuristic_speed
@@ -140,6 +145,7 @@ class PlannerOptions:
     max_step_back: float = 0.35
     grid_resolution: float = 0.05
     refuse_self_penetration: bool = True
+    whole_body: bool = True
 
     @property
     def search(self) -> SearchOptions:

@@ -88,6 +88,13 @@ class PartSet:
                 out[sel] = self.parts[k]._exact_capsule_clearance(seg, radii[sel])
         return out
 
+    def exact_pairs(self, a: np.ndarray, b: np.ndarray, radii: np.ndarray,
+                    part: np.ndarray) -> np.ndarray:
+        """Exact clearance (N,) of capsules ``[a, b]`` (N, 3), (N, 3) with radii (N,) to
+        one part each, indices (N,)."""
+        return self._exact(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64),
+                           np.asarray(radii, dtype=np.float64), np.asarray(part))
+
     def _refine(self, a: np.ndarray, b: np.ndarray, radii: np.ndarray, part: np.ndarray,
                 exact_below: float) -> np.ndarray:
         """Clearance of capsules (N,) to one part each: bound, exact below ``exact_below``."""

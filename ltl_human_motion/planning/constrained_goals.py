@@ -1,0 +1,150 @@
+"""Goal motions from the whole-body program where the hand-shaped model's motion meets
+an obstacle.
+
+:func:`constrained_primitive` takes a goal primitive whose body, or part in hand,
+comes into an obstacle, as the reference the worker's kinematic model tracks under
+clearance, range-of-motion, speed and planted-feet constraints
+(:func:`ltl_human_motion.motion.goals.optimizer.track_reference`), and returns the tracked
+motion where it still reaches the task's target at contact.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ltl_human_motion.motion.goals.kinematics import HeldPart
+from ltl_human_motion.motion.goals.optimizer import (
+    TrackingResult,
+    WholeBodyOptions,
+    track_reference,
+)
+from ltl_human_motion.motion.skeleton import JOINT_INDEX
+from ltl_human_motion.motion.types import MotionPrimitive, world_positions
+from ltl_human_motion.scene.clearance import PartSet
+
+__all__ = ["CONTACT_TOLERANCE", "PartSetField", "constrained_primitive"]
+
+#: How far (m) the tracked palm may be from the reference's at the contact and hold
+#: frames for the motion to still do the task (the termination tests of Table I allow
+#: about a centimetre).
+CONTACT_TOLERANCE = 0.008
+
+
+#: How far (m) any joint of the program's last frame may be from the reference's before
+#: it is faded out (:func:`~ltl_human_motion.motion.goals.optimizer.track_reference`; the
+#: bones stretch by as much, as in the goal models' own end blends).
+END_TOLERANCE = 0.01
+
+
+@dataclass(frozen=True)
+class PartSetField:
+    """A cell's obstacle parts seen from a worker's start frame: floor pose (x, y, yaw)
+    ``pose``; implements :class:`~ltl_human_motion.motion.goals.optimizer.ObstacleField`."""
+
+    parts: PartSet
+    pose: tuple[float, float, float]
+
+    def _world(self, p: np.ndarray) -> np.ndarray:
+        x, y, yaw = self.pose
+        c, s = math.cos(yaw), math.sin(yaw)
+        out = np.empty_like(p)
+        out[:, 0] = c * p[:, 0] - s * p[:, 1] + x
+        out[:, 1] = s * p[:, 0] + c * p[:, 1] + y
+        out[:, 2] = p[:, 2]
+        return out
+
+    def near(self, a: np.ndarray, b: np.ndarray, radii: np.ndarray, within: float
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(capsule, part, clearance) of every pair nearer than ``within``, (M,) each."""
+        seg = np.stack([self._world(a), self._world(b)], axis=1)
+        clear = self.parts.pair_clearance(seg, radii, exact_below=within)
+        cap, part = np.nonzero(clear < within)
+        return cap, part, clear[cap, part]
+
+    def exact(self, a: np.ndarray, b: np.ndarray, radii: np.ndarray, part: np.ndarray
+              ) -> np.ndarray:
+        """Exact clearance (M,) of capsules (M, 3), (M, 3) to one part each (M,)."""
+        return self.parts.exact_pairs(self._world(a), self._world(b), radii, part)
+
+
+#: Fraction of the verifier's joint speed limits the program keeps to (its per-axis
+#: bound lets a speed reach 1.22 times the value given).
+SPEED_ROOM = 0.75
+#: How far (m) beyond the verifier's self-penetration threshold the program keeps the
+#: body's own capsule pairs.
+SELF_MARGIN = 0.01
+
+
+@dataclass(frozen=True)
+class BodyPairs:
+    """The verifier's self-penetration pairs (:mod:`.biomechanics`) as the program keeps
+    them apart (:class:`~ltl_human_motion.motion.goals.constraints.SelfPairs`)."""
+
+    ends_a: np.ndarray
+    ends_b: np.ndarray
+    least: np.ndarray
+
+
+def program_options(kind: str, stature: float) -> WholeBodyOptions:
+    """The whole-body program's options for goal task ``kind``: the verifier's joint speed
+    limits (with :data:`SPEED_ROOM`) and self-penetration pairs (with
+    :data:`SELF_MARGIN`) for a worker of ``stature``."""
+    from ltl_human_motion.planning.biomechanics import (
+        _PAIR_CAPSULES,
+        _PAIR_ENDS,
+        BiomechanicsLimits,
+        _speed_limits,
+    )
+    from ltl_human_motion.scene.occupancy import capsule_radii
+    limits = BiomechanicsLimits()
+    speeds = _speed_limits(1, [kind], limits, stature / limits.reference_stature)[0]
+    r = capsule_radii(stature)
+    a, b = _PAIR_CAPSULES
+    pairs = BodyPairs(_PAIR_ENDS[0], _PAIR_ENDS[1], np.maximum(r[a], r[b]) + SELF_MARGIN)
+    return WholeBodyOptions(speed_limits=tuple(float(v) * SPEED_ROOM for v in speeds),
+                            self_pairs=pairs)
+
+
+def _primitive(mp: MotionPrimitive, world: np.ndarray) -> MotionPrimitive:
+    """``mp`` with start-frame joint positions ``world`` (T, J, 3) (goal primitives keep
+    their heading: yaw 0 throughout)."""
+    root = np.zeros((len(world), 4))
+    root[:, :3] = world[:, 0]
+    root[:, :2] -= world[0, 0, :2]
+    meta = dict(mp.meta)
+    meta["whole_body"] = True
+    return MotionPrimitive(name=mp.name + "_wb", task=mp.task, poses=world - world[:, :1],
+                           root=root, fps=mp.fps, source=mp.source + " + whole-body program",
+                           meta=meta)
+
+
+def constrained_primitive(mp: MotionPrimitive, parts: PartSet,
+                          pose: tuple[float, float, float], stature: float,
+                          held: HeldPart | None = None, held_from: int = 0
+                          ) -> tuple[MotionPrimitive | None, float, TrackingResult]:
+    """The goal primitive ``mp`` (started at floor pose ``pose``) remade by the whole-body
+    program among the obstacle ``parts``: the primitive, or None where the tracked palm
+    misses the reference's by more than :data:`CONTACT_TOLERANCE` at the contact or hold
+    frames, an obstacle is still within 0 or the end cannot be faded in; that miss (m);
+    the program's result."""
+    if mp.meta.get("hand") in (None, "none") or float(mp.meta.get("yaw_span", 0.0)) != 0.0 \
+            or np.any(mp.root[:, 3] != 0.0):
+        raise ValueError(f"{mp.name}: the whole-body program remakes hand goal primitives")
+    ref = world_positions(mp)
+    tracked = ("l_hand", "r_hand") if mp.meta["hand"] == "both" else (mp.meta["hand"],)
+    hold = [int(f) for f in mp.meta.get("hold_frames", [])] \
+        + [int(mp.meta.get("contact_frame", len(ref) - 1))]
+    result = track_reference(ref, stature, PartSetField(parts, tuple(map(float, pose))),
+                             tracked=tracked, fps=mp.fps, held=held, held_from=held_from,
+                             release_from=max(hold),
+                             options=program_options(mp.task, stature))
+    miss = max(float(np.linalg.norm(result.positions[f, JOINT_INDEX[j]]
+                                     - ref[f, JOINT_INDEX[j]]))
+               for f in hold for j in tracked)
+    if miss > CONTACT_TOLERANCE or result.least_clearance < 0.0 \
+            or result.end_miss > END_TOLERANCE:
+        return None, miss, result
+    return _primitive(mp, result.positions), miss, result

@@ -1,0 +1,118 @@
+"""The whole-body program: constraints hold on every frame the verifier checks."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ltl_human_motion.motion.goals import make_goal_primitive, reach_placement
+from ltl_human_motion.motion.goals.kinematics import body_kinematics
+from ltl_human_motion.motion.goals.optimizer import track_reference
+from ltl_human_motion.motion.skeleton import JOINT_INDEX, PARENTS, Skeleton
+from ltl_human_motion.motion.types import world_positions
+from ltl_human_motion.planning.constrained_goals import (
+    CONTACT_TOLERANCE,
+    END_TOLERANCE,
+    PartSetField,
+    constrained_primitive,
+)
+from ltl_human_motion.scene.clearance import PartSet
+from ltl_human_motion.scene.occupancy import capsules_from_positions
+from ltl_human_motion.scene.shapes import Box
+
+STATURE = 1.55
+_FEET = [JOINT_INDEX[j] for j in ("l_ankle", "l_toe", "r_ankle", "r_toe")]
+
+
+@pytest.fixture(scope="module")
+def reach():
+    """A 1.55 m worker's right-hand grasp of a part at 1.45 m (start frame)."""
+    skeleton = Skeleton(STATURE)
+    d, lat = reach_placement("grasp", 1.45, skeleton)
+    mp = make_goal_primitive("grasp", np.array([d, lat, 1.45]), skeleton,
+                             rng=np.random.default_rng(0), hand="r_hand")
+    return mp, world_positions(mp)
+
+
+def _clearance(positions: np.ndarray, parts: PartSet) -> np.ndarray:
+    """Least clearance of every frame's body capsules (T, J, 3) to ``parts``, exact."""
+    seg, rad = capsules_from_positions(positions, STATURE)
+    return parts.body_clearance(seg, rad, exact_below=np.inf)
+
+
+def _bone_lengths(positions: np.ndarray) -> np.ndarray:
+    child = np.arange(1, positions.shape[1])
+    return np.linalg.norm(positions[:, child] - positions[:, np.array(PARENTS[1:])], axis=-1)
+
+
+def test_configurations_reproduce_the_motion(reach):
+    _, ref = reach
+    kin = body_kinematics(STATURE)
+    q = kin.configurations(ref[::20])
+    back = np.array([kin.positions(x) for x in q])
+    assert np.abs(back - ref[::20]).max() < 1e-6
+
+
+def test_motion_far_from_obstacles_is_the_reference(reach):
+    _, ref = reach
+    far = PartSet([Box.from_bounds(np.array([3.0, 3.0, 0.0]), np.array([3.5, 3.5, 1.0]))])
+    result = track_reference(ref, STATURE, PartSetField(far, (0.0, 0.0, 0.0)),
+                             tracked=("r_hand",), fps=120.0)
+    assert not result.constrained
+    assert np.array_equal(result.positions, ref)
+
+
+def test_upper_arm_under_a_board_keeps_clear_and_reaches(reach):
+    """A board 5.5 cm above the elbow at contact: the reference's upper arm enters it by
+    about 4 cm; the program keeps every capsule clear on every frame, reaches the
+    target, keeps the feet planted and the bones their length."""
+    mp, ref = reach
+    contact = int(mp.meta["contact_frame"])
+    elbow = ref[contact, JOINT_INDEX["r_elbow"]]
+    board = PartSet([Box.from_bounds(np.array([elbow[0] - 0.1, -0.6, elbow[2] + 0.055]),
+                                     np.array([elbow[0] + 0.1, 0.0, elbow[2] + 0.09]))])
+    assert _clearance(ref, board).min() < -0.02
+    made, miss, result = constrained_primitive(mp, board, (0.0, 0.0, 0.0), STATURE)
+    assert made is not None, (miss, result.end_miss, result.least_clearance)
+    out = world_positions(made)
+    assert _clearance(out, board).min() >= 0.0
+    hand = JOINT_INDEX["r_hand"]
+    assert np.linalg.norm(out[contact, hand] - ref[contact, hand]) <= CONTACT_TOLERANCE
+    assert np.abs(out[:, _FEET] - ref[:, _FEET]).max() < 1e-3
+    assert np.abs(_bone_lengths(out) - _bone_lengths(ref)).max() < END_TOLERANCE
+    speed = np.linalg.norm(np.diff(out, axis=0), axis=-1).max() * made.fps
+    assert speed < 2.5
+
+
+def test_world_pose_is_the_start_frame_turned(reach):
+    """The same board seen from a worker standing at (2, 1) turned by 90 degrees."""
+    mp, ref = reach
+    contact = int(mp.meta["contact_frame"])
+    elbow = ref[contact, JOINT_INDEX["r_elbow"]]
+    lo = np.array([elbow[0] - 0.1, -0.6, elbow[2] + 0.055])
+    hi = np.array([elbow[0] + 0.1, 0.0, elbow[2] + 0.09])
+    # start-frame (x, y) -> world (2 - y, 1 + x)
+    world = Box.from_bounds(np.array([2.0 - hi[1], 1.0 + lo[0], lo[2]]),
+                            np.array([2.0 - lo[1], 1.0 + hi[0], hi[2]]))
+    made, _, _ = constrained_primitive(mp, PartSet([world]), (2.0, 1.0, np.pi / 2),
+                                       STATURE)
+    assert made is not None
+    placed = world_positions(made, 2.0, 1.0, np.pi / 2)
+    assert _clearance(placed, PartSet([world])).min() >= 0.0
+
+
+def test_a_hand_path_through_a_board_is_never_returned_colliding(reach):
+    """A board between the palm and its target: the program either keeps the body clear
+    and still reaches (it does not here) or the motion is refused; a colliding motion
+    is never returned."""
+    mp, ref = reach
+    contact = int(mp.meta["contact_frame"])
+    hand = ref[contact, JOINT_INDEX["r_hand"]]
+    board = PartSet([Box.from_bounds(np.array([hand[0] - 0.15, -0.6, hand[2] - 0.10]),
+                                     np.array([hand[0] + 0.3, 0.4, hand[2] - 0.07]))])
+    made, miss, result = constrained_primitive(mp, board, (0.0, 0.0, 0.0), STATURE)
+    if made is None:
+        assert miss > CONTACT_TOLERANCE or result.least_clearance < 0 \
+            or result.end_miss > END_TOLERANCE
+    else:
+        assert _clearance(world_positions(made), board).min() >= 0.0
