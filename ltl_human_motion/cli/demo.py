@@ -75,8 +75,8 @@ def _ros(args: argparse.Namespace) -> dict:
     if missed:
         load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
         summary["warning"] = (
-            f"the occupancy stream missed {missed} of its 10 ms deadlines (those messages "
-            f"were skipped; worst {summary.get('occupancy_worst_late_ms', 0.0):.1f} ms late): "
+            f"the occupancy stream missed {missed} of its 10 ms deadlines (messages late or "
+            f"skipped; worst {summary.get('occupancy_worst_late_ms', 0.0):.1f} ms late): "
             "a robot reading it would have seen stale occupancy; the stream's thread did not "
             f"get a core in time (load average {load:.1f} on {os.cpu_count()} cores)")
     return {"ok": bool(summary.get("success")), **summary}
