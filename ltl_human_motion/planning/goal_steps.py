@@ -804,14 +804,14 @@ class GoalSteps:
             return None, 0
         joint = holding_joint(mp.meta.get("hand"))
         hand = world_positions(mp, *self.state.pose)[:, JOINT_INDEX[joint]]
-        if taken is not None:
-            contact = int(mp.meta.get("contact_frame", 0))
-            start, at = lift_frame(mp, hand), hand[contact]
-        else:
-            start, at = 0, hand[0]
         obj = self.ctx.cell.objects[name]
         lo, hi = obj.shape.aabb()
-        centre = self.where(name) + (lo + hi) / 2 - obj.position - at
+        if taken is not None:
+            contact = int(mp.meta.get("contact_frame", 0))
+            start, offset = lift_frame(mp, hand), self.where(name) - hand[contact]
+        else:
+            start, offset = 0, self.state.held_offset(name)
+        centre = offset + (lo + hi) / 2 - obj.position
         yaw = float(self.state.pose[2])
         c, s = math.cos(yaw), math.sin(yaw)
         to_local = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
