@@ -28,7 +28,12 @@ from ltl_human_motion.batch.specs import (
     load_specs,
     specs_from_yaml,
 )
-from ltl_human_motion.batch.store import DATASET_FORMAT, DATASET_VERSION, DatasetStore
+from ltl_human_motion.batch.store import (
+    DATASET_FORMAT,
+    DATASET_VERSION,
+    BatchOutputError,
+    DatasetStore,
+)
 from ltl_human_motion.batch.worker import (
     ARRAY_NAMES,
     BatchJob,
@@ -43,6 +48,7 @@ __all__ = [
     "DATASET_VERSION",
     "BatchConfigError",
     "BatchJob",
+    "BatchOutputError",
     "BatchSpecs",
     "BatchSummary",
     "CorruptDatasetError",

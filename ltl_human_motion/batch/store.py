@@ -32,30 +32,62 @@ CPU times, worker: the only part that differs between runs).
 
 from __future__ import annotations
 
+import errno
+import functools
 import hashlib
 import io
 import json
 import os
 import re
 import zipfile
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
 from ltl_human_motion.atomic import atomic_write_bytes, atomic_write_text
 from ltl_human_motion.batch.specs import BatchConfigError
 from ltl_human_motion.batch.worker import ARRAY_NAMES, ItemResult
+from ltl_human_motion.errors import LtlHumanMotionError
 
-__all__ = ["DATASET_FORMAT", "DATASET_VERSION", "DatasetStore", "npz_bytes_of",
-           "shard_name"]
+__all__ = ["DATASET_FORMAT", "DATASET_VERSION", "BatchOutputError", "DatasetStore",
+           "npz_bytes_of", "shard_name"]
 
 DATASET_FORMAT = "ltl_human_motion.motion_dataset"
 DATASET_VERSION = 1
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 _ITEM_FILE = re.compile(r"^item-(\d{10})\.npz$")
 _SHARD_JSON = re.compile(r"^shard-(\d{6})\.json$")
+
+
+class BatchOutputError(LtlHumanMotionError):
+    """The dataset folder cannot be written (missing, read-only, disk full); the message
+    names the folder and the cause. What was written before stays: a rerun finishes."""
+
+
+_FULL = (errno.ENOSPC, errno.EDQUOT)
+_NOT_WRITABLE = (errno.EROFS, errno.EACCES, errno.EPERM)
+_T = TypeVar("_T")
+
+
+def _output_errors(method: Callable[..., _T]) -> Callable[..., _T]:
+    """Turn an OSError of a :class:`DatasetStore` method into a BatchOutputError."""
+    @functools.wraps(method)
+    def wrapper(self: DatasetStore, *args: Any, **kwargs: Any) -> _T:
+        try:
+            return method(self, *args, **kwargs)
+        except OSError as exc:
+            cause = exc.strerror or type(exc).__name__
+            if exc.errno in _FULL:
+                hint = "; free some space and run the same command again to finish"
+            elif exc.errno in _NOT_WRITABLE:
+                hint = "; choose a folder you can write to"
+            else:
+                hint = ""
+            raise BatchOutputError(f"cannot write the dataset to {self.root} ({cause}){hint}"
+                                   ) from None
+    return wrapper
 
 
 def shard_name(shard: int) -> str:
@@ -117,6 +149,7 @@ class DatasetStore:
     def header_path(self) -> Path:
         return self.root / "dataset.json"
 
+    @_output_errors
     def _open(self) -> None:
         if self.header_path.is_file():
             try:
@@ -211,6 +244,7 @@ class DatasetStore:
                 out.add(int(m.group(1)))
         return out
 
+    @_output_errors
     def recover(self) -> set[int]:
         """Finish what a killed run left half done; return the indices already done."""
         committed = self.committed_shards()
@@ -227,6 +261,7 @@ class DatasetStore:
         return done | {i for i in staged if self.shard_of(i) not in committed}
 
     # ------------------------------------------------------------------ writing
+    @_output_errors
     def stage(self, result: ItemResult) -> None:
         """Write one finished item atomically."""
         text = json.dumps({"record": result.record, "timing": result.timing}, sort_keys=True,
@@ -251,6 +286,7 @@ class DatasetStore:
     def shard_complete(self, shard: int, staged: set[int]) -> bool:
         return all(i in staged for i in self.shard_range(shard))
 
+    @_output_errors
     def pack(self, shard: int) -> None:
         """Write shard ``shard`` from its staged items, commit it, remove the staged files."""
         stem = shard_name(shard)
@@ -298,6 +334,7 @@ class DatasetStore:
         path = self.shards / f"{shard_name(shard)}.json"
         return json.loads(path.read_text(encoding="utf-8"))
 
+    @_output_errors
     def finalize(self) -> dict[str, Any]:
         """Write ``manifest.jsonl`` (sorted by index) and the completed header.
 
