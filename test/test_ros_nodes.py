@@ -154,27 +154,49 @@ def test_markers_show_body_objects_task_and_cell(client: ClientSession) -> None:
 
 def test_occupancy_streams_at_100_hz_with_prediction(node_set: Bringup,
                                                     client: ClientSession) -> None:
-    # The stream keeps its 10 ms schedule: over 2 s every slot is either published or
-    # counted as a missed deadline (a loaded machine misses some; how many is for
-    # bench/occupancy_stream.py to measure), and what was published arrives.
+    # The stream keeps its 10 ms schedule, judged by the node's own timing record (a
+    # subscriber in this loaded process loses messages of its own, issue 34): over 2 s
+    # every slot has a tick or was skipped, the ticks stay on the grid, most start within
+    # half a period of their slot, and the missed-deadline count is what the gaps between
+    # ticks show a subscriber (how many a loaded machine misses is for
+    # bench/occupancy_stream.py to measure). What was published arrives.
     occupancy = node_set.node("occupancy_node", "1")
+    period = 0.01
     start = client.occupancy.count
     published, missed = occupancy.messages_published, occupancy.deadlines_missed
     t0 = time.monotonic()
     time.sleep(2.0)
-    elapsed = time.monotonic() - t0
+    t1 = time.monotonic()
     published = occupancy.messages_published - published
-    slots = published + occupancy.deadlines_missed - missed
-    assert abs(slots - 100 * elapsed) <= 25, (       # a stall at either end: <= 0.25 s
-        f"{published} published + {slots - published} missed in {elapsed:.2f} s")
-    wait_until(lambda: client.occupancy.count - start >= 0.95 * published, 2.0,
+    missed = occupancy.deadlines_missed - missed
+    full = occupancy.stream_record()
+    inside = np.flatnonzero((full[:, 1] >= t0) & (full[:, 1] <= t1))
+    record = full[inside]
+    due, began = record[:, 0], record[:, 1]
+    steps = np.diff(due) / period
+    assert np.allclose(steps, np.round(steps), atol=1e-3) and np.all(steps >= 1 - 1e-3), \
+        "ticks off the 10 ms grid"
+    slots = round((due[-1] - due[0]) / period) + 1
+    assert abs(slots - 100 * (t1 - t0)) <= 25, (       # a stall at either end: <= 0.25 s
+        f"{len(record)} ticks, {slots - len(record)} slots skipped in {t1 - t0:.2f} s")
+    assert abs(published - len(record)) <= 2
+    late = began - due
+    assert np.all(late >= 0) and np.median(late) < period / 2, \
+        f"median start {np.median(late) * 1e3:.1f} ms after its slot"
+    # Deadlines a subscriber sees missed at each tick: a gap of 1.5 periods or more. The
+    # counter was read around the window, so a tick at either edge may or may not count.
+    per_tick = np.maximum(np.floor(np.diff(full[:, 1]) / period + 0.5) - 1, 0)
+    first, last = inside[0] - 1, inside[-1] - 1           # per_tick[i] is tick i + 1's
+    fewest = int(per_tick[first + 1:last].sum())
+    most = int(per_tick[max(first - 1, 0):last + 2].sum())
+    assert fewest <= missed <= most, \
+        f"counted {missed} missed deadlines, the gaps between ticks show {fewest}-{most}"
+    wait_until(lambda: client.occupancy.count - start >= 0.9 * published, 2.0,
                f"the {published} occupancy messages published")
     log = client.occupancy
     msgs = log.messages[-150:]
     stamps = np.array([m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in msgs])
-    periods = np.diff(stamps)
-    assert np.all(periods > 0), "stamps must increase"
-    assert abs(np.median(periods) - 0.01) < 0.002, f"median period {np.median(periods)}"
+    assert np.all(np.diff(stamps) > 0), "stamps must increase"
     last = msgs[-1]
     assert last.header.frame_id == "world" and last.human_id == "1"
     assert list(last.part_names) == list(BODY_PARTS)

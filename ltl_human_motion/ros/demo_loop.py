@@ -60,8 +60,8 @@ def run_ros_demo(spec: str, cell: str, out_dir: str | Path, duration: float | No
         ``synthesis_wall_time``, ``stats``, ``played_seconds``, ``received`` (per topic:
         count and rate as seen by the client), ``occupancy_rate_hz``, ``tf_frames``,
         ``markers_namespaces``, ``recorded`` (per topic: count and rate) and ``mcap``;
-        ``occupancy_messages``, ``occupancy_deadlines_missed`` (ticks skipped because the
-        stream started a period or more late) and ``occupancy_worst_late_ms``.
+        ``occupancy_messages``, ``occupancy_deadlines_missed`` (deadlines a subscriber
+        saw missed: gaps of 1.5 periods or more) and ``occupancy_worst_late_ms``.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -23,9 +23,11 @@ Timing: the stream runs on a :class:`~ltl_human_motion.ros.wall_schedule.WallSch
 thread (an absolute schedule on the monotonic clock, outside the executor, so other
 callbacks of the process cannot delay it and a late tick does not shift the ones after
 it). Capsule rows of every frame are computed once when a motion is loaded, so a message
-costs one interpolation and the CDR encoding. A tick that starts a period or more late
-counts as a missed deadline: ``deadlines_missed`` counts them and a warning (throttled to
-one per :data:`MISS_WARNING_PERIOD`) gives the count and the worst delay. On a loaded
+costs one interpolation and the CDR encoding. ``deadlines_missed`` counts the deadlines
+a subscriber sees missed (a skipped slot, or a message half a period or more late: see
+:mod:`~ltl_human_motion.ros.wall_schedule`) and a warning (throttled to one per
+:data:`MISS_WARNING_PERIOD`) gives the count and the worst delay;
+:meth:`OccupancyNode.stream_record` is the stream's own timing record. On a loaded
 machine the thread's wake-up can wait longer than a period for a CPU, so it asks for a
 real-time priority (``stream_priority``; refused without CAP_SYS_NICE or an ``rtprio``
 limit, and then logged). With
@@ -221,13 +223,21 @@ class OccupancyNode(Node):
         priority = self.param("stream_priority")
         return min(priority + 1, 99) if priority > 0 else 0
 
-    def _on_miss(self, skipped: int, late: float) -> None:
-        self.deadlines_missed += skipped
+    def _on_miss(self, missed: int, late: float) -> None:
+        self.deadlines_missed += missed
         self.worst_late = max(self.worst_late, late)
+        skipped = int(late * self.param("rate"))
         self.get_logger().warning(
             f"occupancy stream of human {self.human_id} missed {self.deadlines_missed} "
             f"deadline(s) so far (this tick {late * 1e3:.1f} ms late, "
             f"{skipped} message(s) skipped)", throttle_duration_sec=MISS_WARNING_PERIOD)
+
+    def stream_record(self) -> np.ndarray:
+        """The stream's recent ticks: array (n, 2) of each tick's slot (due time) and
+        start time, monotonic seconds (empty under ``use_sim_time``)."""
+        if self._schedule is None:
+            return np.zeros((0, 2))
+        return self._schedule.record()
 
     def _on_error(self, exc: BaseException) -> None:
         self.get_logger().error(f"occupancy tick failed: {type(exc).__name__}: {exc}",

@@ -2,8 +2,16 @@
 
 Tick ``k`` is due at ``t0 + k * period`` on ``time.monotonic()``: a late tick does not
 delay the ones after it (no drift, unlike sleeping a period after the work). A tick that
-starts one period or more late has missed its deadline; the slots it overran are skipped
-(the stream keeps its phase instead of bursting to catch up) and counted.
+starts one period or more late skips the slots it overran (the stream keeps its phase
+instead of bursting to catch up).
+
+Missed deadlines are counted as a subscriber expecting one message per period sees them
+(issue 34): a tick that starts ``gap`` >= 1.5 periods after the previous one misses
+``round(gap / period) - 1`` deadlines. Counting only the skipped slots hid the late
+ticks: on a loaded machine (2 cores, ``stress-ng --cpu 2``) a 15 s stream had 236 gaps of
+15 ms or more at a subscriber and 251 between the node's own ticks, while the skipped
+slots were fewer and the old count rose by a few. :meth:`WallSchedule.record` keeps each
+recent tick's slot and start time, the stream's own timing record.
 
 On a loaded machine the thread's wake-up can wait for a CPU longer than a period. With
 ``priority`` > 0 the thread asks for the real-time policy ``SCHED_FIFO`` at that priority
@@ -19,7 +27,19 @@ import math
 import os
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
+
+import numpy as np
+
+#: Ticks kept in :meth:`WallSchedule.record` (20 s at 100 Hz).
+RECORD_TICKS = 2000
+
+
+def missed_deadlines(gap: float, period: float) -> int:
+    """Deadlines a subscriber expecting one message per ``period`` misses when two come
+    ``gap`` seconds apart: ``round(gap / period) - 1`` from 1.5 periods on, else 0."""
+    return max(int(gap / period + 0.5) - 1, 0)
 
 
 class WallSchedule:
@@ -32,8 +52,9 @@ class WallSchedule:
     on_tick : callable
         The work of one tick; exceptions go to ``on_error`` (the schedule keeps going).
     on_miss : callable, optional
-        Called with ``(skipped, late)`` after a tick that was ``late`` seconds behind its
-        slot and so skipped ``skipped`` >= 1 slots.
+        Called with ``(missed, late)`` before a tick that missed ``missed`` >= 1
+        deadlines (see the module docstring); it started ``late`` seconds after its first
+        due slot.
     on_error : callable, optional
         Called with the exception of a failed tick (default: re-raise, ending the thread).
     name : str
@@ -53,8 +74,12 @@ class WallSchedule:
         self._reset = threading.Event()
         self._wake = threading.Event()
         self.ticks = 0
+        #: Deadlines missed as a subscriber sees them (see the module docstring).
         self.missed = 0
+        #: Slots without a tick.
+        self.skipped = 0
         self.max_late = 0.0
+        self._record: deque[tuple[float, float]] = deque(maxlen=RECORD_TICKS)
         self.priority = int(priority)
         self.realtime = False
         self.priority_error = ""
@@ -72,6 +97,11 @@ class WallSchedule:
     @property
     def period(self) -> float:
         return self._period
+
+    def record(self) -> np.ndarray:
+        """The recent ticks (at most :data:`RECORD_TICKS`), oldest first: array (n, 2) of
+        the slot each tick ran for (its due time) and its start time, monotonic seconds."""
+        return np.array(list(self._record), dtype=np.float64).reshape(-1, 2)
 
     def set_period(self, period: float) -> None:
         """Change the period; the new schedule starts one new period from now."""
@@ -94,6 +124,7 @@ class WallSchedule:
         self._set_priority()
         self._started.set()
         due = time.monotonic() + self._period
+        previous: float | None = None
         while not self._stop.is_set():
             delay = due - time.monotonic()
             if delay > 0:
@@ -104,18 +135,24 @@ class WallSchedule:
                 if self._reset.is_set():
                     self._reset.clear()
                     due = time.monotonic() + self._period
+                    previous = None
                     continue
                 if due - time.monotonic() > 0:
                     continue
-            late = time.monotonic() - due
+            start = time.monotonic()
+            late = start - due
             period = self._period
-            if late >= period:
-                skipped = int(late // period)
-                due += skipped * period
-                self.missed += skipped
-                self.max_late = max(self.max_late, late)
+            skipped = int(late // period)
+            due += skipped * period
+            missed = 0 if previous is None else missed_deadlines(start - previous, period)
+            previous = start
+            self._record.append((due, start))
+            self.skipped += skipped
+            self.max_late = max(self.max_late, late)
+            if missed:
+                self.missed += missed
                 if self._on_miss is not None:
-                    self._on_miss(skipped, late)
+                    self._on_miss(missed, late)
             try:
                 self._on_tick()
             except Exception as exc:
