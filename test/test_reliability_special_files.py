@@ -19,6 +19,7 @@ import pytest
 from ltl_human_motion.batch.specs import BatchConfigError, load_specs
 from ltl_human_motion.errors import CellError
 from ltl_human_motion.ltl.vocabulary import load_vocabulary
+from ltl_human_motion.robot.sim.trajectory import load_robot_config
 from ltl_human_motion.scene.cell import load_cell
 from ltl_human_motion.yaml_limits import MAX_YAML_BYTES, TextFileError, read_text_file
 
@@ -53,6 +54,8 @@ def test_every_loader_refuses_a_file_that_is_not_regular_at_once(
     with pytest.raises(BatchConfigError,
                        match=rf"^specs file {path} is not a regular file \({kind}\)$"):
         load_specs(path)
+    with pytest.raises(ValueError, match=rf"^robot config {path} is not a regular file"):
+        load_robot_config(path)
     assert time.monotonic() - started < 2.0
 
 

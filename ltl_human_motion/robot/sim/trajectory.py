@@ -163,10 +163,13 @@ def load_robot_config(path: str | Path | None) -> dict[str, Any]:
         return cfg
     import yaml
 
+    from ltl_human_motion.yaml_limits import read_text_file
+
     where = str(path)
+    text = read_text_file(path, "robot config")       # TextFileError, a ValueError
     try:
-        data = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
-    except (OSError, yaml.YAMLError) as exc:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
         raise ValueError(f"{where}: cannot read robot config: {exc}") from exc
     if not isinstance(data, Mapping):
         raise ValueError(f"{where}: expected a mapping at the top level")
