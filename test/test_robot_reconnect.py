@@ -23,6 +23,10 @@ pytest.importorskip("rtde_io")
 HOST = "127.0.0.1"
 PARAMS = SSMParameters()
 MIN = PARAMS.min_slider
+#: Worker's x (m): beyond S_p (1.06 m) of every pose of the simulator's pick-and-place
+#: cycle (at 1.9 m the home pose is 0.998 m away: "stop", and the test passed only when
+#: the arm had left home before it connected).
+FAR = 3.0
 
 
 @pytest.fixture
@@ -39,29 +43,29 @@ def test_dropped_connection_goes_to_minimum_and_reconnects(sim: URSimHandle) -> 
                                 config=config)
     new_sim = None
     try:
-        d = feed_and_step(ctl, human_at(1.9), steps=10)[-1]
+        d = feed_and_step(ctl, human_at(FAR), steps=10)[-1]
         assert d.connected and d.mode in ("reduced", "full")
         sim.kill()                                        # controller crash / cable pulled
         # Detected when the socket closes or robot data freeze for robot_stale_after
         # (0.5 s): wait in real time (bounded), not a number of steps, which a loaded
         # machine stretches or squeezes.
         deadline = time.monotonic() + 5.0
-        modes = [d.mode for d in feed_and_step(ctl, human_at(1.9), steps=40)]
+        modes = [d.mode for d in feed_and_step(ctl, human_at(FAR), steps=40)]
         while modes[-1] != "disconnected" and time.monotonic() < deadline:
-            modes = [d.mode for d in feed_and_step(ctl, human_at(1.9), steps=5)]
+            modes = [d.mode for d in feed_and_step(ctl, human_at(FAR), steps=5)]
         assert modes[-1] == "disconnected"
-        lost = [d for d in feed_and_step(ctl, human_at(1.9), steps=5)]
+        lost = [d for d in feed_and_step(ctl, human_at(FAR), steps=5)]
         assert all(x.slider == MIN and not x.connected for x in lost)
         new_sim = start_sim()                     # the controller comes back
         deadline = time.monotonic() + 5.0
         while time.monotonic() < deadline:
-            d = feed_and_step(ctl, human_at(1.9), steps=1)[0]
+            d = feed_and_step(ctl, human_at(FAR), steps=1)[0]
             if d.connected and d.mode != "disconnected":
                 break
         assert d.connected and d.mode in ("reduced", "full"), d
         assert ctl.reconnects == 2
         time.sleep(0.05)
-        d = feed_and_step(ctl, human_at(1.9), steps=1)[0]
+        d = feed_and_step(ctl, human_at(FAR), steps=1)[0]
         time.sleep(0.05)
         assert new_sim.status()["speed_slider"] == pytest.approx(d.slider, abs=0.05)
     finally:
