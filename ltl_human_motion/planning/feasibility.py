@@ -380,6 +380,23 @@ class _Checker:
                 f"parts only translate): {part} cannot be put in", task=task, reason="size")
         return None
 
+    def passage(self, task: str, part: str, target: str, is_region: bool
+                ) -> PlanningError | None:
+        """Can ``part`` be brought from where it lies into region or container
+        ``target`` at all, translating among the obstacles (:mod:`.passage`)?"""
+        from ltl_human_motion.planning.passage import can_pass
+        shape = self.cell.region(target).shape if is_region \
+            else self.cell.object(target).shape
+        lo, hi = shape.aabb()
+        if can_pass(self.cell, part, np.asarray(lo), np.asarray(hi)):
+            return None
+        lo_p, hi_p = self.cell.object(part).shape.aabb()
+        size = " x ".join(f"{v:.2f}" for v in np.asarray(hi_p) - np.asarray(lo_p))
+        return PlanningError(
+            f"task {task}: no way from where {part} lies into {target} is wide enough for "
+            f"it ({size} m; parts only translate): {task} can never hold", task=task,
+            reason="size")
+
     def seat(self, task: str, name: str) -> PlanningError | None:
         obj = self.cell.object(name)
         surface = obj.sitting_surface_at(obj.position)
@@ -443,9 +460,11 @@ def _problems(cell, steps: Sequence[tuple[str, Sequence[str]]], stature: float
             if task in ("carry", "move"):
                 found.append(check.fits(text, a[0], a[1], is_region=True))
                 found.append(check.region(text, a[1]))
+                found.append(check.passage(text, a[0], a[1], is_region=True))
             elif task == "insert":
                 found.append(check.fits(text, a[0], a[1], is_region=False))
                 found.append(check.part(text, a[1]))
+                found.append(check.passage(text, a[0], a[1], is_region=False))
             elif task in ("walk", "leftHand", "rightHand"):
                 found.append(check.region(text, a[0]))
             elif task == "sit":

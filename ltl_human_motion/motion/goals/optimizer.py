@@ -81,7 +81,7 @@ class WholeBodyOptions:
 
     margin: float = 0.02
     hand_margin: float = 0.01
-    part_margin: float = 0.006
+    part_margin: float = 0.004
     influence: float = 0.12
     damper: float = 0.3
     iterations: int = 1
