@@ -20,7 +20,7 @@ from ltl_human_motion.batch.specs import BatchConfigError, load_specs
 from ltl_human_motion.errors import CellError
 from ltl_human_motion.ltl.vocabulary import load_vocabulary
 from ltl_human_motion.robot.sim.trajectory import load_robot_config
-from ltl_human_motion.scene.cell import load_cell
+from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
 from ltl_human_motion.yaml_limits import MAX_YAML_BYTES, TextFileError, read_text_file
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -67,6 +67,15 @@ def test_a_file_beyond_the_byte_limit_is_refused_after_reading_the_limit(
     with pytest.raises(TextFileError, match="has more than 20,000,000 bytes"):
         read_text_file(path, "cell file")
     assert "start_region" in read_text_file(ROOT / "config" / "paper_cell.yaml", "cell file")
+
+
+def test_a_mesh_that_is_a_fifo_is_refused_without_reading(special: dict[str, tuple[Path, str]]
+                                                         ) -> None:
+    fifo, _ = special["fifo"]
+    text = (f"start_region: R0\nregions: {{R0: {{lo: [0, 0, 0], hi: [1, 1, 0.1]}}}}\n"
+            f"obstacles: {{part: {{mesh: {fifo}}}}}\n")
+    with pytest.raises(CellError, match=rf"mesh file {fifo} is not a regular file"):
+        cell_from_yaml(text, source="fifo_mesh.yaml")
 
 
 def test_a_missing_file_still_says_it_cannot_be_read(tmp_path: Path) -> None:

@@ -154,7 +154,8 @@ class _Parser:
         if not path.is_absolute():
             path = self.base_dir / path
         if not path.is_file():
-            raise self.error(key, f"mesh file not found: {path}")
+            raise self.error(key, f"mesh file {path} is not a regular file" if path.exists()
+                             else f"mesh file not found: {path}")
         import trimesh
         try:
             mesh = trimesh.load(str(path), force="mesh")
