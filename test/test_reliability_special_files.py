@@ -106,3 +106,19 @@ def test_the_commands_answer_in_one_line_naming_the_file(
     assert lines == [f"ltl-human-motion {args[0]}: error: {what} {path.name} is not a regular "
                      f"file ({kind})"], proc.stderr
     assert not (path.parent / "o").exists()
+
+
+@pytest.mark.parametrize("name", ["fifo", "zero", "missing"])
+def test_bringup_refuses_a_config_that_is_not_a_regular_file(
+        special: dict[str, tuple[Path, str]], name: str) -> None:
+    pytest.importorskip("rclpy")
+    if name == "missing":
+        path, cause = special["fifo"][0].parent / "nope.yaml", "does not exist"
+    else:
+        path, kind = special[name]
+        cause = f"is not a regular file ({kind})"
+    proc = _cli(["bringup", path.name], cwd=path.parent)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.strip().splitlines() == [
+        f"ltl-human-motion bringup: error: bringup configuration {path.name} {cause}"]
+

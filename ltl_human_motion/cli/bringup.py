@@ -87,11 +87,17 @@ def _run(args: argparse.Namespace, stop: _StopSignals) -> int:
         raise MissingDependencyError(
             f"bringup needs rclpy and the built interfaces ({exc}); run scripts/setup.sh "
             f"and source scripts/env.sh") from None
+    from ltl_human_motion.ros.bringup_config import load_bringup_config
     from ltl_human_motion.ros.entry_points import exit_without_final_collection
 
     exit_without_final_collection()
+    try:
+        config = load_bringup_config(args.config)
+    except (OSError, ValueError) as exc:           # missing, not a regular file, malformed
+        print(f"ltl-human-motion bringup: error: {exc}", file=sys.stderr)
+        return 2
     overrides = {"store_dir": str(args.store_dir)} if args.store_dir is not None else None
-    node_set = Bringup(args.config, record=args.record, overrides=overrides)
+    node_set = Bringup(config, record=args.record, overrides=overrides)
     stop.node_set = node_set
     if stop.requested:                       # a signal during start-up that was swallowed
         node_set.shutdown()

@@ -28,6 +28,7 @@ from typing import Any
 import yaml
 
 from ltl_human_motion.atomic import atomic_write_text
+from ltl_human_motion.yaml_limits import read_text_file
 
 PACKAGE = "ltl_human_motion"
 #: Node kinds a bringup can start, in start order.
@@ -149,10 +150,11 @@ def load_bringup_config(path: str | Path | None = None) -> BringupConfig:
         Naming the file and the key when the file is malformed.
     """
     path = Path(path) if path is not None else DEFAULT_CONFIG
-    if not path.is_file():
+    if not path.exists():
         raise FileNotFoundError(f"bringup configuration {path} does not exist")
+    text = read_text_file(path, "bringup configuration")   # TextFileError: a ValueError
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
         raise ValueError(f"{path}: not valid YAML: {exc}") from None
     if not isinstance(data, dict):
