@@ -17,6 +17,7 @@ from collections import Counter
 from pathlib import Path
 
 import pytest
+import yaml
 
 rclpy = pytest.importorskip("rclpy")
 
@@ -89,8 +90,15 @@ def test_bringup_records_the_node_set_atomically(tmp_path: Path) -> None:
         assert channel.message_encoding == "cdr" and schema.encoding == "ros2msg"
         assert "offered_qos_profiles" in channel.metadata
     assert channels["/tf"][1].name == "tf2_msgs/msg/TFMessage"
-    assert "durability: transient_local" in channels["/tf_static"][0].metadata[
-        "offered_qos_profiles"]
+    # Each channel keeps the QoS its publishers offer (as ``ros2 bag record`` does), so
+    # the latched topics -- the body's URDF among them -- replay latched.
+    durability = {topic: {p["durability"] for p in yaml.safe_load(
+        channel.metadata["offered_qos_profiles"])} for topic, (channel, _) in channels.items()}
+    latched = {t for t, d in durability.items() if d == {"transient_local"}}
+    assert latched == {"/tf_static", "/motion_catalog", "/humans/bodies/h1/urdf"}, durability
+    assert all(d == {"volatile"} for t, d in durability.items() if t not in latched)
+    urdf_text = next(m.data for t, m in decoded if t == "/humans/bodies/h1/urdf")
+    assert "<robot" in urdf_text and counts["/humans/bodies/h1/urdf"] == 1
     assert counts["/human_1/occupancy"] >= 100 and counts["/tf"] >= 20
     assert counts == Counter(bringup.recorder.counts)
     occupancy = next(m for t, m in decoded if t == "/human_1/occupancy")

@@ -74,11 +74,13 @@ class Bringup:
         self.mcap_path: Path | None = None
         try:
             if record is not None:
-                # First, so it is subscribed before the others publish anything.
-                self.recorder = Recorder(record, topics=self.config.topics(),
-                                         context=context)
+                # First, so it joins before the others publish anything; it subscribes
+                # each topic once its publisher exists, with the QoS that one offers.
+                self.recorder = Recorder(record, context=context)
             for spec in self.config.node_specs():
                 self.nodes.append(self._make(spec, synthesize_fn))
+            if self.recorder is not None:
+                self.recorder.follow(self.config.topics())
             if any(isinstance(n, OccupancyNode) for n in self.nodes):
                 # The occupancy stream thread waits less for the GIL, and what exists now
                 # stays out of the collector's full passes (which hold the GIL).

@@ -3,10 +3,12 @@
 The :class:`Recorder` node subscribes generically (``raw=True``: the serialized CDR bytes
 as they arrive) to a given set of topics and to every topic it discovers later, except
 ``exclude``. Each topic becomes an MCAP channel (``message_encoding="cdr"``, with
-rosbag2's ``offered_qos_profiles`` metadata) whose schema is the full ``ros2msg``
-definition from :mod:`ltl_human_motion.ros.msgdefs`. Latched topics (transient-local
-publishers, e.g. ``/tf_static``) are subscribed transient-local, so their last message is
-recorded even if it was published before the recorder joined.
+rosbag2's ``offered_qos_profiles`` metadata: the profiles its publishers offer, as
+``ros2 bag record`` writes them) whose schema is the full ``ros2msg`` definition from
+:mod:`ltl_human_motion.ros.msgdefs`. A topic is subscribed once it has a publisher, with
+the QoS its publishers offer (rosbag2's rule: reliable if all are, transient local if all
+are), so a latched topic (``/tf_static``, a body's URDF) is recorded with its last message
+even if that was published before the recorder joined, and replays latched.
 
 The file is written to a temporary file beside the target and renamed onto it by
 :meth:`Recorder.close`; an interrupted run never leaves a truncated ``.mcap`` behind.
@@ -24,11 +26,12 @@ from typing import Any
 
 from mcap.writer import CompressionType, Writer
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.duration import Duration
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.topic_endpoint_info import TopicEndpointInfo
 
 from ltl_human_motion.atomic import atomic_path
-from ltl_human_motion.ros.common import LATCHED_QOS, TF_QOS
 from ltl_human_motion.ros.msgdefs import message_definition
 
 DEFAULT_EXCLUDE = ("/rosout", "/parameter_events")
@@ -40,18 +43,41 @@ def message_class(full_type: str) -> Any:
     return getattr(importlib.import_module(f"{package}.{kind}"), name)
 
 
-def qos_yaml(latched: bool) -> str:
-    """rosbag2's ``offered_qos_profiles`` metadata for one publisher profile."""
-    durability = "transient_local" if latched else "volatile"
-    depth = 1 if latched else 100
-    return (
-        f"- history: keep_last\n  depth: {depth}\n  reliability: reliable\n"
-        f"  durability: {durability}\n"
-        "  deadline:\n    sec: 9223372036\n    nsec: 854775807\n"
-        "  lifespan:\n    sec: 9223372036\n    nsec: 854775807\n"
-        "  liveliness: automatic\n"
-        "  liveliness_lease_duration:\n    sec: 9223372036\n    nsec: 854775807\n"
-        "  avoid_ros_namespace_conventions: false\n")
+def _duration_yaml(name: str, duration: Duration) -> str:
+    sec, nsec = divmod(int(duration.nanoseconds), 1_000_000_000)
+    return f"  {name}:\n    sec: {sec}\n    nsec: {nsec}\n"
+
+
+def qos_yaml(profiles: Iterable[QoSProfile]) -> str:
+    """rosbag2's ``offered_qos_profiles`` metadata: a YAML list of publisher profiles."""
+    out = []
+    for q in profiles:
+        out.append(
+            f"- history: {q.history.short_key}\n  depth: {int(q.depth)}\n"
+            f"  reliability: {q.reliability.short_key}\n"
+            f"  durability: {q.durability.short_key}\n"
+            + _duration_yaml("deadline", q.deadline) + _duration_yaml("lifespan", q.lifespan)
+            + f"  liveliness: {q.liveliness.short_key}\n"
+            + _duration_yaml("liveliness_lease_duration", q.liveliness_lease_duration)
+            + f"  avoid_ros_namespace_conventions: "
+              f"{str(bool(q.avoid_ros_namespace_conventions)).lower()}\n")
+    return "".join(out)
+
+
+def subscription_qos(offered: Iterable[QoSProfile], depth: int = 100) -> QoSProfile:
+    """The profile that receives what every offered profile sends (``ros2 bag record``'s
+    rule): reliable if all publishers are, transient local if all are (else best effort,
+    volatile), keep last ``depth``."""
+    offered = list(offered)
+    reliable = bool(offered) and all(q.reliability == ReliabilityPolicy.RELIABLE
+                                     for q in offered)
+    latched = bool(offered) and all(q.durability == DurabilityPolicy.TRANSIENT_LOCAL
+                                    for q in offered)
+    return QoSProfile(depth=depth, history=HistoryPolicy.KEEP_LAST,
+                      reliability=ReliabilityPolicy.RELIABLE if reliable
+                      else ReliabilityPolicy.BEST_EFFORT,
+                      durability=DurabilityPolicy.TRANSIENT_LOCAL if latched
+                      else DurabilityPolicy.VOLATILE)
 
 
 class Recorder(Node):
@@ -62,7 +88,8 @@ class Recorder(Node):
     path : path
         The ``.mcap`` file to write (folders are created).
     topics : mapping of str to str, optional
-        Topics to subscribe at once, name -> type (``pkg/msg/Type``).
+        Topics to record, name -> type (``pkg/msg/Type``): each is subscribed as soon as
+        it has a publisher (at once if it has one now), with that publisher's QoS.
     discover : bool
         Also record every topic that appears later (polled every ``discovery_period`` s).
     exclude : iterable of str
@@ -90,28 +117,44 @@ class Recorder(Node):
         self.last_ns: dict[str, int] = {}
         self._closed = False
         self._group = MutuallyExclusiveCallbackGroup()
-        for name, type_name in (topics or {}).items():
-            self._subscribe(name, type_name, latched=name == "/tf_static"
-                            or name.endswith("motion_catalog"))
-        self._discovery = (self.create_timer(discovery_period, self._discover,
-                                             callback_group=self._group) if discover else None)
+        self._discover_all = discover
+        self._pending: dict[str, str] = {}
+        self.follow(topics or {})
+        self._discovery = self.create_timer(discovery_period, self._discover,
+                                            callback_group=self._group)
+
+    def follow(self, topics: Mapping[str, str]) -> None:
+        """Record ``topics`` (name -> type): those with a publisher now at once, the others
+        when one appears."""
+        for name, type_name in topics.items():
+            if name not in self._recorded_subs and name not in self._exclude:
+                self._pending[name] = type_name
+        self._subscribe_published(list(self._pending.items()))
 
     def _discover(self) -> None:
-        for name, types in self.get_topic_names_and_types():
-            if name in self._recorded_subs or name in self._exclude or not types:
+        found = list(self._pending.items())
+        if self._discover_all:
+            found += [(name, types[0]) for name, types in self.get_topic_names_and_types()
+                      if types and name not in self._pending]
+        self._subscribe_published(found)
+
+    def _subscribe_published(self, topics: list[tuple[str, str]]) -> None:
+        for name, type_name in topics:
+            if name in self._recorded_subs or name in self._exclude:
                 continue
             infos = self.get_publishers_info_by_topic(name)
             if not infos:
                 continue
-            latched = any(i.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
-                          for i in infos)
+            self._pending.pop(name, None)
             try:
-                self._subscribe(name, types[0], latched)
+                self._subscribe(name, type_name, infos)
             except (ImportError, AttributeError, FileNotFoundError, ValueError) as exc:
                 self._exclude.add(name)
-                self.get_logger().warning(f"not recording {name} ({types[0]}): {exc}")
+                self.get_logger().warning(f"not recording {name} ({type_name}): {exc}")
 
-    def _subscribe(self, topic: str, type_name: str, latched: bool) -> None:
+    def _subscribe(self, topic: str, type_name: str, publishers: list[TopicEndpointInfo]
+                   ) -> None:
+        offered = [i.qos_profile for i in publishers]
         msg_class = message_class(type_name)
         with self._lock:
             if self._closed or topic in self._recorded_subs:
@@ -124,12 +167,11 @@ class Recorder(Node):
                 self._schemas[type_name] = schema_id
             self._channels[topic] = self._writer.register_channel(
                 topic=topic, message_encoding="cdr", schema_id=schema_id,
-                metadata={"offered_qos_profiles": qos_yaml(latched)})
+                metadata={"offered_qos_profiles": qos_yaml(offered)})
             self.counts[topic] = 0
-        qos = LATCHED_QOS if latched else QoSProfile(depth=100, reliability=TF_QOS.reliability)
         self._recorded_subs[topic] = self.create_subscription(
-            msg_class, topic, lambda data, t=topic: self._on_message(t, data), qos, raw=True,
-            callback_group=self._group)
+            msg_class, topic, lambda data, t=topic: self._on_message(t, data),
+            subscription_qos(offered), raw=True, callback_group=self._group)
 
     def _on_message(self, topic: str, data: bytes) -> None:
         stamp = time.time_ns()
@@ -159,8 +201,7 @@ class Recorder(Node):
             if self._closed:
                 return self.path
             self._closed = True
-            if self._discovery is not None:
-                self._discovery.cancel()
+            self._discovery.cancel()
             self._writer.finish()
         self._stack.close()
         return self.path
