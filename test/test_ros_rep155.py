@@ -20,6 +20,7 @@ urdf_parser = pytest.importorskip("urdf_parser_py.urdf")
 from geometry_msgs.msg import PointStamped, TwistStamped  # noqa: E402
 from hri_msgs.msg import IdsList  # noqa: E402
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
+from rcl_interfaces.srv import GetParameters  # noqa: E402
 from ros_fakes import scripted_synthesize  # noqa: E402
 from scipy.spatial.transform import Rotation  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
@@ -105,7 +106,8 @@ def test_tracked_lists_both_bodies(session) -> None:
 
 def test_joint_states_name_the_urdf_joints(session) -> None:
     msg = session.joints.last
-    assert list(msg.name) == urdf.joint_names("h1")
+    assert list(msg.name) == urdf.joint_names("h1", rep155=True)
+    assert {"l_p_shoulder_h1", "l_elbow_h1", "r_knee_h1", "y_head_h1"} <= set(msg.name)
     assert len(msg.position) == 66 and np.isfinite(msg.position).all()
     assert msg.header.stamp.sec > 0
 
@@ -124,8 +126,12 @@ def test_the_latched_urdf_loads_and_reproduces_the_tf_frames(session) -> None:
         root = poses[(stamp, "body_h1")][None]
         fk = forward_kinematics(robot, root, {n: np.array([q]) for n, q in
                                               zip(msg.name, msg.position, strict=True)})
+        hips = (poses[(stamp, "l_hip_h1")][:3, 3] + poses[(stamp, "r_hip_h1")][:3, 3]) / 2
+        # REP 155: the body frame's origin at the hips' midpoint (the played motion keeps
+        # its pelvis -> hip bones rigid; test_rep155_urdf bounds the slack of others).
+        np.testing.assert_allclose(poses[(stamp, "body_h1")][:3, 3], hips, atol=1e-3)
         for name in JOINT_NAMES:
-            link = urdf.link_name(name, "h1")
+            link = urdf.link_name(name, "h1", rep155=True)
             np.testing.assert_allclose(fk[link][0, :3, 3], poses[(stamp, link)][:3, 3],
                                        atol=1e-3, err_msg=link)
             # ... which sit on today's human_1/<joint> frames of the same stamp.
@@ -157,8 +163,18 @@ def test_rep155_frames_form_one_tree_under_body(session) -> None:
     for msg in session.tf.messages:
         for t in msg.transforms:
             parents[t.child_frame_id] = t.header.frame_id
+    assert parents["body_h1"] == "world"
     for j, name in enumerate(JOINT_NAMES):
-        link = urdf.link_name(name, "h1")
-        expected = "world" if j == 0 else urdf.link_name(JOINT_NAMES[PARENTS[j]], "h1")
+        link = urdf.link_name(name, "h1", rep155=True)
+        expected = "body_h1" if j == 0 else urdf.link_name(JOINT_NAMES[PARENTS[j]], "h1",
+                                                           rep155=True)
         assert parents[link] == expected
     assert "head_h1" in parents and "body_h2" in parents
+    assert all(f.endswith(("_h1", "_h2")) for f in parents if not f.startswith("human_"))
+
+
+def test_human_description_parameter_holds_the_urdf(session) -> None:
+    """REP 155: the URDF of body <id> is the parameter ``human_description_<id>``."""
+    response = session.call(GetParameters, "/human_1/skeleton_publisher/get_parameters",
+                            GetParameters.Request(names=["human_description_h1"]))
+    assert response.values[0].string_value == session.urdf.last.data

@@ -2,18 +2,24 @@
 
 The URDF reproduces the canonical 23-joint skeleton (:mod:`~ltl_human_motion.motion.skeleton`):
 
-* Every skeleton joint ``j`` has a link ``<j>_<id>`` (REP 155 style names: the pelvis is
-  ``body_<id>``, the head ``head_<id>``) whose origin is the joint's position. Its axes
-  are the rest pose's (x forward, y left, z up; REP 103) turned by the rotation of the
-  bone that ends at ``j``, so a bone's rest offset is also its offset in the parent's
-  link frame.
+* Every skeleton joint ``j`` has a link ``<j>_<id>`` (the head ``head_<id>``, the pelvis
+  ``body_<id>`` or, with ``rep155``, ``pelvis_<id>``) whose origin is the joint's
+  position. Its axes are the rest pose's (x forward, y left, z up; REP 103) turned by the
+  rotation of the bone that ends at ``j``, so a bone's rest offset is also its offset in
+  the parent's link frame.
 * Every bone ``p -> c`` is three revolute joints at ``p`` (a ball joint as three
-  rotations about the axes of :data:`BONE_JOINTS`, outer to inner), a link
-  ``<c>_bone_<id>`` that carries the bone's capsule, and a fixed joint to ``<c>_<id>``
-  translated by the rest offset ``rest[c] - rest[p]``.
-* The root link ``body_<id>`` sits at the pelvis; its pose in the world frame is the
-  transform ``world -> body_<id>`` (:func:`root_poses`), which the skeleton publisher puts
-  on TF (robot_state_publisher leaves floating roots to others).
+  rotations about the axes of :data:`BONE_JOINTS`, outer to inner) with links
+  ``<c>_bone_<axis>_<id>`` between them, a link ``<c>_bone_<id>`` that carries the bone's
+  capsule, and a fixed joint ``<c>_end_<id>`` to ``<c>_<id>`` translated by the rest
+  offset ``rest[c] - rest[p]``. Every link and joint name ends in ``_<id>``.
+* The root link is ``body_<id>``; its pose in the world frame is the transform
+  ``world -> body_<id>`` (:func:`root_poses`), which the skeleton publisher puts on TF
+  (robot_state_publisher leaves floating roots to others). By default it sits at the
+  pelvis joint (the whole-body program's model). With ``rep155`` it is REP 155's body
+  frame: its origin at the midpoint of the hips (the pelvis link's hip sockets, rest
+  offsets carried by the pelvis' rotation), its axes the pelvis link's, and the pelvis a
+  fixed child link ``pelvis_<id>``; the revolute joints then take REP 155's recommended
+  names (:func:`joint_names`).
 
 Joint angles per frame (:func:`joint_angles`) come from the motion's positions with the
 BVH exporter's rotations (:func:`~ltl_human_motion.planning.exports.bvh_rotations`: swing
@@ -141,14 +147,42 @@ _MASS_FRACTION = {
 _MIN_MASS = 0.01
 
 
-def link_name(joint: str, human_id: str) -> str:
-    """The URDF link (and TF frame) of skeleton joint ``joint`` for human ``human_id``."""
-    special = {"pelvis": "body", "head": "head"}
-    return f"{special.get(joint, joint)}_{human_id}"
+def link_name(joint: str, human_id: str, rep155: bool = False) -> str:
+    """The URDF link (and TF frame) of skeleton joint ``joint`` for human ``human_id``
+    (the pelvis' is the root ``body_<id>``, with ``rep155`` the root's child
+    ``pelvis_<id>``)."""
+    if joint == "pelvis" and not rep155:
+        return f"body_{human_id}"
+    return f"{joint}_{human_id}"
 
 
-def joint_names(human_id: str) -> list[str]:
-    """Names of the URDF's revolute joints (3 per bone, 66), in :func:`joint_angles` order."""
+#: REP 155's rotation names of the axes (REP 103: roll about x, pitch y, yaw z).
+_REP155_AXIS = {"x": "r", "y": "p", "z": "y"}
+#: Our anatomical joints that REP 155's model names otherwise: the joint that turns the
+#: head is its ``head`` joint, the lumbar spine its ``waist``.
+_REP155_JOINT = {"neck": "head", "lumbar": "waist"}
+#: REP 155's one-axis joints: their pitch axis takes the bare name (``l_elbow``).
+_REP155_HINGES = ("elbow", "knee", "waist")
+
+
+def rep155_joint_name(bone: BoneJoint, axis: str) -> str:
+    """REP 155's recommended name (without the id) of ``bone``'s rotation about ``axis``:
+    ``l_y_shoulder``, ``p_head``, ``l_elbow`` (a hinge's pitch), ``l_r_elbow``, ..."""
+    side, base = (bone.name[:2], bone.name[2:]) if bone.name[:2] in ("l_", "r_") \
+        else ("", bone.name)
+    base = _REP155_JOINT.get(base, base)
+    if base in _REP155_HINGES and axis == "y":
+        return f"{side}{base}"
+    return f"{side}{_REP155_AXIS[axis]}_{base}"
+
+
+def joint_names(human_id: str, rep155: bool = False) -> list[str]:
+    """Names of the URDF's revolute joints (3 per bone, 66), in :func:`joint_angles` order:
+    ``<anatomical>_<axis>_<id>`` (``l_shoulder_y_7``), with ``rep155`` REP 155's names
+    (:func:`rep155_joint_name`: ``l_p_shoulder_7``)."""
+    if rep155:
+        return [f"{rep155_joint_name(b, axis)}_{human_id}" for b in _bones()
+                for axis in b.axes]
     return [f"{b.name}_{axis}_{human_id}" for b in _bones() for axis in b.axes]
 
 
@@ -245,12 +279,24 @@ def body_id(human_id: str) -> str:
     return f"h{human_id}" if human_id[:1].isdigit() else human_id
 
 
-def root_poses(positions: np.ndarray, skeleton: Skeleton | None = None) -> np.ndarray:
-    """Homogeneous poses (T, 4, 4) of ``body_<id>`` in the world frame."""
+def hip_offset(skeleton: Skeleton | None = None) -> np.ndarray:
+    """The midpoint of the hips in the pelvis link's frame (3,), metres: the origin of
+    REP 155's ``body_<id>`` relative to ``pelvis_<id>``."""
+    rest = (skeleton or Skeleton()).rest_positions()
+    return (rest[JOINT_INDEX["l_hip"]] + rest[JOINT_INDEX["r_hip"]]) / 2 - rest[0]
+
+
+def root_poses(positions: np.ndarray, skeleton: Skeleton | None = None,
+               rep155: bool = False) -> np.ndarray:
+    """Homogeneous poses (T, 4, 4) of ``body_<id>`` in the world frame from positions
+    (T, J, 3): at the pelvis joint, with ``rep155`` at the midpoint of the hips
+    (:func:`hip_offset` turned by the pelvis link)."""
     pos = np.asarray(positions, dtype=np.float64)
     T = np.tile(np.eye(4), (len(pos), 1, 1))
     T[:, :3, :3] = link_rotations(pos, skeleton)[:, 0]
     T[:, :3, 3] = pos[:, 0]
+    if rep155:
+        T[:, :3, 3] += T[:, :3, :3] @ hip_offset(skeleton)
     return T
 
 
@@ -302,8 +348,9 @@ def _inertial(link: ET.Element, mass: float, centre: np.ndarray, radius: float,
 
 
 def worker_urdf(stature: float = 1.75, human_id: str = "1", *,
-                body_mass: float = BODY_MASS) -> str:
-    """The URDF (XML text) of a worker of ``stature`` metres, links named for ``human_id``.
+                body_mass: float = BODY_MASS, rep155: bool = False) -> str:
+    """The URDF (XML text) of a worker of ``stature`` metres, links named for ``human_id``;
+    with ``rep155`` REP 155's body frame and joint names (see the module docstring).
 
     Raises
     ------
@@ -322,17 +369,29 @@ def worker_urdf(stature: float = 1.75, human_id: str = "1", *,
         links[name] = ET.SubElement(robot, "link", name=name)
         return links[name]
 
-    add_link(link_name("pelvis", human_id))
+    def link(joint: str) -> str:
+        return link_name(joint, human_id, rep155)
+
+    names = iter(joint_names(human_id, rep155))
+    if rep155:
+        add_link(f"body_{human_id}")
+        _inertial(links[f"body_{human_id}"], _MIN_MASS, np.zeros(3), 0.01, 0.0)
+        add_link(link("pelvis"))
+        fixed = ET.SubElement(robot, "joint", name=f"pelvis_end_{human_id}", type="fixed")
+        ET.SubElement(fixed, "parent", link=f"body_{human_id}")
+        ET.SubElement(fixed, "child", link=link("pelvis"))
+        _origin(fixed, -hip_offset(skeleton))
+    else:
+        add_link(link("pelvis"))
     for c in range(1, len(JOINT_NAMES)):
         p, child = PARENTS[c], JOINT_NAMES[c]
         bone = _BY_CHILD[child]
-        parent_link = link_name(JOINT_NAMES[p], human_id)
-        chain = [f"{child}_bone_{human_id}_{axis}" for axis in bone.axes[:2]] \
+        parent_link = link(JOINT_NAMES[p])
+        chain = [f"{child}_bone_{axis}_{human_id}" for axis in bone.axes[:2]] \
             + [f"{child}_bone_{human_id}"]
         for k, axis in enumerate(bone.axes):
             add_link(chain[k])
-            joint = ET.SubElement(robot, "joint", name=f"{bone.name}_{axis}_{human_id}",
-                                  type="revolute")
+            joint = ET.SubElement(robot, "joint", name=next(names), type="revolute")
             ET.SubElement(joint, "parent", link=parent_link if k == 0 else chain[k - 1])
             ET.SubElement(joint, "child", link=chain[k])
             _origin(joint, np.zeros(3))
@@ -341,10 +400,10 @@ def worker_urdf(stature: float = 1.75, human_id: str = "1", *,
             ET.SubElement(joint, "limit", lower=f"{np.radians(lo - LIMIT_MARGIN):.6g}",
                           upper=f"{np.radians(hi + LIMIT_MARGIN):.6g}",
                           effort=f"{JOINT_EFFORT:g}", velocity=f"{JOINT_VELOCITY:g}")
-        add_link(link_name(child, human_id))
+        add_link(link(child))
         fixed = ET.SubElement(robot, "joint", name=f"{child}_end_{human_id}", type="fixed")
         ET.SubElement(fixed, "parent", link=chain[-1])
-        ET.SubElement(fixed, "child", link=link_name(child, human_id))
+        ET.SubElement(fixed, "child", link=link(child))
         _origin(fixed, rest[c] - rest[p])
         offset = rest[c] - rest[p]
         mass = max(body_mass * _MASS_FRACTION[child], _MIN_MASS)
@@ -352,14 +411,14 @@ def worker_urdf(stature: float = 1.75, human_id: str = "1", *,
                   float(np.linalg.norm(offset)))
         for k in range(2):
             _inertial(links[chain[k]], _MIN_MASS, np.zeros(3), 0.01, 0.0)
-        _inertial(links[link_name(child, human_id)], _MIN_MASS, np.zeros(3), 0.01, 0.0)
-    _inertial(links[link_name("pelvis", human_id)],
+        _inertial(links[link(child)], _MIN_MASS, np.zeros(3), 0.01, 0.0)
+    _inertial(links[link("pelvis")],
               body_mass * _MASS_FRACTION["pelvis"], np.zeros(3), 0.1 * stature / 1.75, 0.1)
 
     for k, (part, ja, jb, _) in enumerate(BODY_CAPSULES):
         a, b = JOINT_INDEX[ja], JOINT_INDEX[jb]
         if a == b:                                   # a sphere at the joint
-            _capsule_geometry(links[link_name(ja, human_id)], np.zeros(3), np.zeros(3),
+            _capsule_geometry(links[link(ja)], np.zeros(3), np.zeros(3),
                               float(radii[k]), part)
         elif PARENTS[b] == a:                        # the bone a -> b: its bone link
             _capsule_geometry(links[f"{jb}_bone_{human_id}"], np.zeros(3), rest[b] - rest[a],
@@ -368,7 +427,7 @@ def worker_urdf(stature: float = 1.75, human_id: str = "1", *,
             base = PARENTS[a]
             if PARENTS[b] != base:
                 raise ValueError(f"capsule {part}: {ja} and {jb} share no parent")
-            _capsule_geometry(links[link_name(JOINT_NAMES[base], human_id)],
+            _capsule_geometry(links[link(JOINT_NAMES[base])],
                               rest[a] - rest[base], rest[b] - rest[base], float(radii[k]), part)
     ET.indent(robot)
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"

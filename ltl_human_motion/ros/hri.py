@@ -14,15 +14,19 @@ token cannot): human ``1`` is body ``h1`` (topics ``/humans/bodies/h1/...``, fra
   (found by topic discovery every :data:`DISCOVERY_PERIOD`), so the publishers of
   several humans, in one process or several, agree.
 * ``/humans/bodies/<id>/joint_states`` (``sensor_msgs/JointState``): the 66 revolute
-  joints of the worker's URDF (:mod:`ltl_human_motion.motion.urdf`), radians.
+  joints of the worker's REP 155 URDF (:mod:`ltl_human_motion.motion.urdf` with
+  ``rep155``: REP 155's joint names, ``l_p_shoulder_<id>``, ``l_elbow_<id>``, ...),
+  radians.
 * ``/humans/bodies/<id>/urdf`` (``std_msgs/String``, transient local): that URDF, for the
-  stature of the motion played (republished when it changes).
+  stature of the motion played (republished when it changes); the same text is the
+  node's parameter ``human_description_<id>`` (REP 155's ``/human_description_<bodyID>``).
 * ``/humans/bodies/<id>/position`` (``geometry_msgs/PointStamped``) and ``/velocity``
   (``geometry_msgs/TwistStamped``): the body frame's origin and velocity in the world
   frame.
-* TF: ``<world> -> body_<id>`` (REP 155's body frame, at the pelvis) and, with
-  ``link_frames``, the frame of every skeleton joint named as in the URDF (``head_<id>``,
-  ``l_elbow_<id>``, ...) relative to its skeleton parent. Turn ``link_frames`` off when
+* TF: ``<world> -> body_<id>`` (REP 155's body frame: origin at the midpoint of the hips,
+  x forward, z up) and, with ``link_frames``, ``body_<id> -> pelvis_<id>`` and the frame
+  of every other skeleton joint named as in the URDF (``head_<id>``, ``l_elbow_<id>``,
+  ...) relative to its skeleton parent. Turn ``link_frames`` off when
   ``robot_state_publisher`` turns the URDF and ``joint_states`` into TF itself.
 
 Per-frame link rotations and velocities are computed once per motion (:meth:`BodyInterface.prepare`,
@@ -49,6 +53,7 @@ from std_msgs.msg import String
 from ltl_human_motion.motion import urdf
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton
 from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS
+from ltl_human_motion.ros.params import declare_or_set_string
 from ltl_human_motion.ros.playback import Frame, Playback
 
 BODIES = "/humans/bodies"
@@ -120,15 +125,24 @@ def link_transforms(positions: np.ndarray, quats: np.ndarray) -> np.ndarray:
     return out
 
 
-def body_velocity(positions: np.ndarray, root_quaternions: np.ndarray, fps: float
+def body_origins(pelvis: np.ndarray, pelvis_quaternions: np.ndarray, stature: float
+                 ) -> np.ndarray:
+    """REP 155 body frame origins (..., 3): the midpoint of the hips, from the pelvis
+    joint's positions (..., 3) and the pelvis link's quaternions (..., 4: x y z w)."""
+    offset = urdf.hip_offset(_skeleton(stature))
+    R = Rotation.from_quat(np.reshape(pelvis_quaternions, (-1, 4)))
+    return np.asarray(pelvis, dtype=np.float64) + R.apply(offset).reshape(np.shape(pelvis))
+
+
+def body_velocity(origins: np.ndarray, root_quaternions: np.ndarray, fps: float
                   ) -> np.ndarray:
     """Per frame, the body frame's linear and angular velocity in the world frame: (T, 6),
-    from joint positions (T, J, 3) and the root link's quaternions (T, 4)."""
-    pos = np.asarray(positions, dtype=np.float64)
-    out = np.zeros((len(pos), 6))
-    if len(pos) < 2:
+    from its origins (T, 3) and quaternions (T, 4)."""
+    origins = np.asarray(origins, dtype=np.float64)
+    out = np.zeros((len(origins), 6))
+    if len(origins) < 2:
         return out
-    out[:, :3] = np.gradient(pos[:, 0], axis=0) * fps
+    out[:, :3] = np.gradient(origins, axis=0) * fps
     R = Rotation.from_quat(root_quaternions)
     step = (R[1:] * R[:-1].inv()).as_rotvec() * fps
     out[1:, 3:] = step
@@ -165,8 +179,10 @@ class BodyInterface:
         self._velocity_pub = node.create_publisher(TwistStamped,
                                                    body_topic(human_id, "velocity"),
                                                    STREAM_QOS)
-        self.joint_names = urdf.joint_names(self.body_id)
-        self.link_names = [urdf.link_name(j, self.body_id) for j in JOINT_NAMES]
+        self.joint_names = urdf.joint_names(self.body_id, rep155=True)
+        self.link_names = [urdf.link_name(j, self.body_id, rep155=True) for j in JOINT_NAMES]
+        self.body_frame = f"body_{self.body_id}"
+        self.description_parameter = f"human_description_{self.body_id}"
         self._urdf_stature: float | None = None
         self._tables: dict[str, tuple[float, np.ndarray, np.ndarray]] = {}
         self._last_seen: dict[str, float] = {}
@@ -179,7 +195,10 @@ class BodyInterface:
         if self._urdf_stature is not None and abs(self._urdf_stature - stature) < 1e-9:
             return
         self._urdf_stature = stature
-        self._urdf_pub.publish(String(data=urdf.worker_urdf(stature, self.body_id)))
+        text = urdf.worker_urdf(stature, self.body_id, rep155=True)
+        declare_or_set_string(self.node, self.description_parameter, text,
+                              "REP 155 URDF of this body (as on its urdf topic)")
+        self._urdf_pub.publish(String(data=text))
 
     def prepare(self, motion_id: str, motion: Any) -> tuple[float, np.ndarray, np.ndarray]:
         """Per-frame tables of ``motion`` (a SynthesizedMotion): stature, link quaternions
@@ -190,7 +209,8 @@ class BodyInterface:
             stature = float(body.skeleton.stature)
             positions = np.asarray(body.positions, dtype=np.float64)
             quats = link_quaternions(positions, stature)
-            velocity = body_velocity(positions, quats[:, 0], float(body.fps))
+            origins = body_origins(positions[:, 0], quats[:, 0], stature)
+            velocity = body_velocity(origins, quats[:, 0], float(body.fps))
             if len(self._tables) >= MAX_TABLES:
                 self._tables.pop(next(iter(self._tables)))
             self._tables[motion_id] = (stature, quats, velocity)
@@ -242,9 +262,10 @@ class BodyInterface:
         joints.header.stamp = stamp
         self._joint_pub.publish(joints)
         i = min(frame.index, len(velocity) - 1)
+        origin = body_origins(rows[0, :3], rows[0, 3:], stature)
         position = PointStamped()
         position.header.stamp, position.header.frame_id = stamp, self.world_frame
-        x, y, z = (float(v) for v in frame.positions[0])
+        x, y, z = (float(v) for v in origin)
         position.point.x, position.point.y, position.point.z = x, y, z
         self._position_pub.publish(position)
         twist = TwistStamped()
@@ -254,14 +275,17 @@ class BodyInterface:
         twist.twist.angular.x, twist.twist.angular.y, twist.twist.angular.z = map(float,
                                                                                  v[3:])
         self._velocity_pub.publish(twist)
-        count = len(JOINT_NAMES) if self.link_frames else 1
+        edges = [(self.world_frame, self.body_frame, np.concatenate([origin, rows[0, 3:]]))]
+        if self.link_frames:
+            pelvis = np.concatenate([-urdf.hip_offset(_skeleton(stature)), [0, 0, 0, 1.0]])
+            edges.append((self.body_frame, self.link_names[0], pelvis))
+            edges += [(self.link_names[PARENTS[j]], self.link_names[j], rows[j])
+                      for j in range(1, len(JOINT_NAMES))]
         transforms = []
-        for j in range(count):
+        for parent, child, row in edges:
             t = TransformStamped()
             t.header.stamp = stamp
-            t.header.frame_id = self.world_frame if j == 0 else self.link_names[PARENTS[j]]
-            t.child_frame_id = self.link_names[j]
-            row = rows[j]
+            t.header.frame_id, t.child_frame_id = parent, child
             tr, q = t.transform.translation, t.transform.rotation
             tr.x, tr.y, tr.z = (float(a) for a in row[:3])
             q.x, q.y, q.z, q.w = (float(a) for a in row[3:])

@@ -109,3 +109,12 @@ def topic_name(value: Any) -> str | None:
     """Check: a non-empty ROS topic name."""
     ok = isinstance(value, str) and bool(re.match(r"^[~/A-Za-z_][A-Za-z0-9_/{}~]*$", value))
     return None if ok else f"expected a ROS topic name, got {value!r}"
+
+
+def declare_or_set_string(node: Node, name: str, value: str, description: str) -> None:
+    """Give the string parameter ``name`` of ``node`` the value ``value`` (declared with
+    ``description`` on first use; the node keeps it up to date, not its users)."""
+    if node.has_parameter(name):
+        node.set_parameters([Parameter(name, Parameter.Type.STRING, value)])
+    else:
+        node.declare_parameter(name, value, ParameterDescriptor(description=description))
