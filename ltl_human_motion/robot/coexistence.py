@@ -225,6 +225,28 @@ class _Occupancy:
 
 _KEEP_ALIVE: list[object] = []
 
+#: Seconds :meth:`CoexistenceController.close` waits for one RTDE interface's disconnect
+#: (about 1 ms from a live controller).
+DISCONNECT_TIMEOUT = 1.0
+
+
+def _disconnect_within(obj: Any, timeout: float) -> str | None:
+    """Call ``obj.disconnect()`` on a daemon thread (ur_rtde releases the GIL while it
+    waits); None when it returned within ``timeout`` seconds, else why not."""
+    failure: list[str] = ["no answer within " + f"{timeout:g} s"]
+
+    def run() -> None:
+        try:
+            obj.disconnect()
+            failure.clear()
+        except Exception as exc:
+            failure[:] = [str(exc) or type(exc).__name__]
+
+    thread = threading.Thread(target=run, name="rtde-disconnect", daemon=True)
+    thread.start()
+    thread.join(timeout)
+    return failure[0] if thread.is_alive() or failure else None
+
 
 def _keep_alive_forever(obj: object) -> None:
     """Never destroy ``obj`` (a broken ur_rtde interface whose destructor would abort)."""
@@ -577,9 +599,12 @@ class CoexistenceController:
 
         Issue 34: after the controller went away, destroying the broken
         ``RTDEIOInterface`` (held by a wrapper, so not recognised by its type) made its
-        destructor write to the closed socket: "write: Broken pipe", std::terminate."""
-        if self._recv is not None:
-            self._check_receive_alive()
+        destructor write to the closed socket: "write: Broken pipe", std::terminate. A
+        frozen controller (process stopped, socket open) never answers a disconnect: the
+        controller's timestamp must move first, and each disconnect gets
+        :data:`DISCONNECT_TIMEOUT` seconds."""
+        if self._recv is not None and self.connected and not self._controller_answers():
+            self._recv_ok = self._io_ok = False
         lost = []
         for attr, ok in (("_io", self._io_ok), ("_recv", self._recv_ok)):
             obj = getattr(self, attr)
@@ -587,11 +612,10 @@ class CoexistenceController:
                 continue
             setattr(self, attr, None)
             if ok:
-                try:
-                    obj.disconnect()
+                failure = _disconnect_within(obj, DISCONNECT_TIMEOUT)
+                if failure is None:
                     continue
-                except (RuntimeError, OSError) as exc:
-                    log.warning("RTDE %s: disconnect failed (%s)", attr[1:], exc)
+                log.warning("RTDE %s: disconnect failed (%s)", attr[1:], failure)
             lost.append(attr[1:])
             _keep_alive_forever(obj)
         if lost:
@@ -599,15 +623,22 @@ class CoexistenceController:
                         " and ".join(lost))
         self._recv_ok = self._io_ok = False
 
-    def _check_receive_alive(self) -> None:
-        """Mark both interfaces lost when the receive side says its connection is gone
-        (the io side talks to the same controller)."""
+    def _controller_answers(self) -> bool:
+        """True when the receive side is connected and the controller's timestamp moves
+        within ``robot_stale_after`` (a killed controller closes the socket, a frozen one
+        leaves it open and silent; either never answers a disconnect)."""
+        end = time.monotonic() + self.config.robot_stale_after
         try:
-            alive = bool(self._recv.isConnected())
+            first = self._recv.getTimestamp()
+            while self._recv.isConnected():
+                if self._recv.getTimestamp() != first:
+                    return True
+                if time.monotonic() > end:
+                    return False
+                time.sleep(0.002)
         except (RuntimeError, OSError):
-            alive = False
-        if not alive:
-            self._recv_ok = self._io_ok = False
+            pass
+        return False
 
     def __enter__(self) -> CoexistenceController:
         return self
