@@ -66,9 +66,9 @@ if TYPE_CHECKING:
 
 #: Blocked goal primitives of a step that the whole-body program remakes, at most.
 WHOLE_BODY_TRIES = 1
-#: Whole-body programs one plan runs at most (about 0.3 s each): a step that every
+#: Whole-body programs one plan runs at most (about 0.25 s each): a step that every
 #: placement blocks would otherwise run one per placement.
-WHOLE_BODY_BUDGET = 6
+WHOLE_BODY_BUDGET = 4
 
 #: Seeded primitives tried at each alternative (release place, approach) after the first
 #: (the first gets ``PlannerOptions.goal_attempts``).

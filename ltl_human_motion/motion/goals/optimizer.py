@@ -92,7 +92,7 @@ class WholeBodyOptions:
     damping: float = 1e-3
     com_weight: float = 0.05
     joint_speed: float = 4.0
-    rate: float = 60.0
+    rate: float = 40.0
     root_speed: float = 1.0
     speed_limits: tuple[float, ...] | None = None
     self_pairs: SelfPairs | None = None
