@@ -114,7 +114,8 @@ def test_rviz_config_shows_tf_markers_and_occupancy() -> None:
             "rviz_default_plugins/MarkerArray"} <= set(displays)
     topics = {d["Topic"]["Value"] for d in manager["Displays"]
               if d["Class"] == "rviz_default_plugins/MarkerArray"}
-    assert topics == {"/markers", "/occupancy_markers"}
+    assert topics == {"/markers", "/occupancy_markers", "/ergonomics_markers",
+                      "/robot_markers"}   # test_ros_rviz_config: all the bringups publish
 
 
 # ------------------------------------------------------------------ plain-Python pieces

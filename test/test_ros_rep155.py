@@ -29,7 +29,7 @@ from test_motion_urdf import forward_kinematics  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 
 from ltl_human_motion.motion import urdf  # noqa: E402
-from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS  # noqa: E402
+from ltl_human_motion.motion.skeleton import JOINT_NAMES  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
 from ltl_human_motion.ros.common import LATCHED_QOS  # noqa: E402
@@ -164,10 +164,14 @@ def test_rep155_frames_form_one_tree_under_body(session) -> None:
         for t in msg.transforms:
             parents[t.child_frame_id] = t.header.frame_id
     assert parents["body_h1"] == "world"
+    # Every URDF link is on TF under the same parent as in the URDF (what
+    # robot_state_publisher would publish), so RViz's RobotModel finds all of them.
+    robot = urdf_parser.URDF.from_xml_string(session.urdf.last.data)
+    for joint in robot.joints:
+        assert parents[joint.child] == joint.parent, joint.name
     for j, name in enumerate(JOINT_NAMES):
         link = urdf.link_name(name, "h1", rep155=True)
-        expected = "body_h1" if j == 0 else urdf.link_name(JOINT_NAMES[PARENTS[j]], "h1",
-                                                           rep155=True)
+        expected = "body_h1" if j == 0 else urdf.bone_chain(name, "h1")[-1]
         assert parents[link] == expected
     assert "head_h1" in parents and "body_h2" in parents
     assert all(f.endswith(("_h1", "_h2")) for f in parents if not f.startswith("human_"))

@@ -186,6 +186,19 @@ def joint_names(human_id: str, rep155: bool = False) -> list[str]:
     return [f"{b.name}_{axis}_{human_id}" for b in _bones() for axis in b.axes]
 
 
+def bone_joint(child: str) -> BoneJoint:
+    """The ball joint that turns the bone ending at skeleton joint ``child``."""
+    return _BY_CHILD[child]
+
+
+def bone_chain(child: str, human_id: str) -> list[str]:
+    """The links that the three revolute joints of the bone ending at skeleton joint
+    ``child`` turn, outer to inner: ``<child>_bone_<axis>_<id>`` twice, then the bone's
+    own link ``<child>_bone_<id>`` (which carries its capsule)."""
+    axes = _BY_CHILD[child].axes
+    return [f"{child}_bone_{axis}_{human_id}" for axis in axes[:2]] + [f"{child}_bone_{human_id}"]
+
+
 def _bones() -> list[BoneJoint]:
     return [_BY_CHILD[JOINT_NAMES[j]] for j in range(len(JOINT_NAMES)) if PARENTS[j] >= 0]
 
@@ -387,8 +400,7 @@ def worker_urdf(stature: float = 1.75, human_id: str = "1", *,
         p, child = PARENTS[c], JOINT_NAMES[c]
         bone = _BY_CHILD[child]
         parent_link = link(JOINT_NAMES[p])
-        chain = [f"{child}_bone_{axis}_{human_id}" for axis in bone.axes[:2]] \
-            + [f"{child}_bone_{human_id}"]
+        chain = bone_chain(child, human_id)
         for k, axis in enumerate(bone.axes):
             add_link(chain[k])
             joint = ET.SubElement(robot, "joint", name=next(names), type="revolute")

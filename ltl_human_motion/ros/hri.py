@@ -24,10 +24,12 @@ token cannot): human ``1`` is body ``h1`` (topics ``/humans/bodies/h1/...``, fra
   (``geometry_msgs/TwistStamped``): the body frame's origin and velocity in the world
   frame.
 * TF: ``<world> -> body_<id>`` (REP 155's body frame: origin at the midpoint of the hips,
-  x forward, z up) and, with ``link_frames``, ``body_<id> -> pelvis_<id>`` and the frame
-  of every other skeleton joint named as in the URDF (``head_<id>``, ``l_elbow_<id>``,
-  ...) relative to its skeleton parent. Turn ``link_frames`` off when
-  ``robot_state_publisher`` turns the URDF and ``joint_states`` into TF itself.
+  x forward, z up) and, with ``link_frames``, every other link of the URDF as
+  robot_state_publisher would put it (``body_<id> -> pelvis_<id>``, each bone's three
+  rotations ``<parent>_<id> -> <child>_bone_<axis>_<id> -> ... -> <child>_bone_<id>``,
+  then ``<child>_<id>`` at the joint's position), so RViz's RobotModel finds every link.
+  Turn ``link_frames`` off when ``robot_state_publisher`` turns the URDF and
+  ``joint_states`` into TF itself.
 
 Per-frame link rotations and velocities are computed once per motion (:meth:`BodyInterface.prepare`,
 before the playback clock starts);
@@ -182,6 +184,11 @@ class BodyInterface:
         self.joint_names = urdf.joint_names(self.body_id, rep155=True)
         self.link_names = [urdf.link_name(j, self.body_id, rep155=True) for j in JOINT_NAMES]
         self.body_frame = f"body_{self.body_id}"
+        #: Per bone: its three revolute joints' links (urdf.bone_chain) and unit axes.
+        self._chains = [urdf.bone_chain(JOINT_NAMES[j], self.body_id)
+                        for j in range(1, len(JOINT_NAMES))]
+        self._axes = np.array([np.eye(3)["xyz".index(a)] for j in range(1, len(JOINT_NAMES))
+                               for a in urdf.bone_joint(JOINT_NAMES[j]).axes])
         self.description_parameter = f"human_description_{self.body_id}"
         self._urdf_stature: float | None = None
         self._tables: dict[str, tuple[float, np.ndarray, np.ndarray]] = {}
@@ -238,6 +245,26 @@ class BodyInterface:
             ids.add(self.body_id)
         return sorted(ids)
 
+    def _link_edges(self, rows: np.ndarray, angles: np.ndarray, stature: float
+                    ) -> list[tuple[str, str, np.ndarray]]:
+        """(parent, child, x y z qx qy qz qw) of every URDF link below ``body_<id>``, as
+        robot_state_publisher would give them from the URDF and ``angles`` (66,), except
+        that each joint link sits at the joint's position (``rows``: (J, 7) of
+        :func:`link_transforms`)."""
+        pelvis = np.concatenate([-urdf.hip_offset(_skeleton(stature)), [0, 0, 0, 1.0]])
+        edges = [(self.body_frame, self.link_names[0], pelvis)]
+        rotations = Rotation.from_rotvec(
+            (self._axes * angles[:, None]).reshape(-1, 3)).as_quat().reshape(-1, 3, 4)
+        for j in range(1, len(JOINT_NAMES)):
+            chain = [self.link_names[PARENTS[j]], *self._chains[j - 1]]
+            for k in range(3):
+                edges.append((chain[k], chain[k + 1],
+                              np.concatenate([np.zeros(3), rotations[j - 1, k]])))
+            offset = Rotation.from_quat(rows[j, 3:]).inv().apply(rows[j, :3])
+            edges.append((chain[-1], self.link_names[j],
+                          np.concatenate([offset, [0.0, 0.0, 0.0, 1.0]])))
+        return edges
+
     def publish(self, frame: Frame | None, playback: Playback, stamp: Any
                 ) -> list[TransformStamped]:
         """One tick: ``tracked`` always, the body's topics while shown; returns the body's
@@ -277,10 +304,7 @@ class BodyInterface:
         self._velocity_pub.publish(twist)
         edges = [(self.world_frame, self.body_frame, np.concatenate([origin, rows[0, 3:]]))]
         if self.link_frames:
-            pelvis = np.concatenate([-urdf.hip_offset(_skeleton(stature)), [0, 0, 0, 1.0]])
-            edges.append((self.body_frame, self.link_names[0], pelvis))
-            edges += [(self.link_names[PARENTS[j]], self.link_names[j], rows[j])
-                      for j in range(1, len(JOINT_NAMES))]
+            edges += self._link_edges(rows, np.asarray(joints.position), stature)
         transforms = []
         for parent, child, row in edges:
             t = TransformStamped()
