@@ -16,8 +16,9 @@ from dataclasses import dataclass
 
 from ltl_human_motion.errors import PlanningError
 
-__all__ = ["ENTERING_TASKS", "HAND_TASKS", "REGION_ATOM", "TASK_ARGUMENTS", "TASK_NAMES",
-           "TaskStep", "shorthand_conjuncts", "task_step", "task_text", "two_hand_region"]
+__all__ = ["ENTERING_TASKS", "HAND_TASKS", "INPUT_ARGUMENTS", "REGION_ATOM", "TASK_ARGUMENTS",
+           "TASK_NAMES", "TaskStep", "shorthand_conjuncts", "task_step", "task_text",
+           "two_hand_region"]
 
 TASK_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "wait": ("duration",),
@@ -35,6 +36,17 @@ TASK_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "kneel": (),
     "walk": ("region",),
     "carry": ("object", "region"),
+}
+
+#: Built-in input propositions (robot events the worker observes, docs/reactive.md) and
+#: their argument kinds: ``robot_in(R)`` (a capsule of the robot's body is inside region
+#: R), ``robot_moving`` (its joint speed is above a threshold), ``offered(O)`` (the robot
+#: holds part O in a handover region). A cell declares Boolean inputs of its own under
+#: ``inputs:``. Inputs are read, never done: they are not tasks.
+INPUT_ARGUMENTS: dict[str, tuple[str, ...]] = {
+    "robot_in": ("region",),
+    "robot_moving": (),
+    "offered": ("object",),
 }
 
 #: Table I task names in the paper's order.

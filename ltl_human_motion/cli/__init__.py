@@ -20,7 +20,7 @@ from ltl_human_motion.errors import LtlHumanMotionError
 
 SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tasks", "library", "synthesize", "render", "paper", "batch", "bringup", "call", "ur_sim",
-    "coexist", "demo", "study",
+    "coexist", "demo", "study", "react",
 )
 
 

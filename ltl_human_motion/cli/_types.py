@@ -18,3 +18,14 @@ def stature(text: str) -> float:
             f"body height must be {MIN_LIBRARY_STATURE} to {MAX_LIBRARY_STATURE} m, got "
             f"{value:g}")
     return value
+
+
+def positive(text: str) -> int:
+    """A whole number >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a number >= 1, got {value}")
+    return value

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from ltl_human_motion.cli._types import positive as _positive
 from ltl_human_motion.ltl import (
     BACKENDS,
     MODES,
@@ -27,16 +28,6 @@ from ltl_human_motion.yaml_limits import TextFileError, read_text_file
 
 NAME = "tasks"
 HELP = "print task sequences (or the Büchi automaton) satisfying an LTL specification"
-
-
-def _positive(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a number >= 1, got {value}")
-    return value
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

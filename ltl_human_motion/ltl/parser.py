@@ -29,6 +29,11 @@ Atoms are task predicates of Table I with their arguments (``carry(O1, R2)``), t
 atom ``enter(R)``, shorthands defined by the cell (expanded in place), or, with
 ``free_atoms=True``, plain propositions such as ``p0``. A quoted atom ``"grasp(O1)"`` is
 read like the unquoted predicate.
+
+Input propositions (robot events: ``robot_in(R)``, ``robot_moving``, ``offered(O)`` and
+the cell's declared ``inputs``) are read only with ``reactive=True`` (a GR(1)
+specification, docs/reactive.md); elsewhere, and in a shorthand's body, an input is
+refused at its position, since the worker cannot do it as a task.
 """
 
 from __future__ import annotations
@@ -57,7 +62,7 @@ from ltl_human_motion.ltl.formula import (
 )
 from ltl_human_motion.ltl.limits import MAX_NESTING, MAX_SPEC_CHARS, check_formula_limits
 from ltl_human_motion.ltl.vocabulary import Vocabulary, vocabulary_from
-from ltl_human_motion.vocabulary import REGION_ATOM, TASK_ARGUMENTS
+from ltl_human_motion.vocabulary import INPUT_ARGUMENTS, REGION_ATOM, TASK_ARGUMENTS
 
 __all__ = ["ParsedSpec", "parse", "parse_spec"]
 
@@ -108,11 +113,15 @@ class ParsedSpec:
     tasks : tuple of Atom
         Task atoms and shorthand instances written in the text, in order of first
         appearance (the candidate task steps of this specification).
+    inputs : tuple of Atom
+        Input propositions written in the text, in order of first appearance (only with
+        ``reactive=True``).
     """
 
     text: str
     formula: Formula
     tasks: tuple[Atom, ...]
+    inputs: tuple[Atom, ...] = ()
 
 
 def _is_ident_start(ch: str) -> bool:
@@ -219,15 +228,18 @@ def _error(text: str, message: str, pos: int) -> SpecError:
 
 class _Parser:
     def __init__(self, text: str, vocab: Vocabulary, free_atoms: bool,
-                 bindings: dict[str, str] | None = None, depth: int = 0) -> None:
+                 bindings: dict[str, str] | None = None, depth: int = 0,
+                 reactive: bool = False) -> None:
         self.text = text
         self.vocab = vocab
         self.free_atoms = free_atoms
         self.bindings = bindings or {}
         self.depth = depth
+        self.reactive = reactive
         self.toks = _Lexer(text).tokens()
         self.i = 0
         self.tasks: list[Atom] = []
+        self.inputs: list[Atom] = []
 
     # ---------------------------------------------------------------- token helpers
     def peek(self) -> _Token:
@@ -324,12 +336,14 @@ class _Parser:
     def quoted(self, tok: _Token) -> Formula:
         inner = tok.value.strip()
         try:
-            sub = _Parser(inner, self.vocab, self.free_atoms, self.bindings, self.depth)
+            sub = _Parser(inner, self.vocab, self.free_atoms, self.bindings, self.depth,
+                          self.reactive)
             name_tok = sub.advance()
             if name_tok.kind == "ident" and sub.toks[-1].kind == "eof":
                 f = sub.predicate(name_tok)
                 if sub.peek().kind == "eof":
                     self.tasks.extend(t for t in sub.tasks if t not in self.tasks)
+                    self.inputs.extend(t for t in sub.inputs if t not in self.inputs)
                     return f
         except SpecError as exc:
             if self.vocab.objects is not None or not self.free_atoms:
@@ -369,23 +383,43 @@ class _Parser:
         if name in self.vocab.shorthands:
             return self.shorthand(tok, args, arg_toks)
         if name in TASK_ARGUMENTS or name == REGION_ATOM:
-            kinds = TASK_ARGUMENTS.get(name, ("region",))
-            if len(args) != len(kinds):
-                wanted = ", ".join(kinds) if kinds else "no arguments"
-                raise self.error(f"task '{name}' takes {len(kinds)} argument"
-                                 f"{'' if len(kinds) == 1 else 's'} ({wanted}), got "
-                                 f"{len(args)}", tok.pos)
-            checked = tuple(self.check_arg(a, t, kind, name)
-                            for a, t, kind in zip(args, arg_toks, kinds))
-            atom = Atom(name, checked)
+            atom = self.typed_atom(tok, "task", TASK_ARGUMENTS.get(name, ("region",)), args,
+                                   arg_toks)
             if name != REGION_ATOM and atom not in self.tasks:
                 self.tasks.append(atom)
             return atom
+        if name in INPUT_ARGUMENTS or name in self.vocab.inputs:
+            return self.input_atom(tok, args, arg_toks)
         if self.free_atoms:
             return Atom(name, tuple(args))
         known = sorted(set(TASK_ARGUMENTS) | {REGION_ATOM} | set(self.vocab.shorthands))
         raise self.error(f"unknown task '{name}'; {did_you_mean(name, known)}expected one of: "
                          f"{', '.join(known)}", tok.pos)
+
+    def input_atom(self, tok: _Token, args: list[str], arg_toks: list[_Token]) -> Atom:
+        name = tok.value
+        if not self.reactive:
+            where = " in the body of a shorthand" if self.depth else ""
+            raise self.error(f"'{name}' is an input (a robot or cell event the worker "
+                             f"observes), not a task the worker can do{where}; inputs "
+                             "belong in a reactive specification "
+                             "(assumptions -> guarantees, `ltl-human-motion react`)", tok.pos)
+        atom = self.typed_atom(tok, "input", INPUT_ARGUMENTS.get(name, ()), args, arg_toks)
+        if atom not in self.inputs:
+            self.inputs.append(atom)
+        return atom
+
+    def typed_atom(self, tok: _Token, what: str, kinds: tuple[str, ...], args: list[str],
+                   arg_toks: list[_Token]) -> Atom:
+        """The atom ``tok(args)`` with its arguments checked against ``kinds``."""
+        name = tok.value
+        if len(args) != len(kinds):
+            wanted = ", ".join(kinds) if kinds else "no arguments"
+            raise self.error(f"{what} '{name}' takes {len(kinds)} argument"
+                             f"{'' if len(kinds) == 1 else 's'} ({wanted}), got "
+                             f"{len(args)}", tok.pos)
+        return Atom(name, tuple(self.check_arg(a, t, kind, name)
+                                for a, t, kind in zip(args, arg_toks, kinds)))
 
     def check_arg(self, value: str, tok: _Token, kind: str, task: str) -> str:
         if kind == "duration":
@@ -440,7 +474,8 @@ class _Parser:
         return formula
 
 
-def parse_spec(text: str, cell: object = None, *, free_atoms: bool = False) -> ParsedSpec:
+def parse_spec(text: str, cell: object = None, *, free_atoms: bool = False,
+               reactive: bool = False) -> ParsedSpec:
     """Parse ``text`` and report the task steps it mentions.
 
     Parameters
@@ -451,6 +486,9 @@ def parse_spec(text: str, cell: object = None, *, free_atoms: bool = False) -> P
         Objects, regions and shorthands; None checks task names and arities only.
     free_atoms : bool
         Accept unknown names as plain propositions (``p0``) instead of raising.
+    reactive : bool
+        Accept input propositions (robot events; :attr:`ParsedSpec.inputs`). Without it
+        an input is refused at its position.
 
     Returns
     -------
@@ -467,16 +505,18 @@ def parse_spec(text: str, cell: object = None, *, free_atoms: bool = False) -> P
         raise SpecError(f"the specification has {len(text)} characters; at most "
                         f"{MAX_SPEC_CHARS} are allowed (MAX_SPEC_CHARS)")
     vocab = vocabulary_from(cell)
-    parser = _Parser(text, vocab, free_atoms)
+    parser = _Parser(text, vocab, free_atoms, reactive=reactive)
     try:
         formula = parser.parse()
     except RecursionError:
         raise SpecError(f"the specification nests operators deeper than {MAX_NESTING} "
                         "(MAX_NESTING)", text=text) from None
     check_formula_limits(formula, text)
-    return ParsedSpec(text=text, formula=formula, tasks=tuple(parser.tasks))
+    return ParsedSpec(text=text, formula=formula, tasks=tuple(parser.tasks),
+                      inputs=tuple(parser.inputs))
 
 
-def parse(text: str, cell: object = None, *, free_atoms: bool = False) -> Formula:
+def parse(text: str, cell: object = None, *, free_atoms: bool = False,
+          reactive: bool = False) -> Formula:
     """Parse an LTL specification into a :class:`Formula` (see :func:`parse_spec`)."""
-    return parse_spec(text, cell, free_atoms=free_atoms).formula
+    return parse_spec(text, cell, free_atoms=free_atoms, reactive=reactive).formula

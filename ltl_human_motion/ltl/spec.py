@@ -121,6 +121,8 @@ class Specification:
     tasks : tuple of Task
         Candidate task steps.
     vocabulary : Vocabulary
+    inputs : tuple of Atom
+        Input propositions of a reactive specification (docs/reactive.md), else empty.
     """
 
     text: str
@@ -128,6 +130,7 @@ class Specification:
     always_on: tuple[tuple[str, Formula], ...]
     tasks: tuple[Atom, ...]
     vocabulary: Vocabulary = field(repr=False)
+    inputs: tuple[Atom, ...] = ()
 
     @cached_property
     def formula(self) -> Formula:
@@ -162,8 +165,8 @@ def _atom_from_key(key: str) -> Atom:
     return Atom(key)
 
 
-def build_specification(text: str, cell: object = None, *,
-                        free_atoms: bool = False) -> Specification:
+def build_specification(text: str, cell: object = None, *, free_atoms: bool = False,
+                        reactive: bool = False) -> Specification:
     """Parse ``text`` (or a name of :data:`PAPER_SPECS`) and add the always-on conjuncts.
 
     Parameters
@@ -172,6 +175,8 @@ def build_specification(text: str, cell: object = None, *,
     cell : CellVocabulary, dict, path or None
     free_atoms : bool
         Accept plain propositions such as ``p0`` (then also candidate task steps).
+    reactive : bool
+        Accept input propositions (robot events, :attr:`Specification.inputs`).
 
     Raises
     ------
@@ -180,7 +185,7 @@ def build_specification(text: str, cell: object = None, *,
     """
     vocab = vocabulary_from(cell)
     text = resolve_spec_text(text)
-    parsed = parse_spec(text, vocab, free_atoms=free_atoms)
+    parsed = parse_spec(text, vocab, free_atoms=free_atoms, reactive=reactive)
     tasks: list[Atom] = []
     for task in parsed.tasks:
         if task.name in vocab.shorthands and _shorthand_atoms(task, vocab) is None:
@@ -191,7 +196,8 @@ def build_specification(text: str, cell: object = None, *,
             tasks.append(task)
     if free_atoms:
         tasks.extend(sorted((a for a in atoms(parsed.formula) if a.name != REGION_ATOM
-                             and a not in tasks and not a.args), key=str))
+                             and a not in tasks and not a.args
+                             and a not in parsed.inputs), key=str))
     tasks = list(dict.fromkeys(tasks))
     letters = [letter_of(t, vocab) for t in tasks]
     always_on: list[tuple[str, Formula]] = []
@@ -212,4 +218,4 @@ def build_specification(text: str, cell: object = None, *,
     if final is not None:
         always_on.append((f"final region {final}", Finally(Atom(REGION_ATOM, (final,)))))
     return Specification(text=text, user_formula=parsed.formula, always_on=tuple(always_on),
-                         tasks=tuple(tasks), vocabulary=vocab)
+                         tasks=tuple(tasks), vocabulary=vocab, inputs=parsed.inputs)

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
 from ltl_human_motion.errors import CellError
-from ltl_human_motion.vocabulary import TASK_ARGUMENTS
+from ltl_human_motion.vocabulary import INPUT_ARGUMENTS, TASK_ARGUMENTS
 
 __all__ = [
     "TASK_SIGNATURES", "CellVocabulary", "Vocabulary", "load_vocabulary", "vocabulary_from",
@@ -39,7 +39,9 @@ class Vocabulary:
     """Names a specification may use.
 
     ``objects``/``regions`` of None mean "not checked" (no cell given).
-    ``shorthands`` maps a name to ``(params, body_text)``.
+    ``shorthands`` maps a name to ``(params, body_text)``. ``inputs`` maps the cell's own
+    Boolean input propositions to their ``std_msgs/Bool`` topics (the built-in inputs
+    of :data:`~ltl_human_motion.vocabulary.INPUT_ARGUMENTS` need no declaration).
     """
 
     objects: frozenset[str] | None = None
@@ -47,6 +49,7 @@ class Vocabulary:
     shorthands: Mapping[str, tuple[tuple[str, ...], str]] = field(default_factory=dict)
     final_region: str | None = None
     source: str = "<cell>"
+    inputs: Mapping[str, str] = field(default_factory=dict)
 
 
 def _names(value: Any, key: str, source: str) -> frozenset[str] | None:
@@ -93,6 +96,25 @@ def _shorthands(value: Any, source: str) -> dict[str, tuple[tuple[str, ...], str
     return out
 
 
+def _inputs(value: Any, source: str, shorthands: Mapping[str, Any]) -> dict[str, str]:
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise CellError(f"{source}: 'inputs' must be a mapping name -> std_msgs/Bool topic, "
+                        f"e.g. {{door_open: /cell/door_open}}")
+    out: dict[str, str] = {}
+    for name, topic in value.items():
+        name = str(name)
+        if name in TASK_ARGUMENTS or name in INPUT_ARGUMENTS or name in shorthands:
+            raise CellError(f"{source}: input '{name}' is already a task, a built-in input "
+                            "or a shorthand; choose another name")
+        if not isinstance(topic, str) or not topic.startswith("/"):
+            raise CellError(f"{source}: input '{name}' needs an absolute topic name such as "
+                            f"/cell/{name}, got {topic!r}")
+        out[name] = topic
+    return out
+
+
 def vocabulary_from(cell: Any) -> Vocabulary:
     """A :class:`Vocabulary` from a cell object, a dict, a YAML path, or None.
 
@@ -123,14 +145,15 @@ def vocabulary_from(cell: Any) -> Vocabulary:
     if final is not None and str(final) not in regions:
         raise CellError(f"{source}: final_region '{final}' is not one of the regions "
                         f"{sorted(regions)}")
-    return Vocabulary(objects=objects, regions=regions,
-                      shorthands=_shorthands(get("shorthands"), source),
-                      final_region=None if final is None else str(final), source=source)
+    shorthands = _shorthands(get("shorthands"), source)
+    return Vocabulary(objects=objects, regions=regions, shorthands=shorthands,
+                      final_region=None if final is None else str(final), source=source,
+                      inputs=_inputs(get("inputs"), source, shorthands))
 
 
 def load_vocabulary(path: str | Path) -> Vocabulary:
     """Read the names of a cell YAML file: the keys ``objects``, ``regions``,
-    ``shorthands`` and ``final_region`` (the geometry is the scene module's to read).
+    ``shorthands``, ``inputs`` and ``final_region`` (the geometry is the scene module's to read).
 
     Raises
     ------

@@ -269,6 +269,9 @@ class Cell:
         The frame the file was written in (``"zup"`` or ``"paper_yup"``); the cell itself
         is always z up.
     description : str
+    inputs : dict of str to str
+        The cell's own Boolean input propositions (robot or cell events a reactive
+        specification reads, docs/reactive.md) and their ``std_msgs/Bool`` topics.
     """
 
     name: str
@@ -284,6 +287,7 @@ class Cell:
     workspace_hi: np.ndarray = field(default_factory=lambda: np.array([5.0, 5.0, 3.0]))
     frame: str = "zup"
     description: str = ""
+    inputs: dict[str, str] = field(default_factory=dict)
 
     # ---------------------------------------------------------------- look-ups
     def region(self, name: str) -> Region:

@@ -24,7 +24,7 @@ from ltl_human_motion.errors import CellError, did_you_mean
 from ltl_human_motion.scene.cell import Cell, Obstacle, Region, SceneObject
 from ltl_human_motion.scene.frames import ZUP_FROM_YUP, extents_zup_from_yup, zup_from_yup
 from ltl_human_motion.scene.shapes import Box, Cylinder, MeshShape, Shape, Sphere
-from ltl_human_motion.vocabulary import TASK_ARGUMENTS, shorthand_conjuncts
+from ltl_human_motion.vocabulary import INPUT_ARGUMENTS, TASK_ARGUMENTS, shorthand_conjuncts
 from ltl_human_motion.yaml_limits import (
     TextFileError,
     YamlLimitError,
@@ -289,7 +289,7 @@ class _Parser:
 
 
 _TOP_KEYS = {"name", "description", "frame", "floor_z", "workspace", "start_region",
-             "final_region", "objects", "regions", "obstacles", "shorthands"}
+             "final_region", "objects", "regions", "obstacles", "shorthands", "inputs"}
 
 
 def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Cell:
@@ -396,10 +396,21 @@ def _parse_cell(data: Any, source: str, base_dir: Path, default_name: str) -> Ce
                                            f"nor an object or region") from None
         shorthands[sname] = (params, body.strip())
 
+    inputs: dict[str, str] = {}
+    for k, topic in section("inputs").items():
+        if k in TASK_ARGUMENTS or k in INPUT_ARGUMENTS or k in shorthands:
+            raise p.error(f"inputs.{k}", "already a task, a built-in input or a shorthand")
+        if k in objects or k in regions:
+            raise p.error(f"inputs.{k}", "already names an object or a region")
+        if not isinstance(topic, str) or not re.fullmatch(r"(/[A-Za-z_][A-Za-z0-9_]*)+", topic):
+            raise p.error(f"inputs.{k}", f"expected the absolute name of a std_msgs/Bool "
+                                         f"topic such as /cell/{k}, got {_r(topic)}")
+        inputs[k] = topic
+
     return Cell(name=name, source=source, objects=objects, regions=regions,
                 obstacles=obstacles, start_region=start, final_region=final,
                 shorthands=shorthands, floor_z=floor_z, workspace_lo=ws_lo,
-                workspace_hi=ws_hi, frame=frame, description=description)
+                workspace_hi=ws_hi, frame=frame, description=description, inputs=inputs)
 
 
 def cell_from_yaml(text: str, source: str = "<inline>",

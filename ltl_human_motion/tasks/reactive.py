@@ -1,0 +1,391 @@
+"""A worker who reacts to the robot: GR(1) strategies over the cell model
+(docs/reactive.md).
+
+:func:`reactive_worker` parses a reactive specification, builds the worker's physical
+model (:class:`~ltl_human_motion.tasks.model.CellModel`: two hands, parts held, posture)
+as a :class:`~ltl_human_motion.ltl.gr1.Plant` whose moves are the specification's tasks
+plus the idle step ``wait(WAIT_STEP)``, and solves the game. An unrealizable
+specification raises :class:`UnrealizableError` naming the guarantee the robot can
+defeat and a counter-strategy in words, before any motion planning.
+
+:func:`random_input_lasso` draws robot behaviours that keep the assumptions and
+:func:`run_strategy` runs the strategy on one: the joint run of a finite strategy on an
+eventually periodic input is eventually periodic, so it is returned as an exact lasso
+that the independent evaluator checks against the whole specification.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ltl_human_motion.errors import SpecError
+from ltl_human_motion.ltl.evaluator import evaluate_lasso
+from ltl_human_motion.ltl.formula import Atom
+from ltl_human_motion.ltl.gr1 import (
+    Gr1Conjunct,
+    Gr1Game,
+    Gr1Spec,
+    Plant,
+    Strategy,
+    input_valuations,
+    split_gr1,
+)
+from ltl_human_motion.ltl.spec import Specification, build_specification, letter_of
+from ltl_human_motion.tasks.model import CellModel, CellState
+
+__all__ = ["MAX_PLANT_STATES", "WAIT_STEP", "JointLasso", "ReactiveWorker",
+           "UnrealizableError", "random_input_lasso", "reactive_worker", "run_strategy"]
+
+#: Length (s) of the idle step ``wait(WAIT_STEP)``: a waiting worker reads the inputs
+#: again after at most this long, so it reacts to an event within WAIT_STEP (a human
+#: reaction time is 0.2-0.3 s).
+WAIT_STEP = 0.3
+
+#: States of the worker's physical model beyond which the game is refused.
+MAX_PLANT_STATES = 5000
+
+#: Steps a strategy run may take before its joint lasso must have closed.
+MAX_RUN_STEPS = 2000
+
+
+class UnrealizableError(SpecError):
+    """No strategy of the worker meets the guarantees against every robot behaviour
+    that keeps the assumptions; the message names the defeated guarantee and how."""
+
+
+@dataclass
+class ReactiveWorker:
+    """A solved reactive specification.
+
+    Attributes
+    ----------
+    specification : Specification
+        The whole specification (always-on conjuncts included), with its inputs.
+    gr1 : Gr1Spec
+        Assumptions and guarantees (the final region's ``F enter(R)`` among them).
+    tasks : tuple of Atom
+        Task of each plant move index (the idle ``wait`` last).
+    plant : Plant
+    game : Gr1Game
+    strategy : Strategy
+    """
+
+    specification: Specification
+    gr1: Gr1Spec
+    tasks: tuple[Atom, ...]
+    plant: Plant
+    game: Gr1Game
+    strategy: Strategy
+
+    def letter(self, inputs: dict[str, bool], task: int) -> frozenset[str]:
+        """The joint letter of one step: true inputs and the task's atoms."""
+        return frozenset(k for k, v in inputs.items() if v) | self.plant.labels[task]
+
+
+@dataclass(frozen=True)
+class JointLasso:
+    """A joint run ``prefix . cycle^omega`` of inputs and the worker's tasks.
+
+    Attributes
+    ----------
+    prefix_inputs, cycle_inputs : tuple of dict
+        Input values per step.
+    prefix_tasks, cycle_tasks : tuple of int
+        Task index per step.
+    """
+
+    prefix_inputs: tuple[dict[str, bool], ...]
+    prefix_tasks: tuple[int, ...]
+    cycle_inputs: tuple[dict[str, bool], ...]
+    cycle_tasks: tuple[int, ...]
+
+
+def _plant(model: CellModel, tasks: tuple[Atom, ...], labels: tuple[frozenset[str], ...]
+           ) -> Plant:
+    """The reachable states of ``model`` under ``tasks`` (breadth first)."""
+    index: dict[CellState, int] = {}
+    order: list[CellState] = []
+
+    def moves_from(state: CellState) -> tuple[tuple[int, int, float], ...]:
+        out = []
+        for k, task in enumerate(tasks):
+            nxt = model.step(state, task)
+            if nxt is None:
+                continue
+            s2, cost = nxt
+            if s2 not in index:
+                if len(order) >= MAX_PLANT_STATES:
+                    raise SpecError(f"the worker's model has more than {MAX_PLANT_STATES} "
+                                    "states with these tasks (MAX_PLANT_STATES); use fewer "
+                                    "parts or tasks")
+                index[s2] = len(order)
+                order.append(s2)
+                queue.append(s2)
+            out.append((k, index[s2], float(cost)))
+        return tuple(out)
+
+    queue: deque[CellState] = deque()
+    initial = moves_from(model.initial_state())
+    moves: dict[int, tuple[tuple[int, int, float], ...]] = {}
+    while queue:
+        state = queue.popleft()
+        moves[index[state]] = moves_from(state)
+    return Plant(labels, initial, tuple(moves[i] for i in range(len(order))))
+
+
+def _input_words(key: str, value: bool) -> str:
+    name, _, rest = key.partition("(")
+    arg = rest.rstrip(")")
+    if name == "robot_in":
+        return f"stays in {arg}" if value else f"stays out of {arg}"
+    if name == "robot_moving":
+        return "keeps moving" if value else "stays still"
+    if name == "offered":
+        return f"keeps offering {arg}" if value else f"never offers {arg}"
+    return f"keeps {key} {'true' if value else 'false'}"
+
+
+def _realizable(spec: Gr1Spec, plant: Plant, fixed: dict[str, bool] | None = None) -> bool:
+    return Gr1Game(spec, plant, fixed).solve()
+
+
+def _with_guarantees(spec: Gr1Spec, guarantees: list[Gr1Conjunct]) -> Gr1Spec:
+    return Gr1Spec(spec.assumptions, tuple(guarantees), spec.inputs)
+
+
+def _minimal_safety(spec: Gr1Spec, plant: Plant, fixed: dict[str, bool] | None,
+                    goal: list[Gr1Conjunct], safety: list[Gr1Conjunct]) -> list[Gr1Conjunct]:
+    """A subset of ``safety`` that with ``goal`` is still unrealizable (deletion)."""
+    kept = list(safety)
+    for c in list(safety):
+        trial = [s for s in kept if s is not c]
+        if not _realizable(_with_guarantees(spec, trial + goal), plant, fixed):
+            kept = trial
+    return kept
+
+
+def explain_unrealizable(spec: Gr1Spec, plant: Plant,
+                         pretty: Callable[[str], str] = str) -> str:
+    """Why ``spec`` is unrealizable on ``plant``: the guarantee the robot can defeat,
+    a counter-strategy in words, and an assumption that would help (``pretty`` rewrites
+    a conjunct's text for the message)."""
+    assumption = spec.assumption_formula()
+    counter: dict[str, bool] | None = None
+    for values in input_valuations(spec.inputs):
+        letter = frozenset(k for k, v in values.items() if v)
+        if evaluate_lasso(assumption, [], [letter]) and not _realizable(spec, plant, values):
+            counter = values
+            break
+    safety = [c for c in spec.guarantees if c.kind in ("init", "safety")]
+    goals = [c for c in spec.guarantees if c.kind in ("liveness", "eventually")]
+    if not _realizable(_with_guarantees(spec, safety), plant, counter):
+        core = _minimal_safety(spec, plant, counter, [], safety)
+        defeated = f"the safety guarantee{'s' if len(core) > 1 else ''} " + \
+            ", ".join(f"'{pretty(c.text)}'" for c in core)
+    else:
+        single = [g for g in goals
+                  if not _realizable(_with_guarantees(spec, [*safety, g]), plant, counter)]
+        if single:
+            core = _minimal_safety(spec, plant, counter, [single[0]], safety)
+            defeated = ("the guarantee " if len(single) == 1 else "each of the guarantees ") \
+                + ", ".join(f"'{pretty(g.text)}'" for g in single) + (
+                    " given " + ", ".join(f"'{pretty(c.text)}'" for c in core) if core else "")
+        else:
+            defeated = "the guarantees " + ", ".join(f"'{pretty(g.text)}'" for g in goals) \
+                + " together"
+    if counter is None:
+        how = ("no fixed robot behaviour suffices: the robot wins by reacting to the "
+               "worker's moves")
+        hint = "add assumptions on how the robot behaves (G F ..., G(... -> X ...))"
+    else:
+        words = [_input_words(k, v) for k, v in counter.items()] or ["does anything"]
+        how = f"the robot {' and '.join(words)} forever"
+        fixes = []
+        for k, v in counter.items():
+            text = f"G F {'!' if v else ''}{k}"
+            body = Atom(*_split_key(k))
+            lit = body if not v else _negate(body)
+            extra = Gr1Spec((*spec.assumptions, Gr1Conjunct("liveness", lit, text)),
+                            spec.guarantees, spec.inputs)
+            if _realizable(extra, plant):
+                fixes.append(text)
+        hint = (f"add an assumption such as {' or '.join(fixes)}" if fixes else
+                "no single recurrence assumption on one input makes it realizable; "
+                "weaken the guarantees or assume more about the robot")
+    return (f"the robot can defeat {defeated} (with the worker's two hands and the parts "
+            f"it holds): {how}; {hint}")
+
+
+def _split_key(key: str) -> tuple[str, tuple[str, ...]]:
+    name, _, rest = key.partition("(")
+    return name, tuple(a.strip() for a in rest.rstrip(")").split(",") if a.strip())
+
+
+def _negate(f: Atom):
+    from ltl_human_motion.ltl.formula import Not
+    return Not(f)
+
+
+def _readable(text: str, specification: Specification) -> str:
+    """A conjunct's text without Spot's quotes, shorthands folded back
+    (``leftHand(R1) & rightHand(R1)`` -> ``assemble(R1)``)."""
+    from ltl_human_motion.ltl.formula import to_spot
+    from ltl_human_motion.ltl.parser import parse_spec
+
+    def plain(t: str) -> str:
+        return re.sub(r'"([^"]*)"', r"\1", t)
+    text = plain(text)
+    for task in specification.tasks:
+        if task.name in specification.vocabulary.shorthands:
+            body = plain(to_spot(parse_spec(task.key, specification.vocabulary).formula))
+            text = text.replace(f"({body})", f" {task.key}").replace(body, task.key)
+    return re.sub(r"([(!])\s+", r"\1", re.sub(r"\s{2,}", " ", text))
+
+
+def reactive_worker(text: str, cell, *, wait_step: float = WAIT_STEP) -> ReactiveWorker:
+    """Parse, check and solve a reactive specification on ``cell``.
+
+    Parameters
+    ----------
+    text : str
+        ``assumptions -> guarantees`` over inputs (robot events) and tasks.
+    cell : Cell
+        The scene cell (its model gives the physics and the costs).
+    wait_step : float
+        Seconds of the idle step the worker may take to wait for the robot.
+
+    Raises
+    ------
+    SpecError
+        Malformed, or not of GR(1) form.
+    UnrealizableError
+        No strategy exists; the message explains why (no motion is planned).
+    """
+    specification = build_specification(text, cell, reactive=True)
+    final = [c for label, c in specification.always_on if label.startswith("final region")]
+    gr1 = split_gr1(specification.user_formula, specification.inputs)
+    if final:
+        from ltl_human_motion.ltl.formula import to_spot
+        gr1 = Gr1Spec(gr1.assumptions, (*gr1.guarantees, Gr1Conjunct(
+            "eventually", final[0].arg, to_spot(final[0]))), gr1.inputs)
+    idle = Atom("wait", (repr(float(wait_step)),))
+    tasks = tuple(dict.fromkeys((*specification.tasks, idle)))
+    labels = tuple(letter_of(t, specification.vocabulary) for t in tasks)
+    plant = _plant(CellModel.from_cell(cell), tasks, labels)
+    game = Gr1Game(gr1, plant)
+    if not game.solve():
+        raise UnrealizableError("unrealizable: " + explain_unrealizable(
+            gr1, plant, lambda t: _readable(t, specification)), text=specification.text)
+    return ReactiveWorker(specification, gr1, tasks, plant, game, game.strategy())
+
+
+def random_input_lasso(worker: ReactiveWorker, rng: np.random.Generator, *,
+                       max_prefix: int = 3, max_cycle: int = 4, tries: int = 500
+                       ) -> tuple[list[dict[str, bool]], list[dict[str, bool]]]:
+    """A seeded random robot behaviour ``prefix . cycle^omega`` that keeps the
+    assumptions: random orders of the input values and random dwell (a value held for
+    several steps), from a random walk on the assumptions' safety, closed into a loop
+    and kept when the evaluator says it meets every assumption.
+
+    Raises
+    ------
+    SpecError
+        When ``tries`` draws found none (assumptions that few behaviours keep).
+    """
+    game = worker.game
+    aut = game.aut
+    names = game.inputs
+    values = list(input_valuations(names))
+    env_init, env_action = aut.init["env"], aut.action["env"]
+
+    def env(v: dict[str, bool], primed: bool = False) -> dict[str, bool]:
+        return {game._env[k] + ("'" if primed else ""): b for k, b in v.items()}
+
+    def ok_init(v: dict[str, bool]) -> bool:
+        return aut.let(env(v), env_init) == aut.true if names else True
+
+    def ok_step(a: dict[str, bool], b: dict[str, bool]) -> bool:
+        return aut.let({**env(a), **env(b, True)}, env_action) == aut.true if names else True
+
+    assumption = worker.gr1.assumption_formula()
+    for _ in range(tries):
+        n_pre = int(rng.integers(0, max_prefix + 1))
+        n_cyc = int(rng.integers(1, max_cycle + 1))
+        starts = [v for v in values if ok_init(v)]
+        if not starts:
+            break
+        word = [starts[int(rng.integers(len(starts)))]]
+        while len(word) < n_pre + n_cyc:
+            nxt = [v for v in values if ok_step(word[-1], v)]
+            if not nxt:
+                break
+            if rng.random() < 0.4 and word[-1] in nxt:
+                word.append(word[-1])           # the robot dwells
+            else:
+                word.append(nxt[int(rng.integers(len(nxt)))])
+        if len(word) < n_pre + n_cyc or not ok_step(word[-1], word[n_pre]):
+            continue
+        pre, cyc = word[:n_pre], word[n_pre:]
+        letters = [frozenset(k for k, b in v.items() if b) for v in word]
+        if evaluate_lasso(assumption, letters[:n_pre], letters[n_pre:]):
+            return pre, cyc
+    raise SpecError(f"no random robot behaviour keeping the assumptions was found in "
+                    f"{tries} draws")
+
+
+def run_strategy(worker: ReactiveWorker, prefix: list[dict[str, bool]],
+                 cycle: list[dict[str, bool]]) -> JointLasso:
+    """Run the strategy from its start on inputs ``prefix . cycle^omega``; the joint run
+    as an exact lasso (it closes when the strategy's state repeats at the same place of
+    the input cycle), as short as the joint word allows.
+
+    Raises
+    ------
+    SpecError
+        When the run has not closed within :data:`MAX_RUN_STEPS` steps.
+    """
+    strategy = worker.strategy
+    strategy.reset()
+    word = list(prefix) + list(cycle)
+    n = len(prefix)
+    seen: dict[tuple, int] = {}
+    inputs: list[dict[str, bool]] = []
+    tasks: list[int] = []
+    pos = 0
+    for i in range(MAX_RUN_STEPS):
+        inputs.append(word[pos])
+        tasks.append(strategy.step(word[pos]))
+        if pos >= n:
+            key = (strategy.memory(), pos)
+            if key in seen:
+                j = seen[key]
+                return _shortest(list(zip(inputs, tasks)), j + 1)
+            seen[key] = i
+        pos = pos + 1 if pos + 1 < len(word) else n
+    raise SpecError(f"the strategy's run did not repeat within {MAX_RUN_STEPS} steps")
+
+
+def _shortest(steps: list[tuple[dict[str, bool], int]], n_prefix: int) -> JointLasso:
+    """The shortest lasso of the same infinite word as ``steps`` (looping back to
+    ``n_prefix``): the cycle cut to its smallest period, the prefix rolled into it."""
+    pre, cyc = steps[:n_prefix], steps[n_prefix:]
+    m = len(cyc)
+    period = next(p for p in range(1, m + 1) if m % p == 0 and cyc == cyc[:p] * (m // p))
+    cyc = cyc[:period]
+    while pre and pre[-1] == cyc[-1]:
+        pre.pop()
+        cyc = [cyc[-1], *cyc[:-1]]
+    return JointLasso(tuple(x for x, _ in pre), tuple(k for _, k in pre),
+                      tuple(x for x, _ in cyc), tuple(k for _, k in cyc))
+
+
+def joint_satisfies(worker: ReactiveWorker, run: JointLasso) -> bool:
+    """Whether the joint run meets the whole specification (independent evaluator)."""
+    pre = [worker.letter(x, k) for x, k in zip(run.prefix_inputs, run.prefix_tasks)]
+    cyc = [worker.letter(x, k) for x, k in zip(run.cycle_inputs, run.cycle_tasks)]
+    return evaluate_lasso(worker.specification.formula, pre, cyc)
