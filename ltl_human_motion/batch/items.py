@@ -126,6 +126,12 @@ def validate_against_cell(specs: BatchSpecs, cell: Cell) -> None:
                 raise BatchConfigError(f"{specs.source}: {section}.{name}: cell {cell.name!r} "
                                        f"has no such {section[:-1]}; known: "
                                        f"{', '.join(sorted(known)) or '(none)'}")
+    named = {*cell.objects, *cell.regions, *(o.name for o in cell.obstacles)}
+    for name in specs.descriptions:
+        if name not in named:
+            raise BatchConfigError(f"{specs.source}: descriptions.{name}: cell {cell.name!r} "
+                                   "has no such object, region or obstacle; known: "
+                                   f"{', '.join(sorted(named))}")
     for i, entry in enumerate(specs.specs):
         try:
             build_specification(entry.spec, cell)

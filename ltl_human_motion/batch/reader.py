@@ -26,7 +26,12 @@ from typing import Any
 import numpy as np
 
 from ltl_human_motion.batch.store import DATASET_FORMAT, DATASET_VERSION
-from ltl_human_motion.batch.worker import ARRAY_NAMES, motion_sha256
+from ltl_human_motion.batch.worker import (
+    ARRAY_NAMES,
+    LABEL_NAMES,
+    labels_sha256,
+    motion_sha256,
+)
 from ltl_human_motion.errors import MotionFormatError
 
 __all__ = ["CorruptDatasetError", "MotionDataset", "MotionItem", "deterministic_record",
@@ -56,6 +61,11 @@ class MotionItem:
     task_index : ndarray of int16, shape (T,)
         Task step per frame, -1 while walking between tasks.
     objects : dict of str to ndarray, shape (T, 3)
+    task_label : ndarray of int16, shape (T,), or None
+        Step of the task sequence each frame works towards (its walk included), -1 after
+        the last; None in datasets of version 1.
+    phase : ndarray of int8, shape (T,), or None
+        Index into the header's ``phases`` (walk, reach, manipulate, transition).
     """
 
     record: dict[str, Any]
@@ -63,6 +73,18 @@ class MotionItem:
     root_yaw: np.ndarray
     task_index: np.ndarray
     objects: dict[str, np.ndarray]
+    task_label: np.ndarray | None = None
+    phase: np.ndarray | None = None
+
+    @property
+    def captions(self) -> list[str]:
+        """The canonical caption first, then paraphrases ([] in version 1 datasets)."""
+        return list(self.record.get("captions") or [])
+
+    @property
+    def ltl(self) -> str:
+        """The LTL specification the motion satisfies."""
+        return str(self.record.get("ltl") or self.record["spec"])
 
     @property
     def index(self) -> int:
@@ -108,8 +130,18 @@ class MotionDataset:
         return self.items(verified_only=False)
 
     def __repr__(self) -> str:
-        return (f"MotionDataset({str(self.root)!r}, {len(self.records)} items, "
-                f"{len(self)} stored)")
+        counts = self.counts()
+        return (f"MotionDataset({str(self.root)!r}, {len(self.records)} items: "
+                f"{counts['ok']} verified, {counts['unverified']} unverified, "
+                f"{counts['failed']} failed; {len(self)} stored)")
+
+    def counts(self) -> dict[str, int]:
+        """Items per status (``ok``, ``unverified``, ``failed``); ``len(self)`` is the
+        number stored (ok and unverified), ``len(self.failed())`` the failed ones."""
+        out = {"ok": 0, "unverified": 0, "failed": 0}
+        for r in self.records:
+            out[r["status"]] = out.get(r["status"], 0) + 1
+        return out
 
     def failed(self) -> list[dict[str, Any]]:
         """Records of failed items (with ``error``: type, message, check)."""
@@ -147,9 +179,18 @@ class MotionDataset:
         if self.verify_checksums and motion_sha256(part) != record["motion_sha256"]:
             raise CorruptDatasetError(f"{self.root / record['shard']}: item "
                                       f"{record['index']} does not match its motion_sha256")
+        labels: dict[str, np.ndarray | None] = dict.fromkeys(LABEL_NAMES)
+        if all(name in arrays for name in LABEL_NAMES):
+            labels = {name: arrays[name][a:b] for name in LABEL_NAMES}
+            expected = record.get("labels_sha256")
+            if self.verify_checksums and expected is not None \
+                    and labels_sha256(labels) != expected:
+                raise CorruptDatasetError(f"{self.root / record['shard']}: item "
+                                          f"{record['index']} does not match its "
+                                          "labels_sha256")
         objects = {n: part["objects"][:, k] for k, n in enumerate(self.object_names)}
         return MotionItem(record, part["positions"], part["root_yaw"], part["task_index"],
-                          objects)
+                          objects, labels["task_label"], labels["phase"])
 
     def verify(self) -> None:
         """Check every shard against its SHA-256 (raises CorruptDatasetError)."""
@@ -181,7 +222,9 @@ class MotionDataset:
                 arrays = {name: z[name] for name in z.files}
         except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
             raise CorruptDatasetError(f"{path}: cannot read shard: {exc}") from exc
-        missing = [n for n in ("item_index", "frame_offsets", *ARRAY_NAMES) if n not in arrays]
+        names = ("item_index", "frame_offsets", *ARRAY_NAMES,
+                 *(LABEL_NAMES if int(self.header.get("version", 1)) >= 2 else ()))
+        missing = [n for n in names if n not in arrays]
         if missing:
             raise CorruptDatasetError(f"{path}: shard lacks arrays {missing}")
         self._shard_path, self._shard = rel, arrays

@@ -116,13 +116,14 @@ def make_job(cell: str | os.PathLike[str], specs: BatchSpecs, dtype: str = "floa
     job = BatchJob(cell_yaml=text, cell_source=str(source), cell_base_dir=str(source.parent),
                    options=dict(specs.options), sequence_mode=specs.sequence_mode,
                    keep_unverified=specs.keep_unverified, dtype=dtype,
-                   statures=specs.statures)
+                   statures=specs.statures, descriptions=dict(specs.descriptions))
     return job, parsed
 
 
 def _header(job: BatchJob, specs: BatchSpecs, cell: Cell, seed: int, count: int,
             shard_size: int) -> dict[str, Any]:
-    from ltl_human_motion.motion.skeleton import JOINT_NAMES
+    from ltl_human_motion.batch.captions import PHASES
+    from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS
     ident = {"job": job.fingerprint(), "specs": specs.fingerprint(), "seed": int(seed),
              "count": int(count), "shard_size": int(shard_size)}
     fingerprint = hashlib.sha256(json.dumps(ident, sort_keys=True).encode()).hexdigest()
@@ -131,7 +132,8 @@ def _header(job: BatchJob, specs: BatchSpecs, cell: Cell, seed: int, count: int,
                      "sha256": hashlib.sha256(job.cell_yaml.encode()).hexdigest()},
             "specs": specs.to_dict(), "seed": int(seed), "count": int(count),
             "shard_size": int(shard_size), "dtype": job.dtype,
-            "joint_names": list(JOINT_NAMES), "object_names": sorted(cell.objects),
+            "joint_names": list(JOINT_NAMES), "joint_parents": list(PARENTS),
+            "object_names": sorted(cell.objects), "phases": list(PHASES),
             "complete": False}
 
 

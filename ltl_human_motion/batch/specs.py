@@ -19,6 +19,8 @@ A specs file is YAML (see ``config/specs_example.yaml``)::
     sequence_mode: random           # task-sequence variations: random | coverage | all
     keep_unverified: false          # keep motions that fail a check (status "unverified")
     options: {max_nodes: 20000}     # SynthesisOptions.from_dict keys
+    descriptions:                   # how captions name things (default: by name)
+      kit: kit tray                 # objects, regions and obstacles of the cell
 
 Statures are drawn from a grid (``min + k * step``) because every body size needs its
 own motion library (built once, ~5 s, then cached on disk). Start poses vary with the
@@ -47,7 +49,7 @@ __all__ = [
 
 SPECS_VERSION = 1
 _TOP_KEYS = {"version", "specs", "cycles", "stature", "objects", "regions", "sequence_mode",
-             "keep_unverified", "options"}
+             "keep_unverified", "options", "descriptions"}
 _SPEC_KEYS = {"name", "spec", "weight", "cycles"}
 _MODES = ("random", "coverage", "all")
 MAX_STATURE_GRID = 81
@@ -113,6 +115,9 @@ class BatchSpecs:
         Keys of :meth:`SynthesisOptions.from_dict`.
     source : str
         File the specs came from (for messages).
+    descriptions : dict of str to str
+        Noun phrases captions use for objects, regions and obstacles of the cell
+        (:mod:`~ltl_human_motion.batch.captions`).
     """
 
     specs: tuple[SpecEntry, ...]
@@ -124,15 +129,19 @@ class BatchSpecs:
     keep_unverified: bool = False
     options: dict[str, Any] = field(default_factory=dict)
     source: str = "<inline>"
+    descriptions: dict[str, str] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """Normalized plain form (no ``source``); the dataset stores it."""
-        return {"version": SPECS_VERSION, "specs": [s.to_dict() for s in self.specs],
-                "cycles": list(self.cycles), "statures": list(self.statures),
-                "objects": {k: self.objects[k].to_dict() for k in sorted(self.objects)},
-                "regions": {k: self.regions[k].to_dict() for k in sorted(self.regions)},
-                "sequence_mode": self.sequence_mode, "keep_unverified": self.keep_unverified,
-                "options": dict(sorted(self.options.items()))}
+        out = {"version": SPECS_VERSION, "specs": [s.to_dict() for s in self.specs],
+               "cycles": list(self.cycles), "statures": list(self.statures),
+               "objects": {k: self.objects[k].to_dict() for k in sorted(self.objects)},
+               "regions": {k: self.regions[k].to_dict() for k in sorted(self.regions)},
+               "sequence_mode": self.sequence_mode, "keep_unverified": self.keep_unverified,
+               "options": dict(sorted(self.options.items()))}
+        if self.descriptions:               # absent otherwise: older fingerprints hold
+            out["descriptions"] = dict(sorted(self.descriptions.items()))
+        return out
 
     def fingerprint(self) -> str:
         """SHA-256 (hex) of the normalized specs."""
@@ -301,12 +310,20 @@ def specs_from_yaml(text: str, source: str = "<inline>") -> BatchSpecs:
         SynthesisOptions.from_dict(dict(options))
     except (ValueError, TypeError) as exc:
         raise chk.error("options", str(exc)) from exc
+    descriptions = data.get("descriptions") or {}
+    if not isinstance(descriptions, Mapping):
+        raise chk.error("descriptions", f"expected a mapping name -> phrase, got "
+                                        f"{descriptions!r}")
+    for k, v in descriptions.items():
+        if not isinstance(v, str) or not v.strip():
+            raise chk.error(f"descriptions.{k}", f"expected a non-empty phrase, got {v!r}")
     return BatchSpecs(
         specs=tuple(entries),
         cycles=chk.int_choices(data.get("cycles", 1), "cycles"),
         statures=chk.statures(data.get("stature", 1.75)),
         objects=jitters["objects"], regions=jitters["regions"], sequence_mode=mode,
-        keep_unverified=keep, options=dict(options), source=source)
+        keep_unverified=keep, options=dict(options), source=source,
+        descriptions={str(k): v.strip() for k, v in descriptions.items()})
 
 
 def load_specs(path: str | os.PathLike[str]) -> BatchSpecs:

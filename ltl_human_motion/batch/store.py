@@ -1,6 +1,6 @@
 """On-disk layout of a motion dataset, written crash-safely by one process (the driver).
 
-Layout of ``out/``::
+Layout of ``out/`` (docs/datasets.md describes every file and field)::
 
     dataset.json                    header: format, job fingerprint, specs, seed, count,
                                     shard size, joint and object names; at the end also
@@ -9,29 +9,34 @@ Layout of ``out/``::
     shards/shard-000001.npz         columnar arrays of items [100, 200)
     shards/shard-000001.json        the shard's records and SHA-256 (commit marker)
     manifest.jsonl                  every record sorted by index (rebuilt at the end)
+    .lock                           held by the run writing the folder
 
 Every file is written atomically (temporary file, fsync, rename). An item counts as done
 when its staged file or its shard's ``.json`` exists, so a run killed at any point and
 started again recomputes only unfinished items. A shard is packed when all its items are
 staged: its ``.npz`` is written, then its ``.json`` (the commit), then the staged files are
 removed; a crash in between leaves the staged files, from which the shard is rebuilt
-(byte-identical: shard files hold no timing data).
+(byte-identical: shard files hold no timing data). A complete run removes ``staging/``
+and ``.lock``.
 
 Shard arrays (F = total frames of the shard's stored items, n = their number):
 ``item_index`` (n,) int64, ``frame_offsets`` (n + 1,) int64, ``positions`` (F, J, 3),
-``root_yaw`` (F,), ``task_index`` (F,) int16 and ``objects`` (F, N, 3). Item ``k`` is
-rows ``frame_offsets[k]:frame_offsets[k + 1]``. Failed items have records but no rows.
+``root_yaw`` (F,), ``task_index`` (F,) int16, ``objects`` (F, N, 3), ``task_label``
+(F,) int16 and ``phase`` (F,) int8 (version 2). Item ``k`` is rows
+``frame_offsets[k]:frame_offsets[k + 1]``. Failed items have records but no rows.
 
 A record holds ``index``, ``status`` (ok | unverified | failed), ``spec_name``, ``spec``,
-``seed``, ``params`` (cycles, stature, object/region offsets), ``sequence``, ``lasso``,
-``duration``, ``n_frames``, ``fps``, ``start_pose`` (x, y, yaw), ``nodes_expanded``,
-``verified``, ``verification`` (every check), ``motion_sha256``, ``error`` (type,
-message, check, task), ``shard``, ``row``, ``shard_sha256`` and ``timing`` (compute and
-CPU times, worker: the only part that differs between runs).
+``ltl``, ``seed``, ``params`` (cycles, stature, object/region offsets), ``sequence``,
+``lasso``, ``duration``, ``n_frames``, ``fps``, ``start_pose`` (x, y, yaw),
+``nodes_expanded``, ``verified``, ``verification`` (every check), ``realism``,
+``motion_sha256``, ``captions``, ``steps``, ``labels_sha256``, ``error`` (type, message,
+check, task), ``shard``, ``row``, ``shard_sha256`` and ``timing`` (compute and CPU times,
+worker: the only part that differs between runs).
 """
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import functools
 import hashlib
@@ -48,14 +53,14 @@ import numpy as np
 
 from ltl_human_motion.atomic import atomic_write_bytes, atomic_write_text
 from ltl_human_motion.batch.specs import BatchConfigError
-from ltl_human_motion.batch.worker import ARRAY_NAMES, ItemResult
+from ltl_human_motion.batch.worker import STORED_NAMES, ItemResult
 from ltl_human_motion.errors import LtlHumanMotionError
 
 __all__ = ["DATASET_FORMAT", "DATASET_VERSION", "BatchOutputError", "DatasetStore",
            "npz_bytes_of", "shard_name"]
 
 DATASET_FORMAT = "ltl_human_motion.motion_dataset"
-DATASET_VERSION = 1
+DATASET_VERSION = 2
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 _ITEM_FILE = re.compile(r"^item-(\d{10})\.npz$")
 _SHARD_JSON = re.compile(r"^shard-(\d{6})\.json$")
@@ -192,21 +197,40 @@ class DatasetStore:
         return True
 
     def _lock(self) -> None:
-        """Hold an exclusive lock on ``out/.lock`` (released when the process ends)."""
+        """Hold an exclusive lock on ``out/.lock`` (released when the process ends).
+
+        A finished run removes the file while it holds the lock; a run that locked the
+        removed file (opened just before) sees that the path no longer names it and
+        locks the new one instead."""
         import fcntl
-        # Held (not a context manager) until close() or the end of the process.
-        self._lock_fh = open(self.root / ".lock", "a+b")
-        try:
-            fcntl.flock(self._lock_fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
+        path = self.root / ".lock"
+        while True:
+            # Held (not a context manager) until close() or the end of the process.
+            self._lock_fh = open(path, "a+b")
+            try:
+                fcntl.flock(self._lock_fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                self._lock_fh.close()
+                raise BatchConfigError(f"{self.root}: another batch run is writing to this "
+                                       "folder") from None
+            try:
+                same = os.stat(path).st_ino == os.fstat(self._lock_fh.fileno()).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                return
             self._lock_fh.close()
-            raise BatchConfigError(f"{self.root}: another batch run is writing to this "
-                                   "folder") from None
 
     def close(self) -> None:
-        """Release the folder lock."""
+        """Release the folder lock; after :meth:`finalize` remove ``.lock`` and the empty
+        ``staging/`` folder, so a finished dataset holds only its own files."""
         fh = getattr(self, "_lock_fh", None)
         if fh is not None and not fh.closed:
+            if getattr(self, "_finished", False):
+                with contextlib.suppress(OSError):
+                    self.staging.rmdir()
+                with contextlib.suppress(OSError):
+                    (self.root / ".lock").unlink()
             fh.close()
 
     def _write_header(self, header: dict[str, Any]) -> None:
@@ -268,7 +292,7 @@ class DatasetStore:
                           allow_nan=False)
         entries: list[tuple[str, np.ndarray]] = [("meta", np.array(text))]
         if result.arrays is not None:
-            entries += [(name, result.arrays[name]) for name in ARRAY_NAMES]
+            entries += [(name, result.arrays[name]) for name in STORED_NAMES]
         atomic_write_bytes(self._item_path(result.index), npz_bytes_of(entries))
         meta = json.loads(text)                 # as a read-back would give it
         self._staged_here[result.index] = (meta["record"], meta["timing"], result.arrays)
@@ -280,7 +304,7 @@ class DatasetStore:
         path = self._item_path(index)
         with np.load(path, allow_pickle=False) as z:
             meta = json.loads(str(z["meta"].reshape(-1)[0]))
-            arrays = ({n: z[n] for n in ARRAY_NAMES} if "positions" in z.files else None)
+            arrays = ({n: z[n] for n in STORED_NAMES} if "positions" in z.files else None)
         return meta["record"], meta["timing"], arrays
 
     def shard_complete(self, shard: int, staged: set[int]) -> bool:
@@ -308,8 +332,9 @@ class DatasetStore:
         n_objects = len(self.header["object_names"])
         empty = {"positions": np.zeros((0, n_joints, 3), dtype),
                  "root_yaw": np.zeros((0,), dtype), "task_index": np.zeros((0,), np.int16),
-                 "objects": np.zeros((0, n_objects, 3), dtype)}
-        for name in ARRAY_NAMES:
+                 "objects": np.zeros((0, n_objects, 3), dtype),
+                 "task_label": np.zeros((0,), np.int16), "phase": np.zeros((0,), np.int8)}
+        for name in STORED_NAMES:
             parts = [a[name] for _, a in stored]
             entries.append((name, np.concatenate(parts) if parts else empty[name]))
         data = npz_bytes_of(entries)
@@ -361,4 +386,5 @@ class DatasetStore:
         atomic_write_text(self.root / "manifest.jsonl", "".join(f"{ln}\n" for ln in lines))
         header = dict(self.header, complete=True, counts=counts, shards=shards)
         self._write_header(header)
+        self._finished = True
         return counts

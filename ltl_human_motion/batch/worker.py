@@ -24,11 +24,17 @@ import numpy as np
 from ltl_human_motion.batch.items import ItemParams, cell_for_item
 from ltl_human_motion.batch.memory import keep_freed_memory
 
-__all__ = ["ARRAY_NAMES", "BatchJob", "ItemResult", "motion_sha256", "pool_initializer",
-           "prepare_worker", "run_item"]
+__all__ = ["ARRAY_NAMES", "LABEL_NAMES", "STORED_NAMES", "BatchJob", "ItemResult",
+           "labels_sha256", "motion_sha256", "pool_initializer", "prepare_worker",
+           "run_item"]
 
-#: Per-item arrays, in the order they are hashed and stored.
+#: Per-item motion arrays, in the order they are hashed (``motion_sha256``) and stored.
 ARRAY_NAMES = ("positions", "root_yaw", "task_index", "objects")
+#: Per-frame label arrays (``labels_sha256``), stored after the motion arrays.
+LABEL_NAMES = ("task_label", "phase")
+STORED_NAMES = ARRAY_NAMES + LABEL_NAMES
+#: Captions per item: the canonical sentence and paraphrases.
+N_CAPTIONS = 4
 DTYPES = ("float32", "float64")
 #: Libraries kept preloaded per worker (each is ~80 MB in memory).
 PRELOAD_LIMIT = 8
@@ -58,6 +64,8 @@ class BatchJob:
         Storage type of positions, yaw and object tracks.
     statures : tuple of float
         The stature grid (libraries are preloaded when it is small).
+    descriptions : dict of str to str
+        Names captions use for things of the cell (the specs file's ``descriptions``).
     assess : dict or None
         Settings of a per-item assessment (:func:`ltl_human_motion.study.item.assess_item`:
         ergonomics, cycle time, offline SSM) whose figures go into ``record["study"]``;
@@ -73,6 +81,7 @@ class BatchJob:
     dtype: str = "float32"
     statures: tuple[float, ...] = (1.75,)
     assess: dict[str, Any] | None = None
+    descriptions: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.dtype not in DTYPES:
@@ -85,6 +94,8 @@ class BatchJob:
                 "keep_unverified": self.keep_unverified, "dtype": self.dtype}
         if self.assess is not None:
             data["assess"] = self.assess
+        if self.descriptions:
+            data["descriptions"] = self.descriptions
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode("utf-8")).hexdigest()
 
     def synthesis_options(self):
@@ -114,8 +125,9 @@ class ItemResult:
         Compute times and the worker (differ between runs).
     arrays : dict of str to ndarray or None
         ``positions`` (T, J, 3), ``root_yaw`` (T,), ``task_index`` (T,) int16,
-        ``objects`` (T, N, 3) with N = objects of the cell sorted by name; None when
-        the item failed.
+        ``objects`` (T, N, 3) with N = objects of the cell sorted by name,
+        ``task_label`` (T,) int16 and ``phase`` (T,) int8
+        (:mod:`~ltl_human_motion.batch.captions`); None when the item failed.
     """
 
     record: dict[str, Any]
@@ -131,18 +143,22 @@ class ItemResult:
 
 _CELLS: dict[str, Any] = {}
 _OPTIONS: dict[str, Any] = {}
+_NAMES: dict[str, Any] = {}
 
 
 def _cell_and_options(job: BatchJob) -> tuple[Any, Any]:
     key = job.fingerprint()
     if key not in _CELLS:
+        from ltl_human_motion.batch.captions import CellNames
         from ltl_human_motion.scene.cell import cell_from_yaml
         if len(_CELLS) > 4:
             _CELLS.clear()
             _OPTIONS.clear()
+            _NAMES.clear()
         _CELLS[key] = cell_from_yaml(job.cell_yaml, source=job.cell_source,
                                      base_dir=job.cell_base_dir)
         _OPTIONS[key] = job.synthesis_options()
+        _NAMES[key] = CellNames.from_cell(_CELLS[key], job.descriptions)
     return _CELLS[key], _OPTIONS[key]
 
 
@@ -204,14 +220,35 @@ def _plain(value: Any) -> Any:
     return str(value)
 
 
-def motion_sha256(arrays: dict[str, np.ndarray]) -> str:
-    """SHA-256 (hex) over the item arrays: names, dtypes, shapes and bytes, in order."""
+def _sha256_of(arrays: dict[str, np.ndarray], names: tuple[str, ...]) -> str:
     h = hashlib.sha256()
-    for name in ARRAY_NAMES:
+    for name in names:
         arr = np.ascontiguousarray(arrays[name])
         h.update(f"{name}|{arr.dtype.str}|{arr.shape}|".encode())
         h.update(arr.tobytes())
     return h.hexdigest()
+
+
+def motion_sha256(arrays: dict[str, np.ndarray]) -> str:
+    """SHA-256 (hex) over the item arrays: names, dtypes, shapes and bytes, in order."""
+    return _sha256_of(arrays, ARRAY_NAMES)
+
+
+def labels_sha256(arrays: dict[str, np.ndarray]) -> str:
+    """SHA-256 (hex) over the label arrays (:data:`LABEL_NAMES`), as :func:`motion_sha256`."""
+    return _sha256_of(arrays, LABEL_NAMES)
+
+
+def _annotate(synth, names, record: dict[str, Any]) -> dict[str, np.ndarray]:
+    """Captions and goal steps into ``record``; the per-frame label arrays."""
+    from ltl_human_motion.batch.captions import GoalStep, captions, frame_labels
+    steps = [GoalStep.from_dict(d) for d in synth.stats.get("steps", [])]
+    labels = frame_labels(synth.n_frames, [seg.end_frame for seg in synth.timeline], steps,
+                          synth.stats.get("segments", []), synth.positions, synth.fps)
+    record["steps"] = [s.to_dict() for s in steps]
+    record["captions"] = captions(synth.sequence, steps, names, int(record["seed"]),
+                                  N_CAPTIONS, labels.phase, synth.fps)
+    return {"task_label": labels.task, "phase": labels.phase}
 
 
 def _arrays(synth, dtype: str) -> dict[str, np.ndarray]:
@@ -244,12 +281,15 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
     from ltl_human_motion.planning.pipeline import get_library, synthesize
 
     t0, c0 = time.perf_counter(), time.process_time()
+    from ltl_human_motion.ltl.spec import PAPER_SPECS
+
     record: dict[str, Any] = {
         "index": item.index, "spec_name": item.spec_name, "spec": item.spec,
-        "seed": item.seed, "params": item.params_dict(), "status": "failed",
+        "ltl": PAPER_SPECS.get(item.spec.strip(), item.spec), "seed": item.seed, "params": item.params_dict(), "status": "failed",
         "sequence": None, "lasso": None, "duration": None, "n_frames": None, "fps": None,
         "verified": False, "verification": None, "motion_sha256": None, "error": None,
-        "nodes_expanded": None, "start_pose": None}
+        "nodes_expanded": None, "start_pose": None, "captions": None, "steps": None,
+        "labels_sha256": None}
     timing: dict[str, Any] = {"worker": f"{socket.gethostname()}:{os.getpid()}"}
     arrays = None
     try:
@@ -283,6 +323,8 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
     if verified or job.keep_unverified:
         arrays = _arrays(synth, job.dtype)
         record["motion_sha256"] = motion_sha256(arrays)
+        arrays.update(_annotate(synth, _NAMES[job.fingerprint()], record))
+        record["labels_sha256"] = labels_sha256(arrays)
         record["status"] = "ok" if verified else "unverified"
     if not verified:
         record["error"] = {"type": "VerificationError", "message": detail,

@@ -35,6 +35,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dtype", choices=("float32", "float64"), default="float32",
                         help="storage type of positions and tracks (default float32)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    parser.add_argument("--export-bvh", type=Path, default=None, metavar="DIR",
+                        help="when complete, also write one BVH per stored motion and "
+                             "items.jsonl (captions) to DIR (docs/datasets.md)")
+    parser.add_argument("--export-windows", type=Path, default=None, metavar="FILE.npz",
+                        help="when complete, also write fixed-length windows (positions, "
+                             "captions, labels) to one npz (docs/datasets.md)")
+    parser.add_argument("--window", type=int, nargs=3, default=(64, 32, 4),
+                        metavar=("LENGTH", "STRIDE", "STEP"),
+                        help="windows of --export-windows: frames per window, frames "
+                             "between starts, keep every STEP-th frame (default 64 32 4: "
+                             "2.1 s at 30 fps)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -47,6 +58,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"ltl-human-motion batch: error: --{name.replace('_', '-')} must be >= 1",
                   file=sys.stderr)
             return 2
+    if min(args.window) < 1:
+        print("ltl-human-motion batch: error: --window values must be >= 1", file=sys.stderr)
+        return 2
     if args.workers is not None and args.workers < 0:
         print("ltl-human-motion batch: error: --workers must be >= 0", file=sys.stderr)
         return 2
@@ -60,9 +74,30 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"ltl-human-motion batch: error: {exc}", file=sys.stderr)
         return 2
-    print(json.dumps(summary.to_dict(), indent=1))
+    result = summary.to_dict()
+    if summary.complete:
+        try:
+            result.update(_exports(args))
+        except (ValueError, OSError) as exc:
+            print(f"ltl-human-motion batch: error: export: {exc}", file=sys.stderr)
+            return 2
+    print(json.dumps(result, indent=1))
     if not summary.complete:
         print(f"ltl-human-motion batch: {len(summary.lost)} items were lost with their "
               "workers; run the same command again to finish", file=sys.stderr)
         return 1
     return 0
+
+
+def _exports(args: argparse.Namespace) -> dict[str, object]:
+    """The exports asked for (``--export-bvh``, ``--export-windows``) of the finished run."""
+    from ltl_human_motion.batch.export import WindowSpec, export_bvh, export_windows
+    out: dict[str, object] = {}
+    if args.export_windows is not None:
+        spec = WindowSpec(*(int(v) for v in args.window))
+        out["windows"] = {"file": str(args.export_windows),
+                          "count": export_windows(args.out, args.export_windows, spec)}
+    if args.export_bvh is not None:
+        out["bvh"] = {"folder": str(args.export_bvh),
+                      "count": len(export_bvh(args.out, args.export_bvh))}
+    return out

@@ -563,6 +563,25 @@ def _blended(plan: Plan, floor_cell, floor_z: float, library, realism: bool,
                              sequence=sequence, seed=int(seed)), held, spans
 
 
+def _step_frames(plan: Plan, spans: list[tuple[int, int]]) -> list[dict[str, Any]]:
+    """Every goal step of ``plan`` (sub-steps before their step) with its sequence
+    index, hand and frames of the motion: ``goal`` [start, end) of its goal primitive,
+    ``contact`` (the task's condition first holds) and ``lift`` (a grasp carries from)."""
+    out = []
+    for i, step in enumerate(plan.steps):
+        for sub in (*step.sub_steps, step):
+            if sub.goal_segment is None:
+                continue
+            a, b = spans[sub.goal_segment]
+            out.append({"step": i, "task": sub.task, "kind": sub.kind, "hand": sub.hand,
+                        "goal": [int(a), int(b)],
+                        "contact": None if sub.contact_frame is None
+                        else min(a + int(sub.contact_frame), b - 1),
+                        "lift": None if sub.lift_frame is None
+                        else min(a + int(sub.lift_frame), b - 1)})
+    return out
+
+
 def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, variant,
                     options, t_automaton, t_sequence, t_library, stature, failed=None
                     ) -> SynthesizedMotion:
@@ -631,6 +650,7 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
                              "walk_primitives": s.walk_segments, "expanded": s.expanded}
                             for i, s in enumerate(plan.steps)],
         "start_pose": list(plan.start_pose),
+        "steps": _step_frames(plan, spans),
         "segments": [[seg.name, int(a), int(b)] for seg, (a, b) in zip(plan.segments, spans)],
         "realism": realism_summary(motion.positions, library.fps, stature, cell.floor_z),
         "foot_locking": bool(realism),
