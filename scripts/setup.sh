@@ -52,7 +52,8 @@ fi
 # 3. Build the interfaces (and tf2_msgs where the environment lacks it) with colcon.
 IFACE_HASH=$(hash_of package.xml CMakeLists.txt msg/*.msg srv/*.srv compat/tf2_msgs/msg/* \
   compat/tf2_msgs/CMakeLists.txt compat/tf2_msgs/package.xml compat/hri_msgs/msg/* \
-  compat/hri_msgs/CMakeLists.txt compat/hri_msgs/package.xml requirements.txt)
+  compat/hri_msgs/CMakeLists.txt compat/hri_msgs/package.xml compat/diagnostic_msgs/msg/* \
+  compat/diagnostic_msgs/CMakeLists.txt compat/diagnostic_msgs/package.xml requirements.txt)
 if ! stamp_ok interfaces "$IFACE_HASH" || [ ! -f "$BUILD/install/setup.bash" ]; then
   log "building interfaces with colcon"
   (
@@ -73,6 +74,9 @@ if ! stamp_ok interfaces "$IFACE_HASH" || [ ! -f "$BUILD/install/setup.bash" ]; 
     fi
     if ! "$VENV/bin/python" -c "import hri_msgs.msg" >/dev/null 2>&1; then
       cp -r compat/hri_msgs "$STAGE/hri_msgs"
+    fi
+    if ! "$VENV/bin/python" -c "import diagnostic_msgs.msg" >/dev/null 2>&1; then
+      cp -r compat/diagnostic_msgs "$STAGE/diagnostic_msgs"
     fi
     "$VENV/bin/colcon" --log-base "$BUILD/log" build \
       --merge-install --base-paths "$STAGE" --build-base "$BUILD/build" --install-base "$BUILD/install" \

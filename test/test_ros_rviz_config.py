@@ -36,6 +36,7 @@ NOT_SHOWN = {
     "sensor_msgs/msg/JointState": "shown through TF (the RobotModel's links)",
     "geometry_msgs/msg/TwistStamped": "no display in rviz_default_plugins",
     "hri_msgs/msg/IdsList": "a list of ids",
+    "diagnostic_msgs/msg/DiagnosticArray": "rqt_robot_monitor's, not RViz's",
 }
 
 

@@ -101,7 +101,7 @@ class BringupConfig:
 
     def topics(self) -> dict[str, str]:
         """The topics the node set publishes, name -> type (for recording)."""
-        out: dict[str, str] = {}
+        out: dict[str, str] = {"/diagnostics": "diagnostic_msgs/msg/DiagnosticArray"}
         specs = self.node_specs()
         if any(s.executable == "synthesis_node" for s in specs):
             out["/motion_catalog"] = f"{PACKAGE}/msg/MotionCatalog"

@@ -80,6 +80,7 @@ from ltl_human_motion.robot.metrics import DecisionRecorder, write_commissioning
 from ltl_human_motion.robot.ssm import SLIDER_MIN, SSMParameters
 from ltl_human_motion.ros import conversions as cv
 from ltl_human_motion.ros.common import STREAM_QOS, TF_QOS, TF_STATIC_QOS
+from ltl_human_motion.ros.diagnostics import ERROR, OK, Status, attach_diagnostics
 from ltl_human_motion.ros.occupancy_decode import decode_human_occupancy, occupancy_from_message
 from ltl_human_motion.ros.params import (
     ParamSpec,
@@ -334,11 +335,29 @@ class CoexistenceNode(Node):
         self._thread = threading.Thread(target=self._control_loop, name="coexistence-control",
                                         daemon=True)
         self._thread.start()
+        attach_diagnostics(self, self.diagnostics)
         mode = "predictive" if self.use_prediction else "reactive"
         self.get_logger().info(
             f"{self.model.name} at {p('robot_host')}: {mode} SSM at {self.rate:g} Hz, "
             f"S_p = {self.params.protective_distance:.3f} m, occupancy from "
             f"{p('occupancy_topic')}")
+
+    def diagnostics(self) -> list[Status]:
+        """The robot connection for ``/diagnostics``: ERROR when the control thread ended
+        or the controller is not connected (the robot then gets no speed commands)."""
+        d = self._latest
+        host = self.param("robot_host")
+        values = {"robot_host": host, "steps": str(self.steps),
+                  "humans": str(len(self.humans))}
+        if d is not None:
+            values.update(mode=d.mode, slider=f"{d.slider:.3f}",
+                          separation_m=f"{d.separation:.3f}")
+        if not self.control_alive:
+            return [Status("robot connection", ERROR, "control loop stopped", values)]
+        if d is None or not d.connected:
+            return [Status("robot connection", ERROR,
+                           f"not connected to the robot controller at {host}", values)]
+        return [Status("robot connection", OK, f"connected to {host} ({d.mode})", values)]
 
     def _report_refusal(self, message: str) -> None:
         """ur_rtde's bare "connect: Connection refused", as a throttled ROS warning."""

@@ -55,10 +55,12 @@ from visualization_msgs.msg import MarkerArray
 from ltl_human_motion.msg import HumanOccupancy, MotionCatalog, TaskState
 from ltl_human_motion.ros import conversions as cv
 from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS, now_seconds, stamp_seconds
+from ltl_human_motion.ros.diagnostics import OK, WARN, Status, attach_diagnostics
 from ltl_human_motion.ros.motion_store import MotionSource, MotionStore
 from ltl_human_motion.ros.occupancy_cdr import capsule_rows, encode_occupancy_rows
 from ltl_human_motion.ros.params import (
     ParamSpec,
+    bounded,
     declare_parameters,
     frame_id,
     identifier,
@@ -84,6 +86,7 @@ _ROWS_KEY = "occupancy_capsule_rows"
 DEFAULT_STREAM_PRIORITY = 0
 
 
+@bounded(0, 99, "an integer 0..99")
 def _priority(value: Any) -> str | None:
     ok = isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= 99
     return None if ok else f"expected an integer 0..99, got {value!r}"
@@ -198,6 +201,8 @@ class OccupancyNode(Node):
         self._marker_timer = None
         self._set_marker_timer(self.param("marker_rate"))
         self.add_post_set_parameters_callback(self._on_parameters_set)
+        self._missed_reported = 0
+        attach_diagnostics(self, self.diagnostics)
         mode = "following task_state" if self.following else "sharing the playback clock"
         if self._schedule is not None and self._schedule.realtime:
             mode += f", stream thread SCHED_FIFO {self._schedule.priority}"
@@ -231,6 +236,17 @@ class OccupancyNode(Node):
             f"occupancy stream of human {self.human_id} missed {self.deadlines_missed} "
             f"deadline(s) so far (this tick {late * 1e3:.1f} ms late, "
             f"{skipped} message(s) skipped)", throttle_duration_sec=MISS_WARNING_PERIOD)
+
+    def diagnostics(self) -> list[Status]:
+        """The stream's deadlines for ``/diagnostics``: WARN when some were missed since
+        the previous report."""
+        missed = self.deadlines_missed
+        new, self._missed_reported = missed - self._missed_reported, missed
+        message = f"{new} deadline(s) missed since the last report" if new else "on time"
+        return [Status("occupancy stream", WARN if new else OK, message, {
+            "rate_hz": f"{self.param('rate'):g}", "deadlines_missed": str(missed),
+            "worst_late_ms": f"{self.worst_late * 1e3:.1f}",
+            "messages_published": str(self.messages_published)})]
 
     def stream_record(self) -> np.ndarray:
         """The stream's recent ticks: array (n, 2) of each tick's slot (due time) and

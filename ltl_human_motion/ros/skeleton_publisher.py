@@ -63,6 +63,7 @@ from ltl_human_motion.ros.common import (
     now_seconds,
     resolve_cell,
 )
+from ltl_human_motion.ros.diagnostics import OK, Status, attach_diagnostics
 from ltl_human_motion.ros.hri import BodyInterface
 from ltl_human_motion.ros.motion_store import MotionSource, MotionStore, check_motion_id
 from ltl_human_motion.ros.params import (
@@ -169,6 +170,7 @@ class SkeletonPublisher(Node):
         self._body_every = 1
         self._set_body_every(self.param("publish_rate"))
         self.add_post_set_parameters_callback(self._on_parameters_set)
+        attach_diagnostics(self, self.diagnostics)
         self._publish_static_frames()
         self._publish_scene()
         wanted = self.param("motion_id")
@@ -180,6 +182,14 @@ class SkeletonPublisher(Node):
 
     def param(self, name: str) -> Any:
         return self.get_parameter(name).value
+
+    def diagnostics(self) -> list[Status]:
+        """The playback state for ``/diagnostics`` (always OK: stopped is a state)."""
+        state = self.playback.state(now_seconds(self))
+        motion = self.playback.motion_id if state != STOPPED else ""
+        return [Status("playback", OK, f"{state} {motion}".strip(), {
+            "state": state, "motion_id": motion, "rate": f"{self.playback.rate:g}",
+            "loop": str(self.playback.loop).lower()})]
 
     # -- inputs ---------------------------------------------------------------------------
     def _load_cell(self, name: str) -> Any:

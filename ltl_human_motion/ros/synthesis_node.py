@@ -64,6 +64,7 @@ from ltl_human_motion.ltl.limits import MAX_SPEC_CHARS
 from ltl_human_motion.motion.library import MAX_LIBRARY_STATURE, MIN_LIBRARY_STATURE
 from ltl_human_motion.msg import MotionCatalog, PlanningStats
 from ltl_human_motion.ros.common import LATCHED_QOS, resolve_cell
+from ltl_human_motion.ros.diagnostics import OK, WARN, Status, attach_diagnostics
 from ltl_human_motion.ros.motion_store import MotionStore, default_store_dir
 from ltl_human_motion.ros.params import ParamSpec, declare_parameters, positive
 from ltl_human_motion.ros.playback import task_sequence_text
@@ -209,6 +210,7 @@ class SynthesisNode(Node):
                          for i in range(int(p("max_concurrent").value))]
         for worker in self._workers:
             worker.start()
+        attach_diagnostics(self, self.diagnostics)
         self._publish_catalog()
         where = self.store.directory or "memory only"
         self.get_logger().info(
@@ -220,6 +222,17 @@ class SynthesisNode(Node):
     def queued(self) -> int:
         """Requests waiting for a worker."""
         return self._queue.qsize()
+
+    def diagnostics(self) -> list[Status]:
+        """The synthesis queue for ``/diagnostics``: WARN when full (new requests are
+        refused as busy)."""
+        queued, running = self.queued, len(self._running)
+        full = queued >= self.max_queued
+        message = f"{queued} queued, {running} running" + (" (full: refusing)" if full else "")
+        return [Status("synthesis queue", WARN if full else OK, message, {
+            "queued": str(queued), "max_queued": str(self.max_queued),
+            "running": str(running), "workers": str(len(self._workers)),
+            "served": str(self.requests_served), "refused": str(self.requests_refused)})]
 
     def _on_request(self, request: SynthesizeMotion.Request,
                     response: SynthesizeMotion.Response) -> SynthesizeMotion.Response:
