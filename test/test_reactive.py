@@ -15,12 +15,17 @@ from ltl_human_motion.ltl import build_specification, parse_spec
 from ltl_human_motion.ltl.gr1 import split_gr1
 from ltl_human_motion.scene.cell_yaml import cell_from_yaml, resolve_cell
 from ltl_human_motion.tasks.model import CellModel
+from ltl_human_motion.robot.events import robot_events
 from ltl_human_motion.tasks.reactive import (
+    WAIT_STEP,
     UnrealizableError,
+    draw_run,
     joint_satisfies,
+    keeps_assumptions,
     random_input_lasso,
     reactive_worker,
     run_strategy,
+    timed_run,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -137,6 +142,39 @@ def test_strategy_reacts_to_the_robot_and_keeps_the_whole_spec(worker):
     assert saw_wait_for_robot
 
 
+def test_a_timed_robot_in_r1_makes_the_worker_wait_then_assemble(worker):
+    def events(t: float) -> dict[str, bool]:
+        return {"robot_in(R1)": 4.0 <= t < 12.0}
+    run, ends = timed_run(worker, events, 12.0)
+    assert keeps_assumptions(worker, run) and joint_satisfies(worker, run)
+    steps = [(x["robot_in(R1)"], worker.tasks[k].key, t) for x, k, t in
+             zip([*run.prefix_inputs, *run.cycle_inputs],
+                 [*run.prefix_tasks, *run.cycle_tasks], ends)]
+    assert steps[0][:2] == (True, "grasp(O1)")          # the grasp ends at 6.9 s, robot in R1
+    waits = [s for s in steps if s[1] == f"wait({WAIT_STEP!r})"]
+    assert waits and all(t <= 12.0 + WAIT_STEP + 1e-9 for _, _, t in waits)
+    first_assembly = next(i for i, s in enumerate(steps) if s[1] == "assemble(R1)")
+    assert not steps[first_assembly - 1][0]             # started after the robot left
+    assert steps[first_assembly - 1][2] - 12.0 <= WAIT_STEP + 1e-9
+
+
+def test_robot_events_from_the_ur_trajectory(cell, worker):
+    events = robot_events(ROOT / "config" / "ur_pick_place.yaml", cell,
+                          ["robot_in(R1)", "robot_moving"])
+    samples = [events.at(t) for t in np.arange(0.0, events.period, 0.1)]
+    assert not any(s["robot_in(R1)"] for s in samples)     # it sweeps away from R1
+    assert any(s["robot_moving"] for s in samples) and not all(s["robot_moving"]
+                                                               for s in samples)
+    from dataclasses import replace
+    base = {"B": (np.array([1.3, -1.45, 0.85]), np.array([1.6, -1.15, 1.2]))}
+    assert all(s["robot_in(B)"] for s in (replace(events, regions=base,
+                                                  inputs=("robot_in(B)",)).at(t)
+                                          for t in (0.0, 2.0, 4.0)))
+    assert events.stopped(1.0)["robot_moving"] is False
+    run, source = draw_run(worker, np.random.default_rng(4), "trajectory", events)
+    assert source == "trajectory" and joint_satisfies(worker, run)
+
+
 def test_the_worker_never_holds_a_third_part(cell):
     w = reactive_worker("(G F !robot_in(R1)) -> (G F grasp(O1) & G F grasp(O2) & "
                         "G(robot_in(R1) -> X !assemble(R1)) & G F assemble(R1))", cell)
@@ -173,6 +211,9 @@ def test_react_cli_writes_the_report(tmp_path, capsys):
     assert len(report["records"]) == 5
     first = report["records"][0]
     assert first["run"]["cycle"] and "verified" in first and first["duration"] > 0
+    assert [r["source"] for r in report["records"]] == ["steps", "timed", "trajectory",
+                                                         "steps", "timed"]
+    assert report["max_reaction_s"] is None or report["max_reaction_s"] <= 0.3
     assert "5/5 runs satisfy" in capsys.readouterr().out
 
 

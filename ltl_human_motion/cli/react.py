@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
+from ltl_human_motion.atomic import atomic_write_text
 from ltl_human_motion.cli._types import positive as _positive
 from ltl_human_motion.cli._types import stature
 
@@ -39,22 +38,30 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument("--stature", type=stature, default=1.75,
                         help="body height in m, 1.55 to 1.95 (default 1.75)")
+    parser.add_argument("--robot", type=Path, default=None,
+                        help="robot YAML whose trajectory gives robot_in/robot_moving for a "
+                             "third of the traces (default config/ur_pick_place.yaml when the "
+                             "specification reads them)")
     parser.add_argument("--no-motion", action="store_true",
                         help="check the strategy's runs only; plan no motion")
     parser.add_argument("--out", type=Path, default=Path("out/react"),
                         help="output folder for react.json (default out/react)")
 
 
-def _write_json(path: Path, data: dict) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".react-", suffix=".json")
+def _robot_events(path: Path | None, cell, inputs: tuple[str, ...]):
+    """The robot's trajectory events, when the specification reads robot_in/robot_moving."""
+    from ltl_human_motion.errors import CellError
+    from ltl_human_motion.robot.events import robot_events
+    if not any(k == "robot_moving" or k.startswith("robot_in(") for k in inputs):
+        return None
+    if path is None:
+        path = Path(__file__).resolve().parents[2] / "config" / "ur_pick_place.yaml"
+        if not path.is_file():
+            return None
     try:
-        with os.fdopen(fd, "w") as f:
-            json.dump(data, f, indent=1)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        return robot_events(path, cell, inputs)
+    except ValueError as exc:
+        raise CellError(f"--robot {path}: {exc}") from None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -62,11 +69,11 @@ def run(args: argparse.Namespace) -> int:
     from ltl_human_motion.errors import CellError
     from ltl_human_motion.scene.cell_yaml import resolve_cell
     from ltl_human_motion.tasks.reactive import (
+        TRACE_KINDS,
         UnrealizableError,
+        draw_run,
         joint_satisfies,
-        random_input_lasso,
         reactive_worker,
-        run_strategy,
     )
 
     cell = resolve_cell(args.cell)
@@ -87,18 +94,17 @@ def run(args: argparse.Namespace) -> int:
         library = get_library(float(args.stature))
     from ltl_human_motion.planning.reactive import motion_of_run
 
+    robot = _robot_events(args.robot, cell, worker.gr1.inputs)
+
     records = []
     satisfied = verified = 0
     for i in range(args.traces):
         rng = np.random.default_rng([int(args.seed) & 0xFFFFFFFF, i])
-        prefix, cycle = random_input_lasso(worker, rng)
-        joint = run_strategy(worker, prefix, cycle)
+        joint, source = draw_run(worker, rng, TRACE_KINDS[i % len(TRACE_KINDS)], robot)
         ok = joint_satisfies(worker, joint)
         satisfied += ok
         record = {
-            "trace": i,
-            "inputs": {"prefix": [sorted(k for k, v in x.items() if v) for x in prefix],
-                       "cycle": [sorted(k for k, v in x.items() if v) for x in cycle]},
+            "trace": i, "source": source,
             "run": {"prefix": [[sorted(k for k, v in x.items() if v), worker.tasks[t].key]
                                for x, t in zip(joint.prefix_inputs, joint.prefix_tasks)],
                     "cycle": [[sorted(k for k, v in x.items() if v), worker.tasks[t].key]
@@ -112,7 +118,8 @@ def run(args: argparse.Namespace) -> int:
             verified += m.verified
             record.update({"verified": m.verified, "motion_checks": m.motion_checks,
                            "observed_satisfies": m.observed_satisfies,
-                           "duration": m.duration, "failed": m.failed, "detail": m.detail,
+                           "duration": m.duration, "reaction_s": m.reaction,
+                           "failed": m.failed, "detail": m.detail,
                            "seconds": time.perf_counter() - t1})
         records.append(record)
         motion = ""
@@ -121,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
                       f"({record['duration']:.1f} s)")
             if not record["verified"]:
                 motion += ": " + ", ".join(record["failed"])
-        print(f"trace {i}: {len(joint.prefix_tasks)}+{len(joint.cycle_tasks)} steps, "
+        print(f"trace {i} ({source}): {len(joint.prefix_tasks)}+{len(joint.cycle_tasks)} steps, "
               f"spec {'satisfied' if ok else 'VIOLATED'}{motion}", flush=True)
     result = {"spec": worker.specification.text, "cell": cell.name, "seed": args.seed,
               "realizable": True, "traces": args.traces, "spec_satisfied": satisfied,
@@ -131,8 +138,12 @@ def run(args: argparse.Namespace) -> int:
               "assumptions": [c.text for c in worker.gr1.assumptions],
               "guarantees": [c.text for c in worker.gr1.guarantees],
               "plant_states": len(worker.plant.moves), "solve_seconds": t_solve,
+              "sources": {k: sum(r["source"] == k for r in records) for k in TRACE_KINDS},
+              "robot": None if robot is None else str(args.robot or "config/ur_pick_place.yaml"),
+              "max_reaction_s": max((r["reaction_s"] for r in records
+                                     if r.get("reaction_s") is not None), default=None),
               "records": records}
-    _write_json(args.out / "react.json", result)
+    atomic_write_text(args.out / "react.json", json.dumps(result, indent=1))
     print(f"realizable: strategy over {len(worker.tasks)} tasks, {len(worker.plant.moves)} "
           f"worker states, solved in {t_solve:.2f} s; {satisfied}/{args.traces} runs satisfy "
           "the specification"

@@ -229,6 +229,7 @@ class Gr1Game:
                            sys=["task", "cs", *self._monitors])
         aut.prime_varlists()
         self.aut = aut
+        self._eqs: dict[str, object] = {}
 
         env_init, env_action = aut.true, aut.true
         for c in spec.assumptions:
@@ -267,14 +268,21 @@ class Gr1Game:
         self._solved: tuple | None = None
 
     # ---------------------------------------------------------------- encoding
+    def _eq(self, expr: str) -> object:
+        """The BDD of ``expr`` (parsed once)."""
+        u = self._eqs.get(expr)
+        if u is None:
+            u = self._eqs[expr] = self.aut.add_expr(expr)
+        return u
+
     def _atom(self, key: str, primed: bool) -> object:
         aut, tick = self.aut, "'" if primed else ""
         if key in self._env:
-            return aut.add_expr(self._env[key] + tick)
+            return self._eq(self._env[key] + tick)
         u = aut.false
         for k, letter in enumerate(self.plant.labels):
             if key in letter:
-                u |= aut.add_expr(f"task{tick} = {k}")
+                u |= self._eq(f"task{tick} = {k}")
         return u
 
     def _bdd(self, f: Formula, primed: bool = False) -> object:
@@ -310,7 +318,7 @@ class Gr1Game:
 
     def _move(self, k: int, s: int, primed: bool) -> object:
         tick = "'" if primed else ""
-        return self.aut.add_expr(f"task{tick} = {k} /\\ cs{tick} = {s}")
+        return self._eq(f"task{tick} = {k}") & self._eq(f"cs{tick} = {s}")
 
     def _plant_init(self) -> object:
         u = self.aut.false
@@ -322,7 +330,7 @@ class Gr1Game:
         aut = self.aut
         u = aut.false
         for s, moves in enumerate(self.plant.moves):
-            here = aut.add_expr(f"cs = {s}")
+            here = self._eq(f"cs = {s}")
             nxt = aut.false
             for k, s2, _ in moves:
                 nxt |= self._move(k, s2, True)

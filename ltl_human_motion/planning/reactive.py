@@ -40,6 +40,9 @@ class TraceMotion:
         specification.
     duration : float
         Seconds of motion.
+    reaction : float or None
+        Longest wait step of the motion, s: from a wait, the worker starts its next task
+        within this long of an event (None: no wait).
     failed : list of str
         Names of the failed checks, or the planning error's reason.
     detail : str
@@ -50,6 +53,7 @@ class TraceMotion:
     motion_checks: bool
     observed_satisfies: bool
     duration: float = 0.0
+    reaction: float | None = None
     failed: list[str] = field(default_factory=list)
     detail: str = ""
     synth: object = None
@@ -103,5 +107,9 @@ def motion_of_run(worker: ReactiveWorker, run: JointLasso, cell, library, seed: 
     if not observed_ok:
         failed.append("reactive_ltl")
     detail = "; ".join(f"{k}: {report[k]['detail']}" for k in failed if k in report)
+    fps = synth.motion.fps
+    waits = [(s.end_frame - s.start_frame) / fps for s in synth.timeline
+             if s.task.startswith("wait(")]
     return TraceMotion(bool(report["passed"]) and observed_ok, bool(report["passed"]),
-                       observed_ok, float(synth.motion.duration), failed, detail, synth)
+                       observed_ok, float(synth.motion.duration),
+                       max(waits) if waits else None, failed, detail, synth)

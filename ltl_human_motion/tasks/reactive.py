@@ -38,13 +38,16 @@ from ltl_human_motion.ltl.gr1 import (
 from ltl_human_motion.ltl.spec import Specification, build_specification, letter_of
 from ltl_human_motion.tasks.model import CellModel, CellState
 
-__all__ = ["MAX_PLANT_STATES", "WAIT_STEP", "JointLasso", "ReactiveWorker",
-           "UnrealizableError", "random_input_lasso", "reactive_worker", "run_strategy"]
+__all__ = ["MAX_PLANT_STATES", "TRACE_KINDS", "WAIT_STEP", "JointLasso", "ReactiveWorker",
+           "UnrealizableError", "draw_run", "joint_satisfies", "keeps_assumptions",
+           "random_input_lasso", "random_schedule", "reactive_worker", "run_strategy",
+           "timed_run"]
 
 #: Length (s) of the idle step ``wait(WAIT_STEP)``: a waiting worker reads the inputs
-#: again after at most this long, so it reacts to an event within WAIT_STEP (a human
-#: reaction time is 0.2-0.3 s).
-WAIT_STEP = 0.3
+#: again at its end. Its motion lasts WAIT_STEP plus the blend into the next primitive
+#: (0.29 s in all on the paper cell), so from a wait the worker starts the next task
+#: within 0.3 s of an event (a human reaction time is 0.2-0.3 s).
+WAIT_STEP = 0.15
 
 #: States of the worker's physical model beyond which the game is refused.
 MAX_PLANT_STATES = 5000
@@ -73,6 +76,10 @@ class ReactiveWorker:
     plant : Plant
     game : Gr1Game
     strategy : Strategy
+    model : CellModel
+        The worker's physical model.
+    states : tuple of CellState
+        The model state of each plant state.
     """
 
     specification: Specification
@@ -81,6 +88,8 @@ class ReactiveWorker:
     plant: Plant
     game: Gr1Game
     strategy: Strategy
+    model: CellModel
+    states: tuple[CellState, ...]
 
     def letter(self, inputs: dict[str, bool], task: int) -> frozenset[str]:
         """The joint letter of one step: true inputs and the task's atoms."""
@@ -106,8 +115,9 @@ class JointLasso:
 
 
 def _plant(model: CellModel, tasks: tuple[Atom, ...], labels: tuple[frozenset[str], ...]
-           ) -> Plant:
-    """The reachable states of ``model`` under ``tasks`` (breadth first)."""
+           ) -> tuple[Plant, tuple[CellState, ...]]:
+    """The reachable states of ``model`` under ``tasks`` (breadth first) as a plant, and
+    the model state of each plant state."""
     index: dict[CellState, int] = {}
     order: list[CellState] = []
 
@@ -135,7 +145,7 @@ def _plant(model: CellModel, tasks: tuple[Atom, ...], labels: tuple[frozenset[st
     while queue:
         state = queue.popleft()
         moves[index[state]] = moves_from(state)
-    return Plant(labels, initial, tuple(moves[i] for i in range(len(order))))
+    return Plant(labels, initial, tuple(moves[i] for i in range(len(order)))), tuple(order)
 
 
 def _input_words(key: str, value: bool) -> str:
@@ -276,12 +286,14 @@ def reactive_worker(text: str, cell, *, wait_step: float = WAIT_STEP) -> Reactiv
     idle = Atom("wait", (repr(float(wait_step)),))
     tasks = tuple(dict.fromkeys((*specification.tasks, idle)))
     labels = tuple(letter_of(t, specification.vocabulary) for t in tasks)
-    plant = _plant(CellModel.from_cell(cell), tasks, labels)
+    model = CellModel.from_cell(cell)
+    plant, states = _plant(model, tasks, labels)
     game = Gr1Game(gr1, plant)
     if not game.solve():
         raise UnrealizableError("unrealizable: " + explain_unrealizable(
             gr1, plant, lambda t: _readable(t, specification)), text=specification.text)
-    return ReactiveWorker(specification, gr1, tasks, plant, game, game.strategy())
+    return ReactiveWorker(specification, gr1, tasks, plant, game, game.strategy(), model,
+                          states)
 
 
 def random_input_lasso(worker: ReactiveWorker, rng: np.random.Generator, *,
@@ -382,6 +394,129 @@ def _shortest(steps: list[tuple[dict[str, bool], int]], n_prefix: int) -> JointL
         cyc = [cyc[-1], *cyc[:-1]]
     return JointLasso(tuple(x for x, _ in pre), tuple(k for _, k in pre),
                       tuple(x for x, _ in cyc), tuple(k for _, k in cyc))
+
+
+def timed_run(worker: ReactiveWorker, events: Callable[[float], dict[str, bool]],
+              until: float, *, grid: float = 0.05) -> tuple[JointLasso, list[float]]:
+    """Run the strategy against a robot whose inputs are ``events(t)`` (``t`` in s) until
+    ``until`` and ``events(until)`` ever after, observed at the end of each task.
+
+    Each task lasts its estimated motion length
+    (:data:`~ltl_human_motion.tasks.model.TIME_CALIBRATION`), ``wait`` its argument,
+    rounded to ``grid`` s (at least one grid step).
+
+    Returns
+    -------
+    run : JointLasso
+    ends : list of float
+        Time (s) at the end of each step of the run as returned (prefix, then cycle).
+    """
+    from ltl_human_motion.tasks.model import TIME_CALIBRATION
+
+    timed = worker.model.with_timing(TIME_CALIBRATION)
+    strategy = worker.strategy
+    strategy.reset()
+    last = int(np.ceil(until / grid))
+    t = 0
+    state = timed.initial_state()
+    seen: dict[tuple, int] = {}
+    steps: list[tuple[dict[str, bool], int]] = []
+    ends: list[float] = []
+    for i in range(MAX_RUN_STEPS):
+        k = strategy.choose()
+        moved = timed.step(state, worker.tasks[k])
+        if moved is None:
+            raise SpecError(f"the strategy chose {worker.tasks[k]}, which the worker's "
+                            "model cannot do there")
+        state, seconds = moved
+        t += max(round(seconds / grid), 1)
+        values = events(min(t, last) * grid)
+        inputs = {key: bool(values.get(key, False)) for key in worker.gr1.inputs}
+        strategy.observe(inputs)
+        steps.append((inputs, k))
+        ends.append(t * grid)
+        key = (strategy.memory(), t if t < last else -1)
+        if key in seen:
+            run = _shortest(steps, seen[key] + 1)
+            return run, ends[:len(run.prefix_tasks) + len(run.cycle_tasks)]
+        seen[key] = i
+    raise SpecError(f"the timed run did not repeat within {MAX_RUN_STEPS} steps")
+
+
+def random_schedule(worker: ReactiveWorker, rng: np.random.Generator, *,
+                    segments: tuple[int, int] = (1, 6), dwell: tuple[float, float] = (0.5, 8.0)
+                    ) -> tuple[Callable[[float], dict[str, bool]], float]:
+    """A seeded random robot behaviour in seconds: 1-6 segments, each holding random
+    input values for a random dwell (0.5-8 s), then values that keep the assumptions
+    when held forever. Returns ``(events(t), until)`` for :func:`timed_run`.
+
+    Raises
+    ------
+    SpecError
+        When no constant robot behaviour keeps the assumptions.
+    """
+    inputs = worker.gr1.inputs
+    assumption = worker.gr1.assumption_formula()
+    tails = [v for v in input_valuations(inputs)
+             if evaluate_lasso(assumption, [], [frozenset(k for k, b in v.items() if b)])]
+    if not tails:
+        raise SpecError("no constant robot behaviour keeps the assumptions; timed robot "
+                        "behaviours need one to end with")
+    n = int(rng.integers(segments[0], segments[1] + 1))
+    values = [{k: bool(rng.random() < 0.5) for k in inputs} for _ in range(n)]
+    values.append(tails[int(rng.integers(len(tails)))])
+    edges = np.concatenate([[0.0], np.cumsum(rng.uniform(dwell[0], dwell[1], n))])
+
+    def events(t: float) -> dict[str, bool]:
+        return values[min(int(np.searchsorted(edges, t, side="right")) - 1, n)]
+    return events, float(edges[-1])
+
+
+def keeps_assumptions(worker: ReactiveWorker, run: JointLasso) -> bool:
+    """Whether the inputs of ``run`` keep every assumption (independent evaluator)."""
+    def letters(xs: tuple[dict[str, bool], ...]) -> list[frozenset[str]]:
+        return [frozenset(k for k, v in x.items() if v) for x in xs]
+    return evaluate_lasso(worker.gr1.assumption_formula(), letters(run.prefix_inputs),
+                          letters(run.cycle_inputs))
+
+
+#: How :func:`draw_run` makes a robot behaviour: a random lasso of steps, a random
+#: schedule in seconds, or the robot's own trajectory.
+TRACE_KINDS = ("steps", "timed", "trajectory")
+
+
+def draw_run(worker: ReactiveWorker, rng: np.random.Generator, kind: str,
+             robot=None, tries: int = 50) -> tuple[JointLasso, str]:
+    """The strategy's run on one seeded random robot behaviour that keeps the
+    assumptions, and the kind actually drawn.
+
+    ``kind`` is one of :data:`TRACE_KINDS`. ``"trajectory"`` needs ``robot`` (an
+    object with ``period`` (s), ``at(t)`` and ``stopped(t)`` giving the inputs, e.g.
+    :class:`~ltl_human_motion.robot.events.RobotEvents`): from a random phase it runs 1-3
+    cycles, then stops. A behaviour that breaks an assumption is drawn again as
+    ``"timed"``, then ``"steps"``.
+    """
+    if kind not in TRACE_KINDS:
+        raise ValueError(f"kind must be one of {TRACE_KINDS}, got {kind!r}")
+    if kind == "trajectory" and robot is not None:
+        phase = float(rng.uniform(0.0, robot.period))
+        until = int(rng.integers(1, 4)) * robot.period
+
+        def events(t: float) -> dict[str, bool]:
+            return robot.at(t + phase) if t < until else robot.stopped(t + phase)
+        run, _ = timed_run(worker, events, until)
+        if keeps_assumptions(worker, run):
+            return run, "trajectory"
+    if kind in ("timed", "trajectory"):
+        for _ in range(tries):
+            try:
+                events, until = random_schedule(worker, rng)
+            except SpecError:
+                break
+            run, _ = timed_run(worker, events, until)
+            if keeps_assumptions(worker, run):
+                return run, "timed"
+    return run_strategy(worker, *random_input_lasso(worker, rng)), "steps"
 
 
 def joint_satisfies(worker: ReactiveWorker, run: JointLasso) -> bool:

@@ -1,0 +1,109 @@
+"""Reactive worker (issue 36): the done-when run and the synthesis target.
+
+1. ``ltl-human-motion react`` on the paper cell with :data:`SPEC`
+   (``(G F !robot_in(R1)) -> (G(robot_in(R1) -> X !assemble(R1)) & G F grasp(O1) &
+   G F assemble(R1))``) over ``--traces`` robot behaviours (default 200; steps, timed
+   and the UR trajectory in turn): runs satisfying the specification, motions verified,
+   the longest wait step. The same guarantees without the assumption must be refused
+   as unrealizable.
+2. Synthesis of a specification with 6 inputs and 12 tasks on the paper cell (with a
+   declared ``door_open`` input): realizability and the strategy, target <= 1 s.
+
+Prints the numbers and writes ``bench/results/react.json`` (the per-trace report goes to
+``out/bench_react/react.json``). Not a test: run ``python bench/react.py``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import json
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from ltl_human_motion.atomic import atomic_write_text  # noqa: E402
+from ltl_human_motion.cli import main  # noqa: E402
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml  # noqa: E402
+from ltl_human_motion.tasks.reactive import reactive_worker  # noqa: E402
+
+GUARANTEES = "G(robot_in(R1) -> X !assemble(R1)) & G F grasp(O1) & G F assemble(R1)"
+SPEC = f"(G F !robot_in(R1)) -> ({GUARANTEES})"
+
+#: Six inputs (five built in, one declared by the cell) and twelve tasks.
+LARGE_ASSUMPTIONS = ["G F !robot_in(R1)", "G F !robot_in(R0)", "G F !robot_moving",
+                     "G F offered(O1)", "G F offered(O2)", "G F !door_open"]
+LARGE_GUARANTEES = [
+    "G(robot_in(R1) -> X !(assemble(R1) | leftHand(R1)))",
+    "G(robot_in(R0) -> X !(move(O1, R0) | move(O2, R0)))",
+    "G(robot_moving -> X !(carry(O1, R1) | carry(O2, R1)))",
+    "G(door_open -> X !(walk(R0) | walk(R1)))",
+    "G(offered(O1) -> X !release(O1))", "G(offered(O2) -> X !release(O2))",
+    "G F grasp(O1)", "G F grasp(O2)", "G F assemble(R1)"]
+
+
+def done_when(traces: int, seed: int) -> dict:
+    out = ROOT / "out" / "bench_react"
+    t0 = time.perf_counter()
+    code = main(["react", "--cell", "config/paper_cell.yaml", "--spec", SPEC, "--traces",
+                 str(traces), "--seed", str(seed), "--out", str(out)])
+    wall = time.perf_counter() - t0
+    report = json.loads((out / "react.json").read_text())
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        refused = main(["react", "--cell", "config/paper_cell.yaml", "--spec", GUARANTEES,
+                        "--traces", "5", "--out", str(out / "unrealizable")])
+    seconds = [r["seconds"] for r in report["records"]]
+    return {"spec": SPEC, "exit_code": code, "traces": report["traces"],
+            "spec_satisfied": report["spec_satisfied"], "verified": report["verified"],
+            "realizable": report["realizable"], "sources": report["sources"],
+            "max_reaction_s": report["max_reaction_s"], "solve_seconds": report["solve_seconds"],
+            "motion_seconds_median": statistics.median(seconds), "wall_seconds": wall,
+            "not_verified": [{"trace": r["trace"], "failed": r["failed"]}
+                             for r in report["records"] if not r["verified"]],
+            "without_assumption": {"exit_code": refused, "message": err.getvalue().strip()}}
+
+
+def large_synthesis(repeats: int) -> dict:
+    text = (ROOT / "config" / "paper_cell.yaml").read_text() \
+        + "\ninputs:\n  door_open: /cell/door_open\n"
+    cell = cell_from_yaml(text, source="paper_cell + door_open", base_dir=ROOT / "config")
+    spec = f"({' & '.join(LARGE_ASSUMPTIONS)}) -> ({' & '.join(LARGE_GUARANTEES)})"
+    times, worker = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        worker = reactive_worker(spec, cell)
+        times.append(time.perf_counter() - t0)
+    return {"spec": spec, "inputs": len(worker.gr1.inputs),
+            "tasks": len(worker.specification.tasks), "worker_states": len(worker.plant.moves),
+            "seconds": times, "median_seconds": statistics.median(times), "target_seconds": 1.0}
+
+
+def main_bench() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--traces", type=int, default=200)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args()
+    result = {"machine": {"cpus": os.cpu_count(), "load": os.getloadavg()},
+              "done_when": done_when(args.traces, args.seed),
+              "synthesis_6_inputs_12_tasks": large_synthesis(args.repeats)}
+    d, s = result["done_when"], result["synthesis_6_inputs_12_tasks"]
+    print(f"paper cell: {d['spec_satisfied']}/{d['traces']} satisfied, {d['verified']}/"
+          f"{d['traces']} verified, longest wait step {d['max_reaction_s']:.3f} s, "
+          f"{d['wall_seconds']:.0f} s; without the assumption exit "
+          f"{d['without_assumption']['exit_code']}")
+    print(f"synthesis, {s['inputs']} inputs and {s['tasks']} tasks ({s['worker_states']} worker "
+          f"states): median {s['median_seconds']:.3f} s (target <= 1 s)")
+    atomic_write_text(ROOT / "bench" / "results" / "react.json", json.dumps(result, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main_bench())
