@@ -186,6 +186,7 @@ class GoalSteps:
         self.executor = executor
         self.goals = goals
         self.programs_left = WHOLE_BODY_BUDGET
+        self.program_note: str | None = None
 
     def where(self, name: str) -> np.ndarray:
         """Where part ``name`` rests now (3,) (:func:`.plan_state.object_position`)."""
@@ -253,6 +254,7 @@ class GoalSteps:
                 other = OTHER_HAND.get(candidate.meta.get("hand"))
                 if other:
                     kwargs["hand"], switched = other, candidate.meta.get("hand")
+        self.program_note = None
         if mp is None and blocked and self.ctx.options.whole_body:
             mp = self.whole_body(blocked, kind, grasped, part, container)
         if mp is None:
@@ -734,8 +736,10 @@ class GoalSteps:
         into = (f"{len(blocked)} of the {kind} motions tried ({attempts}) run into an "
                 f"obstacle, {self_hits} take a limb through the body" if self_hits
                 else f"every {kind} motion tried ({attempts}) runs into an obstacle")
-        return PlanningError(f"task {text}: {into}; {self.what_blocks(blocked, grasped)}",
-                             task=text, reason="blocked")
+        program = "" if self.program_note is None else \
+            f"; the whole-body program, kept clear of every obstacle: {self.program_note}"
+        return PlanningError(f"task {text}: {into}; {self.what_blocks(blocked, grasped)}"
+                             f"{program}", task=text, reason="blocked")
 
     def what_blocks(self, blocked: list[MotionPrimitive], grasped: str | None) -> str:
         """In words, what blocks the least blocked of ``blocked`` (goal primitives at the
@@ -757,25 +761,38 @@ class GoalSteps:
         """The first of ``blocked`` (hand goal primitives that met an obstacle) that the
         whole-body program (:mod:`.constrained_goals`) remakes clear of every obstacle,
         still reaching the target and passing the checks of :meth:`segment`; None if
-        none does."""
-        from ltl_human_motion.planning.constrained_goals import constrained_primitive
+        none does (then :attr:`program_note` says why, for the refusal)."""
+        from ltl_human_motion.planning.constrained_goals import (
+            constrained_primitive,
+            contact_tolerance,
+        )
+        self.program_note = None
         for candidate in blocked[:WHOLE_BODY_TRIES]:
             if candidate.meta.get("hand") in (None, "none") or self.programs_left <= 0 \
                     or not self.palm_clear(candidate):
                 continue
             self.programs_left -= 1
             held, held_from = self.held_part(candidate, kind, grasped, part)
-            made, _, _ = constrained_primitive(candidate, self.ctx.cell.part_set,
-                                            self.state.pose, self.ctx.stature, held, held_from)
-            if made is None or not self.goal_clear(made, grasped):
-                continue
-            if self.ctx.options.refuse_self_penetration and not body_sound(made, kind,
-                                                                          self.ctx.stature):
-                continue
-            if kind == "extract" and part is not None and container is not None \
+            made, miss, result = constrained_primitive(
+                candidate, self.ctx.cell.part_set, self.state.pose, self.ctx.stature, held,
+                held_from)
+            failed = body_failures(made, kind, self.ctx.stature) \
+                if made is not None and self.ctx.options.refuse_self_penetration else []
+            if made is None:
+                self.program_note = (
+                    f"its palm stops {100 * miss:.1f} cm from the target"
+                    if miss > contact_tolerance(kind) else "it cannot keep every part clear"
+                    if result.least_clearance < 0.0 else
+                    f"it ends {100 * result.end_miss:.1f} cm from the pose it must end in")
+            elif not self.goal_clear(made, grasped):
+                self.program_note = "a part in hand still meets an obstacle"
+            elif failed:
+                self.program_note = f"its motion fails the {', '.join(failed)} check"
+            elif kind == "extract" and part is not None and container is not None \
                     and not self.pulls_out(made, part, container):
-                continue
-            return made
+                self.program_note = f"it does not take {part} out of {container}"
+            else:
+                return made
         return None
 
     def palm_clear(self, mp: MotionPrimitive) -> bool:
@@ -839,11 +856,10 @@ class GoalSteps:
         return not np.any(object_collides(self.ctx.cell, grasped, centre))
 
 
-def body_sound(mp: MotionPrimitive, kind: str, stature: float) -> bool:
-    """Whether goal primitive ``mp`` of task ``kind`` passes the verifier's biomechanical
-    checks on its own (speeds, ranges of motion, self-penetration, balance, planted
-    feet)."""
+def body_failures(mp: MotionPrimitive, kind: str, stature: float) -> list[str]:
+    """The verifier's biomechanical checks (speeds, ranges of motion, self-penetration,
+    balance, planted feet) that goal primitive ``mp`` of task ``kind`` fails on its own."""
     from ltl_human_motion.planning.biomechanics import check_biomechanics
     world = world_positions(mp)
     checks = check_biomechanics(world, mp.fps, stature=stature, labels=[kind] * len(world))
-    return all(entry["passed"] for entry in checks.values())
+    return [name for name, entry in checks.items() if not entry["passed"]]

@@ -144,9 +144,7 @@ def _posture_weights(kin: BodyKinematics, base: float) -> np.ndarray:
     model = kin.model
     out = np.full(model.nv - 6, float(base))
     for j in range(2, model.njoints):
-        anatomical = model.names[j].rsplit("_", 2)[0]
-        side_free = anatomical[2:] if anatomical[:2] in ("l_", "r_") else anatomical
-        out[model.idx_vs[j] - 6] = base * POSTURE_GAINS.get(side_free, 1.0)
+        out[model.idx_vs[j] - 6] = base * POSTURE_GAINS.get(_anatomical(model.names[j]), 1.0)
     return out
 
 
@@ -162,7 +160,14 @@ def _rigid_joints(kin: BodyKinematics) -> np.ndarray:
     """Indices into the revolute joints' velocities (nv - 6,) of :data:`RIGID_JOINTS`."""
     model = kin.model
     return np.array([model.idx_vs[j] - 6 for j in range(2, model.njoints)
-                     if model.names[j].rsplit("_", 2)[0][2:] in RIGID_JOINTS], dtype=int)
+                     if _anatomical(model.names[j]) in RIGID_JOINTS], dtype=int)
+
+
+def _anatomical(joint: str) -> str:
+    """The anatomical joint of a URDF joint name, without side: ``l_sternal_z_wbik`` ->
+    ``sternal``."""
+    name = joint.rsplit("_", 2)[0]
+    return name[2:] if name[:2] in ("l_", "r_") else name
 
 
 class _Tracker:
