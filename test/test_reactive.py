@@ -199,6 +199,16 @@ def test_unrealizable_spec_is_explained(cell):
     assert "add an assumption such as G F !robot_in(R1)" in message
 
 
+def test_a_spec_the_worker_cannot_meet_whatever_the_robot_does_says_so(cell):
+    with pytest.raises(UnrealizableError) as exc:
+        reactive_worker("(G F !robot_in(R1)) -> G F grasp(O1)", cell)
+    assert "the worker cannot meet the guarantee 'G F grasp(O1)' whatever the robot does" \
+        in exc.value.message
+    with pytest.raises(UnrealizableError, match="the robot keeps offering O1 forever"):
+        reactive_worker("(G F offered(O1)) -> G(offered(O1) -> X grasp(O1)) & "
+                        "G F assemble(R1)", cell)
+
+
 def test_react_cli_writes_the_report(tmp_path, capsys):
     out = tmp_path / "react"
     code = main(["react", "--cell", str(PAPER), "--spec", REACTIVE, "--traces", "5",

@@ -206,10 +206,14 @@ class Gr1Game:
     plant : Plant
     fixed_inputs : mapping of str to bool, optional
         Inputs the robot holds at these values forever (used to find counter-strategies).
+    cooperative : bool
+        The worker also picks the inputs, keeping the assumptions (init, safety and
+        liveness become its own): solvable iff some robot behaviour lets the worker win.
     """
 
     def __init__(self, spec: Gr1Spec, plant: Plant,
-                 fixed_inputs: Mapping[str, bool] | None = None) -> None:
+                 fixed_inputs: Mapping[str, bool] | None = None,
+                 cooperative: bool = False) -> None:
         from omega.symbolic import temporal as trl
 
         self.spec = spec
@@ -224,9 +228,11 @@ class Gr1Game:
         decl.update({m: "bool" for m in self._monitors})
         decl["task"] = (0, max(n_tasks - 1, 1))
         decl["cs"] = (0, max(n_states - 1, 1))
+        decl["_free"] = "bool"
         aut.declare_variables(**decl)
-        aut.varlist.update(env=list(self._env.values()),
-                           sys=["task", "cs", *self._monitors])
+        inputs = list(self._env.values())
+        aut.varlist.update(env=["_free"] if cooperative else inputs,
+                           sys=["task", "cs", *self._monitors, *(inputs if cooperative else ())])
         aut.prime_varlists()
         self.aut = aut
         self._eqs: dict[str, object] = {}
@@ -258,6 +264,11 @@ class Gr1Game:
             sys_action &= mn.equiv(mv | self._bdd(c.body))
             goals.append(mv)
         holds = [~self._bdd(c.body) for c in spec.assumptions if c.kind == "liveness"]
+        if cooperative:
+            sys_init, sys_action = sys_init & env_init, sys_action & env_action
+            env_init = env_action = aut.true
+            goals += [~h for h in holds]
+            holds = []
         aut.init["env"], aut.init["sys"] = env_init, sys_init
         aut.action["env"], aut.action["sys"] = env_action, sys_action
         aut.win["<>[]"] = holds or [aut.false]

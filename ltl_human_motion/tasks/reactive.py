@@ -25,7 +25,7 @@ import numpy as np
 
 from ltl_human_motion.errors import SpecError
 from ltl_human_motion.ltl.evaluator import evaluate_lasso
-from ltl_human_motion.ltl.formula import Atom
+from ltl_human_motion.ltl.formula import Atom, Not, to_spot
 from ltl_human_motion.ltl.gr1 import (
     Gr1Conjunct,
     Gr1Game,
@@ -160,8 +160,9 @@ def _input_words(key: str, value: bool) -> str:
     return f"keeps {key} {'true' if value else 'false'}"
 
 
-def _realizable(spec: Gr1Spec, plant: Plant, fixed: dict[str, bool] | None = None) -> bool:
-    return Gr1Game(spec, plant, fixed).solve()
+def _realizable(spec: Gr1Spec, plant: Plant, fixed: dict[str, bool] | None = None,
+                cooperative: bool = False) -> bool:
+    return Gr1Game(spec, plant, fixed, cooperative).solve()
 
 
 def _with_guarantees(spec: Gr1Spec, guarantees: list[Gr1Conjunct]) -> Gr1Spec:
@@ -169,14 +170,36 @@ def _with_guarantees(spec: Gr1Spec, guarantees: list[Gr1Conjunct]) -> Gr1Spec:
 
 
 def _minimal_safety(spec: Gr1Spec, plant: Plant, fixed: dict[str, bool] | None,
-                    goal: list[Gr1Conjunct], safety: list[Gr1Conjunct]) -> list[Gr1Conjunct]:
+                    goal: list[Gr1Conjunct], safety: list[Gr1Conjunct],
+                    cooperative: bool = False) -> list[Gr1Conjunct]:
     """A subset of ``safety`` that with ``goal`` is still unrealizable (deletion)."""
     kept = list(safety)
     for c in list(safety):
         trial = [s for s in kept if s is not c]
-        if not _realizable(_with_guarantees(spec, trial + goal), plant, fixed):
+        if not _realizable(_with_guarantees(spec, trial + goal), plant, fixed, cooperative):
             kept = trial
     return kept
+
+
+def _defeated(spec: Gr1Spec, plant: Plant, fixed: dict[str, bool] | None,
+              pretty: Callable[[str], str], cooperative: bool = False) -> str:
+    """The guarantees that cannot all be met (with the fewest safety guarantees that
+    make them so), in words."""
+    safety = [c for c in spec.guarantees if c.kind in ("init", "safety")]
+    goals = [c for c in spec.guarantees if c.kind in ("liveness", "eventually")]
+    if not _realizable(_with_guarantees(spec, safety), plant, fixed, cooperative):
+        core = _minimal_safety(spec, plant, fixed, [], safety, cooperative)
+        return f"the safety guarantee{'s' if len(core) > 1 else ''} " + \
+            ", ".join(f"'{pretty(c.text)}'" for c in core)
+    single = [g for g in goals if not _realizable(_with_guarantees(spec, [*safety, g]),
+                                                   plant, fixed, cooperative)]
+    if not single:
+        return "the guarantees " + ", ".join(f"'{pretty(g.text)}'" for g in goals) + \
+            " together"
+    core = _minimal_safety(spec, plant, fixed, [single[0]], safety, cooperative)
+    return ("the guarantee " if len(single) == 1 else "each of the guarantees ") \
+        + ", ".join(f"'{pretty(g.text)}'" for g in single) \
+        + (" given " + ", ".join(f"'{pretty(c.text)}'" for c in core) if core else "")
 
 
 def explain_unrealizable(spec: Gr1Spec, plant: Plant,
@@ -184,6 +207,11 @@ def explain_unrealizable(spec: Gr1Spec, plant: Plant,
     """Why ``spec`` is unrealizable on ``plant``: the guarantee the robot can defeat,
     a counter-strategy in words, and an assumption that would help (``pretty`` rewrites
     a conjunct's text for the message)."""
+    if not _realizable(spec, plant, cooperative=True):
+        return (f"the worker cannot meet {_defeated(spec, plant, None, pretty, True)} "
+                "whatever the robot does, with its two hands, the parts it holds and the "
+                "specification's tasks; add the tasks that free its hands (e.g. an "
+                "assembly or a release) or weaken the guarantees")
     assumption = spec.assumption_formula()
     counter: dict[str, bool] | None = None
     for values in input_valuations(spec.inputs):
@@ -191,23 +219,7 @@ def explain_unrealizable(spec: Gr1Spec, plant: Plant,
         if evaluate_lasso(assumption, [], [letter]) and not _realizable(spec, plant, values):
             counter = values
             break
-    safety = [c for c in spec.guarantees if c.kind in ("init", "safety")]
-    goals = [c for c in spec.guarantees if c.kind in ("liveness", "eventually")]
-    if not _realizable(_with_guarantees(spec, safety), plant, counter):
-        core = _minimal_safety(spec, plant, counter, [], safety)
-        defeated = f"the safety guarantee{'s' if len(core) > 1 else ''} " + \
-            ", ".join(f"'{pretty(c.text)}'" for c in core)
-    else:
-        single = [g for g in goals
-                  if not _realizable(_with_guarantees(spec, [*safety, g]), plant, counter)]
-        if single:
-            core = _minimal_safety(spec, plant, counter, [single[0]], safety)
-            defeated = ("the guarantee " if len(single) == 1 else "each of the guarantees ") \
-                + ", ".join(f"'{pretty(g.text)}'" for g in single) + (
-                    " given " + ", ".join(f"'{pretty(c.text)}'" for c in core) if core else "")
-        else:
-            defeated = "the guarantees " + ", ".join(f"'{pretty(g.text)}'" for g in goals) \
-                + " together"
+    defeated = _defeated(spec, plant, counter, pretty)
     if counter is None:
         how = ("no fixed robot behaviour suffices: the robot wins by reacting to the "
                "worker's moves")
@@ -219,7 +231,7 @@ def explain_unrealizable(spec: Gr1Spec, plant: Plant,
         for k, v in counter.items():
             text = f"G F {'!' if v else ''}{k}"
             body = Atom(*_split_key(k))
-            lit = body if not v else _negate(body)
+            lit = body if not v else Not(body)
             extra = Gr1Spec((*spec.assumptions, Gr1Conjunct("liveness", lit, text)),
                             spec.guarantees, spec.inputs)
             if _realizable(extra, plant):
@@ -236,15 +248,9 @@ def _split_key(key: str) -> tuple[str, tuple[str, ...]]:
     return name, tuple(a.strip() for a in rest.rstrip(")").split(",") if a.strip())
 
 
-def _negate(f: Atom):
-    from ltl_human_motion.ltl.formula import Not
-    return Not(f)
-
-
 def _readable(text: str, specification: Specification) -> str:
     """A conjunct's text without Spot's quotes, shorthands folded back
     (``leftHand(R1) & rightHand(R1)`` -> ``assemble(R1)``)."""
-    from ltl_human_motion.ltl.formula import to_spot
     from ltl_human_motion.ltl.parser import parse_spec
 
     def plain(t: str) -> str:
@@ -280,7 +286,6 @@ def reactive_worker(text: str, cell, *, wait_step: float = WAIT_STEP) -> Reactiv
     final = [c for label, c in specification.always_on if label.startswith("final region")]
     gr1 = split_gr1(specification.user_formula, specification.inputs)
     if final:
-        from ltl_human_motion.ltl.formula import to_spot
         gr1 = Gr1Spec(gr1.assumptions, (*gr1.guarantees, Gr1Conjunct(
             "eventually", final[0].arg, to_spot(final[0]))), gr1.inputs)
     idle = Atom("wait", (repr(float(wait_step)),))
