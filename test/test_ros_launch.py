@@ -47,7 +47,8 @@ LAUNCH_FILES = {"bringup.launch": ROOT / "config" / "bringup.yaml",
                 "coexistence.launch": ROOT / "config" / "bringup_coexistence.yaml"}
 #: A value no config file holds, per launch argument. 127.0.0.3: loopback, nothing serves
 #: RTDE there, so the coexistence node cannot command another test's simulated arm.
-OVERRIDES = {"robot_host": "127.0.0.3", "store_dir": "/tmp/ltl_hm_launch_override_motions"}
+OVERRIDES = {"robot_host": "127.0.0.3", "store_dir": "/tmp/ltl_hm_launch_override_motions",
+             "use_sim_time": "true"}
 
 
 def _launch(monkeypatch: pytest.MonkeyPatch, stem: str, values: dict[str, str]
@@ -84,7 +85,7 @@ def test_each_launch_argument_overrides_the_config_file(
     specs = {s.fully_qualified_name: s for s in config.node_specs()}
     declared, _ = _launch(monkeypatch, stem, {})
     names = [name for _, name, _ in declared]
-    assert names == ["config"] + [a.name for a in LAUNCH_ARGUMENTS[stem]]
+    assert names == ["config"] + [a.name for a in LAUNCH_ARGUMENTS[stem]] + ["namespace"]
     for argument in LAUNCH_ARGUMENTS[stem]:
         value = OVERRIDES[argument.name]
         _, nodes = _launch(monkeypatch, stem, {argument.name: value})
@@ -97,8 +98,10 @@ def test_each_launch_argument_overrides_the_config_file(
             if spec.executable in argument.executables:
                 targets += 1
                 in_file = config.parameter(spec, argument.parameter)
-                assert in_file != value, f"{argument.name}: pick a value the file lacks"
-                assert got[argument.parameter] == value, (stem, argument.name, fqn)
+                assert in_file != argument.convert(value), \
+                    f"{argument.name}: pick a value the file lacks"
+                assert got[argument.parameter] == argument.convert(value), \
+                    (stem, argument.name, fqn)
             for key, expected in spec.parameters.items():
                 assert got[key] == expected, (fqn, key)
         assert targets > 0, argument.name
@@ -113,7 +116,16 @@ def test_without_arguments_the_file_holds(monkeypatch: pytest.MonkeyPatch,
         got = _rcl_parameters(launch_ros_command(kw, tmp_path), kw["name"], kw["namespace"])
         for argument in LAUNCH_ARGUMENTS[stem]:
             if spec.executable in argument.executables:
-                assert got.get(argument.parameter) == config.parameter(spec, argument.parameter)
+                # use_sim_time, which no shipped file sets, is every node's own (false).
+                assert got.get(argument.parameter) == config.parameter(
+                    spec, argument.parameter, False if argument.name == "use_sim_time" else None)
+
+
+def test_a_bad_use_sim_time_names_the_launch_argument(monkeypatch: pytest.MonkeyPatch
+                                                      ) -> None:
+    with pytest.raises(ValueError, match="launch argument use_sim_time: expected true or "
+                                         "false, got 'maybe'"):
+        _launch(monkeypatch, "bringup.launch", {"use_sim_time": "maybe"})
 
 
 def test_a_dict_under_double_star_loses_to_the_file_as_in_issue_14(tmp_path: Path) -> None:
@@ -158,8 +170,64 @@ def test_coexistence_launch_processes_get_the_launch_arguments(
                 got = _get_parameters(session, fqn, wanted, timeout=90.0)
                 for argument in LAUNCH_ARGUMENTS[stem]:
                     if kw["executable"] in argument.executables:
-                        assert got[argument.parameter] == OVERRIDES[argument.name], \
-                            (fqn, argument.name)
+                        assert got[argument.parameter] == argument.convert(
+                            OVERRIDES[argument.name]), (fqn, argument.name)
+    finally:
+        for proc in procs:
+            proc.terminate()
+        deadline = time.monotonic() + 15
+        for proc in procs:
+            try:
+                proc.wait(timeout=max(deadline - time.monotonic(), 0.1))
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+
+
+def test_a_bad_namespace_names_the_launch_argument(monkeypatch: pytest.MonkeyPatch) -> None:
+    with pytest.raises(ValueError, match="launch argument namespace: expected a ROS "
+                                         "namespace such as 'cell_a', got '9 lives'"):
+        _launch(monkeypatch, "bringup.launch", {"namespace": "9 lives"})
+
+
+def test_bringup_launch_under_a_namespace_keeps_its_wiring_inside(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """``namespace:=cell_a``: the real node processes (launch_ros's command lines) run
+    under /cell_a, and their catalog and marker topics move there with them; a plain
+    rclpy client reads the graph."""
+    _, nodes = _launch(monkeypatch, "bringup.launch",
+                       {"namespace": "/cell_a/", "store_dir": str(tmp_path / "m")})
+    assert {kw["namespace"] for kw in nodes} == {"cell_a", "cell_a/human_1"}
+    procs = []
+    try:
+        for kw in nodes:
+            code = (f"import sys; from ltl_human_motion.ros.entry_points import "
+                    f"{kw['executable']} as main; sys.exit(main(sys.argv))")
+            procs.append(subprocess.Popen(
+                [sys.executable, "-c", code, *launch_ros_command(kw, tmp_path)],
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        with ClientSession("launch_ns_client") as session:
+            node = session.node
+            wanted = {("/cell_a", "synthesis_node"), ("/cell_a/human_1", "skeleton_publisher"),
+                      ("/cell_a/human_1", "occupancy_node"),
+                      ("/cell_a/human_1", "ergonomics_node")}
+
+            def ready() -> bool:
+                names = {(ns, n) for n, ns in node.get_node_names_and_namespaces()}
+                return wanted <= names and node.count_subscribers(
+                    "/cell_a/motion_catalog") >= 3 and node.count_publishers(
+                    "/cell_a/markers") >= 1
+            deadline = time.monotonic() + 90.0
+            while not ready() and time.monotonic() < deadline:
+                time.sleep(0.2)
+            assert ready(), sorted(node.get_node_names_and_namespaces())
+            assert node.count_publishers("/cell_a/motion_catalog") == 1
+            for topic in ("/cell_a/occupancy_markers", "/cell_a/ergonomics_markers",
+                          "/cell_a/human_1/occupancy"):
+                assert node.count_publishers(topic) == 1, topic
+            for topic in ("/motion_catalog", "/markers", "/occupancy_markers"):
+                assert node.count_publishers(topic) == 0, topic
+            assert node.count_publishers("/humans/bodies/h1/joint_states") == 1
     finally:
         for proc in procs:
             proc.terminate()

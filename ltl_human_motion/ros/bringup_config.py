@@ -19,8 +19,9 @@ human's nodes run in namespace ``human_<id>`` with parameter ``human_id: <id>``.
 from __future__ import annotations
 
 import hashlib
+import re
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,6 +37,17 @@ NODE_KINDS = ("synthesis_node", "skeleton_publisher", "occupancy_node", "ergonom
               "coexistence_node")
 PER_HUMAN = ("skeleton_publisher", "occupancy_node", "ergonomics_node")
 DEFAULT_CONFIG = Path(__file__).resolve().parents[2] / "config" / "bringup.yaml"
+#: Topic parameters whose absolute defaults wire a node set together, by node kind: the
+#: ``namespace:=`` launch argument moves them into the namespace (:func:`namespace_overrides`).
+SET_TOPICS: dict[str, dict[str, str]] = {
+    "skeleton_publisher": {"markers_topic": "/markers", "catalog_topic": "/motion_catalog"},
+    "occupancy_node": {"markers_topic": "/occupancy_markers",
+                       "catalog_topic": "/motion_catalog"},
+    "ergonomics_node": {"markers_topic": "/ergonomics_markers",
+                        "catalog_topic": "/motion_catalog"},
+    "coexistence_node": {"markers_topic": "/robot_markers"},
+}
+_NAMESPACE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$")
 
 
 @dataclass(frozen=True)
@@ -110,7 +122,7 @@ class BringupConfig:
             if spec.executable == "skeleton_publisher":
                 out["/tf"] = "tf2_msgs/msg/TFMessage"
                 out["/tf_static"] = "tf2_msgs/msg/TFMessage"
-                out[self.parameter(spec, "markers_topic", "/markers")] = \
+                out[self.parameter(spec, "markers_topic", _markers(spec))] = \
                     "visualization_msgs/msg/MarkerArray"
                 out[f"{ns}/task_state"] = f"{PACKAGE}/msg/TaskState"
                 if self.parameter(spec, "rep155", True):
@@ -125,20 +137,62 @@ class BringupConfig:
             elif spec.executable == "occupancy_node":
                 out[f"{ns}/occupancy"] = f"{PACKAGE}/msg/HumanOccupancy"
                 if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
-                    out[self.parameter(spec, "markers_topic", "/occupancy_markers")] = \
+                    out[self.parameter(spec, "markers_topic", _markers(spec))] = \
                         "visualization_msgs/msg/MarkerArray"
             elif spec.executable == "ergonomics_node":
                 out[f"{ns}/ergonomics"] = f"{PACKAGE}/msg/ErgonomicsState"
-                out[self.parameter(spec, "markers_topic", "/ergonomics_markers")] = \
+                out[self.parameter(spec, "markers_topic", _markers(spec))] = \
                     "visualization_msgs/msg/MarkerArray"
             elif spec.executable == "coexistence_node":
                 out["/tf"] = out["/tf_static"] = "tf2_msgs/msg/TFMessage"
                 out["/joint_states"] = "sensor_msgs/msg/JointState"
                 out["/safety_status"] = f"{PACKAGE}/msg/SafetyStatus"
                 if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
-                    out[self.parameter(spec, "markers_topic", "/robot_markers")] = \
+                    out[self.parameter(spec, "markers_topic", _markers(spec))] = \
                         "visualization_msgs/msg/MarkerArray"
         return out
+
+
+def _markers(spec: NodeSpec) -> str:
+    return SET_TOPICS[spec.executable]["markers_topic"]
+
+
+def check_namespace(namespace: str) -> str:
+    """``namespace`` without its slashes at either end ('' for none).
+
+    Raises
+    ------
+    ValueError
+        If it is no ROS namespace (tokens of letters, digits and '_', not starting with
+        a digit, separated by '/').
+    """
+    ns = namespace.strip().strip("/")
+    if ns and not _NAMESPACE.match(ns):
+        raise ValueError(f"launch argument namespace: expected a ROS namespace such as "
+                         f"'cell_a', got {namespace!r}")
+    return ns
+
+
+def node_namespace(namespace: str, node: NodeSpec) -> str:
+    """The namespace of ``node`` when its node set runs under ``namespace``."""
+    return "/".join(x for x in (check_namespace(namespace), node.namespace) if x)
+
+
+def namespace_overrides(config: BringupConfig, node: NodeSpec, namespace: str
+                        ) -> dict[str, str]:
+    """Topic parameters of ``node`` moved under ``namespace`` (those of
+    :data:`SET_TOPICS` whose value in ``config`` is absolute), so that node sets in
+    different namespaces keep their catalogs and markers apart. TF, REP 155's
+    ``/humans/...``, ``/joint_states`` and ``/diagnostics`` stay global."""
+    ns = check_namespace(namespace)
+    if not ns:
+        return {}
+    out = {}
+    for param, default in SET_TOPICS.get(node.executable, {}).items():
+        value = config.parameter(node, param, default)
+        if isinstance(value, str) and value.startswith("/"):
+            out[param] = f"/{ns}{value}"
+    return out
 
 
 def load_bringup_config(path: str | Path | None = None) -> BringupConfig:
@@ -181,9 +235,26 @@ def load_bringup_config(path: str | Path | None = None) -> BringupConfig:
     return BringupConfig(path.resolve(), ordered, tuple(humans), threads, data)
 
 
+def launch_bool(text: str) -> bool:
+    """A launch argument's ``true``/``false`` (any case; also 1/0, yes/no) as a bool.
+
+    Raises
+    ------
+    ValueError
+        Naming the text when it is none of these.
+    """
+    value = text.strip().lower()
+    if value in ("true", "1", "yes", "on"):
+        return True
+    if value in ("false", "0", "no", "off"):
+        return False
+    raise ValueError(f"expected true or false, got {text!r}")
+
+
 @dataclass(frozen=True)
 class LaunchArgument:
-    """A ``ros2 launch`` argument that sets one node parameter on top of the file.
+    """A ``ros2 launch`` argument that sets one node parameter on top of the file;
+    ``convert`` turns its text into the parameter's type.
 
     An empty value (the default) keeps the file's value.
     """
@@ -192,14 +263,20 @@ class LaunchArgument:
     parameter: str
     executables: tuple[str, ...]
     description: str
+    convert: Callable[[str], Any] = str
 
 
+_USE_SIM_TIME = LaunchArgument(
+    "use_sim_time", "use_sim_time", NODE_KINDS,
+    "true: every node runs on /clock (ROS time), e.g. replaying a bag ('' = the file's)",
+    launch_bool)
 #: The launch arguments of each launch file (besides ``config:=``), by file stem.
 LAUNCH_ARGUMENTS: dict[str, tuple[LaunchArgument, ...]] = {
     "bringup.launch": (
         LaunchArgument("store_dir", "store_dir",
                        ("synthesis_node", "skeleton_publisher", "occupancy_node"),
                        "folder of <motion_id>.npz ('' = the file's)"),
+        _USE_SIM_TIME,
     ),
     "coexistence.launch": (
         LaunchArgument("robot_host", "robot_host", ("coexistence_node",),
@@ -207,15 +284,28 @@ LAUNCH_ARGUMENTS: dict[str, tuple[LaunchArgument, ...]] = {
         LaunchArgument("store_dir", "store_dir",
                        ("synthesis_node", "skeleton_publisher", "occupancy_node"),
                        "folder of <motion_id>.npz ('' = the file's)"),
+        _USE_SIM_TIME,
     ),
 }
 
 
 def launch_overrides(arguments: tuple[LaunchArgument, ...], values: Mapping[str, str],
                      node: NodeSpec) -> dict[str, Any]:
-    """The parameters the launch ``values`` (argument name -> text) set on ``node``."""
-    return {arg.parameter: values[arg.name] for arg in arguments
-            if node.executable in arg.executables and values.get(arg.name, "") != ""}
+    """The parameters the launch ``values`` (argument name -> text) set on ``node``.
+
+    Raises
+    ------
+    ValueError
+        Naming the launch argument when its text does not convert.
+    """
+    out = {}
+    for arg in arguments:
+        if node.executable in arg.executables and values.get(arg.name, "") != "":
+            try:
+                out[arg.parameter] = arg.convert(values[arg.name])
+            except ValueError as exc:
+                raise ValueError(f"launch argument {arg.name}: {exc}") from None
+    return out
 
 
 def write_override_params(config: BringupConfig, node: NodeSpec,

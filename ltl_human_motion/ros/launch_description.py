@@ -5,6 +5,9 @@ Each node gets the bringup file as ``--params-file``, then a params file with it
 per-node parameters (``human_id``) and the launch arguments of the file
 (:data:`~ltl_human_motion.ros.bringup_config.LAUNCH_ARGUMENTS`), written so that they
 override the bringup file (:func:`~ltl_human_motion.ros.bringup_config.launch_parameters`).
+``namespace:=`` puts every node under a namespace
+(:func:`~ltl_human_motion.ros.bringup_config.node_namespace`) and moves the node set's own
+topics with it (:func:`~ltl_human_motion.ros.bringup_config.namespace_overrides`).
 """
 
 from __future__ import annotations
@@ -17,6 +20,8 @@ from ltl_human_motion.ros.bringup_config import (
     launch_overrides,
     launch_parameters,
     load_bringup_config,
+    namespace_overrides,
+    node_namespace,
 )
 
 
@@ -45,11 +50,14 @@ def node_set_description(stem: str, config_file: str) -> Any:
     def nodes(context: Any) -> list[Any]:
         config = load_bringup_config(LaunchConfiguration("config").perform(context))
         values = {a.name: LaunchConfiguration(a.name).perform(context) for a in arguments}
+        namespace = LaunchConfiguration("namespace").perform(context)
         return [
             Node(package="ltl_human_motion", executable=spec.executable, name=spec.name,
-                 namespace=spec.namespace or None, output="screen", emulate_tty=True,
-                 parameters=launch_parameters(config, spec,
-                                              launch_overrides(arguments, values, spec)))
+                 namespace=node_namespace(namespace, spec) or None, output="screen",
+                 emulate_tty=True,
+                 parameters=launch_parameters(config, spec, {
+                     **namespace_overrides(config, spec, namespace),
+                     **launch_overrides(arguments, values, spec)}))
             for spec in config.node_specs()
         ]
 
@@ -58,5 +66,8 @@ def node_set_description(stem: str, config_file: str) -> Any:
                               description="bringup file (ROS 2 params layout)"),
         *[DeclareLaunchArgument(a.name, default_value="", description=a.description)
           for a in arguments],
+        DeclareLaunchArgument("namespace", default_value="", description=(
+            "put the node set under this namespace ('' = none); its catalog and marker "
+            "topics move with it, TF, /humans/... and /diagnostics stay global")),
         OpaqueFunction(function=nodes),
     ])
