@@ -145,20 +145,38 @@ def _get_parameters(session: ClientSession, fqn: str, names: list[str],
     return {n: parameter_value_to_python(v) for n, v in zip(names, response.values)}
 
 
+def _start(nodes: list[dict[str, Any]], folder: Path) -> list[subprocess.Popen]:
+    """The node executables of ``nodes``, each with launch_ros's command line."""
+    procs = []
+    for kw in nodes:
+        code = (f"import sys; from ltl_human_motion.ros.entry_points import "
+                f"{kw['executable']} as main; sys.exit(main(sys.argv))")
+        procs.append(subprocess.Popen(
+            [sys.executable, "-c", code, *launch_ros_command(kw, folder)],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+    return procs
+
+
+def _stop(procs: list[subprocess.Popen]) -> None:
+    for proc in procs:
+        proc.terminate()
+    deadline = time.monotonic() + 15
+    for proc in procs:
+        try:
+            proc.wait(timeout=max(deadline - time.monotonic(), 0.1))
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
 def test_coexistence_launch_processes_get_the_launch_arguments(
         monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     """The real node executables, started with launch_ros's command line, read back by
     a plain rclpy client."""
     stem = "coexistence.launch"
     _, nodes = _launch(monkeypatch, stem, OVERRIDES)
-    procs = []
+    procs = _start(nodes, tmp_path)
     try:
-        for kw in nodes:
-            code = (f"import sys; from ltl_human_motion.ros.entry_points import "
-                    f"{kw['executable']} as main; sys.exit(main(sys.argv))")
-            procs.append(subprocess.Popen(
-                [sys.executable, "-c", code, *launch_ros_command(kw, tmp_path)],
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         with ClientSession("launch_test_client") as session:
             for kw in nodes:
                 fqn = f"/{kw['namespace']}/{kw['name']}" if kw["namespace"] \
@@ -173,15 +191,7 @@ def test_coexistence_launch_processes_get_the_launch_arguments(
                         assert got[argument.parameter] == argument.convert(
                             OVERRIDES[argument.name]), (fqn, argument.name)
     finally:
-        for proc in procs:
-            proc.terminate()
-        deadline = time.monotonic() + 15
-        for proc in procs:
-            try:
-                proc.wait(timeout=max(deadline - time.monotonic(), 0.1))
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+        _stop(procs)
 
 
 def test_a_bad_namespace_names_the_launch_argument(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -198,14 +208,8 @@ def test_bringup_launch_under_a_namespace_keeps_its_wiring_inside(
     _, nodes = _launch(monkeypatch, "bringup.launch",
                        {"namespace": "/cell_a/", "store_dir": str(tmp_path / "m")})
     assert {kw["namespace"] for kw in nodes} == {"cell_a", "cell_a/human_1"}
-    procs = []
+    procs = _start(nodes, tmp_path)
     try:
-        for kw in nodes:
-            code = (f"import sys; from ltl_human_motion.ros.entry_points import "
-                    f"{kw['executable']} as main; sys.exit(main(sys.argv))")
-            procs.append(subprocess.Popen(
-                [sys.executable, "-c", code, *launch_ros_command(kw, tmp_path)],
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         with ClientSession("launch_ns_client") as session:
             node = session.node
             wanted = {("/cell_a", "synthesis_node"), ("/cell_a/human_1", "skeleton_publisher"),
@@ -229,12 +233,4 @@ def test_bringup_launch_under_a_namespace_keeps_its_wiring_inside(
                 assert node.count_publishers(topic) == 0, topic
             assert node.count_publishers("/humans/bodies/h1/joint_states") == 1
     finally:
-        for proc in procs:
-            proc.terminate()
-        deadline = time.monotonic() + 15
-        for proc in procs:
-            try:
-                proc.wait(timeout=max(deadline - time.monotonic(), 0.1))
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+        _stop(procs)
