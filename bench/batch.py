@@ -1,19 +1,23 @@
-"""Benchmark of dataset generation: verified S2 motions per minute, 1 vs 2 workers.
+"""Benchmark of dataset generation on two specs files, 1 vs 2 workers (issues 8 and 37).
 
-Runs ``run_batch`` on the paper cell with S2 (shortest task sequence: grasp O1, grasp O2,
-assemble R1; object and start jitter; stature 1.75 m) on a local process pool with 1 and
-with 2 workers, ``--repeat`` times each into fresh folders, and reports medians:
-throughput (verified motions per wall-clock minute, worker start-up included),
-throughput per core, scaling efficiency ``T2 / (2 T1)`` and the median per-item compute
-time, next to the scaling efficiency of a pure-CPU loop measured before and after (what
-a machine shared with other jobs actually offers). From the workers' CPU time (robust
-to other load) it gives the CPU-bound per-core rate ``60 / mean item CPU seconds``, and
-the CPU the driver process spends per item (receiving, staging, packing, checksums),
-which shares the cores with the workers.
-Then it profiles an in-process run (``workers=0``, after a warm-up) with cProfile and
-reports the top functions by cumulative time and the time per pipeline stage.
-Prints a summary and writes ``bench/results/batch.json``. Not a test: run
-``python bench/batch.py`` (about 1-2 minutes on 2 cores).
+Cases: ``S2`` (the paper cell, S2 with object and start jitter, 1.75 m) and ``kitting``
+(``config/specs_kitting.yaml`` on ``config/kitting_cell.yaml``: pick two parts, kit three,
+a response and a precedence pattern, 1.60-1.90 m). Each runs ``run_batch`` on a local
+process pool with 1 and with 2 workers, ``--repeat`` times into fresh folders, with the
+biomechanical checks on, and reports medians of:
+
+* real time per core: seconds of verified motion per CPU second of the whole run, start-up
+  included (the driver's CPU and that of its worker processes, from ``getrusage``: robust
+  to other load on a shared machine), the issue's target 400x;
+* verified motions per wall-clock minute, per core, and the scaling efficiency
+  ``T2 / (2 T1)``, next to that of a pure-CPU loop measured before and after (what a
+  machine shared with other jobs actually offers);
+* the median per-item compute time and the driver's CPU per item.
+
+Then it profiles an in-process run of each case (``workers=0``, after a warm-up) with
+cProfile: the top functions and the time per pipeline stage. Prints a summary and writes
+``bench/results/batch.json``. Not a test: ``python bench/batch.py`` (several minutes on 2
+cores; ``--cases kitting --repeat 1`` for one case).
 """
 
 from __future__ import annotations
@@ -25,10 +29,13 @@ import json
 import os
 import platform
 import pstats
+import resource
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -47,6 +54,15 @@ regions: {R0: [0.05, 0.05, 0.0]}
 sequence_mode: all
 """
 TARGET_PER_CORE = 1000.0       # verified S2 motions per minute per core (issue 8)
+TARGET_REAL_TIME = 400.0       # seconds of verified motion per CPU second (issue 37)
+#: name -> (cell, specs file or None for SPECS, what it is)
+CASES = {
+    "S2": ("paper_cell", None, "S2 (sequence_mode all: grasp O1, grasp O2, assemble), "
+                               "object and start jitter, 1.75 m"),
+    "kitting": ("kitting_cell", ROOT / "config" / "specs_kitting.yaml",
+                "config/specs_kitting.yaml: pick two, kit three, response, precedence; "
+                "1.60-1.90 m"),
+}
 STAGES = ("automaton_time", "sequence_time", "planning_time", "blending_time",
           "verification_time")
 
@@ -72,34 +88,48 @@ def _spin_efficiency(n: int = 30_000_000) -> float:
     return single / pair
 
 
-def _throughput(specs, count: int, workers: int, folder: Path, seed: int) -> dict:
-    out = folder / f"w{workers}-s{seed}"
+def _cpu() -> float:
+    """CPU seconds of this process and of its finished children (the pool's workers)."""
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), \
+        resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+def _throughput(cell: str, specs, count: int, workers: int, folder: Path, seed: int) -> dict:
+    out = folder / f"{cell}-w{workers}-s{seed}"
     first: list[float] = []
     t0 = time.perf_counter()
     c0 = time.process_time()
-    summary = run_batch("paper_cell", specs, count, out, seed=seed, workers=workers,
+    all0 = _cpu()
+    summary = run_batch(cell, specs, count, out, seed=seed, workers=workers,
                         shard_size=max(count // 4, 1), progress=False,
                         on_item=lambda _: first or first.append(time.perf_counter() - t0))
+    wall = time.perf_counter() - t0
+    cpu_all = _cpu() - all0
     driver_cpu = time.process_time() - c0
     records = open_dataset(out, verify_checksums=False).records
-    compute = [r["timing"]["compute_time"] for r in records if r["status"] == "ok"]
+    ok = [r for r in records if r["status"] == "ok"]
+    compute = [r["timing"]["compute_time"] for r in ok]
+    motion = sum(r["duration"] for r in ok)
     return {"workers": workers, "count": count, "verified": summary.verified_this_run,
             "failed": summary.counts.get("failed", 0), "elapsed_s": summary.elapsed,
-            "verified_per_minute": summary.verified_per_minute,
+            "wall_s": wall, "cpu_s": cpu_all, "verified_motion_s": motion,
+            "real_time_per_core": motion / cpu_all if cpu_all > 0 else None,
+            "real_time_per_core_wall": motion / (wall * workers),
+            "verified_per_minute": summary.verified_this_run * 60.0 / wall,
             "median_compute_s": statistics.median(compute) if compute else None,
-            "mean_compute_s": statistics.fmean(compute) if compute else None,
-            "mean_cpu_s": statistics.fmean(r["timing"]["cpu_time"] for r in records
-                                           if r["status"] == "ok") if compute else None,
+            "mean_cpu_s": statistics.fmean(r["timing"]["cpu_time"] for r in ok)
+            if ok else None,
             "first_result_s": first[0] if first else None,
             "driver_cpu_ms_per_item": 1000.0 * driver_cpu / count}
 
 
-def _profile(specs, count: int, folder: Path, top: int) -> dict:
-    run_batch("paper_cell", specs, 2, folder / "warm", seed=999, workers=0, progress=False)
+def _profile(cell: str, specs, count: int, folder: Path, top: int) -> dict:
+    run_batch(cell, specs, 2, folder / f"{cell}-warm", seed=999, workers=0, progress=False)
     prof = cProfile.Profile()
     t0 = time.perf_counter()
     prof.enable()
-    run_batch("paper_cell", specs, count, folder / "prof", seed=123, workers=0,
+    run_batch(cell, specs, count, folder / f"{cell}-prof", seed=123, workers=0,
               progress=False)
     prof.disable()
     wall = time.perf_counter() - t0
@@ -111,7 +141,7 @@ def _profile(specs, count: int, folder: Path, top: int) -> dict:
                      "cum_share": round(ct / wall, 4)})
     rows.sort(key=lambda r: -r["cumtime_s"])
     by_self = sorted(rows, key=lambda r: -r["tottime_s"])[:top]
-    records = open_dataset(folder / "prof", verify_checksums=False).records
+    records = open_dataset(folder / f"{cell}-prof", verify_checksums=False).records
     stage = {s: statistics.median(r["timing"].get(s, 0.0) for r in records) for s in STAGES}
     compute = statistics.median(r["timing"]["compute_time"] for r in records)
     stage["other_time"] = max(compute - sum(stage.values()), 0.0)
@@ -125,11 +155,54 @@ def _profile(specs, count: int, folder: Path, top: int) -> dict:
             "top_self": by_self}
 
 
+def _case(name: str, args: argparse.Namespace, folder: Path) -> dict:
+    cell, path, what = CASES[name]
+    text = SPECS if path is None else path.read_text()
+    if args.no_biomechanics:
+        text += "options: {biomechanics: false}\n" if path is None else ""
+    specs = specs_from_yaml(text, f"bench/batch.py:{name}" if path is None else str(path))
+    if args.no_biomechanics and path is not None:
+        specs = replace(specs, options={**specs.options, "biomechanics": False})
+    runs: dict[int, list[dict]] = {1: [], 2: []}
+    for rep in range(args.repeat):
+        for workers in (1, 2):
+            r = _throughput(cell, specs, args.count, workers, folder, seed=rep)
+            runs[workers].append(r)
+            print(f"  {name}: {workers} worker(s), run {rep + 1}: {r['verified']}/{args.count} "
+                  f"verified, {r['verified_motion_s']:.0f} s of motion in {r['cpu_s']:.1f} "
+                  f"CPU s = {r['real_time_per_core']:.0f}x real time per core; "
+                  f"{r['wall_s']:.1f} s wall, load {os.getloadavg()[0]:.1f}", file=sys.stderr)
+    med = {w: statistics.median(r["verified_per_minute"] for r in rs) for w, rs in runs.items()}
+    rt = {w: statistics.median(r["real_time_per_core"] for r in rs) for w, rs in runs.items()}
+    rt_wall = {w: statistics.median(r["real_time_per_core_wall"] for r in rs)
+               for w, rs in runs.items()}
+    compute = [r["median_compute_s"] for r in runs[1] if r["median_compute_s"]]
+    profile = _profile(cell, specs, args.profile_items, folder, args.top)
+    return {
+        "spec": what, "cell": cell, "biomechanics": not args.no_biomechanics,
+        "count_per_run": args.count, "repeat": args.repeat,
+        "real_time_per_core_1_worker": rt[1], "real_time_per_core_2_workers": rt[2],
+        "real_time_per_core_wall_1_worker": rt_wall[1],
+        "real_time_per_core_wall_2_workers": rt_wall[2],
+        "target_real_time_per_core": TARGET_REAL_TIME,
+        "meets_real_time_target": min(rt.values()) >= TARGET_REAL_TIME,
+        "verified_per_minute_1_worker": med[1], "verified_per_minute_2_workers": med[2],
+        "per_core_verified_per_minute": med[2] / 2.0,
+        "scaling_efficiency": med[2] / (2.0 * med[1]) if med[1] else None,
+        "median_item_compute_s": statistics.median(compute) if compute else None,
+        "driver_cpu_ms_per_item": statistics.median(r["driver_cpu_ms_per_item"]
+                                                    for r in runs[2]),
+        "runs": runs, "profile": profile,
+    }
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--count", type=int, default=100,
                         help="items per run (default 100: a dataset run, not start-up)")
     parser.add_argument("--repeat", type=int, default=3, help="runs per setting (default 3)")
+    parser.add_argument("--cases", nargs="+", choices=sorted(CASES), default=list(CASES),
+                        help="specs files to measure (default: all)")
     parser.add_argument("--profile-items", type=int, default=10)
     parser.add_argument("--top", type=int, default=15)
     parser.add_argument("--no-biomechanics", action="store_true",
@@ -140,60 +213,40 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     args.out = args.out or str(ROOT / "bench" / "results" / (
         "batch_without_biomechanics.json" if args.no_biomechanics else "batch.json"))
-    specs = specs_from_yaml(SPECS + ("options: {biomechanics: false}\n"
-                                     if args.no_biomechanics else ""), "bench/batch.py:SPECS")
     load_before = list(os.getloadavg())
     spin = [_spin_efficiency()]
-    runs: dict[int, list[dict]] = {1: [], 2: []}
+    cases = {}
     with tempfile.TemporaryDirectory(prefix="lhm-bench-batch-") as tmp:
-        folder = Path(tmp)
-        for rep in range(args.repeat):
-            for workers in (1, 2):
-                r = _throughput(specs, args.count, workers, folder, seed=rep)
-                runs[workers].append(r)
-                print(f"  {workers} worker(s), run {rep + 1}: {r['verified']}/{args.count} "
-                      f"verified in {r['elapsed_s']:.1f} s = "
-                      f"{r['verified_per_minute']:.0f}/min", file=sys.stderr)
+        for name in args.cases:
+            cases[name] = _case(name, args, Path(tmp))
         spin.append(_spin_efficiency())
-        profile = _profile(specs, args.profile_items, folder, args.top)
-    med = {w: statistics.median(r["verified_per_minute"] for r in rs) for w, rs in runs.items()}
-    compute = statistics.median(r["median_compute_s"] for r in runs[1] if r["median_compute_s"])
-    cpu = statistics.median(r["mean_cpu_s"] for rs in runs.values() for r in rs
-                            if r["mean_cpu_s"])
+    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip() or None
     result = {
-        "benchmark": "batch", "spec": "S2 (sequence_mode all: grasp O1, grasp O2, assemble)",
-        "biomechanics": not args.no_biomechanics,
-        "cell": "paper_cell", "count_per_run": args.count, "repeat": args.repeat,
+        "benchmark": "batch", "commit": commit,
+        "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
         "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                     "platform": platform.platform(),
                     "load_average_before": load_before,
                     "load_average_after": list(os.getloadavg())},
-        "verified_per_minute_1_worker": med[1],
-        "verified_per_minute_2_workers": med[2],
-        "per_core_verified_per_minute": med[2] / 2.0,
-        "scaling_efficiency": med[2] / (2.0 * med[1]) if med[1] else None,
         "machine_spin_efficiency_before_after": spin,
-        "median_item_compute_s": compute,
-        "steady_state_per_core_per_minute": 60.0 / compute if compute else None,
-        "median_of_mean_item_cpu_s": cpu,
-        "cpu_bound_per_core_per_minute": 60.0 / cpu if cpu else None,
         "target_per_core_per_minute": TARGET_PER_CORE,
-        "driver_cpu_ms_per_item": statistics.median(r["driver_cpu_ms_per_item"]
-                                                    for r in runs[2]),
-        "meets_target": med[2] / 2.0 >= TARGET_PER_CORE,
-        "meets_target_cpu_bound": bool(cpu) and 60.0 / cpu >= TARGET_PER_CORE,
-        "runs": runs, "profile": profile,
+        "cases": cases,
     }
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(args.out, json.dumps(result, indent=1) + "\n")
-    print(json.dumps({k: v for k, v in result.items() if k not in ("runs", "profile")},
-                     indent=1))
-    print("\nwhere the time goes (median per item, in-process):")
-    for stage, secs in profile["stage_median_s"].items():
-        print(f"  {stage:<18} {secs * 1000:8.1f} ms  {profile['stage_share'][stage]:6.1%}")
-    print("top functions by cumulative time:")
-    for row in profile["top_cumulative"]:
-        print(f"  {row['cumtime_s']:8.3f} s {row['cum_share']:6.1%}  {row['function']}")
+    for name, case in cases.items():
+        print(f"{name}: " + json.dumps({k: v for k, v in case.items()
+                                        if k not in ("runs", "profile")}, indent=1))
+        profile = case["profile"]
+        print(f"\n{name}: where the time goes (median per item, in-process):")
+        for stage, secs in profile["stage_median_s"].items():
+            print(f"  {stage:<18} {secs * 1000:8.1f} ms  {profile['stage_share'][stage]:6.1%}")
+        print("top functions by cumulative time:")
+        for row in profile["top_cumulative"]:
+            print(f"  {row['cumtime_s']:8.3f} s {row['cum_share']:6.1%}  {row['function']}")
+    print(f"machine: {os.cpu_count()} cores, load {load_before} before, "
+          f"{result['machine']['load_average_after']} after; spin efficiency {spin}")
     print(f"written to {args.out}")
     return 0
 

@@ -24,6 +24,9 @@ __all__ = ["VOXEL", "can_pass"]
 VOXEL = 0.04
 
 _FREE: BoundedCache = BoundedCache(32)
+#: Components of the free space per obstacle layout (owner: the cell's obstacle tuple,
+#: which cells jittered from one another share), workspace and part size.
+_LABELS: BoundedCache = BoundedCache(32)
 
 
 def _free_space(cell, half: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -53,19 +56,34 @@ def _reachable(cell, part: str) -> tuple[np.ndarray, np.ndarray]:
     return _FREE.get_or_build((part,), lambda: _fill(cell, part), owner=cell)
 
 
+def _components(cell, half: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
+    """The labelled components of the free space (:func:`_free_space`), the grid's origin
+    and a memo of reachable sets per seed labels; built once per obstacle layout,
+    workspace and part size (a part moved to another place of the same cell reuses it)."""
+    def build() -> tuple[np.ndarray, np.ndarray, dict]:
+        from scipy import ndimage
+        free, origin = _free_space(cell, half)
+        return ndimage.label(free)[0], origin, {}
+    lo, hi = (np.asarray(v, dtype=np.float64) for v in cell.workspace)
+    key = (tuple(lo.tolist()), tuple(hi.tolist()), tuple(half.tolist()))
+    return _LABELS.get_or_build(key, build, owner=cell.obstacles)
+
+
 def _fill(cell, part: str) -> tuple[np.ndarray, np.ndarray]:
     """:func:`_reachable`, computed."""
-    from scipy import ndimage
     p_lo, p_hi = (np.asarray(v, dtype=np.float64) for v in cell.object(part).shape.aabb())
-    free, origin = _free_space(cell, (p_hi - p_lo) / 2)
-    labels, _ = ndimage.label(free)
+    labels, origin, reached = _components(cell, (p_hi - p_lo) / 2)
     k = np.clip(np.round(((p_lo + p_hi) / 2 - origin) / VOXEL).astype(int), 0,
-                np.array(free.shape) - 1)
+                np.array(labels.shape) - 1)
     near = labels[max(k[0] - 1, 0):k[0] + 2, max(k[1] - 1, 0):k[1] + 2,
                   max(k[2] - 1, 0):k[2] + 2]
     seeds = np.unique(near[near > 0])
-    reach = np.isin(labels, seeds) if seeds.size else np.ones_like(free)
-    return reach, origin
+    key = tuple(seeds.tolist())
+    if key not in reached:
+        if len(reached) >= 16:
+            reached.clear()
+        reached[key] = np.isin(labels, seeds) if seeds.size else np.ones(labels.shape, bool)
+    return reached[key], origin
 
 
 def can_pass(cell, part: str, lo: np.ndarray, hi: np.ndarray) -> bool:

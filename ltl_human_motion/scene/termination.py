@@ -39,8 +39,10 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, N_JOINTS, Skeleton
 from ltl_human_motion.scene.cell import Cell
+from ltl_human_motion.scene.shapes import Box, Shape
 from ltl_human_motion.scene.predicates import (
     enclose,
     enclose_object,
@@ -133,6 +135,27 @@ def _per_frame_objects(fn, *trajs: np.ndarray) -> np.ndarray:
     return vals[np.asarray(inverse).reshape(-1)]
 
 
+def _boxes_enclosed(inner: Shape, inner_at: np.ndarray, outer: Shape,
+                    outer_at: np.ndarray | None, *trajs: np.ndarray) -> np.ndarray | None:
+    """enclose(inner, outer) per frame (T,) for two boxes that translate with their
+    objects (``trajs``: the inner's positions (T, 3), then the outer's if it moves;
+    ``*_at``: the positions their shapes are given at), as :func:`shape_enclosed_in`
+    computes it for each distinct row, in one vectorized pass; None unless both are
+    boxes."""
+    if not (isinstance(inner, Box) and isinstance(outer, Box)):
+        return None
+    uniq, inverse = np.unique(np.concatenate(trajs, axis=-1), axis=0, return_inverse=True)
+    centres = inner.center + (uniq[:, :3] - inner_at)
+    origin = outer.center if outer_at is None else outer.center + (uniq[:, 3:] - outer_at)
+    corners = inner.moved_to(np.zeros(3)).vertices()     # corner offsets, as vertices() adds
+    local = (centres[:, None, :] + corners - np.asarray(origin)[..., None, :]) \
+        @ matrix_from_yaw(outer.yaw)
+    lo, hi = local.min(axis=1), local.max(axis=1)
+    tol = 1e-9                                           # shape_enclosed_in's
+    vals = np.all(lo >= -outer.half - tol, axis=-1) & np.all(hi <= outer.half + tol, axis=-1)
+    return vals[np.asarray(inverse).reshape(-1)]
+
+
 def _single(task: str, args: tuple[str, ...], window: np.ndarray, cell: Cell,
             objects_state: Mapping[str, np.ndarray] | None, eps: float, stature: float,
             fps: float | None) -> np.ndarray:
@@ -159,17 +182,20 @@ def _single(task: str, args: tuple[str, ...], window: np.ndarray, cell: Cell,
         return enclose(window, cell.region(args[0]), part, stature=stature)
     if task == "walk":
         return enter(window, cell.region(args[0]), stature=stature)
-    if task == "move":
+    if task in ("move", "carry"):
         obj, region = cell.object(args[0]), cell.region(args[1])
-        return _per_frame_objects(lambda p: enclose_object(obj.occupancy_at(p), region),
-                                  obj_traj(args[0]))
-    if task == "carry":
-        obj, region = cell.object(args[0]), cell.region(args[1])
-        inside = _per_frame_objects(lambda p: enclose_object(obj.occupancy_at(p), region),
-                                    obj_traj(args[0]))
-        return inside & enter(window, region, stature=stature)
+        inside = _boxes_enclosed(obj.shape, obj.position, region.shape, None,
+                                 obj_traj(args[0]))
+        if inside is None:
+            inside = _per_frame_objects(lambda p: enclose_object(obj.occupancy_at(p), region),
+                                        obj_traj(args[0]))
+        return inside if task == "move" else inside & enter(window, region, stature=stature)
     if task in ("insert", "extract"):
         o1, o2 = cell.object(args[0]), cell.object(args[1])
+        fast = None if task != "insert" else _boxes_enclosed(
+            o1.shape, o1.position, o2.shape, o2.position, obj_traj(args[0]), obj_traj(args[1]))
+        if fast is not None:
+            return fast
         if task == "insert":
             def fn(p1, p2):
                 return enclose_object(o1.occupancy_at(p1), o2.occupancy_at(p2))
