@@ -50,7 +50,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
+import rclpy.logging
 from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.impl.rcutils_logger import RcutilsLogger
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
@@ -276,6 +278,14 @@ class SynthesisNode(Node):
                 self._serve(job)
             self._reply(job)
 
+    def _worker_logger(self) -> RcutilsLogger:
+        """The node's logger; once the node is stopping (Ctrl-C cancels the syntheses under
+        way), one of another name that only prints: the context and its rosout publisher
+        are gone by then ("Failed to publish log message to rosout")."""
+        if self._stopping.is_set() or not self.context.ok():
+            return rclpy.logging.get_logger(f"{self.get_logger().name}.shutdown")
+        return self.get_logger()
+
     def _serve(self, job: _Job) -> None:
         response = job.response
         job.deadline = Deadline(_max_seconds(job.request.options_json))
@@ -285,17 +295,17 @@ class SynthesisNode(Node):
             motions, cell = self._run(job.request, job.deadline)
             self._fill(response, motions)
             self._fill_ergonomics(response, motions, cell, int(job.request.cycles) or 1)
-            self.get_logger().info(
+            self._worker_logger().info(
                 f"synthesized {len(motions)} motion(s) in "
                 f"{time.perf_counter() - job.received:.2f} s: {', '.join(response.motion_ids)}")
         except (LtlHumanMotionError, ValueError) as exc:
             self._fail(response, exc)
-            self.get_logger().warning(f"synthesis request rejected: {exc}")
+            self._worker_logger().warning(f"synthesis request rejected: {exc}")
         except RecursionError:
             self._fail(response, ValueError("the request nests too deeply to be read"))
-            self.get_logger().warning("synthesis request rejected: nested too deeply")
+            self._worker_logger().warning("synthesis request rejected: nested too deeply")
         except Exception as exc:   # keep serving; report the failure to the caller
-            self.get_logger().error(
+            self._worker_logger().error(
                 f"synthesis failed unexpectedly: {exc!r}\n{traceback.format_exc()}")
             response.success = False
             response.error_message = f"internal error ({type(exc).__name__}): {exc}"
@@ -307,7 +317,7 @@ class SynthesisNode(Node):
         try:
             self._send_now(job.response, job.header)
         except Exception as exc:   # a destroyed service or a gone client
-            self.get_logger().warning(f"cannot send a synthesis response: {exc}")
+            self._worker_logger().warning(f"cannot send a synthesis response: {exc}")
         self._finished(refused=False)
 
     def _finished(self, refused: bool) -> None:
