@@ -13,9 +13,9 @@ from ltl_human_motion.cli import main
 from ltl_human_motion.errors import CellError, SpecError
 from ltl_human_motion.ltl import build_specification, parse_spec
 from ltl_human_motion.ltl.gr1 import split_gr1
+from ltl_human_motion.robot.events import robot_events
 from ltl_human_motion.scene.cell_yaml import cell_from_yaml, resolve_cell
 from ltl_human_motion.tasks.model import CellModel
-from ltl_human_motion.robot.events import robot_events
 from ltl_human_motion.tasks.reactive import (
     WAIT_STEP,
     UnrealizableError,
@@ -110,7 +110,9 @@ def test_gr1_form_is_checked():
     assert [c.kind for c in spec.assumptions] == ["liveness"]
     assert [c.kind for c in spec.guarantees] == ["safety", "liveness", "liveness"]
     with pytest.raises(SpecError, match="mentions grasp"):
-        split("(G F grasp(O1)) -> G F assemble(R1)")
+        split("(G F (grasp(O1) | robot_in(R1))) -> G F assemble(R1)")
+    plain = split("grasp(O1) -> walk(R0)")          # no input on the left: a guarantee
+    assert (plain.assumptions, [c.kind for c in plain.guarantees]) == ((), ["init"])
     with pytest.raises(SpecError, match="not of GR\\(1\\) form"):
         split("(F G robot_in(R1)) -> G F assemble(R1)")
     with pytest.raises(SpecError, match="not of GR\\(1\\) form"):

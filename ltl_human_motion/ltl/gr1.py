@@ -26,6 +26,7 @@ its goal, then the cheapest by the plant's costs.
 from __future__ import annotations
 
 import itertools
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -49,7 +50,8 @@ from ltl_human_motion.ltl.formula import (
     top_level_conjuncts,
 )
 
-__all__ = ["Gr1Conjunct", "Gr1Game", "Gr1Spec", "Plant", "Strategy", "split_gr1"]
+__all__ = ["Gr1Conjunct", "Gr1Game", "Gr1Spec", "Plant", "Strategy", "plain_text",
+           "split_gr1"]
 
 @dataclass(frozen=True)
 class Gr1Conjunct:
@@ -117,8 +119,13 @@ def _temporal_depth(f: Formula) -> tuple[int, bool]:
     return 0, True
 
 
+def plain_text(f: Formula) -> str:
+    """``f`` in Spot's syntax without the quotes around atoms (``G F grasp(O1)``)."""
+    return re.sub(r'"([^"]*)"', r"\1", to_spot(f))
+
+
 def _classify(f: Formula, role: str) -> Gr1Conjunct:
-    text = to_spot(f)
+    text = plain_text(f)
     depth, other = _temporal_depth(f)
     if not other and depth == 0:
         return Gr1Conjunct("init", f, text)
@@ -148,7 +155,8 @@ def split_gr1(formula: Formula, inputs: Iterable[Atom]) -> Gr1Spec:
     Parameters
     ----------
     formula : Formula
-        ``A -> G`` or ``G`` alone; conjunctions are split at the top.
+        ``A -> G`` (``A`` mentions an input) or ``G`` alone; conjunctions are split at
+        the top.
     inputs : iterable of Atom
         The input propositions (the rest are the worker's).
 
@@ -158,9 +166,9 @@ def split_gr1(formula: Formula, inputs: Iterable[Atom]) -> Gr1Spec:
         A conjunct outside GR(1), or an assumption that mentions a task of the worker.
     """
     keys = tuple(dict.fromkeys(a.key for a in inputs))
-    if isinstance(formula, Implies):
+    if isinstance(formula, Implies) and {a.key for a in atoms(formula.left)} & set(keys):
         left, right = top_level_conjuncts(formula.left), top_level_conjuncts(formula.right)
-    else:
+    else:                                   # no input on the left: one guarantee
         left, right = [], top_level_conjuncts(formula)
     assumptions = []
     for f in left:
@@ -304,7 +312,8 @@ class Gr1Game:
             return self._atom(f.key, primed)
         if isinstance(f, Next):
             if primed:
-                raise SpecError(f"X X in '{to_spot(f)}' looks two steps ahead; GR(1) allows one")
+                raise SpecError(f"X X in '{plain_text(f)}' looks two steps ahead; GR(1) "
+                                "allows one")
             return self._bdd(f.arg, True)
         if isinstance(f, Not):
             return ~self._bdd(f.arg, primed)
@@ -325,7 +334,7 @@ class Gr1Game:
             return a.equiv(b)
         if isinstance(f, Xor):
             return ~a.equiv(b)
-        raise SpecError(f"'{to_spot(f)}' is not of GR(1) form")
+        raise SpecError(f"'{plain_text(f)}' is not of GR(1) form")
 
     def _move(self, k: int, s: int, primed: bool) -> object:
         tick = "'" if primed else ""

@@ -25,7 +25,7 @@ import numpy as np
 
 from ltl_human_motion.errors import SpecError
 from ltl_human_motion.ltl.evaluator import evaluate_lasso
-from ltl_human_motion.ltl.formula import Atom, Not, to_spot
+from ltl_human_motion.ltl.formula import Atom, Not
 from ltl_human_motion.ltl.gr1 import (
     Gr1Conjunct,
     Gr1Game,
@@ -33,6 +33,7 @@ from ltl_human_motion.ltl.gr1 import (
     Plant,
     Strategy,
     input_valuations,
+    plain_text,
     split_gr1,
 )
 from ltl_human_motion.ltl.spec import Specification, build_specification, letter_of
@@ -253,12 +254,9 @@ def _readable(text: str, specification: Specification) -> str:
     (``leftHand(R1) & rightHand(R1)`` -> ``assemble(R1)``)."""
     from ltl_human_motion.ltl.parser import parse_spec
 
-    def plain(t: str) -> str:
-        return re.sub(r'"([^"]*)"', r"\1", t)
-    text = plain(text)
     for task in specification.tasks:
         if task.name in specification.vocabulary.shorthands:
-            body = plain(to_spot(parse_spec(task.key, specification.vocabulary).formula))
+            body = plain_text(parse_spec(task.key, specification.vocabulary).formula)
             text = text.replace(f"({body})", f" {task.key}").replace(body, task.key)
     return re.sub(r"([(!])\s+", r"\1", re.sub(r"\s{2,}", " ", text))
 
@@ -287,7 +285,7 @@ def reactive_worker(text: str, cell, *, wait_step: float = WAIT_STEP) -> Reactiv
     gr1 = split_gr1(specification.user_formula, specification.inputs)
     if final:
         gr1 = Gr1Spec(gr1.assumptions, (*gr1.guarantees, Gr1Conjunct(
-            "eventually", final[0].arg, to_spot(final[0]))), gr1.inputs)
+            "eventually", final[0].arg, plain_text(final[0]))), gr1.inputs)
     idle = Atom("wait", (repr(float(wait_step)),))
     tasks = tuple(dict.fromkeys((*specification.tasks, idle)))
     labels = tuple(letter_of(t, specification.vocabulary) for t in tasks)
