@@ -218,10 +218,12 @@ def test_worker_in_robot_workspace_slows_the_robot_which_resumes_after(
     joints = stack.joints.last
     assert list(joints.name) == list(UR_JOINT_NAMES) and len(joints.position) == 6
     frames = {t.child_frame_id for m in stack.tf.messages for t in m.transforms}
-    assert {"ur/link_1", "ur/link_6", "ur/tool_tip"} <= frames
+    # ur_description's link names (test_ros_ur_frames checks their placement).
+    assert {"ur/shoulder_link", "ur/upper_arm_link", "ur/wrist_3_link"} <= frames
     static = {(t.header.frame_id, t.child_frame_id) for m in stack.tf_static.messages
               for t in m.transforms}
-    assert ("world", "ur/base") in static
+    assert {("world", "ur/base_link"), ("ur/base_link", "ur/base"), ("ur/flange", "ur/tool0"),
+            ("ur/tool0", "ur/tool_tip")} <= static
     assert {m.ns for m in stack.markers.last.markers} >= {"robot/capsules", "robot/status"}
     assert stack.status.last.protective_distance == pytest.approx(S_P)
     assert stack.node.control_alive

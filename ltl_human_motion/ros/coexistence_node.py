@@ -26,9 +26,14 @@ Publishes (at ``publish_rate``):
 
 * ``/joint_states`` (sensor_msgs/JointState): the six UR joints
   (``<joint_prefix>shoulder_pan_joint`` ... ``wrist_3_joint``) as read over RTDE.
-* ``/tf``: ``<tf_prefix>base`` -> ``<tf_prefix>link_1`` ... ``link_6`` (the DH frames
-  after each joint; ``link_6`` is the flange) -> ``<tf_prefix>tool_tip``;
-  ``/tf_static``: ``<world_frame>`` -> ``<tf_prefix>base`` (the base pose parameters).
+* ``/tf``: the arm's links as ur_description names and places them
+  (:mod:`ltl_human_motion.ros.ur_frames`): ``<tf_prefix>base_link_inertia`` ->
+  ``shoulder_link`` -> ``upper_arm_link`` -> ``forearm_link`` -> ``wrist_1_link`` ->
+  ``wrist_2_link`` -> ``wrist_3_link``; ``/tf_static``: ``<world_frame>`` ->
+  ``<tf_prefix>base_link`` (from the base pose parameters, which place the controller's
+  ``base``), ``base_link`` -> ``base`` and ``base_link_inertia``, ``wrist_3_link`` ->
+  ``flange`` -> ``tool0`` (the flange, DH frame 6) -> ``tool_tip`` (``tool_length`` along
+  z).
 * ``safety_status`` (ltl_human_motion/msg/SafetyStatus): separation, effective
   separation, S_p, slider command, mode and connection of the latest control step.
 * ``markers_topic`` (``/robot_markers``, at ``marker_rate``): the arm's collision capsules
@@ -71,7 +76,6 @@ from ltl_human_motion.robot.coexistence import (
 from ltl_human_motion.robot.fusion import OccupancySample, fuse_occupancies
 from ltl_human_motion.robot.kinematics import (
     UR_MODELS,
-    forward_kinematics,
     pose_from_xyz_rpy,
     robot_capsules,
     ur_model,
@@ -79,6 +83,7 @@ from ltl_human_motion.robot.kinematics import (
 from ltl_human_motion.robot.metrics import DecisionRecorder, write_commissioning_report
 from ltl_human_motion.robot.ssm import SLIDER_MIN, SSMParameters
 from ltl_human_motion.ros import conversions as cv
+from ltl_human_motion.ros import ur_frames
 from ltl_human_motion.ros.common import STREAM_QOS, TF_QOS, TF_STATIC_QOS
 from ltl_human_motion.ros.diagnostics import ERROR, OK, Status, attach_diagnostics
 from ltl_human_motion.ros.occupancy_decode import decode_human_occupancy, occupancy_from_message
@@ -478,8 +483,14 @@ class CoexistenceNode(Node):
     # ------------------------------------------------------------------ outputs
     def _publish_static(self) -> None:
         stamp = self.get_clock().now().to_msg()
+        base_link = self.base @ np.linalg.inv(ur_frames.BASE_IN_BASE_LINK)
+        tip = np.eye(4)
+        tip[2, 3] = self.model.tool_length
         self._tf_static_pub.publish(TFMessage(transforms=[
-            _transform(self.world_frame, f"{self.prefix}base", self.base, stamp)]))
+            _transform(self.world_frame, f"{self.prefix}base_link", base_link, stamp),
+            *[_transform(f"{self.prefix}{f.parent}", f"{self.prefix}{f.child}", f.transform,
+                         stamp) for f in ur_frames.STATIC_FRAMES],
+            _transform(f"{self.prefix}tool0", f"{self.prefix}tool_tip", tip, stamp)]))
 
     def _publish_state(self) -> None:
         d = self._latest
@@ -498,15 +509,10 @@ class CoexistenceNode(Node):
         joints = JointState(name=self.joint_names, position=list(d.q))
         joints.header.stamp = stamp
         self._joint_pub.publish(joints)
-        frames = forward_kinematics(np.asarray(d.q), self.model)
-        names = [f"{self.prefix}base"] + [f"{self.prefix}link_{i}" for i in range(1, 7)]
-        transforms = [_transform(names[i], names[i + 1],
-                                 np.linalg.solve(frames[i], frames[i + 1]), stamp)
-                      for i in range(6)]
-        tip = np.eye(4)
-        tip[2, 3] = self.model.tool_length
-        transforms.append(_transform(names[6], f"{self.prefix}tool_tip", tip, stamp))
-        self._tf_pub.publish(TFMessage(transforms=transforms))
+        names = [f"{self.prefix}{n}" for n in ("base_link_inertia", *ur_frames.UR_LINKS)]
+        links = ur_frames.link_transforms(np.asarray(d.q), self.model)
+        self._tf_pub.publish(TFMessage(transforms=[
+            _transform(names[i], names[i + 1], links[i], stamp) for i in range(6)]))
 
     def _publish_markers(self) -> None:
         d = self._latest
