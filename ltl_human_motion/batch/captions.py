@@ -280,6 +280,8 @@ _TEMPLATES: dict[str, tuple[str, ...]] = {
                 "steps over to {dest}"),
     "grasp": ("picks up {obj}{hand}", "takes {obj}{hand}", "grabs {obj}{hand}",
               "lifts {obj}{hand}"),
+    "fetch": ("walks to {obj} and picks it up{hand}", "goes over to {obj} and takes it{hand}",
+              "heads to {obj} and grabs it{hand}", "steps over to {obj} and lifts it{hand}"),
     "insert": ("puts {obj} into {dest}{hand}", "inserts {obj} into {dest}{hand}",
                "places {obj} in {dest}{hand}"),
     "carry_insert": ("carries {obj} to {dest} and puts it in", "brings {obj} over to "
@@ -367,6 +369,8 @@ def _clauses(sequence: Sequence[str], steps: Sequence[GoalStep], phase: np.ndarr
                 key = f"carry_{kind}"
                 if out and out[-1].key == "grasp" and out[-1].obj == obj:
                     obj = "it"
+            elif walked and kind == "grasp" and args and args[0] not in names.support:
+                key = "fetch"
             elif walked and kind not in ("walk", "carry"):
                 place = names.support.get(args[0], obj) if kind == "grasp" and args else \
                     (dest or obj)
@@ -407,6 +411,16 @@ def _render(clause: _Clause, style: int, rng: np.random.Generator | None) -> str
     return body
 
 
+def _there(parts: list[str], clauses: list[_Clause]) -> list[str]:
+    """'walks to R1, assembles the parts at R1' -> '..., assembles the parts there'."""
+    out = list(parts)
+    for i in range(1, len(clauses)):
+        if clauses[i - 1].key == "walk_to" and clauses[i].dest \
+                and clauses[i - 1].dest == clauses[i].dest:
+            out[i] = out[i].replace(f" at {clauses[i].dest}", " there")
+    return out
+
+
 def _sentence(subject: str, parts: list[str], join: tuple[str, str]) -> str:
     if not parts:
         return f"{subject} stands still."
@@ -444,12 +458,12 @@ def captions(sequence: Sequence[str], steps: Sequence[GoalStep], names: CellName
     out = []
     for k in range(n):
         if k == 0:
-            parts = [_render(c, 0, None) for c in clauses]
+            parts = _there([_render(c, 0, None) for c in clauses], clauses)
             out.append(_sentence(_SUBJECTS[0], parts, _JOIN[0]))
             continue
         rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, k])
         hand_style = int(rng.integers(len(_HANDS)))
-        parts = [_render(c, hand_style, rng) for c in clauses]
+        parts = _there([_render(c, hand_style, rng) for c in clauses], clauses)
         subject = _SUBJECTS[int(rng.integers(len(_SUBJECTS)))]
         join = _JOIN[int(rng.integers(len(_JOIN)))]
         text = _sentence(subject, parts, join)
