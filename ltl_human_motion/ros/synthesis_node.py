@@ -35,7 +35,17 @@ keeps motions in memory only (evicted ones are gone).
 Parameters: ``default_cell`` (str, "paper_cell"; used when a request leaves ``cell``
 empty), ``store_dir`` (str, ""; read only), ``max_concurrent`` (int, 4; read only),
 ``max_queued`` (int, 64; read only), ``max_in_memory`` (int, 32; read only),
-``max_memory_mb`` (float, 256; read only).
+``max_memory_mb`` (float, 256; read only), ``autostart`` (bool, true; read only),
+``preload_library`` (bool, false; read only).
+
+A lifecycle (managed) node, so that commissioning tools can bring it up in order: with
+``autostart`` (the default) it configures and activates itself at once; with
+``autostart: false`` it waits for ``<node>/change_state``. *Configure* loads the default
+cell (and, with ``preload_library``, the motion library of the default stature, so the
+first request does not wait for it); a cell that does not load fails the transition,
+naming the cell. *Activate* starts serving and announcing the catalog; while not active
+the service answers every request with ``success: false``, "not active". *Deactivate*
+and *cleanup* go back.
 """
 
 from __future__ import annotations
@@ -53,7 +63,7 @@ from typing import TYPE_CHECKING, Any
 import rclpy.logging
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.impl.rcutils_logger import RcutilsLogger
-from rclpy.node import Node
+from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 if TYPE_CHECKING:
@@ -149,7 +159,7 @@ class _Job:
     deadline: Deadline | None = None
 
 
-class SynthesisNode(Node):
+class SynthesisNode(LifecycleNode):
     """Serves ``synthesize_motion`` and announces stored motions on ``motion_catalog``.
 
     Parameters
@@ -178,6 +188,10 @@ class SynthesisNode(Node):
                       "to store_dir)", positive, read_only=True),
             ParamSpec("max_memory_mb", 256.0, "Megabytes of motions kept in memory",
                       positive, read_only=True),
+            ParamSpec("autostart", True, "Configure and activate at once (false: wait for "
+                      "the lifecycle's change_state)", read_only=True),
+            ParamSpec("preload_library", False, "Configure also loads the motion library of "
+                      "the default stature", read_only=True),
         ])
         p = self.get_parameter
         store_dir = p("store_dir").value
@@ -194,7 +208,9 @@ class SynthesisNode(Node):
         self._jobs_lock = threading.Lock()
         self._stopping = threading.Event()
         self._catalog_lock = threading.Lock()
-        self._catalog_pub = self.create_publisher(MotionCatalog, "motion_catalog", LATCHED_QOS)
+        self._catalog_pub = self.create_lifecycle_publisher(MotionCatalog, "motion_catalog",
+                                                            LATCHED_QOS)
+        self._active = False
         qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=SERVICE_HISTORY_DEPTH,
                          reliability=ReliabilityPolicy.RELIABLE)
         self._service = self.create_service(SynthesizeMotion, "synthesize_motion",
@@ -213,11 +229,45 @@ class SynthesisNode(Node):
         for worker in self._workers:
             worker.start()
         attach_diagnostics(self, self.diagnostics)
+        if p("autostart").value:
+            self.trigger_configure()
+            self.trigger_activate()
+
+    # ------------------------------------------------------------------ lifecycle
+    def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Load the default cell (and the library with ``preload_library``)."""
+        cell = self.get_parameter("default_cell").value
+        try:
+            resolve_cell(cell)
+            if self.get_parameter("preload_library").value:
+                from ltl_human_motion.planning.pipeline import get_library
+                get_library()
+        except Exception as exc:   # any failure to load: the transition fails, named
+            self.get_logger().error(f"configure failed: default_cell {cell!r}: "
+                                    f"{type(exc).__name__}: {exc}")
+            return TransitionCallbackReturn.FAILURE
+        return super().on_configure(state)
+
+    def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Serve requests and announce the catalog."""
+        result = super().on_activate(state)
+        self._active = True
         self._publish_catalog()
         where = self.store.directory or "memory only"
         self.get_logger().info(
             f"serving {self._service.service_name}; motions stored in {where} (in memory: "
             f"{self.store.max_in_memory} motions, {self.store.max_bytes / 1e6:g} MB)")
+        return result
+
+    def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Refuse new requests ("not active"); those queued or running still finish."""
+        self._active = False
+        return super().on_deactivate(state)
+
+    @property
+    def active(self) -> bool:
+        """True while the node serves requests (lifecycle state active)."""
+        return self._active
 
     # ------------------------------------------------------------------ requests
     @property
@@ -244,6 +294,9 @@ class SynthesisNode(Node):
         try:
             if self._stopping.is_set():
                 raise _RefusalError("the synthesis node is shutting down")
+            if not self._active:
+                raise _RefusalError("the synthesis node is not active (lifecycle); "
+                                    "activate it with its change_state service")
             _check_limits(request)
             with self._jobs_lock:
                 if self._queue.qsize() >= self.max_queued:
@@ -395,6 +448,8 @@ class SynthesisNode(Node):
             response.error_column = exc.column or 0
 
     def _publish_catalog(self) -> None:
+        if not self._active:
+            return                   # announced when activated
         with self._catalog_lock:
             msg = MotionCatalog()
             msg.header.stamp = self.get_clock().now().to_msg()
