@@ -11,6 +11,9 @@ This package is the only place in ``ltl_human_motion`` that imports ``rclpy``. M
   playback and recording in one call; :mod:`~ltl_human_motion.ros.client` -- service calls
   with bounded waits and topic watchers (the hand-made test motions and the scripted
   synthesizer live in ``test/ros_fakes.py``, outside the package).
+* :mod:`~ltl_human_motion.ros.hri` -- the REP 155 body interface;
+  :mod:`~ltl_human_motion.ros.diagnostics` -- ``/diagnostics`` of the nodes;
+  :mod:`~ltl_human_motion.ros.ur_frames` -- the arm's TF frames as ur_description has them.
 * :mod:`~ltl_human_motion.ros.playback`, :mod:`~ltl_human_motion.ros.motion_store` and
   :mod:`~ltl_human_motion.ros.bringup_config` are plain Python (no rclpy import), so
   launch files and tools can use them without a ROS context.
