@@ -201,6 +201,21 @@ def test_unrealizable_spec_is_explained(cell):
     assert "add an assumption such as G F !robot_in(R1)" in message
 
 
+def test_among_winning_moves_the_cheapest(cell):
+    w = reactive_worker("(G F !robot_in(R1)) -> (G F (grasp(O1) | grasp(O2)) & "
+                        "G F assemble(R1) & G(robot_in(R1) -> X !assemble(R1)))", cell)
+    model = w.model
+    start = model.initial_state()
+    cost = {t.key: model.step(start, t)[1] for t in w.tasks if t.name == "grasp"}
+    assert cost["grasp(O1)"] < cost["grasp(O2)"]        # O1 lies nearer the start
+    rng = np.random.default_rng(5)
+    for _ in range(10):
+        run = run_strategy(w, *random_input_lasso(w, rng))
+        first = (run.prefix_tasks or run.cycle_tasks)[0]
+        assert w.tasks[first].key == "grasp(O1)"
+        assert joint_satisfies(w, run)
+
+
 def test_a_spec_the_worker_cannot_meet_whatever_the_robot_does_says_so(cell):
     with pytest.raises(UnrealizableError) as exc:
         reactive_worker("(G F !robot_in(R1)) -> G F grasp(O1)", cell)

@@ -25,6 +25,16 @@ HELP = ("synthesize a reactive worker (GR(1): robot events -> tasks) and verify 
         "motions on random robot behaviours")
 
 
+def _speed(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a speed in rad/s, got {text!r}") from None
+    if not (np.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"expected a finite speed >= 0 rad/s, got {text}")
+    return value
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``ltl-human-motion react``."""
     parser.add_argument("--cell", required=True,
@@ -42,13 +52,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="robot YAML whose trajectory gives robot_in/robot_moving for a "
                              "third of the traces (default config/ur_pick_place.yaml when the "
                              "specification reads them)")
+    parser.add_argument("--moving-threshold", type=_speed, default=0.05, metavar="RAD_S",
+                        help="joint speed in rad/s above which robot_moving holds on the "
+                             "robot's trajectory (default 0.05)")
     parser.add_argument("--no-motion", action="store_true",
                         help="check the strategy's runs only; plan no motion")
     parser.add_argument("--out", type=Path, default=Path("out/react"),
                         help="output folder for react.json (default out/react)")
 
 
-def _robot_events(path: Path | None, cell, inputs: tuple[str, ...]):
+def _robot_events(path: Path | None, cell, inputs: tuple[str, ...], threshold: float):
     """The robot's trajectory events, when the specification reads robot_in/robot_moving."""
     from ltl_human_motion.errors import CellError
     from ltl_human_motion.robot.events import robot_events
@@ -59,7 +72,7 @@ def _robot_events(path: Path | None, cell, inputs: tuple[str, ...]):
         if not path.is_file():
             return None
     try:
-        return robot_events(path, cell, inputs)
+        return robot_events(path, cell, inputs, threshold)
     except ValueError as exc:
         raise CellError(f"--robot {path}: {exc}") from None
 
@@ -94,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
         library = get_library(float(args.stature))
     from ltl_human_motion.planning.reactive import motion_of_run
 
-    robot = _robot_events(args.robot, cell, worker.gr1.inputs)
+    robot = _robot_events(args.robot, cell, worker.gr1.inputs, args.moving_threshold)
 
     records = []
     satisfied = verified = 0

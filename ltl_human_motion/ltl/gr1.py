@@ -388,7 +388,7 @@ class Strategy:
     Moore reading (docs/reactive.md): step i's task is chosen at the boundary before it,
     from the inputs observed at the end of the steps before; step i's inputs are those
     observed at its end. Deterministic: among the moves the transducer allows, the one
-    closest to the goal it pursues (the lowest layer of that goal's attractor, then of
+    closest to the next goal to reach (the lowest layer of that goal's attractor, then of
     the goals after it, for every input to come, so the worker does not idle where it
     can progress), then the cheapest by the plant's cost, then the lowest task index and
     goal counter.
@@ -409,16 +409,27 @@ class Strategy:
     def _sys_vars(self) -> list[str]:
         return [*self.game.aut.varlist["sys"], "_goal"]
 
-    def _ranks(self, values: dict[str, object]) -> tuple[int, ...]:
-        """Layers of a successor (its system part ``values``) in the attractors of the
-        goal it pursues and of the goals after it, whatever the inputs."""
+    def _next_goal(self) -> int:
+        """The goal to reach next: the counter's, or the one after it where the current
+        state already meets the counter's goal."""
+        if not self.state:
+            return 0
+        aut = self.game.aut
+        c = int(self.state["_goal"])
+        here = {k: v for k, v in self.state.items() if k != "_goal"}
+        goals = aut.win["[]<>"]
+        return (c + 1) % len(goals) if aut.let(here, goals[c]) == aut.true else c
+
+    def _ranks(self, values: dict[str, object], first: int) -> tuple[int, ...]:
+        """Layers of a successor (its system part ``values``) in the attractors of goal
+        ``first`` and of the goals after it, whatever the inputs."""
         aut = self.game.aut
         sys = {k: v for k, v in values.items() if k != "_goal"}
         env = aut.varlist["env"]
         n = len(self.layers)
         out = []
         for i in range(n):
-            layers = self.layers[(int(values["_goal"]) + i) % n]
+            layers = self.layers[(first + i) % n]
             out.append(next((r for r, layer in enumerate(layers)
                              if aut.forall(env, aut.let(sys, layer)) == aut.true),
                             len(layers)))
@@ -446,8 +457,11 @@ class Strategy:
         if not picks:
             raise SpecError("the inputs broke an assumption; the strategy has no move")
 
+        first = self._next_goal()
+
         def key(p: dict[str, object]) -> tuple:
-            return (self._ranks(p), costs.get((int(p["task"]), int(p["cs"])), float("inf")),
+            return (self._ranks(p, first),
+                    costs.get((int(p["task"]), int(p["cs"])), float("inf")),
                     int(p["task"]), int(p["_goal"]))
         self._chosen = min(picks, key=key)
         return int(self._chosen["task"])

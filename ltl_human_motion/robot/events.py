@@ -89,8 +89,12 @@ def robot_events(path: str | Path, cell, inputs: Sequence[str],
     Raises
     ------
     ValueError
-        A malformed robot file (the message names it).
+        A malformed robot file (the message names it), or a threshold that is not a
+        finite number >= 0.
     """
+    if not (np.isfinite(moving_threshold) and moving_threshold >= 0):
+        raise ValueError(f"moving_threshold must be a finite speed >= 0 rad/s, got "
+                         f"{moving_threshold}")
     cfg = load_robot_config(path)
     model = ur_model(cfg["model"])
     if cfg["tool_length"] is not None:
