@@ -37,6 +37,7 @@ NOT_SHOWN = {
     "geometry_msgs/msg/TwistStamped": "no display in rviz_default_plugins",
     "hri_msgs/msg/IdsList": "a list of ids",
     "diagnostic_msgs/msg/DiagnosticArray": "rqt_robot_monitor's, not RViz's",
+    "lifecycle_msgs/msg/TransitionEvent": "the synthesis node's lifecycle transitions",
 }
 
 
