@@ -66,6 +66,9 @@ if TYPE_CHECKING:
 
 #: Blocked goal primitives of a step that the whole-body program remakes, at most.
 WHOLE_BODY_TRIES = 1
+#: Placements (the first of a step's tries, in order) at which the whole-body program
+#: remakes a blocked goal primitive, once every try has failed without it.
+WHOLE_BODY_PLACEMENTS = 2
 #: Whole-body programs one plan runs at most (about 0.25 s each): a step that every
 #: placement blocks would otherwise run one per placement.
 WHOLE_BODY_BUDGET = 4
@@ -187,6 +190,7 @@ class GoalSteps:
         self.goals = goals
         self.programs_left = WHOLE_BODY_BUDGET
         self.program_note: str | None = None
+        self.program_mode = False
 
     def where(self, name: str) -> np.ndarray:
         """Where part ``name`` rests now (3,) (:func:`.plan_state.object_position`)."""
@@ -255,7 +259,7 @@ class GoalSteps:
                 if other:
                     kwargs["hand"], switched = other, candidate.meta.get("hand")
         self.program_note = None
-        if mp is None and blocked and self.ctx.options.whole_body:
+        if mp is None and blocked and self.program_mode:
             mp = self.whole_body(blocked, kind, grasped, part, container)
         if mp is None:
             raise self.refusal(text, kind, attempts, blocked, grasped, (kept_in, self_hits),
@@ -341,29 +345,42 @@ class GoalSteps:
         primitives its preparation walked). Raises the first failure (``failure`` if
         given: the blocked walk to the first placement), with how many other placements
         were tried."""
-        for k, (target, prepare) in enumerate(tries):
-            mark = self.state.mark()
+        first = failure
+        for program in (False, True):
+            if program and not (self.ctx.options.whole_body and failure is not None
+                                and failure.reason == "blocked" and self.programs_left > 0):
+                break
+            self.program_mode = program
             try:
-                walked = prepare() if prepare is not None else 0
-                if callable(target):
-                    target = target()          # where the preparation left the worker
-                seg, mp = self.segment(
-                    kind, target, i, text, carry_stance=carrying_before,
-                    seconds=float(args[0]) if kind == "wait" and args else None,
-                    grasped=args[0] if kind == "grasp" else None,
-                    part=args[0] if kind in ("move", "insert", "release", "extract") and args
-                    else None, container=args[1] if kind == "extract" else None,
-                    attempts=None if k == 0 or target is None else ALTERNATIVE_ATTEMPTS)
-                return seg, mp, target, walked
-            except PlanningError as exc:
-                # Blocked, or out of reach from where the walk ended (it came from the
-                # side of a machine): the other placements may do; an alternative may
-                # fail in any way.
-                if k == 0 and exc.reason not in ("blocked", "unreachable"):
-                    raise
-                failure = failure or exc
-                # What a failed try placed (a walk, an arm transition) is taken back.
-                self.state.restore(mark)
+                for k, (target, prepare) in enumerate(
+                        tries[:WHOLE_BODY_PLACEMENTS] if program else tries):
+                    mark = self.state.mark()
+                    try:
+                        walked = prepare() if prepare is not None else 0
+                        if callable(target):
+                            target = target()          # where the preparation left the worker
+                        seg, mp = self.segment(
+                            kind, target, i, text, carry_stance=carrying_before,
+                            seconds=float(args[0]) if kind == "wait" and args else None,
+                            grasped=args[0] if kind == "grasp" else None,
+                            part=args[0] if kind in ("move", "insert", "release", "extract")
+                            and args else None,
+                            container=args[1] if kind == "extract" else None,
+                            attempts=None if k == 0 or target is None
+                            else ALTERNATIVE_ATTEMPTS)
+                        return seg, mp, target, walked
+                    except PlanningError as exc:
+                        # Blocked, or out of reach from where the walk ended (it came from
+                        # the side of a machine): the other placements may do; an
+                        # alternative may fail in any way.
+                        if k == 0 and exc.reason not in ("blocked", "unreachable"):
+                            raise
+                        if failure is None or (program and k == 0 and first is None):
+                            failure = exc       # the program's try at the first placement
+                        # What a failed try placed (a walk, an arm transition) is taken back.
+                        self.state.restore(mark)
+            finally:
+                self.program_mode = False
         if len(tries) == 1:
             raise failure
         raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements tried",
