@@ -65,7 +65,8 @@ def test_every_node_reports_on_diagnostics(session) -> None:
 
 def _describe(session, node: str, names: list[str]) -> dict:
     response = session.call(DescribeParameters, f"{node}/describe_parameters",
-                            DescribeParameters.Request(names=names))
+                            DescribeParameters.Request(names=names), timeout=30.0,
+                            resend_after=3.0)
     return dict(zip(names, response.descriptors, strict=True))
 
 
@@ -90,6 +91,7 @@ def test_an_out_of_range_value_is_refused_with_the_range(session) -> None:
     value = ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=-5.0)
     response = session.call(SetParameters, "/human_1/occupancy_node/set_parameters",
                             SetParameters.Request(parameters=[
-                                Parameter(name="marker_rate", value=value)]))
+                                Parameter(name="marker_rate", value=value)]),
+                            timeout=30.0, resend_after=3.0)
     assert not response.results[0].successful
     assert response.results[0].reason

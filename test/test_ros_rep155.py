@@ -180,5 +180,6 @@ def test_rep155_frames_form_one_tree_under_body(session) -> None:
 def test_human_description_parameter_holds_the_urdf(session) -> None:
     """REP 155: the URDF of body <id> is the parameter ``human_description_<id>``."""
     response = session.call(GetParameters, "/human_1/skeleton_publisher/get_parameters",
-                            GetParameters.Request(names=["human_description_h1"]))
+                            GetParameters.Request(names=["human_description_h1"]),
+                            timeout=30.0, resend_after=3.0)
     assert response.values[0].string_value == session.urdf.last.data
