@@ -8,10 +8,12 @@ plus the idle step ``wait(WAIT_STEP)``, and solves the game. An unrealizable
 specification raises :class:`UnrealizableError` naming the guarantee the robot can
 defeat and a counter-strategy in words, before any motion planning.
 
-:func:`random_input_lasso` draws robot behaviours that keep the assumptions and
-:func:`run_strategy` runs the strategy on one: the joint run of a finite strategy on an
-eventually periodic input is eventually periodic, so it is returned as an exact lasso
-that the independent evaluator checks against the whole specification.
+:func:`draw_run` draws a robot behaviour that keeps the assumptions (a lasso of steps,
+:func:`random_input_lasso`; a schedule in seconds, :func:`random_schedule`; or the
+robot's own trajectory) and runs the strategy on it (:func:`run_strategy`,
+:func:`timed_run`): the joint run of a finite strategy on an eventually periodic input is
+eventually periodic, so it is returned as an exact lasso that the independent evaluator
+checks against the whole specification (:func:`joint_satisfies`).
 """
 
 from __future__ import annotations
