@@ -14,7 +14,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -169,6 +169,13 @@ ONE_HAND_AUTO_TASKS = ("grasp", "release", "move", "insert", "extract")
 EXTRACT_CHECK_STRIDE = 4
 
 
+@dataclass
+class ProgramBudget:
+    """Whole-body programs a plan may still run (:data:`WHOLE_BODY_BUDGET`)."""
+
+    left: int
+
+
 class GoalSteps:
     """Makes the goal segments of one plan.
 
@@ -188,9 +195,7 @@ class GoalSteps:
         self.state = state
         self.executor = executor
         self.goals = goals
-        self.programs_left = WHOLE_BODY_BUDGET
-        self.program_note: str | None = None
-        self.program_mode = False
+        self.programs = ProgramBudget(WHOLE_BODY_BUDGET)
 
     def where(self, name: str) -> np.ndarray:
         """Where part ``name`` rests now (3,) (:func:`.plan_state.object_position`)."""
@@ -199,13 +204,15 @@ class GoalSteps:
     def segment(self, kind: str, target: np.ndarray | None, label: int,
                 text: str, *, carry_stance: bool = False, seconds: float | None = None,
                 grasped: str | None = None, attempts: int | None = None,
-                part: str | None = None, container: str | None = None
-                ) -> tuple[int, MotionPrimitive]:
+                part: str | None = None, container: str | None = None,
+                program: bool = False) -> tuple[int, MotionPrimitive]:
         """Make, check and place the goal primitive of ``kind`` for ``target``.
 
         ``carry_stance``: the arms are already in the carry stance; ``seconds``: how long
         a wait lasts; ``grasped``: the part a grasp picks up (checked from contact on);
         ``attempts``: seeded primitives tried (default ``options.goal_attempts``);
+        ``program``: a step every placement blocked: remake a blocked primitive with the
+        whole-body program (:meth:`whole_body`);
         ``part``: the part a move, insert or release puts down (done by the hand holding
         it; for extract, the part taken out of ``container``). A grasp or extract while
         one hand holds a part is done by the other hand.
@@ -258,12 +265,12 @@ class GoalSteps:
                 other = OTHER_HAND.get(candidate.meta.get("hand"))
                 if other:
                     kwargs["hand"], switched = other, candidate.meta.get("hand")
-        self.program_note = None
-        if mp is None and blocked and self.program_mode:
-            mp = self.whole_body(blocked, kind, grasped, part, container)
+        note = None
+        if mp is None and blocked and program:
+            mp, note = self.whole_body(blocked, kind, grasped, part, container)
         if mp is None:
             raise self.refusal(text, kind, attempts, blocked, grasped, (kept_in, self_hits),
-                               part, container)
+                               part, container, note)
         seg = self.executor.add(mp, self.state.pose, label, self.ctx.overlap)
         self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
         self.state.gait_state = None
@@ -348,39 +355,35 @@ class GoalSteps:
         first = failure
         for program in (False, True):
             if program and not (self.ctx.options.whole_body and failure is not None
-                                and failure.reason == "blocked" and self.programs_left > 0):
+                                and failure.reason == "blocked" and self.programs.left > 0):
                 break
-            self.program_mode = program
-            try:
-                for k, (target, prepare) in enumerate(
-                        tries[:WHOLE_BODY_PLACEMENTS] if program else tries):
-                    mark = self.state.mark()
-                    try:
-                        walked = prepare() if prepare is not None else 0
-                        if callable(target):
-                            target = target()          # where the preparation left the worker
-                        seg, mp = self.segment(
-                            kind, target, i, text, carry_stance=carrying_before,
-                            seconds=float(args[0]) if kind == "wait" and args else None,
-                            grasped=args[0] if kind == "grasp" else None,
-                            part=args[0] if kind in ("move", "insert", "release", "extract")
-                            and args else None,
-                            container=args[1] if kind == "extract" else None,
-                            attempts=None if k == 0 or target is None
-                            else ALTERNATIVE_ATTEMPTS)
-                        return seg, mp, target, walked
-                    except PlanningError as exc:
-                        # Blocked, or out of reach from where the walk ended (it came from
-                        # the side of a machine): the other placements may do; an
-                        # alternative may fail in any way.
-                        if k == 0 and exc.reason not in ("blocked", "unreachable"):
-                            raise
-                        if failure is None or (program and k == 0 and first is None):
-                            failure = exc       # the program's try at the first placement
-                        # What a failed try placed (a walk, an arm transition) is taken back.
-                        self.state.restore(mark)
-            finally:
-                self.program_mode = False
+            for k, (target, prepare) in enumerate(
+                    tries[:WHOLE_BODY_PLACEMENTS] if program else tries):
+                mark = self.state.mark()
+                try:
+                    walked = prepare() if prepare is not None else 0
+                    if callable(target):
+                        target = target()          # where the preparation left the worker
+                    seg, mp = self.segment(
+                        kind, target, i, text, carry_stance=carrying_before,
+                        seconds=float(args[0]) if kind == "wait" and args else None,
+                        grasped=args[0] if kind == "grasp" else None,
+                        part=args[0] if kind in ("move", "insert", "release", "extract")
+                        and args else None,
+                        container=args[1] if kind == "extract" else None,
+                        attempts=None if k == 0 or target is None
+                        else ALTERNATIVE_ATTEMPTS, program=program)
+                    return seg, mp, target, walked
+                except PlanningError as exc:
+                    # Blocked, or out of reach from where the walk ended (it came from
+                    # the side of a machine): the other placements may do; an
+                    # alternative may fail in any way.
+                    if k == 0 and exc.reason not in ("blocked", "unreachable"):
+                        raise
+                    if failure is None or (program and k == 0 and first is None):
+                        failure = exc       # the program's try at the first placement
+                    # What a failed try placed (a walk, an arm transition) is taken back.
+                    self.state.restore(mark)
         if len(tries) == 1:
             raise failure
         raise PlanningError(f"{failure}; so did {len(tries) - 1} other placements tried",
@@ -736,10 +739,11 @@ class GoalSteps:
 
     def refusal(self, text: str, kind: str, attempts: int, blocked: list[MotionPrimitive],
                 grasped: str | None, counts: tuple[int, int], part: str | None,
-                container: str | None) -> PlanningError:
+                container: str | None, note: str | None = None) -> PlanningError:
         """The error of a goal primitive none of whose ``attempts`` tries was clear;
         ``counts``: how many kept the part in its container, and how many took a limb
-        through the body, of those clear of obstacles."""
+        through the body, of those clear of obstacles; ``note``: what the whole-body
+        program reached, where it ran."""
         kept_in, self_hits = counts
         if self_hits and not blocked:
             return PlanningError(f"task {text}: every {kind} motion tried ({attempts}) "
@@ -753,8 +757,8 @@ class GoalSteps:
         into = (f"{len(blocked)} of the {kind} motions tried ({attempts}) run into an "
                 f"obstacle, {self_hits} take a limb through the body" if self_hits
                 else f"every {kind} motion tried ({attempts}) runs into an obstacle")
-        program = "" if self.program_note is None else \
-            f"; the whole-body program, kept clear of every obstacle: {self.program_note}"
+        program = "" if note is None else \
+            f"; the whole-body program, kept clear of every obstacle: {note}"
         return PlanningError(f"task {text}: {into}; {self.what_blocks(blocked, grasped)}"
                              f"{program}", task=text, reason="blocked")
 
@@ -774,21 +778,22 @@ class GoalSteps:
         return f"closest try: {least.describe(self.ctx.library.fps)}"
 
     def whole_body(self, blocked: list[MotionPrimitive], kind: str, grasped: str | None,
-                   part: str | None, container: str | None) -> MotionPrimitive | None:
+                   part: str | None, container: str | None
+                   ) -> tuple[MotionPrimitive | None, str | None]:
         """The first of ``blocked`` (hand goal primitives that met an obstacle) that the
         whole-body program (:mod:`.constrained_goals`) remakes clear of every obstacle,
-        still reaching the target and passing the checks of :meth:`segment`; None if
-        none does (then :attr:`program_note` says why, for the refusal)."""
+        still reaching the target and passing the checks of :meth:`segment`, or None;
+        and where none does, what the program reached, for the refusal."""
         from ltl_human_motion.planning.constrained_goals import (
             constrained_primitive,
             contact_tolerance,
         )
-        self.program_note = None
+        note = None
         for candidate in blocked[:WHOLE_BODY_TRIES]:
-            if candidate.meta.get("hand") in (None, "none") or self.programs_left <= 0 \
+            if candidate.meta.get("hand") in (None, "none") or self.programs.left <= 0 \
                     or not self.palm_clear(candidate):
                 continue
-            self.programs_left -= 1
+            self.programs.left -= 1
             held, held_from = self.held_part(candidate, kind, grasped, part)
             made, miss, result = constrained_primitive(
                 candidate, self.ctx.cell.part_set, self.state.pose, self.ctx.stature, held,
@@ -796,21 +801,21 @@ class GoalSteps:
             failed = body_failures(made, kind, self.ctx.stature) \
                 if made is not None and self.ctx.options.refuse_self_penetration else []
             if made is None:
-                self.program_note = (
+                note = (
                     f"its palm stops {100 * miss:.1f} cm from the target"
                     if miss > contact_tolerance(kind) else "it cannot keep every part clear"
                     if result.least_clearance < 0.0 else
                     f"it ends {100 * result.end_miss:.1f} cm from the pose it must end in")
             elif not self.goal_clear(made, grasped):
-                self.program_note = "a part in hand still meets an obstacle"
+                note = "a part in hand still meets an obstacle"
             elif failed:
-                self.program_note = f"its motion fails the {', '.join(failed)} check"
+                note = f"its motion fails the {', '.join(failed)} check"
             elif kind == "extract" and part is not None and container is not None \
                     and not self.pulls_out(made, part, container):
-                self.program_note = f"it does not take {part} out of {container}"
+                note = f"it does not take {part} out of {container}"
             else:
-                return made
-        return None
+                return made, None
+        return None, note
 
     def palm_clear(self, mp: MotionPrimitive) -> bool:
         """Whether the acting palms of goal primitive ``mp`` keep clear of the obstacles
