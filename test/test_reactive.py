@@ -216,11 +216,15 @@ def test_among_winning_moves_the_cheapest(cell):
         assert joint_satisfies(w, run)
 
 
-def test_a_spec_the_worker_cannot_meet_whatever_the_robot_does_says_so(cell):
+def test_unrealizable_explanations_name_the_robots_counter_strategy(cell):
     with pytest.raises(UnrealizableError) as exc:
         reactive_worker("(G F !robot_in(R1)) -> G F grasp(O1)", cell)
     assert "the worker cannot meet the guarantee 'G F grasp(O1)' whatever the robot does" \
         in exc.value.message
+    with pytest.raises(UnrealizableError, match="the robot is in R1 as each assemble\\(R1\\) "
+                       "of the worker ends, and is out of R1 otherwise"):
+        reactive_worker("(G F !robot_in(R1)) -> G(robot_in(R1) -> !assemble(R1)) & "
+                        "G F assemble(R1)", cell)
     with pytest.raises(UnrealizableError, match="the robot keeps offering O1 forever"):
         reactive_worker("(G F offered(O1)) -> G(offered(O1) -> X grasp(O1)) & "
                         "G F assemble(R1)", cell)

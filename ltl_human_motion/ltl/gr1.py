@@ -217,11 +217,16 @@ class Gr1Game:
     cooperative : bool
         The worker also picks the inputs, keeping the assumptions (init, safety and
         liveness become its own): solvable iff some robot behaviour lets the worker win.
+    respond : (int, mapping, mapping), optional
+        ``(k, on, off)``: the robot sets the inputs to ``on`` as a step doing task ``k``
+        ends and to ``off`` as any other step ends (a reacting counter-strategy).
     """
 
     def __init__(self, spec: Gr1Spec, plant: Plant,
                  fixed_inputs: Mapping[str, bool] | None = None,
-                 cooperative: bool = False) -> None:
+                 cooperative: bool = False,
+                 respond: tuple[int, Mapping[str, bool], Mapping[str, bool]] | None = None
+                 ) -> None:
         from omega.symbolic import temporal as trl
 
         self.spec = spec
@@ -256,6 +261,13 @@ class Gr1Game:
             env_init &= lit if value else ~lit
             lit_next = aut.add_expr(self._env[key] + "'")
             env_action &= lit_next if value else ~lit_next
+        if respond is not None:
+            k, on, off = respond
+            trigger = self._eq(f"task' = {k}")
+            for key in self.inputs:
+                lit = self._eq(self._env[key] + "'")
+                env_action &= (trigger & (lit if on[key] else ~lit)) | \
+                    (~trigger & (lit if off[key] else ~lit))
         sys_init = self._plant_init()
         sys_action = self._plant_action()
         goals = []

@@ -151,21 +151,44 @@ def _plant(model: CellModel, tasks: tuple[Atom, ...], labels: tuple[frozenset[st
     return Plant(labels, initial, tuple(moves[i] for i in range(len(order)))), tuple(order)
 
 
-def _input_words(key: str, value: bool) -> str:
+#: How a robot input reads in an explanation: held for ever (true, false), then as a
+#: task ends (true, false).
+_INPUT_WORDS = {
+    "robot_in": ("stays in {}", "stays out of {}", "is in {}", "is out of {}"),
+    "robot_moving": ("keeps moving", "stays still", "moves", "stands still"),
+    "offered": ("keeps offering {}", "never offers {}", "offers {}", "does not offer {}"),
+}
+
+
+def _input_words(key: str, value: bool, forever: bool = True) -> str:
     name, _, rest = key.partition("(")
-    arg = rest.rstrip(")")
-    if name == "robot_in":
-        return f"stays in {arg}" if value else f"stays out of {arg}"
-    if name == "robot_moving":
-        return "keeps moving" if value else "stays still"
-    if name == "offered":
-        return f"keeps offering {arg}" if value else f"never offers {arg}"
-    return f"keeps {key} {'true' if value else 'false'}"
+    forms = _INPUT_WORDS.get(name, (f"keeps {key} true", f"keeps {key} false",
+                                    f"sets {key} true", f"sets {key} false"))
+    return forms[(0 if forever else 2) + (0 if value else 1)].format(rest.rstrip(")"))
 
 
 def _realizable(spec: Gr1Spec, plant: Plant, fixed: dict[str, bool] | None = None,
-                cooperative: bool = False) -> bool:
-    return Gr1Game(spec, plant, fixed, cooperative).solve()
+                cooperative: bool = False, respond=None) -> bool:
+    return Gr1Game(spec, plant, fixed, cooperative, respond).solve()
+
+
+def _reacting_counter(spec: Gr1Spec, plant: Plant, tasks: tuple[str, ...]) -> str | None:
+    """A robot that answers one task of the worker with some inputs and every other task
+    with others, and defeats the worker, in words (None: none found)."""
+    if len(spec.inputs) > 3:
+        return None
+    values = list(input_valuations(spec.inputs))
+    for k, task in enumerate(tasks):
+        for on in values:
+            for off in values:
+                if on != off and not _realizable(spec, plant, respond=(k, on, off)):
+                    changed = [key for key in spec.inputs if on[key] != off[key]]
+                    when = " and ".join(_input_words(key, on[key], False) for key in changed)
+                    other = " and ".join(_input_words(key, off[key], False)
+                                         for key in changed)
+                    return (f"the robot {when} as each {task} of the worker ends, and "
+                            f"{other} otherwise")
+    return None
 
 
 def _with_guarantees(spec: Gr1Spec, guarantees: list[Gr1Conjunct]) -> Gr1Spec:
@@ -206,10 +229,11 @@ def _defeated(spec: Gr1Spec, plant: Plant, fixed: dict[str, bool] | None,
 
 
 def explain_unrealizable(spec: Gr1Spec, plant: Plant,
-                         pretty: Callable[[str], str] = str) -> str:
+                         pretty: Callable[[str], str] = str,
+                         tasks: tuple[str, ...] = ()) -> str:
     """Why ``spec`` is unrealizable on ``plant``: the guarantee the robot can defeat,
     a counter-strategy in words, and an assumption that would help (``pretty`` rewrites
-    a conjunct's text for the message)."""
+    a conjunct's text for the message; ``tasks`` names the plant's tasks)."""
     if not _realizable(spec, plant, cooperative=True):
         return (f"the worker cannot meet {_defeated(spec, plant, None, pretty, True)} "
                 "whatever the robot does, with its two hands, the parts it holds and the "
@@ -224,9 +248,12 @@ def explain_unrealizable(spec: Gr1Spec, plant: Plant,
             break
     defeated = _defeated(spec, plant, counter, pretty)
     if counter is None:
-        how = ("no fixed robot behaviour suffices: the robot wins by reacting to the "
-               "worker's moves")
-        hint = "add assumptions on how the robot behaves (G F ..., G(... -> X ...))"
+        how = _reacting_counter(spec, plant, tasks) or (
+            "no fixed robot behaviour suffices: the robot wins by reacting to the "
+            "worker's moves")
+        hint = ("the worker sees an input only when a task ends: guard a task with the "
+                "inputs of the step before (G(... -> X !task)), or assume more about the "
+                "robot")
     else:
         words = [_input_words(k, v) for k, v in counter.items()] or ["does anything"]
         how = f"the robot {' and '.join(words)} forever"
@@ -296,7 +323,8 @@ def reactive_worker(text: str, cell, *, wait_step: float = WAIT_STEP) -> Reactiv
     game = Gr1Game(gr1, plant)
     if not game.solve():
         raise UnrealizableError("unrealizable: " + explain_unrealizable(
-            gr1, plant, lambda t: _readable(t, specification)), text=specification.text)
+            gr1, plant, lambda t: _readable(t, specification), tuple(t.key for t in tasks)),
+            text=specification.text)
     return ReactiveWorker(specification, gr1, tasks, plant, game, game.strategy(), model,
                           states)
 
