@@ -42,7 +42,6 @@ import numpy as np
 from ltl_human_motion.kernel.rotations import matrix_from_yaw
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, N_JOINTS, Skeleton
 from ltl_human_motion.scene.cell import Cell
-from ltl_human_motion.scene.shapes import Box, Shape
 from ltl_human_motion.scene.predicates import (
     enclose,
     enclose_object,
@@ -50,6 +49,7 @@ from ltl_human_motion.scene.predicates import (
     enter_object,
     ground_enter,
 )
+from ltl_human_motion.scene.shapes import Box, Shape
 from ltl_human_motion.vocabulary import TASK_ARGUMENTS, shorthand_conjuncts
 
 __all__ = [
