@@ -278,6 +278,7 @@ _HANDS = ((" with the {side} hand", " with both hands"),
 _TEMPLATES: dict[str, tuple[str, ...]] = {
     "walk_to": ("walks to {dest}", "goes over to {dest}", "heads to {dest}",
                 "steps over to {dest}"),
+    "walk_along": ("moves along {dest}", "steps along {dest}", "shifts along {dest}"),
     "grasp": ("picks up {obj}{hand}", "takes {obj}{hand}", "grabs {obj}{hand}",
               "lifts {obj}{hand}"),
     "fetch": ("walks to {obj} and picks it up{hand}", "goes over to {obj} and takes it{hand}",
@@ -375,7 +376,11 @@ def _clauses(sequence: Sequence[str], steps: Sequence[GoalStep], phase: np.ndarr
                 place = names.support.get(args[0], obj) if kind == "grasp" and args else \
                     (dest or obj)
                 if place:
-                    out.append(_Clause("walk_to", dest=place))
+                    walks = [c for c in out if c.key in ("walk_to", "walk_along")]
+                    along = bool(walks) and walks[-1].dest == place \
+                        and not any(c.key.startswith("carry") for c in out[out.index(
+                            walks[-1]):])
+                    out.append(_Clause("walk_along" if along else "walk_to", dest=place))
             hand = s.hand if kind in _HAND_TASKS else None
             out.append(_Clause(key, obj, dest, hand,
                                posture if kind in _HAND_TASKS else None))
