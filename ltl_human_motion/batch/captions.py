@@ -4,9 +4,9 @@ A caption is one English sentence per item made from templates, no network model
 tasks in order (with the walks between them), the objects, regions and obstacles by name
 (or by the phrase the specs file's ``descriptions`` gives them), the acting hand, and
 sitting or kneeling, e.g. "The worker walks to the left table, picks up P1 with the right
-hand, carries it to the kit tray and puts it in." Caption 0 is the canonical wording; the others are paraphrases
-drawn with ``numpy.random.default_rng([seed, k])``, so the same item always gets the
-same sentences.
+hand, carries it to the kit tray and puts it in." Caption 0 is the canonical wording; the
+others are paraphrases drawn with ``numpy.random.default_rng([seed, k])``, so the same
+item always gets the same sentences.
 
 Per-frame labels (T = frames of the motion):
 

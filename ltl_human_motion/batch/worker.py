@@ -285,7 +285,8 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
 
     record: dict[str, Any] = {
         "index": item.index, "spec_name": item.spec_name, "spec": item.spec,
-        "ltl": PAPER_SPECS.get(item.spec.strip(), item.spec), "seed": item.seed, "params": item.params_dict(), "status": "failed",
+        "ltl": PAPER_SPECS.get(item.spec.strip(), item.spec), "seed": item.seed,
+        "params": item.params_dict(), "status": "failed",
         "sequence": None, "lasso": None, "duration": None, "n_frames": None, "fps": None,
         "verified": False, "verification": None, "motion_sha256": None, "error": None,
         "nodes_expanded": None, "start_pose": None, "captions": None, "steps": None,
