@@ -119,3 +119,19 @@ def test_did_you_mean() -> None:
     assert did_you_mean("walk", ["grasp", "walk"]) == ""
     assert did_you_mean("xyz", ["grasp", "walk"]) == ""
     assert did_you_mean(5, ["grasp"]) == "" and did_you_mean("a", []) == ""
+
+
+def test_output_into_a_closed_pipe_ends_quietly(tmp_path):
+    """`ltl-human-motion ... | head -1`: the command stops without a traceback when its
+    reader goes away."""
+    import os
+    import subprocess
+    import sys
+    read, write = os.pipe()
+    os.close(read)
+    proc = subprocess.run([sys.executable, "-m", "ltl_human_motion", "tasks", "S2",
+                           "--cell", "paper_cell", "-n", "3"], stdout=write,
+                          stderr=subprocess.PIPE, text=True, timeout=120)
+    os.close(write)
+    assert "Traceback" not in proc.stderr
+    assert proc.returncode in (0, 141)
