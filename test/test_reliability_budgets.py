@@ -46,11 +46,22 @@ def test_64_until_operators_pass_the_operator_limit() -> None:
     assert temporal_operators(formula) == MAX_TEMPORAL_OPERATORS
 
 
+#: Formulas whose translation may finish inside the budget on a fast, idle machine (the
+#: 49-deep chain took 6.3 s unbounded at load 7, under 2 s on a quiet one): they must
+#: answer or refuse, never run on.
+BORDERLINE = {"49-deep U chain"}
+
+
 @pytest.mark.parametrize("name", list(HARD))
 def test_synthesize_sequences_answers_or_refuses_naming_the_budget(name: str) -> None:
     started = time.monotonic()
-    with pytest.raises(SpecError, match=r"within 2 s \(MAX_TRANSLATION_SECONDS\)"):
-        synthesize_sequences(HARD[name], CELL, n=3)
+    try:
+        answer = synthesize_sequences(HARD[name], CELL, n=3)
+    except SpecError as exc:
+        assert "within 2 s (MAX_TRANSLATION_SECONDS)" in str(exc)
+    else:
+        assert name in BORDERLINE, f"{name} was translated within the budget"
+        assert len(answer) > 0
     assert time.monotonic() - started < PROMPT
 
 
