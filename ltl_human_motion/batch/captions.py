@@ -29,6 +29,8 @@ from typing import Any
 
 import numpy as np
 
+from ltl_human_motion.vocabulary import HAND_TASKS
+
 __all__ = ["HOLD_SPEED", "PHASES", "CellNames", "FrameLabels", "GoalStep", "captions",
            "frame_labels"]
 
@@ -44,8 +46,7 @@ _STILL = re.compile(r"^(stand|arms_to_)")
 _TASK = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\((.*)\))?\s*$")
 _CODE = re.compile(r"^[A-Z]+[0-9]*$")
 _SIDES = ("left", "right", "front", "back", "near", "far", "upper", "lower", "top", "bottom")
-_HAND_TASKS = ("grasp", "release", "move", "insert", "extract", "leftHand", "rightHand",
-               "assemble", "carry")
+_HAND_TASKS = (*HAND_TASKS, "carry")
 
 
 @dataclass(frozen=True)

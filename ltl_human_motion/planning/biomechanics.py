@@ -64,6 +64,7 @@ from ltl_human_motion.kernel.vectors import cross3, dot3, norm3
 from ltl_human_motion.motion.ik import center_of_mass
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, JOINT_NAMES
 from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
+from ltl_human_motion.vocabulary import HAND_TASKS
 
 __all__ = [
     "BiomechanicsLimits",
@@ -82,9 +83,6 @@ _FOOT_JOINTS = ("l_ankle", "l_toe", "r_ankle", "r_toe")
 CONTACT_REST_HEIGHTS = (0.039, 0.010)
 #: Tasks whose motion is the pelvis going down or coming up with the legs loaded.
 POSTURE_TRANSITION_TASKS = ("sit", "standUp", "kneel", "stoop")
-#: Hand goal tasks (the hand moves deliberately to a target).
-HAND_GOAL_TASKS = ("grasp", "release", "move", "leftHand", "rightHand", "assemble",
-                   "insert", "extract")
 
 
 @dataclass(frozen=True)
@@ -156,7 +154,7 @@ def _speed_limits(n: int, labels: Sequence[str], lim: BiomechanicsLimits,
     names, code = np.unique(np.asarray(labels[:n], dtype=object).astype(str),
                             return_inverse=True)
     kinds = [_kind(x) for x in names]
-    hand_goal = np.isin(kinds, HAND_GOAL_TASKS)[code]
+    hand_goal = np.isin(kinds, HAND_TASKS)[code]
     posture = np.isin(kinds, POSTURE_TRANSITION_TASKS)[code]
     for s in "lr":
         out[:, _J[f"{s}_hand"]] = np.where(hand_goal, lim.hand_speed_goal, lim.hand_speed)
