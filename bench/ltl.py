@@ -56,7 +56,7 @@ def _cell_model_stage(name: str, repeat: int) -> dict:
     """The pipeline's LTL stage for a paper spec in the paper cell: the cell model's
     product search (on-the-fly translation included) against the letter-graph path it
     replaced (translation, then sequences), both for one sequence."""
-    from ltl_human_motion.scene.cell import load_cell
+    from ltl_human_motion.scene.cell_yaml import load_cell
     from ltl_human_motion.tasks import plan_sequences
 
     cell = load_cell(ROOT / "config" / "paper_cell.yaml")

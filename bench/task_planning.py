@@ -32,14 +32,14 @@ sys.path.insert(0, str(ROOT))
 from ltl_human_motion.atomic import atomic_write_bytes, atomic_write_text  # noqa: E402
 from ltl_human_motion.ltl import build_specification  # noqa: E402
 from ltl_human_motion.ltl.translate_spot import spot_available  # noqa: E402
-from ltl_human_motion.scene.cell import cell_from_yaml  # noqa: E402
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml  # noqa: E402
 from ltl_human_motion.tasks import CellModel, plan_sequences  # noqa: E402
 from ltl_human_motion.tasks.kitting import (  # noqa: E402
     FAMILIES,
     kitting_cell_yaml,
     kitting_spec,
 )
-from ltl_human_motion.tasks.sequences import product_search  # noqa: E402
+from ltl_human_motion.tasks.product import product_search  # noqa: E402
 
 #: Target of the issue: translation plus first sequence at N = 20, seconds.
 TARGET_SECONDS = 1.0

@@ -106,7 +106,7 @@ def test_every_item_has_captions_labels_and_its_ltl(dataset: Path) -> None:
 
 
 def test_captions_are_seeded_and_name_what_the_cell_describes() -> None:
-    from ltl_human_motion.scene.cell import cell_by_name
+    from ltl_human_motion.scene.cell_yaml import cell_by_name
 
     cell = cell_by_name("kitting_cell")
     steps = [GoalStep(0, "grasp(P1)", "grasp", "r_hand", (100, 300), 180, 220),

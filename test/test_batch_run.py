@@ -292,7 +292,7 @@ def test_an_item_is_reproducible_from_its_manifest_record(reference: Path) -> No
     from ltl_human_motion.batch import ItemParams, cell_for_item
     from ltl_human_motion.batch.worker import BatchJob
     from ltl_human_motion.planning.pipeline import synthesize
-    from ltl_human_motion.scene.cell import cell_by_name
+    from ltl_human_motion.scene.cell_yaml import cell_by_name
 
     item = next(iter(open_dataset(reference).items()))
     r = item.record

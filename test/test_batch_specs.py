@@ -15,7 +15,7 @@ from ltl_human_motion.batch import (
     specs_from_yaml,
     validate_against_cell,
 )
-from ltl_human_motion.scene.cell import cell_by_name
+from ltl_human_motion.scene.cell_yaml import cell_by_name
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "config" / "specs_example.yaml"

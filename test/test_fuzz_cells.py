@@ -11,7 +11,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from ltl_human_motion.errors import CellError
-from ltl_human_motion.scene.cell import Cell, cell_from_yaml
+from ltl_human_motion.scene.cell import Cell
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "config" / "paper_cell.yaml").read_text())

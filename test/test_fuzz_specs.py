@@ -12,7 +12,7 @@ from ltl_human_motion.deadline import BudgetExhaustedError, Deadline, active
 from ltl_human_motion.errors import SpecError
 from ltl_human_motion.ltl import parse
 from ltl_human_motion.ltl.translate_builtin import translate_builtin
-from ltl_human_motion.scene.cell import cell_by_name
+from ltl_human_motion.scene.cell_yaml import cell_by_name
 
 CELL = cell_by_name("paper_cell")
 ATOMS = ["grasp(O1)", "grasp(O2)", "assemble(R1)", "wait(1.0)", "leftHand(R1)", "p", "X1"]

@@ -15,7 +15,7 @@ from ltl_human_motion.planning.navigation import (
     NavigationField,
     floor_grid,
 )
-from ltl_human_motion.scene.cell import cell_from_yaml
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml
 
 CELL = """
 name: lanes

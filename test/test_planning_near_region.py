@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from ltl_human_motion.planning.pipeline import get_library, synthesize
-from ltl_human_motion.scene.cell import load_cell
+from ltl_human_motion.scene.cell_yaml import load_cell
 
 AISLE = Path(__file__).resolve().parents[1] / "scenarios" / "cells" / "aisle.yaml"
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ltl_human_motion.scene.cell import load_cell
+from ltl_human_motion.scene.cell_yaml import load_cell
 from ltl_human_motion.scene.predicates import object_clearance, object_collides
 
 CELLS = Path(__file__).resolve().parents[1] / "scenarios" / "cells"

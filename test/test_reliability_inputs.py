@@ -17,7 +17,7 @@ from ltl_human_motion.errors import CellError, SpecError
 from ltl_human_motion.ltl import parse
 from ltl_human_motion.ltl.limits import MAX_NESTING, nesting_depth
 from ltl_human_motion.ltl.translate_builtin import translate_builtin
-from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml, load_cell
 from ltl_human_motion.yaml_limits import MAX_YAML_EXPANDED_NODES
 
 ROOT = Path(__file__).resolve().parents[1]

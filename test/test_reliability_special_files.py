@@ -20,7 +20,7 @@ from ltl_human_motion.batch.specs import BatchConfigError, load_specs
 from ltl_human_motion.errors import CellError
 from ltl_human_motion.ltl.vocabulary import load_vocabulary
 from ltl_human_motion.robot.sim.trajectory import load_robot_config
-from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml, load_cell
 from ltl_human_motion.yaml_limits import MAX_YAML_BYTES, TextFileError, read_text_file
 
 ROOT = Path(__file__).resolve().parents[1]

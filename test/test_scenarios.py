@@ -18,7 +18,7 @@ from ltl_human_motion.planning.feasibility import reach_envelope, step_problems
 from ltl_human_motion.scenarios.corpus import DWYER_PATTERNS, INFEASIBLE_REASONS, load_corpus
 from ltl_human_motion.scenarios.generator import generate_scenario
 from ltl_human_motion.scenarios.run import judge, run_pair
-from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml, load_cell
 from ltl_human_motion.vocabulary import TASK_NAMES
 
 PAIRS = load_corpus()

@@ -13,7 +13,7 @@ from test_scenarios import _supported
 from ltl_human_motion.scenarios.labels import Labeller, Opening, Worker, label_task
 from ltl_human_motion.scenarios.run import failure_cause, judge, run_pair
 from ltl_human_motion.scenarios.unseen import FAMILIES, build_cell, generate_unseen
-from ltl_human_motion.scene.cell import cell_from_yaml
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml
 
 SCENARIOS = generate_unseen(2, seed=0)
 CELLS = {(f, i): build_cell(f, 0, i) for f in FAMILIES for i in range(2)}

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from ltl_human_motion.planning.pipeline import resolve_cell
-from ltl_human_motion.scene.cell import cell_from_yaml
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml
 from ltl_human_motion.study.layout import layout_changes, plot_layouts
 from ltl_human_motion.study.runner import StudyConfig, run_study
 

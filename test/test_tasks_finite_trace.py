@@ -29,9 +29,9 @@ from ltl_human_motion.ltl.formula import (
     Xor,
 )
 from ltl_human_motion.scene import cell_by_name
-from ltl_human_motion.scene.cell import load_cell
+from ltl_human_motion.scene.cell_yaml import load_cell
 from ltl_human_motion.tasks import CellModel, plan_sequences
-from ltl_human_motion.tasks.sequences import product_search
+from ltl_human_motion.tasks.product import product_search
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIO_CELLS = sorted((ROOT / "scenarios" / "cells").glob("*.yaml"))

@@ -11,12 +11,12 @@ import pytest
 from ltl_human_motion.cli import main
 from ltl_human_motion.errors import SpecError
 from ltl_human_motion.ltl import Atom, build_specification, evaluate_lasso
-from ltl_human_motion.scene.cell import cell_from_yaml, load_cell
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml, load_cell
 from ltl_human_motion.tasks import CellModel, Limits, plan_sequences
 from ltl_human_motion.tasks.kitting import kitting_cell_yaml, kitting_spec
 from ltl_human_motion.tasks.model import HELD, IN_PLACE_WALK_PENALTY
-from ltl_human_motion.tasks.product import ProductSearch
-from ltl_human_motion.tasks.sequences import RANDOM_COST_FACTOR, product_search
+from ltl_human_motion.tasks.product import ProductSearch, product_search
+from ltl_human_motion.tasks.sequences import RANDOM_COST_FACTOR
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -150,7 +150,7 @@ def test_heuristic_is_admissible_on_the_states_a_search_reaches(family, n):
 
 def test_pointless_releases_are_no_candidates_unless_needed():
     """A release is a candidate step only for a part nothing else sets down."""
-    from ltl_human_motion.tasks.sequences import task_steps
+    from ltl_human_motion.tasks.product import task_steps
     cell = _kitting(4)
     model = CellModel.from_cell(cell)
     names = lambda text, **kw: {str(t) for t in task_steps(  # noqa: E731
@@ -220,7 +220,7 @@ def test_explicit_automaton_view_gives_the_same_optimum(paper_cell):
     be with backend="spot") finds lassos of the same cost as the on-the-fly tableau."""
     from ltl_human_motion.ltl import translate
     from ltl_human_motion.tasks import ExplicitView, ProductSearch
-    from ltl_human_motion.tasks.sequences import task_steps
+    from ltl_human_motion.tasks.product import task_steps
     for name in ("S1", "S2"):
         spec = build_specification(name, paper_cell)
         model = CellModel.from_cell(paper_cell)
@@ -247,7 +247,7 @@ def test_spots_own_automaton_gives_the_same_sequences(paper_cell):
     grasp of the part in hand (the Spot backend used to give grasp(O1), grasp(O1), ...)."""
     from ltl_human_motion.ltl import automaton_from_hoa, parse, translate
     from ltl_human_motion.tasks import ExplicitView
-    from ltl_human_motion.tasks.sequences import task_steps
+    from ltl_human_motion.tasks.product import task_steps
     hoa = (SPOT_REFERENCE / "S1_formula3.hoa").read_text()
     hoa = hoa.replace('"g"', '"grasp(O1)"').replace('"a"', '"assemble(R1)"')
     spot = automaton_from_hoa(hoa)

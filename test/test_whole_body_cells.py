@@ -11,7 +11,7 @@ import pytest
 
 from ltl_human_motion.planning import synthesize
 from ltl_human_motion.scenarios.unseen import build_cell
-from ltl_human_motion.scene.cell import cell_from_yaml
+from ltl_human_motion.scene.cell_yaml import cell_from_yaml
 from ltl_human_motion.scene.predicates import collision, object_clearance
 
 pytestmark = pytest.mark.slow

@@ -101,7 +101,7 @@ def make_job(cell: str | os.PathLike[str], specs: BatchSpecs, dtype: str = "floa
     dtype : {"float32", "float64"}
     """
     from ltl_human_motion.planning.pipeline import resolve_cell
-    from ltl_human_motion.scene.cell import cell_from_yaml
+    from ltl_human_motion.scene.cell_yaml import cell_from_yaml
     resolved = resolve_cell(Path(cell) if isinstance(cell, os.PathLike) else cell)
     source = Path(resolved.source)
     if not source.is_file():

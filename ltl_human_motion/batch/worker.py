@@ -150,7 +150,7 @@ def _cell_and_options(job: BatchJob) -> tuple[Any, Any]:
     key = job.fingerprint()
     if key not in _CELLS:
         from ltl_human_motion.batch.captions import CellNames
-        from ltl_human_motion.scene.cell import cell_from_yaml
+        from ltl_human_motion.scene.cell_yaml import cell_from_yaml
         if len(_CELLS) > 4:
             _CELLS.clear()
             _OPTIONS.clear()

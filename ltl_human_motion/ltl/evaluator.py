@@ -36,7 +36,7 @@ from ltl_human_motion.ltl.formula import (
     Xor,
 )
 
-__all__ = ["evaluate_lasso", "evaluate_positions"]
+__all__ = ["evaluate_lasso", "evaluate_positions", "propositional_letters"]
 
 Letter = frozenset[str]
 
@@ -165,3 +165,32 @@ def evaluate_lasso(formula: Formula, prefix_letters: Sequence[Iterable[str]],
         If ``cycle_letters`` is empty.
     """
     return evaluate_positions(formula, prefix_letters, cycle_letters)[0]
+
+
+def propositional_letters(f: Formula, letters: Sequence[frozenset[str]]
+                          ) -> tuple[int, ...] | None:
+    """Indices of the letters on which the propositional ``f`` holds (None: temporal)."""
+
+    def ev(g: Formula, letter: frozenset[str]) -> bool | None:
+        if isinstance(g, Atom):
+            return g.key in letter
+        if isinstance(g, Const):
+            return g.value
+        if isinstance(g, Not):
+            v = ev(g.arg, letter)
+            return None if v is None else not v
+        if isinstance(g, (And, Or)):
+            vals = [ev(a, letter) for a in g.args]
+            if any(v is None for v in vals):
+                return None
+            return all(vals) if isinstance(g, And) else any(vals)
+        return None
+
+    out = []
+    for i, letter in enumerate(letters):
+        v = ev(f, letter)
+        if v is None:
+            return None
+        if v:
+            out.append(i)
+    return tuple(out)

@@ -534,7 +534,7 @@ def label_cell(cell: UnseenCell, stature: float,
                labeller: Labeller | None = None) -> UnseenScenario:
     """The cell's candidates labelled for one stature (ambiguous ones in ``dropped``)."""
     if labeller is None:
-        from ltl_human_motion.scene.cell import cell_from_yaml
+        from ltl_human_motion.scene.cell_yaml import cell_from_yaml
         labeller = Labeller(cell_from_yaml(cell.yaml, source=f"<{cell.name}>"), cell.openings)
     scen = UnseenScenario(cell.name, cell.family, cell.yaml, float(stature), seed=cell.seed,
                           index=cell.index)
@@ -552,7 +552,7 @@ def generate_unseen(cells_per_family: int = 2, seed: int = 0,
                     families: tuple[str, ...] = FAMILIES,
                     statures: tuple[float, ...] = STATURES) -> list[UnseenScenario]:
     """``cells_per_family`` cells of each family, each labelled for every stature."""
-    from ltl_human_motion.scene.cell import cell_from_yaml
+    from ltl_human_motion.scene.cell_yaml import cell_from_yaml
     out = []
     for family in families:
         for index in range(int(cells_per_family)):

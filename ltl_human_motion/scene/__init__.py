@@ -4,11 +4,8 @@ Core module: no ROS. Everything is z up (REP 103); cells written in the paper's 
 frame are converted once when loaded (:func:`zup_from_yup`).
 """
 
-from ltl_human_motion.scene.cell import (
-    Cell,
-    Obstacle,
-    Region,
-    SceneObject,
+from ltl_human_motion.scene.cell import Cell, Obstacle, Region, SceneObject
+from ltl_human_motion.scene.cell_yaml import (
     cell_by_name,
     cell_from_yaml,
     cell_search_paths,

@@ -41,15 +41,13 @@ Every error names the file and the key, e.g.
 
 This module holds the data model (:class:`Cell`, :class:`Region`, :class:`SceneObject`,
 :class:`Obstacle`); the YAML loader, with its named limits, is
-:mod:`ltl_human_motion.scene.cell_yaml`. Its public functions (:func:`load_cell`,
-:func:`cell_from_yaml`, :func:`cell_by_name`, :func:`cell_search_paths`) stay importable
-from here.
+:mod:`ltl_human_motion.scene.cell_yaml` (:func:`load_cell`, :func:`cell_from_yaml`,
+:func:`cell_by_name`, :func:`cell_search_paths`), which imports this module.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -57,36 +55,7 @@ from ltl_human_motion.scene.clearance import EXACT_BELOW, PartSet, part_set
 from ltl_human_motion.scene.geometry import min_along_segment
 from ltl_human_motion.scene.shapes import Box, Footprint, Shape
 
-if TYPE_CHECKING:   # served lazily by __getattr__ below
-    from ltl_human_motion.scene.cell_yaml import (
-        cell_by_name,
-        cell_from_yaml,
-        cell_search_paths,
-        load_cell,
-    )
-
-__all__ = [
-    "Cell",
-    "Obstacle",
-    "Region",
-    "SceneObject",
-    "cell_by_name",
-    "cell_from_yaml",
-    "cell_search_paths",
-    "load_cell",
-]
-
-#: Names served by :mod:`.cell_yaml` (imported on first use: it builds these classes).
-_LOADER_NAMES = frozenset({"cell_by_name", "cell_from_yaml", "cell_search_paths", "load_cell",
-                           "MAX_CELL_COORDINATE", "MAX_CELL_ENTRIES", "MAX_WORKSPACE_EXTENT"})
-
-
-def __getattr__(name: str) -> Any:
-    if name in _LOADER_NAMES:
-        from ltl_human_motion.scene import cell_yaml
-
-        return getattr(cell_yaml, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__all__ = ["Cell", "Obstacle", "Region", "SceneObject"]
 
 
 # --------------------------------------------------------------------------- types

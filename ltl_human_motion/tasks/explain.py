@@ -20,6 +20,7 @@ from dataclasses import replace
 from ltl_human_motion.ltl.formula import conj
 from ltl_human_motion.ltl.spec import Specification
 from ltl_human_motion.tasks.model import CellModel, Limits
+from ltl_human_motion.tasks.product import SearchBudgetError, product_search
 
 __all__ = ["explain_infeasible", "feasible"]
 
@@ -33,8 +34,6 @@ CORE_LIMIT = 16
 def feasible(spec: Specification, model: CellModel, backend: str = "builtin") -> bool | None:
     """Whether the product of ``spec`` and ``model`` has an accepting lasso (None: the
     trial ran out of budget)."""
-    from ltl_human_motion.tasks.product import SearchBudgetError
-    from ltl_human_motion.tasks.sequences import product_search
     search, _t, _l = product_search(spec, model, backend, weight=1e6, budget=TRIAL_BUDGET)
     try:
         return bool(search.lassos(1))

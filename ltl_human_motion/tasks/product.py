@@ -30,6 +30,10 @@ a prefix ends in a goal when
 Goals enter the same queue at the cost of prefix plus cycle, so the first goal popped is
 the cost-optimal lasso (with an admissible heuristic and weight 1). Nodes may be popped
 up to ``k`` times, which gives the ``k`` cheapest lassos (k shortest walks).
+
+:func:`product_search` sets a search up for a specification over the candidate steps of
+:func:`task_steps`; the sequences (:mod:`~.sequences`) and the explanations
+(:mod:`~.explain`) both start from it.
 """
 
 from __future__ import annotations
@@ -42,10 +46,16 @@ from dataclasses import dataclass
 
 from ltl_human_motion.ltl.automaton import Automaton, accepting_components, lasso_accepted
 from ltl_human_motion.ltl.automaton import strongly_connected_components as _sccs
-from ltl_human_motion.ltl.formula import And, Atom, Const, Finally, Formula, Globally, Not, Or
+from ltl_human_motion.ltl.evaluator import propositional_letters
+from ltl_human_motion.ltl.formula import Atom, Finally, Formula, Globally, Or, conj
+from ltl_human_motion.ltl.onthefly import LetterTableau
+from ltl_human_motion.ltl.spec import Specification, letter_of
+from ltl_human_motion.ltl.translate import resolve_backend, translate
 from ltl_human_motion.tasks.model import DONE, HELD, CellModel, CellState
+from ltl_human_motion.tasks.recurrence import cycle_steps
 
-__all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "seeded_noise"]
+__all__ = ["ExplicitView", "Lasso", "ProductSearch", "SearchBudgetError", "product_search",
+           "seeded_noise", "task_steps"]
 
 
 #: Longest cycle made of a path's own last steps that the search tries as a goal.
@@ -141,34 +151,6 @@ class Lasso:
     cycle: tuple[int, ...]
     cost: float
     searched_cycle: bool = False
-
-
-def _propositional_letters(f: Formula, letters: Sequence[frozenset[str]]) -> tuple[int, ...] | None:
-    """Indices of the letters on which the propositional ``f`` holds (None: temporal)."""
-
-    def ev(g: Formula, letter: frozenset[str]) -> bool | None:
-        if isinstance(g, Atom):
-            return g.key in letter
-        if isinstance(g, Const):
-            return g.value
-        if isinstance(g, Not):
-            v = ev(g.arg, letter)
-            return None if v is None else not v
-        if isinstance(g, (And, Or)):
-            vals = [ev(a, letter) for a in g.args]
-            if any(v is None for v in vals):
-                return None
-            return all(vals) if isinstance(g, And) else any(vals)
-        return None
-
-    out = []
-    for i, letter in enumerate(letters):
-        v = ev(f, letter)
-        if v is None:
-            return None
-        if v:
-            out.append(i)
-    return tuple(out)
 
 
 class ProductSearch:
@@ -483,7 +465,7 @@ class ProductSearch:
         rest = [a for a in g.arg.args if not isinstance(a, Finally)]
         if len(eventual) != 1 or not rest:
             return None
-        holds = _propositional_letters(Or(tuple(rest)) if len(rest) > 1 else rest[0],
+        holds = propositional_letters(Or(tuple(rest)) if len(rest) > 1 else rest[0],
                                        self._letters)
         if holds is None:
             return None
@@ -497,7 +479,7 @@ class ProductSearch:
         hit = self._fneeds.get(f)
         if hit is not None:
             return hit
-        need = _propositional_letters(f.arg, self._letters)
+        need = propositional_letters(f.arg, self._letters)
         if not need:
             self._fneeds[f] = ((), 0.0, False, None)
             return self._fneeds[f]
@@ -863,3 +845,69 @@ def seeded_noise(seed: int, factor: float) -> Callable[[tuple, int], float]:
 
     return noise
 
+
+#: Parts a task step handles, by task name (argument index of the part).
+_PART_TASKS = {"grasp": 0, "release": 0, "move": 0, "insert": 0, "carry": 0, "extract": 0}
+
+
+def task_steps(spec: Specification, model: CellModel, releases: str = "needed"
+               ) -> tuple[list[Atom], list[frozenset[str]]]:
+    """Candidate steps: the specification's, plus ``grasp`` of every part a step handles,
+    and ``release`` of it when the hands cannot hold them all (a worker picks parts up
+    and puts them down between the tasks the specification names), with their letters.
+
+    ``releases="needed"`` adds a ``release`` only for a part that no step of the
+    specification sets down or uses up (``move``, ``insert``, ``release``, a two-hand
+    shorthand): putting down a part that the specification will have carried elsewhere
+    is a detour a foreman would not accept. ``"all"`` adds one for every handled part
+    (the fallback when the first product has no lasso, and the yardstick of the
+    benchmark's exhaustive search)."""
+    if releases not in ("needed", "all"):
+        raise ValueError(f"releases must be 'needed' or 'all', got {releases!r}")
+    tasks = list(spec.tasks)
+    handled = [t.args[0] for t in spec.tasks if t.name in _PART_TASKS
+               and len(t.args) > _PART_TASKS[t.name] and t.args[0] in model.part_index]
+    handled = list(dict.fromkeys(handled))
+    # A release the specification does not name is only a candidate when the hands cannot
+    # hold every part it handles at once: otherwise a search may put a part down to have
+    # it nearer next time (S2 over several cycles put O2 down beside O1, never assembling it).
+    width = sum(2 if model.two_handed[model.part_index[p]] else 1 for p in handled)
+    freed: set[str] = set()
+    if releases == "needed":
+        for t in spec.tasks:
+            kind = model.kind(t)[0]
+            if kind == "assemble":
+                freed.update(handled)
+            elif kind in ("move", "insert", "release") and t.args:
+                freed.add(t.args[0])
+    for part in handled:
+        helpers = ("grasp", "release") if width > model.limits.hands \
+            and part not in freed else ("grasp",)
+        for helper in helpers:
+            a = Atom(helper, (part,))
+            if a not in tasks:
+                tasks.append(a)
+    letters = [*spec.letters, *(letter_of(t, spec.vocabulary) for t in tasks[len(spec.tasks):])]
+    return tasks, letters
+
+
+def _search_formula(spec: Specification):
+    """The specification without its exclusivity conjunct (the letters make it true)."""
+    return conj(spec.user_formula, *(f for label, f in spec.always_on
+                                     if not label.startswith("exclusivity")))
+
+
+def product_search(spec: Specification, model: CellModel, backend: str = "builtin",
+                   repetitions: int = 1, releases: str = "needed", **kwargs
+                   ) -> tuple[ProductSearch, list[Atom], list[frozenset[str]]]:
+    """A :class:`ProductSearch` of ``spec`` in ``model`` (on-the-fly tableau, or the
+    explicit automaton of Spot for ``backend="spot"``) over the candidate steps of
+    :func:`task_steps` (``releases``)."""
+    tasks, letters = task_steps(spec, model, releases)
+    if resolve_backend(backend) == "spot":
+        view = ExplicitView(translate(spec.formula, backend="spot"), letters)
+    else:
+        view = LetterTableau(_search_formula(spec), letters)
+    search = ProductSearch(view, model, tasks, repetitions=repetitions, **kwargs)
+    search.tail_steps = max(search.tail_steps, cycle_steps(spec, model, tasks, letters))
+    return search, tasks, letters

@@ -13,10 +13,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ltl_human_motion.errors import SpecError
+from ltl_human_motion.ltl.evaluator import propositional_letters
 from ltl_human_motion.ltl.formula import Atom, Finally, Formula, Globally, top_level_conjuncts
 from ltl_human_motion.ltl.spec import Specification
 from ltl_human_motion.tasks.model import CellModel
-from ltl_human_motion.tasks.product import _propositional_letters
 
 __all__ = ["MAX_RECURRENCES", "cycle_steps", "recurrences", "refuse_many_recurrences"]
 
@@ -35,7 +35,7 @@ def recurrences(spec: Specification, letters: Sequence[frozenset[str]]
     out = []
     for c in top_level_conjuncts(spec.user_formula):
         if isinstance(c, Globally) and isinstance(c.arg, Finally):
-            holds = _propositional_letters(c.arg.arg, letters)
+            holds = propositional_letters(c.arg.arg, letters)
             if holds is not None:
                 out.append((c, frozenset(holds)))
     return out

@@ -27,23 +27,22 @@ from dataclasses import dataclass, field
 
 from ltl_human_motion.errors import SpecError, VerificationError
 from ltl_human_motion.ltl.evaluator import evaluate_lasso
-from ltl_human_motion.ltl.formula import Atom, conj
-from ltl_human_motion.ltl.onthefly import LetterTableau
+from ltl_human_motion.ltl.formula import Atom
 from ltl_human_motion.ltl.sequences import TaskSequence, synthesize_sequences
-from ltl_human_motion.ltl.spec import Specification, build_specification, letter_of
-from ltl_human_motion.ltl.translate import resolve_backend, translate
+from ltl_human_motion.ltl.spec import Specification, build_specification
+from ltl_human_motion.tasks.explain import explain_infeasible
 from ltl_human_motion.tasks.model import CellModel, Limits
 from ltl_human_motion.tasks.product import (
-    ExplicitView,
     Lasso,
     ProductSearch,
     SearchBudgetError,
+    product_search,
     seeded_noise,
+    task_steps,
 )
-from ltl_human_motion.tasks.recurrence import cycle_steps, refuse_many_recurrences
+from ltl_human_motion.tasks.recurrence import refuse_many_recurrences
 
-__all__ = ["MODES", "RANDOM_COST_FACTOR", "PlanStats", "has_geometry", "plan_sequences",
-           "product_search", "task_steps"]
+__all__ = ["MODES", "RANDOM_COST_FACTOR", "PlanStats", "has_geometry", "plan_sequences"]
 
 MODES = ("random", "coverage", "all")
 
@@ -63,10 +62,6 @@ WEIGHT_LADDER = ((1.0, 16_000), (1.2, 12_000), (1.5, 100_000), (3.0, 200_000),
 #: Longest cycle made of a prefix's own last steps that is tried (each try is one
 #: evaluator call).
 SHRINK_STEPS = 6
-
-#: Parts a task step handles, by task name (argument index of the part).
-_PART_TASKS = {"grasp": 0, "release": 0, "move": 0, "insert": 0, "carry": 0, "extract": 0}
-
 
 @dataclass
 class PlanStats:
@@ -108,69 +103,6 @@ def has_geometry(cell: object) -> bool:
     objects = getattr(cell, "objects", None)
     return bool(hasattr(cell, "start_region") and hasattr(objects, "values")
                 and all(hasattr(o, "position") for o in objects.values()))
-
-
-def task_steps(spec: Specification, model: CellModel, releases: str = "needed"
-               ) -> tuple[list[Atom], list[frozenset[str]]]:
-    """Candidate steps: the specification's, plus ``grasp`` of every part a step handles,
-    and ``release`` of it when the hands cannot hold them all (a worker picks parts up
-    and puts them down between the tasks the specification names), with their letters.
-
-    ``releases="needed"`` adds a ``release`` only for a part that no step of the
-    specification sets down or uses up (``move``, ``insert``, ``release``, a two-hand
-    shorthand): putting down a part that the specification will have carried elsewhere
-    is a detour a foreman would not accept. ``"all"`` adds one for every handled part
-    (the fallback when the first product has no lasso, and the yardstick of the
-    benchmark's exhaustive search)."""
-    if releases not in ("needed", "all"):
-        raise ValueError(f"releases must be 'needed' or 'all', got {releases!r}")
-    tasks = list(spec.tasks)
-    handled = [t.args[0] for t in spec.tasks if t.name in _PART_TASKS
-               and len(t.args) > _PART_TASKS[t.name] and t.args[0] in model.part_index]
-    handled = list(dict.fromkeys(handled))
-    # A release the specification does not name is only a candidate when the hands cannot
-    # hold every part it handles at once: otherwise a search may put a part down to have
-    # it nearer next time (S2 over several cycles put O2 down beside O1, never assembling it).
-    width = sum(2 if model.two_handed[model.part_index[p]] else 1 for p in handled)
-    freed: set[str] = set()
-    if releases == "needed":
-        for t in spec.tasks:
-            kind = model.kind(t)[0]
-            if kind == "assemble":
-                freed.update(handled)
-            elif kind in ("move", "insert", "release") and t.args:
-                freed.add(t.args[0])
-    for part in handled:
-        helpers = ("grasp", "release") if width > model.limits.hands \
-            and part not in freed else ("grasp",)
-        for helper in helpers:
-            a = Atom(helper, (part,))
-            if a not in tasks:
-                tasks.append(a)
-    letters = [*spec.letters, *(letter_of(t, spec.vocabulary) for t in tasks[len(spec.tasks):])]
-    return tasks, letters
-
-
-def _search_formula(spec: Specification):
-    """The specification without its exclusivity conjunct (the letters make it true)."""
-    return conj(spec.user_formula, *(f for label, f in spec.always_on
-                                     if not label.startswith("exclusivity")))
-
-
-def product_search(spec: Specification, model: CellModel, backend: str = "builtin",
-                   repetitions: int = 1, releases: str = "needed", **kwargs
-                   ) -> tuple[ProductSearch, list[Atom], list[frozenset[str]]]:
-    """A :class:`ProductSearch` of ``spec`` in ``model`` (on-the-fly tableau, or the
-    explicit automaton of Spot for ``backend="spot"``) over the candidate steps of
-    :func:`task_steps` (``releases``)."""
-    tasks, letters = task_steps(spec, model, releases)
-    if resolve_backend(backend) == "spot":
-        view = ExplicitView(translate(spec.formula, backend="spot"), letters)
-    else:
-        view = LetterTableau(_search_formula(spec), letters)
-    search = ProductSearch(view, model, tasks, repetitions=repetitions, **kwargs)
-    search.tail_steps = max(search.tail_steps, cycle_steps(spec, model, tasks, letters))
-    return search, tasks, letters
 
 
 def _ladder(spec: Specification, model: CellModel, backend: str, reps: int, k: int,
@@ -329,7 +261,6 @@ def plan_sequences(spec: str | Specification, cell: object, n: int | None = 5, s
     search, tasks, letters, found = _ladder(spec, model, backend, reps, k, stats)
     stats.search_seconds = time.perf_counter() - t0
     if not found:
-        from ltl_human_motion.tasks.explain import explain_infeasible
         raise SpecError(explain_infeasible(spec, model, backend), text=spec.text)
     if min_steps and found:
         first = found[0]
