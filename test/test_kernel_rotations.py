@@ -13,10 +13,12 @@ from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.kernel.rotations import (
     MOCAP_FROM_ZUP,
     ZUP_FROM_YUP,
+    compact_axis_angle_from_matrix,
     matrix_from_axis_angle,
     matrix_from_compact_axis_angle,
     matrix_from_euler,
     matrix_from_quaternion,
+    matrix_from_unit_axis_angle,
     matrix_from_yaw,
     quaternion_from_matrix,
     quaternion_from_yaw,
@@ -47,6 +49,23 @@ def test_axis_angle_forms_agree(v: np.ndarray) -> None:
         np.testing.assert_allclose(matrix_from_axis_angle(v / angle, angle), R, atol=1e-9)
     else:
         np.testing.assert_allclose(R, np.eye(3), atol=1e-5)
+
+
+def test_per_row_axes_and_rotation_vectors_from_matrices() -> None:
+    rng = np.random.default_rng(3)
+    axes = rng.normal(size=(50, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    angles = rng.uniform(-np.pi, np.pi, 50)
+    R = matrix_from_unit_axis_angle(axes, angles)
+    for k in range(50):
+        np.testing.assert_allclose(R[k], matrix_from_axis_angle(axes[k], angles[k]), atol=1e-12)
+    back = compact_axis_angle_from_matrix(R)
+    np.testing.assert_allclose(matrix_from_compact_axis_angle(back), R, atol=1e-9)
+    np.testing.assert_allclose(np.linalg.norm(back, axis=1), np.abs(angles), atol=1e-9)
+    with pytest.raises(ValueError, match=r"\(\.\.\., 3\)"):
+        matrix_from_unit_axis_angle(np.ones(4), 0.1)
+    with pytest.raises(ValueError, match=r"\(\.\.\., 3, 3\)"):
+        compact_axis_angle_from_matrix(np.eye(4))
 
 
 def test_yaw_euler_and_frames() -> None:

@@ -13,7 +13,7 @@ from ltl_human_motion.robot import (
     JointTrajectory,
     SimulatedUR,
     Waypoint,
-    axis_angle_from_matrix,
+    compact_axis_angle_from_matrix,
     default_pick_and_place,
     forward_kinematics,
     load_robot_config,
@@ -68,7 +68,7 @@ def test_axis_angle_round_trip_including_near_pi() -> None:
     angles = np.concatenate([rng.uniform(0, np.pi, 190), np.full(5, np.pi), np.full(5, 1e-9)])
     v = axes * angles[:, None]
     R = matrix_from_compact_axis_angle(v)
-    back = axis_angle_from_matrix(R)
+    back = compact_axis_angle_from_matrix(R)
     assert np.allclose(matrix_from_compact_axis_angle(back), R, atol=1e-9)
     regular = angles < np.pi - 1e-6
     assert np.allclose(back[regular], v[regular], atol=1e-7)

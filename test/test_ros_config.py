@@ -192,3 +192,13 @@ def test_occupancy_cdr_matches_rclpy() -> None:
         data = encode_human_occupancy(1_700_000_000, 123_456_789, "world", msg.human_id,
                                       names, segments, radii, offsets)
         assert deserialize_message(data, HumanOccupancy) == msg
+
+
+def test_cylinder_orientation_turns_z_onto_the_capsule_axis() -> None:
+    from scipy.spatial.transform import Rotation
+    rng = np.random.default_rng(11)
+    for v in [*rng.normal(size=(20, 3)), np.array([0, 0, 2.0]), np.array([0, 0, -0.5])]:
+        q = cv.quaternion_z_to(v)
+        turned = Rotation.from_quat([q.x, q.y, q.z, q.w]).apply([0.0, 0.0, 1.0])
+        np.testing.assert_allclose(turned, v / np.linalg.norm(v), atol=1e-12)
+    assert cv.quaternion_z_to(np.zeros(3)).w == 1.0

@@ -16,10 +16,12 @@ __all__ = [
     "MOCAP_FROM_ZUP",
     "ZUP_FROM_MOCAP",
     "ZUP_FROM_YUP",
+    "compact_axis_angle_from_matrix",
     "matrix_from_axis_angle",
     "matrix_from_compact_axis_angle",
     "matrix_from_euler",
     "matrix_from_quaternion",
+    "matrix_from_unit_axis_angle",
     "matrix_from_yaw",
     "quaternion_from_matrix",
     "quaternion_from_yaw",
@@ -113,6 +115,32 @@ def matrix_from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.floa
     return matrix_from_quaternion(q)
 
 
+def matrix_from_unit_axis_angle(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
+    """Rotation matrices about unit axes by angles, by Rodrigues' formula.
+
+    Parameters
+    ----------
+    axis : array-like, shape (..., 3)
+        Unit vectors (not normalized here).
+    angle : array-like, shape (...)
+        Radians.
+
+    Returns
+    -------
+    R : ndarray, shape (..., 3, 3)
+    """
+    k = np.asarray(axis, dtype=np.float64)
+    if k.shape[-1:] != (3,):
+        raise ValueError(f"rotation axes: expected shape (..., 3), got {k.shape}")
+    x, y, z = k[..., 0], k[..., 1], k[..., 2]
+    zero = np.zeros_like(x)
+    K = np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1),
+                  np.stack([-y, x, zero], -1)], -2)
+    angle = np.asarray(angle, dtype=np.float64)
+    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+
+
 def matrix_from_compact_axis_angle(rotvec: ArrayLike) -> NDArray[np.float64]:
     """Rotation matrices of rotation vectors (axis times angle), by Rodrigues' formula.
 
@@ -129,13 +157,42 @@ def matrix_from_compact_axis_angle(rotvec: ArrayLike) -> NDArray[np.float64]:
         raise ValueError(f"rotation vectors: expected shape (..., 3), got {v.shape}")
     angle = np.linalg.norm(v, axis=-1)
     safe = np.where(angle > 1e-12, angle, 1.0)
-    k = v / safe[..., None]
-    K = np.zeros((*v.shape[:-1], 3, 3))
-    K[..., 0, 1], K[..., 0, 2] = -k[..., 2], k[..., 1]
-    K[..., 1, 0], K[..., 1, 2] = k[..., 2], -k[..., 0]
-    K[..., 2, 0], K[..., 2, 1] = -k[..., 1], k[..., 0]
-    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    return matrix_from_unit_axis_angle(v / safe[..., None], angle)
+
+
+def compact_axis_angle_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
+    """Rotation vectors (axis times angle, UR's ``rx, ry, rz``) of rotation matrices.
+
+    Parameters
+    ----------
+    R : array-like, shape (..., 3, 3)
+
+    Returns
+    -------
+    rotvec : ndarray, shape (..., 3)
+        Angle in [0, pi].
+    """
+    R = np.asarray(R, dtype=np.float64)
+    if R.shape[-2:] != (3, 3):
+        raise ValueError(f"rotation matrices: expected shape (..., 3, 3), got {R.shape}")
+    trace = np.trace(R, axis1=-2, axis2=-1)
+    angle = np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0))
+    skew = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
+                     R[..., 1, 0] - R[..., 0, 1]], axis=-1)
+    sin = np.sin(angle)
+    out = np.zeros((*R.shape[:-2], 3))
+    regular = sin > 1e-6
+    out[regular] = (skew[regular] * (angle[regular] / (2.0 * sin[regular]))[..., None])
+    near_pi = ~regular & (angle > 1.0)
+    if np.any(near_pi):
+        Rp = R[near_pi]
+        diag = np.clip((np.diagonal(Rp, axis1=-2, axis2=-1) + 1.0) / 2.0, 0.0, None)
+        k = np.argmax(diag, axis=-1)
+        # At angle pi, R = 2 a a^T - I, so row k of (R + I) / 2 is a_k * a.
+        axis = (Rp[np.arange(len(Rp)), k] + np.eye(3)[k]) / 2.0
+        axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+        out[near_pi] = axis * angle[near_pi][..., None]
+    return out
 
 
 def matrix_from_yaw(yaw: ArrayLike) -> NDArray[np.float64]:

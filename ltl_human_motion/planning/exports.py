@@ -46,7 +46,7 @@ import numpy as np
 
 from ltl_human_motion.atomic import atomic_write_bytes, atomic_write_text
 from ltl_human_motion.errors import MotionFormatError
-from ltl_human_motion.kernel.rotations import MOCAP_FROM_ZUP
+from ltl_human_motion.kernel.rotations import MOCAP_FROM_ZUP, matrix_from_unit_axis_angle
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, Skeleton
 from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
@@ -284,16 +284,6 @@ def _normalize(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return v / np.maximum(n, 1e-12), n[..., 0]
 
 
-def _axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rotation matrices (..., 3, 3) about unit ``axis`` (..., 3) by ``angle`` (...)."""
-    x, y, z = axis[..., 0], axis[..., 1], axis[..., 2]
-    zero = np.zeros_like(x)
-    K = np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1),
-                  np.stack([-y, x, zero], -1)], -2)
-    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
-
-
 def _swing(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Smallest rotations taking unit vectors ``u`` (..., 3) onto ``v`` (..., 3)."""
     cross = np.cross(u, v)
@@ -305,7 +295,7 @@ def _swing(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     perp, _ = _normalize(np.cross(u, helper))
     axis = np.where((s < 1e-9)[..., None], perp, axis)
     angle = np.arctan2(s, c)
-    return _axis_angle(axis, angle)
+    return matrix_from_unit_axis_angle(axis, angle)
 
 
 def _twist(rot: np.ndarray, bone: np.ndarray, ref_rest: np.ndarray, ref_cur: np.ndarray
@@ -319,7 +309,7 @@ def _twist(rot: np.ndarray, bone: np.ndarray, ref_rest: np.ndarray, ref_cur: np.
     # Fade the twist out as the reference becomes parallel to the bone (ill-defined).
     weight = np.clip((np.minimum(nu, nw) / np.maximum(np.linalg.norm(ref_cur, axis=-1), 1e-12)
                       - 0.15) / 0.2, 0.0, 1.0)
-    return _axis_angle(bone, angle * weight) @ rot
+    return matrix_from_unit_axis_angle(bone, angle * weight) @ rot
 
 
 def _kabsch(rest: np.ndarray, cur: np.ndarray) -> np.ndarray:

@@ -7,7 +7,10 @@ Core package: no ROS imports. The simulated controller is the sub-package
 connects.
 """
 
-from ltl_human_motion.kernel.rotations import matrix_from_compact_axis_angle
+from ltl_human_motion.kernel.rotations import (
+    compact_axis_angle_from_matrix,
+    matrix_from_compact_axis_angle,
+)
 from ltl_human_motion.robot.coexistence import (
     CoexistenceConfig,
     CoexistenceController,
@@ -19,7 +22,6 @@ from ltl_human_motion.robot.coexistence import (
 from ltl_human_motion.robot.kinematics import (
     UR_MODELS,
     URModel,
-    axis_angle_from_matrix,
     forward_kinematics,
     pose_from_xyz_rpy,
     robot_capsules,
@@ -81,10 +83,10 @@ __all__ = [
     "URSimConfig",
     "URSimHandle",
     "Waypoint",
-    "axis_angle_from_matrix",
     "build_controller",
     "check_capsules",
     "commissioning_metrics",
+    "compact_axis_angle_from_matrix",
     "default_pick_and_place",
     "forward_kinematics",
     "load_robot_config",

@@ -13,10 +13,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ltl_human_motion.kernel.rotations import compact_axis_angle_from_matrix
+
 __all__ = [
     "UR_MODELS",
     "URModel",
-    "axis_angle_from_matrix",
     "forward_kinematics",
     "pose_from_xyz_rpy",
     "robot_capsules",
@@ -142,41 +143,6 @@ def forward_kinematics(q: ArrayLike, model: str | URModel = "ur5e") -> NDArray[n
     return frames
 
 
-def axis_angle_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
-    """Rotation vector (axis times angle, UR's ``rx, ry, rz``) of rotation matrices.
-
-    Parameters
-    ----------
-    R : array-like, shape (..., 3, 3)
-
-    Returns
-    -------
-    rotvec : ndarray, shape (..., 3)
-        Angle in [0, pi].
-    """
-    R = np.asarray(R, dtype=np.float64)
-    if R.shape[-2:] != (3, 3):
-        raise ValueError(f"rotation matrices: expected shape (..., 3, 3), got {R.shape}")
-    trace = np.trace(R, axis1=-2, axis2=-1)
-    angle = np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0))
-    skew = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
-                     R[..., 1, 0] - R[..., 0, 1]], axis=-1)
-    sin = np.sin(angle)
-    out = np.zeros((*R.shape[:-2], 3))
-    regular = sin > 1e-6
-    out[regular] = (skew[regular] * (angle[regular] / (2.0 * sin[regular]))[..., None])
-    near_pi = ~regular & (angle > 1.0)
-    if np.any(near_pi):
-        Rp = R[near_pi]
-        diag = np.clip((np.diagonal(Rp, axis1=-2, axis2=-1) + 1.0) / 2.0, 0.0, None)
-        k = np.argmax(diag, axis=-1)
-        # At angle pi, R = 2 a a^T - I, so row k of (R + I) / 2 is a_k * a.
-        axis = (Rp[np.arange(len(Rp)), k] + np.eye(3)[k]) / 2.0
-        axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
-        out[near_pi] = axis * angle[near_pi][..., None]
-    return out
-
-
 def tcp_pose(q: ArrayLike, model: str | URModel = "ur5e") -> NDArray[np.float64]:
     """Flange pose ``[x, y, z, rx, ry, rz]`` in the base frame (UR's ``actual_TCP_pose``).
 
@@ -191,8 +157,8 @@ def tcp_pose(q: ArrayLike, model: str | URModel = "ur5e") -> NDArray[np.float64]
         Position (m) and rotation vector (rad).
     """
     flange = forward_kinematics(q, model)[..., 6, :, :]
-    return np.concatenate([flange[..., :3, 3], axis_angle_from_matrix(flange[..., :3, :3])],
-                          axis=-1)
+    rotvec = compact_axis_angle_from_matrix(flange[..., :3, :3])
+    return np.concatenate([flange[..., :3, 3], rotvec], axis=-1)
 
 
 def pose_from_xyz_rpy(xyz: ArrayLike = (0.0, 0.0, 0.0),

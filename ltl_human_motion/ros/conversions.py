@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from builtin_interfaces.msg import Duration, Time
 from geometry_msgs.msg import Point, Quaternion, TransformStamped
+from scipy.spatial.transform import Rotation
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker
 
@@ -52,20 +53,12 @@ def quaternion_from_yaw(yaw: float) -> Quaternion:
 
 
 def quaternion_z_to(vector: np.ndarray) -> Quaternion:
-    """The shortest rotation taking +z onto ``vector`` (a cylinder's axis)."""
+    """The shortest rotation taking +z onto ``vector`` (3,) (a cylinder's axis)."""
     v = np.asarray(vector, dtype=np.float64)
-    n = np.linalg.norm(v)
-    if n < 1e-12:
+    if np.linalg.norm(v) < 1e-12:
         return Quaternion(w=1.0)
-    v = v / n
-    axis = np.cross(_Z, v)
-    s = np.linalg.norm(axis)
-    c = float(np.dot(_Z, v))
-    if s < 1e-12:
-        return Quaternion(w=1.0) if c > 0 else Quaternion(x=1.0, w=0.0)
-    half = np.arctan2(s, c) / 2
-    a = axis / s * np.sin(half)
-    return Quaternion(x=float(a[0]), y=float(a[1]), z=float(a[2]), w=float(np.cos(half)))
+    x, y, z, w = (float(c) for c in Rotation.align_vectors(v[None], _Z[None])[0].as_quat())
+    return Quaternion(x=x, y=y, z=z, w=w)
 
 
 def point(xyz: Sequence[float] | np.ndarray) -> Point:

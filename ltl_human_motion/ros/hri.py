@@ -101,16 +101,6 @@ def blend_quaternions(quats: np.ndarray, time: float, fps: float) -> np.ndarray:
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
-def quaternion_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton products ``a * b`` of quaternions (..., 4: x y z w)."""
-    ax, ay, az, aw = np.moveaxis(a, -1, 0)
-    bx, by, bz, bw = np.moveaxis(b, -1, 0)
-    return np.stack([aw * bx + ax * bw + ay * bz - az * by,
-                     aw * by - ax * bz + ay * bw + az * bx,
-                     aw * bz + ax * by - ay * bx + az * bw,
-                     aw * bw - ax * bx - ay * by - az * bz], axis=-1)
-
-
 def link_transforms(positions: np.ndarray, quats: np.ndarray) -> np.ndarray:
     """Transforms (J, 7: x y z qx qy qz qw) of every link relative to its skeleton parent
     (the root's: to the world) for one pose: joint positions (J, 3) and world link
@@ -118,12 +108,12 @@ def link_transforms(positions: np.ndarray, quats: np.ndarray) -> np.ndarray:
     pos = np.asarray(positions, dtype=np.float64)
     q = np.asarray(quats, dtype=np.float64)
     parents = np.array(PARENTS[1:])
-    inverse = q[parents] * np.array([-1.0, -1.0, -1.0, 1.0])
-    R_parent = Rotation.from_quat(q[parents]).as_matrix()
+    parent = Rotation.from_quat(q[parents])
+    R_parent = parent.as_matrix()
     out = np.empty((len(JOINT_NAMES), 7))
     out[0, :3], out[0, 3:] = pos[0], q[0]
     out[1:, :3] = np.einsum("kji,kj->ki", R_parent, pos[1:] - pos[parents])
-    out[1:, 3:] = quaternion_multiply(inverse, q[1:])
+    out[1:, 3:] = (parent.inv() * Rotation.from_quat(q[1:])).as_quat()
     return out
 
 
