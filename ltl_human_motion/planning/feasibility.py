@@ -39,11 +39,12 @@ import numpy as np
 from scipy.sparse.csgraph import connected_components
 
 from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.planning.navigation import FloorGrid
 
-__all__ = ["FloorMap", "ReachEnvelope", "check_steps", "floor_map", "reach_envelope",
-           "step_problems"]
+__all__ = ["FloorMap", "ReachEnvelope", "check_steps", "floor_components", "floor_map",
+           "reach_envelope", "step_problems"]
 
 #: The shoulder girdle rises in an overhead reach: about 0.04 H above the rest pose's
 #: shoulder joint, which brings the skeleton's overhead reach (1.21 H) to the 1.2-1.25 H
@@ -158,9 +159,9 @@ class FloorMap:
     tree: object = None
 
 
-_FLOOR_CACHE: dict[tuple, FloorMap] = {}
+_FLOOR_CACHE: BoundedCache[FloorMap] = BoundedCache(32)
 #: Answers per cell content, stature and task sequence (cells repeat across calls).
-_ANSWER_CACHE: dict[tuple, list[PlanningError]] = {}
+_ANSWER_CACHE: BoundedCache[list[PlanningError]] = BoundedCache(512)
 #: Content digests of the Cell objects seen (a cell is immutable).
 _DIGESTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -183,7 +184,29 @@ def _layout_key(cell, stature: float) -> tuple:
 
 #: Free floor and its components per obstacle layout and stature (objects, regions and
 #: the start region may change from call to call, e.g. in batches, without a rebuild).
-_GRID_CACHE: dict[tuple, tuple] = {}
+_GRID_CACHE: BoundedCache[tuple] = BoundedCache(32)
+
+
+def floor_components(cell, radius: float, resolution: float, block: float = math.inf
+                     ) -> tuple[FloorGrid, np.ndarray]:
+    """The floor grid where a body of ``radius`` (m) keeps clear of the workspace's walls
+    and of every obstacle part whose underside is less than ``block`` (m) above the floor,
+    and the connected component of each grid cell: ``(FloorGrid, labels (nx * ny,))``."""
+    floor = float(cell.floor_z)
+    footprints = [part.footprint() for ob in cell.obstacles for part in ob.parts
+                  if part.aabb()[0][2] - floor < block]
+    lo = np.asarray(cell.workspace_lo[:2], dtype=np.float64)
+    hi = np.asarray(cell.workspace_hi[:2], dtype=np.float64)
+
+    def free(xy: np.ndarray) -> np.ndarray:
+        ok = np.all((xy >= lo + radius) & (xy <= hi - radius), axis=-1)
+        for fp in footprints:
+            ok &= fp.signed_distance(xy) > radius
+        return ok
+
+    grid = FloorGrid(lo, hi, free, resolution)
+    _, labels = connected_components(grid.graph, directed=False)
+    return grid, labels
 
 
 def _floor_grid(cell, stature: float) -> tuple:
@@ -196,28 +219,12 @@ def _floor_grid(cell, stature: float) -> tuple:
     if hit is not None:
         return hit
     H = float(stature)
-    radius = PASSAGE_HALF_WIDTH_FRACTION * H
-    floor = float(cell.floor_z)
-    footprints = [part.footprint() for ob in cell.obstacles for part in ob.parts
-                  if part.aabb()[0][2] - floor < FLOOR_BLOCK_FRACTION * H]
-    lo = np.asarray(cell.workspace_lo[:2], dtype=np.float64)
-    hi = np.asarray(cell.workspace_hi[:2], dtype=np.float64)
-
-    def free(xy: np.ndarray) -> np.ndarray:
-        ok = np.all((xy >= lo + radius) & (xy <= hi - radius), axis=-1)
-        for fp in footprints:
-            ok &= fp.signed_distance(xy) > radius
-        return ok
-
-    grid = FloorGrid(lo, hi, free, FLOOR_RESOLUTION)
+    grid, labels = floor_components(cell, PASSAGE_HALF_WIDTH_FRACTION * H, FLOOR_RESOLUTION,
+                                    FLOOR_BLOCK_FRACTION * H)
     flat_free = grid.free.ravel()
-    _, labels = connected_components(grid.graph, directed=False)
     free_xy = grid.centres[flat_free]
-    out = (grid, free_xy, labels[flat_free], cKDTree(free_xy) if len(free_xy) else None)
-    if len(_GRID_CACHE) >= 32:
-        _GRID_CACHE.pop(next(iter(_GRID_CACHE)))
-    _GRID_CACHE[key] = out
-    return out
+    return _GRID_CACHE.put(key, (grid, free_xy, labels[flat_free],
+                                 cKDTree(free_xy) if len(free_xy) else None))
 
 
 def floor_map(cell, stature: float) -> FloorMap:
@@ -234,11 +241,7 @@ def floor_map(cell, stature: float) -> FloorMap:
         d = np.hypot(*(free_xy - np.asarray(r0.center[:2])).T)
         in_start = d <= max(FLOOR_RESOLUTION, float(d.min()))
     connected = np.isin(free_labels, np.unique(free_labels[in_start]))
-    fmap = FloorMap(grid, free_xy, connected, bool(in_start.any()), tree)
-    if len(_FLOOR_CACHE) >= 32:
-        _FLOOR_CACHE.pop(next(iter(_FLOOR_CACHE)))
-    _FLOOR_CACHE[key] = fmap
-    return fmap
+    return _FLOOR_CACHE.put(key, FloorMap(grid, free_xy, connected, bool(in_start.any()), tree))
 
 
 # ------------------------------------------------------------------------ targets
@@ -427,11 +430,7 @@ def step_problems(cell, steps: Sequence[tuple[str, Sequence[str]]], stature: flo
     hit = _ANSWER_CACHE.get(key)
     if hit is not None:
         return list(hit)
-    out = _problems(cell, steps, stature)
-    if len(_ANSWER_CACHE) >= 512:
-        _ANSWER_CACHE.clear()
-    _ANSWER_CACHE[key] = out
-    return list(out)
+    return list(_ANSWER_CACHE.put(key, _problems(cell, steps, stature)))
 
 
 def _problems(cell, steps: Sequence[tuple[str, Sequence[str]]], stature: float

@@ -557,7 +557,7 @@ def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: 
     return _GRID_CACHE.get_or_build(key, build, owner=clearance)
 
 
-_STAND_CACHE: dict[str, ClearanceMap] = {}
+_STAND_CACHE: BoundedCache[ClearanceMap] = BoundedCache(16)
 
 
 def _layout_key(cell) -> str:
@@ -586,14 +586,8 @@ def stand_clearance_map(cell) -> ClearanceMap:
     walking map (:func:`clearance_maps`) counts tall parts ``tall_extra`` closer. Kept in
     memory per cell (cheap to build).
     """
-    key = _layout_key(cell)
-    stand = _STAND_CACHE.get(key)
-    if stand is None:
-        stand = ClearanceMap(cell, tall_extra=0.0)
-        if len(_STAND_CACHE) >= 16:
-            _STAND_CACHE.pop(next(iter(_STAND_CACHE)))
-        _STAND_CACHE[key] = stand
-    return stand
+    return _STAND_CACHE.get_or_build(_layout_key(cell),
+                                     lambda: ClearanceMap(cell, tall_extra=0.0))
 
 
 def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:

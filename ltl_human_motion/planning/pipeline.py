@@ -24,6 +24,7 @@ import numpy as np
 from ltl_human_motion.deadline import Deadline, checkpoint
 from ltl_human_motion.deadline import active as active_deadline
 from ltl_human_motion.errors import PlanningError, VerificationError
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion.realism import realism_summary
 from ltl_human_motion.motion.retarget import enforce_bone_lengths
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX
@@ -144,7 +145,7 @@ def get_library(stature: float = DEFAULT_STATURE, source: str | None = None):
     return load_library(stature=stature, source=source)
 
 
-_SEQUENCE_CACHE: dict = {}
+_SEQUENCE_CACHE: BoundedCache[list] = BoundedCache(256)
 
 
 def _task_sequences(specification, cell, n: int, seed: int, mode: str, cycles: int,
@@ -160,17 +161,15 @@ def _task_sequences(specification, cell, n: int, seed: int, mode: str, cycles: i
     """
     from ltl_human_motion.tasks import plan_sequences
     key = (specification.formula, specification.letters, n,
-           seed if mode == "random" else None, mode, cycles, backend, id(cell))
-    hit = _SEQUENCE_CACHE.get(key)
-    if hit is not None and hit[0] is cell:
-        return hit[1], 0.0, 0.0
+           seed if mode == "random" else None, mode, cycles, backend)
+    hit = _SEQUENCE_CACHE.get(key, owner=cell)
+    if hit is not None:
+        return hit, 0.0, 0.0
     # The cell model's product search builds the automaton on the fly, as it goes.
     sequences, stats = plan_sequences(specification, cell, n=n, seed=seed, mode=mode,
                                       cycles=cycles, backend=backend)
     t_automaton, t_sequence = stats.automaton_seconds, stats.search_seconds
-    if len(_SEQUENCE_CACHE) > 256:
-        _SEQUENCE_CACHE.clear()
-    _SEQUENCE_CACHE[key] = (cell, sequences)
+    _SEQUENCE_CACHE.put(key, sequences, owner=cell)
     return sequences, t_automaton, t_sequence
 
 

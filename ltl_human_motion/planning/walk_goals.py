@@ -19,6 +19,7 @@ from dataclasses import replace
 import numpy as np
 
 from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.planning.astar import Goal
 from ltl_human_motion.planning.blend import wrap_angle
 from ltl_human_motion.planning.navigation import (
@@ -66,7 +67,7 @@ STALL_BLOCK_RADIUS = 0.3
 RING_SAMPLES = (8, 72)
 
 #: Navigation fields by floor grid and goal (see :meth:`WalkGoals.field`).
-_FIELD_CACHE: dict[tuple, tuple[object, NavigationField]] = {}
+_FIELD_CACHE: BoundedCache[NavigationField] = BoundedCache(16)
 
 
 def _in_sector(x: np.ndarray, y: np.ndarray, target: tuple[float, float],
@@ -228,15 +229,8 @@ class WalkGoals:
         cells = functools.partial(goal_cells, clearance=grid.clearance)
         if key is None:
             return NavigationField.on_grid(grid, cells)
-        full = (id(grid), *key)
-        hit = _FIELD_CACHE.get(full)
-        if hit is not None and hit[0] is grid:         # the grid is held, its id unique
-            return hit[1]
-        field = NavigationField.on_grid(grid, cells)
-        if len(_FIELD_CACHE) >= 16:
-            _FIELD_CACHE.pop(next(iter(_FIELD_CACHE)))
-        _FIELD_CACHE[full] = (grid, field)
-        return field
+        return _FIELD_CACHE.get_or_build(tuple(key), lambda: NavigationField.on_grid(grid, cells),
+                                         owner=grid)
 
     def leads(self, field: NavigationField) -> bool:
         """Whether ``field`` leads from the worker's spot to a goal cell."""

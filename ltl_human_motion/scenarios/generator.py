@@ -447,7 +447,7 @@ def _to_paper_yup(d: dict) -> dict:
 
 def _accessible(cell_yaml: str, targets) -> bool:
     """Whether every target box has comfortable floor near it, connected to R0."""
-    from ltl_human_motion.scenarios.labels import floor_components
+    from ltl_human_motion.planning.feasibility import floor_components
     from ltl_human_motion.scene.cell_yaml import cell_from_yaml
     cell = cell_from_yaml(cell_yaml, source="<generated>")
     grid, labels = floor_components(cell, COMFORT_RADIUS, COMFORT_RESOLUTION)

@@ -43,7 +43,7 @@ from ltl_human_motion.scene.cell import Cell
 from ltl_human_motion.scene.shapes import Box, Cylinder
 from ltl_human_motion.scene.termination import parse_task
 
-__all__ = ["Label", "Labeller", "Opening", "Worker", "floor_components", "label_task"]
+__all__ = ["Label", "Labeller", "Opening", "Worker", "label_task"]
 
 VERTICAL_REACH_FRACTION = 1.25
 REACH_MARGIN = 0.10
@@ -156,31 +156,8 @@ class _Floor:
         return float(np.hypot(d[:, 0], d[:, 1]).min())
 
 
-def floor_components(cell: Cell, radius: float, resolution: float,
-                     block: float = math.inf):
-    """The floor grid where a body of ``radius`` keeps clear of the workspace's walls and
-    of every obstacle part whose underside is less than ``block`` above the floor, and
-    the connected component of each grid cell: ``(FloorGrid, labels (nx * ny,))``."""
-    from scipy.sparse.csgraph import connected_components
-
-    from ltl_human_motion.planning.navigation import FloorGrid
-    floor = float(cell.floor_z)
-    fps = [p.footprint() for ob in cell.obstacles for p in ob.parts
-           if p.aabb()[0][2] - floor < block]
-    lo, hi = cell.workspace_lo[:2], cell.workspace_hi[:2]
-
-    def free(xy: np.ndarray) -> np.ndarray:
-        ok = np.all((xy >= lo + radius) & (xy <= hi - radius), axis=-1)
-        for fp in fps:
-            ok &= fp.signed_distance(xy) > radius
-        return ok
-
-    grid = FloorGrid(lo, hi, free, resolution)
-    _, labels = connected_components(grid.graph, directed=False)
-    return grid, labels
-
-
 def _floor(cell: Cell, radius: float, block: float) -> _Floor:
+    from ltl_human_motion.planning.feasibility import floor_components
     grid, labels = floor_components(cell, radius, FLOOR_RESOLUTION, block)
     flat = grid.free.ravel()
     r0 = cell.start_region
