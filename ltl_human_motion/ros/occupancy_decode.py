@@ -17,57 +17,9 @@ from rclpy.serialization import deserialize_message
 from ltl_human_motion.msg import HumanOccupancy
 from ltl_human_motion.robot.fusion import OccupancySample
 from ltl_human_motion.ros.common import stamp_seconds
+from ltl_human_motion.ros.occupancy_cdr import OCCUPANCY_LAYOUT, CdrReader
 
 __all__ = ["OccupancySample", "decode_human_occupancy", "occupancy_from_message"]
-
-
-class _Reader:
-    """Reads plain little-endian CDR, aligning relative to the payload start."""
-
-    def __init__(self, data: bytes) -> None:
-        self.data = data
-        self.pos = 4                                      # after the encapsulation header
-
-    def _align(self, n: int) -> None:
-        self.pos += (-(self.pos - 4)) % n
-
-    def uint32(self) -> int:
-        self._align(4)
-        (value,) = struct.unpack_from("<I", self.data, self.pos)
-        self.pos += 4
-        return value
-
-    def int32(self) -> int:
-        self._align(4)
-        (value,) = struct.unpack_from("<i", self.data, self.pos)
-        self.pos += 4
-        return value
-
-    def float64(self) -> float:
-        self._align(8)
-        (value,) = struct.unpack_from("<d", self.data, self.pos)
-        self.pos += 8
-        return value
-
-    def string(self) -> str:
-        n = self.uint32()
-        if n == 0 or self.pos + n > len(self.data):
-            raise ValueError("bad string length")
-        text = self.data[self.pos:self.pos + n - 1].decode("utf-8")
-        self.pos += n
-        return text
-
-    def capsules(self) -> np.ndarray:
-        k = self.uint32()
-        if k == 0:
-            return np.zeros((0, 7))
-        self._align(8)
-        end = self.pos + 56 * k
-        if end > len(self.data):
-            raise ValueError("capsule sequence runs past the message")
-        rows = np.frombuffer(self.data, dtype="<f8", count=7 * k, offset=self.pos)
-        self.pos = end
-        return rows.reshape(k, 7).astype(np.float64)
 
 
 def _split(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -84,19 +36,11 @@ def decode_human_occupancy(data: bytes) -> OccupancySample:
     data = bytes(data)
     if data[:2] == b"\x00\x01":
         try:
-            r = _Reader(data)
-            sec, nanosec = r.int32(), r.uint32()
-            r.string()                                    # frame_id
-            human_id = r.string()
-            for _ in range(r.uint32()):
-                r.string()                                # part names
-            segments, radii = _split(r.capsules())
-            r.float64()                                   # prediction_horizon
-            predicted = []
-            for _ in range(r.uint32()):
-                horizon = r.float64()
-                predicted.append((horizon, *_split(r.capsules())))
-            return OccupancySample(human_id, sec + nanosec * 1e-9, segments, radii, predicted)
+            m = CdrReader(data).read(OCCUPANCY_LAYOUT)
+            segments, radii = _split(m["capsules"])
+            predicted = [(p["time_from_now"], *_split(p["capsules"])) for p in m["predicted"]]
+            return OccupancySample(m["human_id"], m["sec"] + m["nanosec"] * 1e-9, segments,
+                                   radii, predicted)
         except (struct.error, ValueError, UnicodeDecodeError):
             pass                                          # let rclpy decide below
     try:
