@@ -202,3 +202,38 @@ def test_cylinder_orientation_turns_z_onto_the_capsule_axis() -> None:
         turned = Rotation.from_quat([q.x, q.y, q.z, q.w]).apply([0.0, 0.0, 1.0])
         np.testing.assert_allclose(turned, v / np.linalg.norm(v), atol=1e-12)
     assert cv.quaternion_z_to(np.zeros(3)).w == 1.0
+
+
+def test_playback_follower_follows_task_state_and_warns_once_per_missing_motion() -> None:
+    from ltl_human_motion.msg import TaskState
+
+    from ltl_human_motion.ros.playback_follower import PlaybackFollower
+
+    context = rclpy.context.Context()
+    rclpy.init(context=context)
+    try:
+        node = rclpy.create_node("follower_test", context=context)
+        store = MotionStore()
+        motion_id = store.add(make_test_motion(duration=2.0, fps=60.0))
+        follower = PlaybackFollower(node, None, store, "", "task_state", "/motion_catalog")
+        assert follower.following and node.count_subscribers("/motion_catalog") == 1
+        assert node.count_subscribers("/task_state") == 1
+        msg = TaskState(motion_id="motion_unknown", playback_state="playing", rate=1.0)
+        follower.on_task_state(msg)
+        follower.on_task_state(msg)
+        assert follower.playback.motion is None
+        assert follower._missing_warned == {"motion_unknown"}
+        msg = TaskState(motion_id=motion_id, playback_state="playing", rate=1.0,
+                        motion_time=0.5)
+        msg.header.stamp.sec = 100
+        follower.on_task_state(msg)
+        assert follower.playback.motion_id == motion_id
+        assert follower.playback.motion_time(100.5) == pytest.approx(1.0)
+        follower.on_task_state(TaskState(playback_state="stopped"))
+        assert follower.playback.motion_time(101.0) is None
+        shared = Playback()
+        assert PlaybackFollower(node, shared, store, "", "t2", "/c2").playback is shared
+        assert node.count_subscribers("/t2") == 0
+        node.destroy_node()
+    finally:
+        rclpy.shutdown(context=context)

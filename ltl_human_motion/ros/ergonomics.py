@@ -34,11 +34,10 @@ from ltl_human_motion.assess import assess_motion
 from ltl_human_motion.assess import reba as reba_mod
 from ltl_human_motion.assess import rula as rula_mod
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
-from ltl_human_motion.msg import ErgonomicsState, MotionCatalog, TaskState
+from ltl_human_motion.msg import ErgonomicsState
 from ltl_human_motion.ros import conversions as cv
-from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS
-from ltl_human_motion.ros.motion_store import MotionSource, MotionStore
-from ltl_human_motion.ros.occupancy_node import follow_task_state
+from ltl_human_motion.ros.common import STREAM_QOS
+from ltl_human_motion.ros.motion_store import MotionStore
 from ltl_human_motion.ros.params import (
     ParamSpec,
     declare_parameters,
@@ -48,6 +47,7 @@ from ltl_human_motion.ros.params import (
     topic_name,
 )
 from ltl_human_motion.ros.playback import Playback
+from ltl_human_motion.ros.playback_follower import PlaybackFollower
 from ltl_human_motion.scene.cell import Cell
 
 __all__ = ["LEVEL_COLORS", "ErgonomicsNode", "cell_masses", "response_figures"]
@@ -114,22 +114,15 @@ class ErgonomicsNode(Node):
         super().__init__(node_name, **node_kwargs)
         declare_parameters(self, ergonomics_parameters())
         self.human_id = str(self.param("human_id"))
-        self.following = playback is None
-        self.playback = playback if playback is not None else Playback()
-        store_dir = self.param("store_dir")
-        self.source = MotionSource(store if store is not None
-                                   else MotionStore(store_dir) if store_dir else None)
+        self.follower = PlaybackFollower(self, playback, store, self.param("store_dir"),
+                                         self.param("task_state_topic"),
+                                         self.param("catalog_topic"))
+        self.following, self.playback = self.follower.following, self.follower.playback
         self._scores: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
-        self._missing_warned: set[str] = set()
         self.messages_published = 0
         self._pub = self.create_publisher(ErgonomicsState, "ergonomics", STREAM_QOS)
         self._marker_pub = self.create_publisher(MarkerArray, self.param("markers_topic"),
                                                  STREAM_QOS)
-        if self.following:
-            self.create_subscription(TaskState, self.param("task_state_topic"),
-                                     self._on_task_state, STREAM_QOS)
-            self.create_subscription(MotionCatalog, self.param("catalog_topic"),
-                                     self.source.on_catalog, LATCHED_QOS)
         self._timer = self.create_timer(1.0 / self.param("rate"), self._tick,
                                         callback_group=MutuallyExclusiveCallbackGroup())
         self.get_logger().info(f"ergonomics of human {self.human_id} at "
@@ -137,9 +130,6 @@ class ErgonomicsNode(Node):
 
     def param(self, name: str) -> Any:
         return self.get_parameter(name).value
-
-    def _on_task_state(self, msg: TaskState) -> None:
-        follow_task_state(self, msg)
 
     def scores(self, motion_id: str, motion: Any
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -43,7 +43,6 @@ the stream thread where the process may have it).
 
 from __future__ import annotations
 
-import gc
 from typing import Any
 
 import numpy as np
@@ -52,11 +51,11 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from visualization_msgs.msg import MarkerArray
 
-from ltl_human_motion.msg import HumanOccupancy, MotionCatalog, TaskState
+from ltl_human_motion.msg import HumanOccupancy
 from ltl_human_motion.ros import conversions as cv
-from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS, now_seconds, stamp_seconds
+from ltl_human_motion.ros.common import STREAM_QOS
 from ltl_human_motion.ros.diagnostics import OK, WARN, Status, attach_diagnostics
-from ltl_human_motion.ros.motion_store import MotionSource, MotionStore
+from ltl_human_motion.ros.motion_store import MotionStore
 from ltl_human_motion.ros.occupancy_cdr import capsule_rows, encode_occupancy_rows
 from ltl_human_motion.ros.params import (
     ParamSpec,
@@ -68,7 +67,8 @@ from ltl_human_motion.ros.params import (
     positive,
     topic_name,
 )
-from ltl_human_motion.ros.playback import STATES, STOPPED, Playback
+from ltl_human_motion.ros.playback import Playback
+from ltl_human_motion.ros.playback_follower import PlaybackFollower
 from ltl_human_motion.ros.wall_schedule import WallSchedule
 
 #: Seconds between two missed-deadline warnings of one node.
@@ -119,33 +119,6 @@ def occupancy_parameters() -> list[ParamSpec]:
     ]
 
 
-def follow_task_state(node: Any, msg: TaskState) -> None:
-    """Re-anchor ``node.playback`` on a player's ``TaskState`` (loading the motion from
-    ``node.source`` when it changes; a missing one is warned about once, via
-    ``node._missing_warned``). Shared by the nodes that follow a player."""
-    if msg.playback_state not in STATES or msg.playback_state == STOPPED \
-            or not msg.motion_id:
-        if node.playback.state(now_seconds(node)) != STOPPED:
-            node.playback.stop()
-        return
-    motion = None
-    if msg.motion_id != node.playback.motion_id:
-        try:
-            motion = node.source.get(msg.motion_id)
-        except (KeyError, ValueError, OSError) as exc:
-            if msg.motion_id not in node._missing_warned:
-                node._missing_warned.add(msg.motion_id)
-                node.get_logger().warning(f"cannot follow {msg.motion_id!r} yet: {exc}")
-            return
-        # Loading imported the planning modules and made the motion's objects: keep them
-        # out of the collector's full passes, which would stall a stream (measured: 120 ms
-        # gaps in bench/occupancy_stream.py --layout launch).
-        gc.freeze()
-    node.playback.sync(msg.motion_id, motion, msg.motion_time,
-                       stamp_seconds(msg.header.stamp), msg.rate, msg.loop,
-                       msg.playback_state)
-
-
 class OccupancyNode(Node):
     """Streams ``HumanOccupancy`` for one human.
 
@@ -164,23 +137,16 @@ class OccupancyNode(Node):
         declare_parameters(self, occupancy_parameters())
         self.human_id = str(self.param("human_id"))
         self.world_frame: str = self.param("world_frame")
-        self.following = playback is None
-        self.playback = playback if playback is not None else Playback()
-        store_dir = self.param("store_dir")
-        self.source = MotionSource(store if store is not None
-                                   else MotionStore(store_dir) if store_dir else None)
+        self.follower = PlaybackFollower(self, playback, store, self.param("store_dir"),
+                                         self.param("task_state_topic"),
+                                         self.param("catalog_topic"))
+        self.following, self.playback = self.follower.following, self.follower.playback
         self._part_names: list[str] | None = None
-        self._missing_warned: set[str] = set()
         self.messages_published = 0
 
         self._pub = self.create_publisher(HumanOccupancy, "occupancy", STREAM_QOS)
         self._marker_pub = self.create_publisher(MarkerArray, self.param("markers_topic"),
                                                  STREAM_QOS)
-        if self.following:
-            self.create_subscription(TaskState, self.param("task_state_topic"),
-                                     self._on_task_state, STREAM_QOS)
-            self.create_subscription(MotionCatalog, self.param("catalog_topic"),
-                                     self.source.on_catalog, LATCHED_QOS)
         self._group = MutuallyExclusiveCallbackGroup()
         self._names = cv.capsule_part_names()
         self.deadlines_missed = 0
@@ -275,9 +241,6 @@ class OccupancyNode(Node):
                                                 callback_group=self._group)
             elif p.name == "marker_rate":
                 self._set_marker_timer(p.value)
-
-    def _on_task_state(self, msg: TaskState) -> None:
-        follow_task_state(self, msg)
 
     def offsets(self) -> np.ndarray:
         """Clock offsets (s) of the published samples: 0, then the predicted ones."""
