@@ -2,9 +2,9 @@
 
 Useful for demos, for testing plots, exports and predicates without a motion library:
 the worker walks from the start region to a spot in front of a region (legs and arms
-swinging rigidly), turns to face it and reaches into it with one or both hands (an
-analytic two-bone arm IK keeps every bone length). It is *not* a planned motion: it
-walks in a straight line and ignores obstacles.
+swinging rigidly), turns to face it and reaches into it with one or both hands (the
+analytic two-bone IK of :mod:`ltl_human_motion.motion.ik` keeps every bone length). It
+is *not* a planned motion: it walks in a straight line and ignores obstacles.
 """
 
 from __future__ import annotations
@@ -13,7 +13,8 @@ import itertools
 
 import numpy as np
 
-from ltl_human_motion.kernel.rotations import matrix_from_yaw
+from ltl_human_motion.kernel.rotations import matrix_from_axis_angle, matrix_from_yaw
+from ltl_human_motion.motion.ik import two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
@@ -21,13 +22,9 @@ from ltl_human_motion.scene.cell import Cell
 
 __all__ = ["demo_synthesized_motion", "reach_pose", "standing_spot"]
 
+_Y = np.array([0.0, 1.0, 0.0])
 _LEG = {"l": [JOINT_INDEX[n] for n in ("l_knee", "l_ankle", "l_toe")],
         "r": [JOINT_INDEX[n] for n in ("r_knee", "r_ankle", "r_toe")]}
-
-
-def _rot_y(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def _smoothstep(u: np.ndarray) -> np.ndarray:
@@ -48,28 +45,19 @@ def standing_spot(cell: Cell, target: np.ndarray, distance: float = 0.4) -> tupl
 def reach_pose(pose: np.ndarray, side: str, target: np.ndarray) -> np.ndarray:
     """Move one arm of ``pose`` (J, 3) so its hand goes towards ``target`` (3,).
 
-    Two-bone IK (shoulder-elbow, elbow-hand) with the elbow pointing down and outwards;
-    bone lengths are kept, an unreachable target is approached as far as the arm goes.
+    Two-bone IK (:func:`~ltl_human_motion.motion.ik.two_bone_ik`: shoulder-elbow,
+    elbow-hand) with the elbow pointing down and outwards; bone lengths are kept, an
+    unreachable target is approached as far as the arm goes.
     """
     out = np.array(pose, dtype=np.float64)
     s, e, w, h = (JOINT_INDEX[f"{side}_{n}"] for n in ("shoulder", "elbow", "wrist", "hand"))
-    l1 = np.linalg.norm(pose[e] - pose[s])
+    l1 = float(np.linalg.norm(pose[e] - pose[s]))
     l_ew = np.linalg.norm(pose[w] - pose[e])
-    l2 = np.linalg.norm(pose[h] - pose[e])
-    to = np.asarray(target, dtype=np.float64) - pose[s]
-    d = float(np.clip(np.linalg.norm(to), abs(l1 - l2) + 1e-3, l1 + l2 - 1e-6))
-    u = to / max(np.linalg.norm(to), 1e-9)
+    l2 = float(np.linalg.norm(pose[h] - pose[e]))
     # Elbow pole: down and away from the body's mid-line (along shoulder - chest).
     lateral = pose[s] - pose[JOINT_INDEX["chest"]]
     pole = np.array([0.0, 0.0, -1.0]) + 0.5 * lateral / max(np.linalg.norm(lateral), 1e-9)
-    pole -= np.dot(pole, u) * u
-    if np.linalg.norm(pole) < 1e-6:
-        pole = np.cross(u, [0.0, 1.0, 0.0])
-    pole /= np.linalg.norm(pole)
-    cos_a = (l1 * l1 + d * d - l2 * l2) / (2 * l1 * d)
-    a = np.arccos(np.clip(cos_a, -1.0, 1.0))
-    elbow = pose[s] + l1 * (np.cos(a) * u + np.sin(a) * pole)
-    hand = pose[s] + d * u
+    elbow, hand = two_bone_ik(pose[s], target, l1, l2, pole, max_stretch=1.0 - 1e-6)
     fore = (hand - elbow) / np.linalg.norm(hand - elbow)
     out[e], out[w], out[h] = elbow, elbow + l_ew * fore, elbow + l2 * fore
     return out
@@ -159,10 +147,10 @@ def demo_synthesized_motion(cell: Cell | None = None, region: str | None = None,
             for side, sign in (("l", 1.0), ("r", -1.0)):
                 hip = rest[JOINT_INDEX[f"{side}_hip"]]
                 idx = _LEG[side]
-                pose[idx] = (rest[idx] - hip) @ _rot_y(-sign * swing).T + hip
+                pose[idx] = (rest[idx] - hip) @ matrix_from_axis_angle(_Y, -sign * swing).T + hip
                 sh = rest[JOINT_INDEX[f"{side}_shoulder"]]
                 arm = [JOINT_INDEX[f"{side}_{n}"] for n in ("elbow", "wrist", "hand")]
-                pose[arm] = (rest[arm] - sh) @ _rot_y(sign * 0.4 * swing).T + sh
+                pose[arm] = (rest[arm] - sh) @ matrix_from_axis_angle(_Y, sign * 0.4 * swing).T + sh
         frames[t] = pose @ matrix_from_yaw(yaw[t]).T + np.array([xy[t, 0], xy[t, 1], 0.0])
     # Reaching: world-frame IK towards target points inside the region.
     sides = {"both": ("l", "r"), "right": ("r",), "left": ("l",)}[hands]
