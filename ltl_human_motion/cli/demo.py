@@ -8,7 +8,10 @@
 3. Robot coexistence: a simulated UR5e speaking RTDE (own process) and the coexistence
    node slowing it down while the worker assembles inside its workspace; commissioning
    metrics as JSON and PNG.
-4. A cell study: S2 in layouts A and B of the paper cell (config/paper_cell.yaml and
+4. A reactive worker (GR(1), docs/reactive.md): the synthesis service returns a strategy,
+   the simulated UR5e works in the assembly region R1 (RTDE, the coexistence node's
+   ur_rtde client), the worker waits at the bench and assembles when the arm has left.
+5. A cell study: S2 in layouts A and B of the paper cell (config/paper_cell.yaml and
    config/paper_cell_b.yaml, the bench moved), a few variants per stature 1.6/1.75/1.9 m,
    ergonomics, cycle time and offline SSM against the UR5e; JSON, PNGs and study.html.
 
@@ -29,9 +32,10 @@ from ltl_human_motion.atomic import atomic_write_text
 
 NAME = "demo"
 HELP = ("run the main job: paper reproduction, ROS 2 loop with MCAP recording, robot "
-        "coexistence, and a study of two layouts of the paper cell")
+        "coexistence, a worker who reacts to the robot, and a study of two layouts of the "
+        "paper cell")
 
-PARTS = ("paper", "ros", "robot", "study")
+PARTS = ("paper", "ros", "robot", "react", "study")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -89,6 +93,14 @@ def _robot(args: argparse.Namespace) -> dict:
     return {"ok": bool(summary.get("success", summary.get("ok", False))), **summary}
 
 
+def _react(args: argparse.Namespace) -> dict:
+    from ltl_human_motion.ros.react_demo import run_react_demo
+    _say("reactive worker: strategy over the service, the UR5e in R1 (RTDE), the worker "
+         "waits at the bench")
+    summary = run_react_demo(args.out / "react")
+    return {"ok": bool(summary.get("success")), **summary}
+
+
 def _study(args: argparse.Namespace) -> dict:
     _say("cell study: layouts A and B of the paper cell, S2, UR5e (offline SSM)")
     from ltl_human_motion.study.runner import StudyConfig, run_study
@@ -119,7 +131,8 @@ def run(args: argparse.Namespace) -> int:
     parts = args.only or list(PARTS)
     args.out.mkdir(parents=True, exist_ok=True)
     results: dict = {}
-    runners = {"paper": _paper, "ros": _ros, "robot": _robot, "study": _study}
+    runners = {"paper": _paper, "ros": _ros, "robot": _robot, "react": _react,
+               "study": _study}
     for name in parts:
         t0 = time.perf_counter()
         try:
@@ -143,6 +156,11 @@ def run(args: argparse.Namespace) -> int:
                      f"{r.get('time_reduced_speed', 0.0):.1f} s slowed"
                      for mode, r in runs.items()]
             line += f"  -> {args.out / 'coexistence'} ({'; '.join(parts)})"
+        elif name == "react" and res["ok"]:
+            line += (f"  -> {args.out / 'react' / 'react_demo.json'} (waited "
+                     f"{res.get('waited_s', 0.0):.1f} s at the bench while the arm was in R1; "
+                     f"assembly {1e3 * res.get('reaction_s', float('nan')):.0f} ms after it "
+                     "left)")
         elif name == "study" and res["ok"]:
             counts = ", ".join(f"{k}: {n} motions" + (f" ({res['failed'][k]} failed: "
                                                          "the report says why)"

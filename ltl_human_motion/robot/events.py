@@ -19,7 +19,8 @@ import numpy as np
 from ltl_human_motion.robot.kinematics import URModel, pose_from_xyz_rpy, robot_capsules, ur_model
 from ltl_human_motion.robot.sim.trajectory import JointTrajectory, load_robot_config
 
-__all__ = ["AXIS_SAMPLES", "DEFAULT_MOVING_THRESHOLD", "RobotEvents", "robot_events"]
+__all__ = ["AXIS_SAMPLES", "DEFAULT_MOVING_THRESHOLD", "RobotEvents", "robot_events",
+           "robot_inputs"]
 
 #: Points per capsule axis in the region test.
 AXIS_SAMPLES = 21
@@ -61,24 +62,35 @@ class RobotEvents:
     def at(self, t: float) -> dict[str, bool]:
         """The inputs at trajectory time ``t`` (s), keyed as in :attr:`inputs`."""
         q, qd, _ = self.trajectory.sample(t)
-        seg, radii = robot_capsules(q, self.model, self.base)          # (7, 2, 3), (7,)
-        s = np.linspace(0.0, 1.0, AXIS_SAMPLES)[None, :, None]
-        points = seg[:, :1, :] + s * (seg[:, 1:, :] - seg[:, :1, :])  # (7, S, 3)
-        out: dict[str, bool] = {}
-        for key in self.inputs:
-            if key == "robot_moving":
-                out[key] = bool(np.max(np.abs(qd)) > self.moving_threshold)
-            elif key.startswith("robot_in(") and key[9:-1] in self.regions:
-                lo, hi = self.regions[key[9:-1]]
-                gap = np.maximum(np.maximum(lo - points, points - hi), 0.0)
-                dist = np.sqrt((gap * gap).sum(-1))                      # (7, S)
-                out[key] = bool(np.any(dist <= radii[:, None]))
-        return out
-
+        return robot_inputs(q, qd, self.model, self.base, self.regions, self.inputs,
+                            self.moving_threshold)
 
     def stopped(self, t: float) -> dict[str, bool]:
         """The inputs of the robot stopped where it is at trajectory time ``t``."""
         return {k: (False if k == "robot_moving" else v) for k, v in self.at(t).items()}
+
+
+def robot_inputs(q: np.ndarray, qd: np.ndarray | None, model: URModel, base: np.ndarray,
+                 regions: Mapping[str, tuple[np.ndarray, np.ndarray]], inputs: Sequence[str],
+                 moving_threshold: float = DEFAULT_MOVING_THRESHOLD) -> dict[str, bool]:
+    """The built-in robot inputs at joint positions ``q`` (6,) rad and joint speeds
+    ``qd`` (6,) rad/s (None: ``robot_moving`` is left out); ``model``, ``base``,
+    ``regions``, ``inputs`` and ``moving_threshold`` as the attributes of
+    :class:`RobotEvents`."""
+    seg, radii = robot_capsules(np.asarray(q, dtype=np.float64), model, base)  # (7, 2, 3)
+    s = np.linspace(0.0, 1.0, AXIS_SAMPLES)[None, :, None]
+    points = seg[:, :1, :] + s * (seg[:, 1:, :] - seg[:, :1, :])              # (7, S, 3)
+    out: dict[str, bool] = {}
+    for key in inputs:
+        if key == "robot_moving":
+            if qd is not None:
+                out[key] = bool(np.max(np.abs(qd)) > moving_threshold)
+        elif key.startswith("robot_in(") and key[9:-1] in regions:
+            lo, hi = regions[key[9:-1]]
+            gap = np.maximum(np.maximum(lo - points, points - hi), 0.0)
+            dist = np.sqrt((gap * gap).sum(-1))                                  # (7, S)
+            out[key] = bool(np.any(dist <= radii[:, None]))
+    return out
 
 
 def robot_events(path: str | Path, cell, inputs: Sequence[str],

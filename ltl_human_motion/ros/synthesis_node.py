@@ -1,7 +1,13 @@
 """The synthesis service node: LTL specification in, verified motions out.
 
 Service ``synthesize_motion`` (ltl_human_motion/srv/SynthesizeMotion, relative to the
-node's namespace) calls ``ltl_human_motion.planning.synthesize``.
+node's namespace) calls ``ltl_human_motion.planning.synthesize``. A reactive
+specification (one that reads inputs such as ``robot_in(R1)``, docs/reactive.md) is solved
+instead and each move of its strategy planned and verified
+(:func:`~ltl_human_motion.planning.strategy_motion.build_program`); the answer carries its
+``strategy_id`` (saved as ``<store_dir>/<id>.strategy.npz``), which the reactive player
+(:mod:`ltl_human_motion.ros.reactive_player`) plays live. An unrealizable one is refused
+with the explanation.
 
 Every request gets an answer. The service callback only checks the request against the
 named limits below and queues it; ``max_concurrent`` worker threads of the node's own
@@ -69,6 +75,7 @@ from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 if TYPE_CHECKING:
     from ltl_human_motion.planning.pipeline import SynthesisOptions
     from ltl_human_motion.planning.result import SynthesizedMotion
+    from ltl_human_motion.planning.strategy_motion import StrategyProgram
 
 from ltl_human_motion.deadline import DEFAULT_MAX_SECONDS, Deadline
 from ltl_human_motion.errors import LtlHumanMotionError, SpecError
@@ -80,6 +87,7 @@ from ltl_human_motion.ros.diagnostics import OK, WARN, Status, attach_diagnostic
 from ltl_human_motion.ros.motion_store import MotionStore, default_store_dir
 from ltl_human_motion.ros.params import ParamSpec, declare_parameters, positive
 from ltl_human_motion.ros.playback import task_sequence_text
+from ltl_human_motion.ros.reactive_player import strategy_path
 from ltl_human_motion.srv import SynthesizeMotion
 
 SynthesizeFn = Callable[..., list]
@@ -93,6 +101,8 @@ MAX_CYCLES = 8
 MAX_OPTIONS_CHARS = 4096
 #: Characters of an inline cell; the shipped cells are under 10 kB.
 MAX_INLINE_CELL_CHARS = 1_000_000
+#: Strategies kept in memory for players in the same process (older ones stay on disk).
+MAX_PROGRAMS_IN_MEMORY = 16
 #: Depth of the service's DDS request history (the default of 10 overwrote requests).
 SERVICE_HISTORY_DEPTH = 1000
 
@@ -169,12 +179,18 @@ class SynthesisNode(LifecycleNode):
         ``store_dir``, ``max_in_memory`` and ``max_memory_mb`` parameters.
     synthesize_fn : callable, optional
         Replaces ``planning.synthesize`` (same signature).
+    programs : dict, optional
+        Where strategies of reactive specifications are kept by id (pass the same dict to
+        a :class:`~ltl_human_motion.ros.reactive_player.ReactivePlayer` in this process).
     """
 
     def __init__(self, *, store: MotionStore | None = None,
                  synthesize_fn: SynthesizeFn | None = None, node_name: str = "synthesis_node",
+                 programs: dict[str, StrategyProgram] | None = None,
                  **node_kwargs: Any) -> None:
         super().__init__(node_name, **node_kwargs)
+        #: Strategies of reactive specifications by id (share with a ReactivePlayer).
+        self.programs: dict[str, StrategyProgram] = programs if programs is not None else {}
         declare_parameters(self, [
             ParamSpec("default_cell", "paper_cell", "Cell used when a request leaves cell empty",
                       lambda v: None if v.strip() else "expected a cell name"),
@@ -345,6 +361,13 @@ class SynthesisNode(LifecycleNode):
         with self._jobs_lock:
             self._running.add(job)
         try:
+            program = self._run_reactive(job.request, job.deadline)
+            if program is not None:
+                self._fill_strategy(response, program)
+                self._worker_logger().info(
+                    f"synthesized strategy {program.strategy_id} ({len(program.clips)} "
+                    f"verified moves) in {time.perf_counter() - job.received:.2f} s")
+                return
             motions, cell = self._run(job.request, job.deadline)
             self._fill(response, motions)
             self._fill_ergonomics(response, motions, cell, int(job.request.cycles) or 1)
@@ -401,6 +424,44 @@ class SynthesisNode(LifecycleNode):
         if not motions:
             raise ValueError("synthesis returned no motion")
         return motions, cell
+
+    def _run_reactive(self, request: SynthesizeMotion.Request, deadline: Deadline
+                      ) -> StrategyProgram | None:
+        """The strategy of a reactive specification (one that reads inputs), with a
+        verified motion per move; None for a plain specification."""
+        from ltl_human_motion.ltl.spec import build_specification
+
+        spec = request.spec
+        if not spec.strip():
+            return None
+        cell_text = request.cell.strip() or self.get_parameter("default_cell").value
+        cell = resolve_cell(cell_text)
+        try:
+            if not build_specification(spec, cell, reactive=True).inputs:
+                return None
+        except SpecError:
+            return None                 # reported by the plain path, as before
+        from ltl_human_motion.planning.pipeline import SynthesisOptions, get_library
+        from ltl_human_motion.planning.strategy_motion import build_program, save_program
+
+        options = synthesis_options(request.options_json) or SynthesisOptions()
+        stature = float(request.stature) or 1.75
+        program = build_program(spec, cell_text, cell, get_library(stature),
+                                seed=int(request.seed), stature=stature,
+                                options=replace(options, deadline=deadline))
+        if self.store.directory is not None:
+            save_program(program, strategy_path(self.store.directory, program.strategy_id))
+        with self._catalog_lock:
+            self.programs[program.strategy_id] = program
+            while len(self.programs) > MAX_PROGRAMS_IN_MEMORY:
+                self.programs.pop(next(iter(self.programs)))
+        return program
+
+    @staticmethod
+    def _fill_strategy(response: SynthesizeMotion.Response, program: StrategyProgram) -> None:
+        response.strategy_id = program.strategy_id
+        response.task_sequences.append(" ; ".join(t.key for t in program.worker.tasks))
+        response.success = True
 
     def _fill(self, response: SynthesizeMotion.Response, motions: list[SynthesizedMotion]) -> None:
         for motion in motions:

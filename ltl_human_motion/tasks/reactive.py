@@ -41,16 +41,22 @@ from ltl_human_motion.ltl.gr1 import (
 from ltl_human_motion.ltl.spec import Specification, build_specification, letter_of
 from ltl_human_motion.tasks.model import CellModel, CellState
 
-__all__ = ["MAX_PLANT_STATES", "TRACE_KINDS", "WAIT_STEP", "JointLasso", "ReactiveWorker",
-           "UnrealizableError", "draw_run", "joint_satisfies", "keeps_assumptions",
-           "random_input_lasso", "random_schedule", "reactive_worker", "run_strategy",
-           "timed_run"]
+__all__ = ["DEMO_SPEC", "MAX_PLANT_STATES", "TRACE_KINDS", "WAIT_STEP", "JointLasso",
+           "ReactiveWorker", "UnrealizableError", "draw_run", "joint_satisfies",
+           "keeps_assumptions", "random_input_lasso", "random_schedule", "reactive_worker",
+           "run_strategy", "timed_run"]
 
 #: Length (s) of the idle step ``wait(WAIT_STEP)``: a waiting worker reads the inputs
 #: again at its end. Its motion lasts WAIT_STEP plus the blend into the next primitive
 #: (0.29 s in all on the paper cell), so from a wait the worker starts the next task
 #: within 0.3 s of an event (a human reaction time is 0.2-0.3 s).
 WAIT_STEP = 0.15
+
+#: The reactive specification of the demo's stage on the paper cell: the worker fetches
+#: O1, walks to the bench (R1), waits there while the robot is in R1 and assembles when
+#: it has left; the robot leaves R1 again and again.
+DEMO_SPEC = ("(G F !robot_in(R1)) -> (G(robot_in(R1) -> X !assemble(R1)) & G F grasp(O1) & "
+             "G F assemble(R1) & G(grasp(O1) -> X walk(R1)))")
 
 #: States of the worker's physical model beyond which the game is refused.
 MAX_PLANT_STATES = 5000

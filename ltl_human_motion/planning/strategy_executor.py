@@ -1,0 +1,304 @@
+"""Live execution of a reactive worker's strategy (docs/reactive.md, "Live in ROS").
+
+Plain Python (no rclpy): times are seconds on the caller's clock. A
+:class:`StrategyExecutor` plays the clips of a
+:class:`~ltl_human_motion.planning.strategy_motion.StrategyProgram` one move after the
+other. At the end of each move it hands the strategy the inputs as they are then (the
+Moore reading of docs/reactive.md) and starts the clip of the move the strategy picks. A
+waiting worker is interruptible: when an input changes during a ``wait`` step, the wait
+ends at once and the next move starts at the time of the change. Tasks under way finish.
+
+Consecutive clips were planned from the same worker state but through different
+histories, so a clip's first pose differs a little from the pose the worker is in; the
+difference is blended out over the clip's first :func:`blend_seconds` (offset blending,
+as at the junctions of the pipeline). The executor is duck-compatible with
+:class:`~ltl_human_motion.ros.playback.Playback` where an occupancy stream reads it
+(``state``, ``stature``, ``motion_id``, ``positions_ahead``, ``sample_ahead``).
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import deque
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ltl_human_motion.planning.strategy_motion import START, StepClip, StrategyProgram
+
+__all__ = ["BLEND_MAX", "BLEND_MIN", "BLEND_SPEED", "LiveFrame", "StrategyExecutor",
+           "StrategyStatus", "blend_seconds"]
+
+#: Shortest and longest blend of a junction, s.
+BLEND_MIN = 0.3
+BLEND_MAX = 1.0
+#: Speed (m/s) at which a joint's junction offset is blended out.
+BLEND_SPEED = 1.5
+
+PLAYING = "playing"
+STOPPED = "stopped"
+
+
+def blend_seconds(offset: float) -> float:
+    """Blend of a junction whose largest joint offset is ``offset`` m."""
+    return float(np.clip(offset / BLEND_SPEED, BLEND_MIN, BLEND_MAX))
+
+
+@dataclass(frozen=True)
+class StrategyStatus:
+    """What the strategy does now.
+
+    Attributes
+    ----------
+    strategy_id : str
+    step : int
+        Index of the move under way (0 first).
+    task : str
+        Its task key.
+    worker_state : int
+        Worker model state the move started from (-1: the start).
+    goal : int
+        Index of the goal (``G F``) the strategy pursues.
+    goals : int
+        Number of goals.
+    inputs : dict of str to bool
+        The inputs as read last.
+    inputs_stamp : float
+        Stamp (s) of the newest input message among them (0: none yet).
+    step_start : float
+        Clock time (s) the move started.
+    reacted_at : float or None
+        Clock time (s) of the latest wait ended by an input change.
+    """
+
+    strategy_id: str
+    step: int
+    task: str
+    worker_state: int
+    goal: int
+    goals: int
+    inputs: dict[str, bool]
+    inputs_stamp: float
+    step_start: float
+    reacted_at: float | None
+
+    def state_text(self) -> str:
+        """The strategy's state in words, e.g. ``"worker state 3, goal 1 of 2"``."""
+        where = "start" if self.worker_state == START else f"worker state {self.worker_state}"
+        return f"{where}, goal {self.goal + 1} of {self.goals}"
+
+
+@dataclass(frozen=True)
+class LiveFrame:
+    """The worker's pose at one instant.
+
+    Attributes
+    ----------
+    positions : ndarray, shape (J, 3)
+        Joint positions, world frame, m.
+    yaw : float
+        Body heading about +z, rad.
+    objects : dict of str to ndarray, shape (3,)
+    step_time : float
+        Seconds of motion into the current move.
+    step_duration : float
+        Seconds of the current move's motion.
+    status : StrategyStatus
+    """
+
+    positions: np.ndarray
+    yaw: float
+    objects: dict[str, np.ndarray]
+    step_time: float
+    step_duration: float
+    status: StrategyStatus
+
+
+class StrategyExecutor:
+    """Thread-safe live run of a strategy.
+
+    Parameters
+    ----------
+    program : StrategyProgram
+    start : float
+        Clock time (s) of the first move's first frame.
+    inputs : mapping of str to bool, optional
+        Input values before any message (missing ones are false).
+    on_step : callable, optional
+        Called with each new :class:`StrategyStatus` (under the executor's lock).
+    rate : float
+        Playback rate (1.0 is real time; 2.0 plays each move in half its time).
+    """
+
+    def __init__(self, program: StrategyProgram, start: float,
+                 inputs: Mapping[str, bool] | None = None,
+                 on_step: Callable[[StrategyStatus], None] | None = None,
+                 rate: float = 1.0) -> None:
+        if not (np.isfinite(rate) and rate > 0):
+            raise ValueError(f"playback rate must be a positive number, got {rate!r}")
+        self.program = program
+        self.rate = float(rate)
+        self._lock = threading.RLock()
+        self._inputs = {k: bool((inputs or {}).get(k, False)) for k in program.inputs}
+        self._inputs_stamp = 0.0
+        self._on_step = on_step
+        self._strategy = program.worker.strategy
+        self._strategy.reset()
+        self._wait = next((i for i, t in enumerate(program.worker.tasks) if t.name == "wait"),
+                          -1)
+        self._step = -1
+        self._source = START
+        self._clip: StepClip | None = None
+        self._start = float(start)
+        self._offset = np.zeros((0, 3))
+        self._yaw_offset = 0.0
+        self._blend = BLEND_MIN
+        self._reacted_at: float | None = None
+        self._stopped = False
+        #: Tasks of the latest moves started (at most 1000).
+        self.steps_done: deque[str] = deque(maxlen=1000)
+        self._begin(float(start), None, 0.0)
+
+    # -- inputs ----------------------------------------------------------------------
+    @property
+    def motion_id(self) -> str:
+        return self.program.strategy_id
+
+    @property
+    def stature(self) -> float:
+        return self.program.stature
+
+    def set_inputs(self, values: Mapping[str, bool], stamp: float, now: float) -> bool:
+        """Take input values (keys of the specification's inputs; others are ignored)
+        from a message stamped ``stamp`` received at clock time ``now``.
+
+        Returns True when this ended a wait: the next move starts at ``now``.
+        """
+        with self._lock:
+            self._advance(now)
+            changed = False
+            for key, value in values.items():
+                if key in self._inputs and self._inputs[key] != bool(value):
+                    self._inputs[key] = bool(value)
+                    changed = True
+            if any(k in self._inputs for k in values):
+                self._inputs_stamp = max(self._inputs_stamp, float(stamp))
+            if changed and not self._stopped and self._clip is not None \
+                    and self._clip.move.task == self._wait and now >= self._start:
+                self._reacted_at = float(now)
+                self._next(float(now))
+                return True
+            return False
+
+    def stop(self) -> None:
+        """Stop: no frames any more."""
+        with self._lock:
+            self._stopped = True
+
+    # -- queries ---------------------------------------------------------------------
+    def state(self, now: float) -> str:
+        """``"playing"``, or ``"stopped"`` after :meth:`stop`."""
+        return STOPPED if self._stopped else PLAYING
+
+    def status(self, now: float) -> StrategyStatus:
+        """The strategy's status at clock time ``now``."""
+        with self._lock:
+            self._advance(now)
+            return self._status()
+
+    def frame_at(self, now: float) -> LiveFrame | None:
+        """The pose at clock time ``now`` (None when stopped)."""
+        with self._lock:
+            if self._stopped:
+                return None
+            self._advance(now)
+            t = max(float(now) - self._start, 0.0) * self.rate
+            positions, yaw = self._pose(np.array([t]))
+            clip = self._clip
+            f = min(t * clip.fps, len(clip.positions) - 1)
+            i0 = int(np.floor(f))
+            i1 = min(i0 + 1, len(clip.positions) - 1)
+            w = f - i0
+            objects = {k: v[i0] * (1 - w) + v[i1] * w for k, v in clip.objects.items()}
+            return LiveFrame(positions[0], float(yaw[0]), objects, t, clip.duration,
+                             self._status())
+
+    def positions_ahead(self, now: float, offsets: np.ndarray) -> np.ndarray | None:
+        """Joint positions (N, J, 3) ``offsets`` (N,) s after ``now`` if the current move
+        runs on (it holds its last pose after its end); None when stopped."""
+        with self._lock:
+            if self._stopped:
+                return None
+            self._advance(now)
+            t = (max(float(now) - self._start, 0.0)
+                 + np.asarray(offsets, dtype=np.float64)) * self.rate
+            return self._pose(t)[0]
+
+    def sample_ahead(self, now: float, offsets: np.ndarray, key: str,
+                     per_frame: Callable[[np.ndarray], np.ndarray]) -> np.ndarray | None:
+        """``per_frame`` (T, J, 3) -> (T, ...) of :meth:`positions_ahead` (``key`` is
+        accepted for compatibility with Playback; nothing is cached)."""
+        positions = self.positions_ahead(now, offsets)
+        return None if positions is None else per_frame(positions)
+
+    # -- internals -------------------------------------------------------------------
+    def _status(self) -> StrategyStatus:
+        state = self._strategy._chosen or self._strategy.state
+        goals = len(self._strategy.game.aut.win["[]<>"])
+        return StrategyStatus(self.program.strategy_id, self._step,
+                              self._clip.task if self._clip is not None else "",
+                              self._source, int(state.get("_goal", 0)), goals,
+                              dict(self._inputs), self._inputs_stamp, self._start,
+                              self._reacted_at)
+
+    def _pose(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Positions (N, J, 3) and yaw (N,) of the current clip at step times ``t`` (N,),
+        the junction offset blended out."""
+        clip = self._clip
+        n = len(clip.positions)
+        f = np.clip(t * clip.fps, 0.0, n - 1)
+        i0 = np.floor(f).astype(np.int64)
+        i1 = np.minimum(i0 + 1, n - 1)
+        w = f - i0
+        pos = clip.positions[i0] * (1 - w)[:, None, None] + clip.positions[i1] * w[:, None, None]
+        yaw = clip.yaw[i0] * (1 - w) + clip.yaw[i1] * w
+        u = np.clip(t / self._blend, 0.0, 1.0)
+        fade = 1.0 - u * u * (3.0 - 2.0 * u)                          # smoothstep down
+        if self._offset.shape == pos.shape[1:]:
+            pos = pos + fade[:, None, None] * self._offset[None]
+        return pos, yaw + fade * self._yaw_offset
+
+    def _advance(self, now: float) -> None:
+        """Finish every move that ended by ``now`` (each at its own end time)."""
+        while not self._stopped and self._clip is not None \
+                and float(now) >= self._start + self._length():
+            self._next(self._start + self._length())
+
+    def _length(self) -> float:
+        """Clock seconds of the current move."""
+        return max(self._clip.duration, 1.0 / self._clip.fps) / self.rate
+
+    def _next(self, at: float) -> None:
+        """End the current move at clock time ``at``: observe the inputs, start the next."""
+        positions, yaw = self._pose(np.array([(at - self._start) * self.rate]))
+        self._strategy.observe(self._inputs)
+        self._source = self._clip.move.target
+        self._begin(at, positions[0], float(yaw[0]))
+
+    def _begin(self, at: float, pose: np.ndarray | None, yaw: float) -> None:
+        task = self._strategy.choose()
+        clip = self.program.clips.get((self._source, task))
+        if clip is None:
+            raise KeyError(f"the strategy's move {self.program.worker.tasks[task].key} from "
+                           f"worker state {self._source} has no motion in the program")
+        self._clip, self._start, self._step = clip, float(at), self._step + 1
+        if pose is None:
+            self._offset, self._yaw_offset, self._blend = np.zeros((0, 3)), 0.0, BLEND_MIN
+        else:
+            self._offset = pose - clip.positions[0]
+            self._yaw_offset = float(np.angle(np.exp(1j * (yaw - clip.yaw[0]))))
+            self._blend = blend_seconds(float(np.max(np.linalg.norm(self._offset, axis=1))))
+        self.steps_done.append(clip.task)
+        if self._on_step is not None:
+            self._on_step(self._status())

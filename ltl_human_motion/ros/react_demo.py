@@ -1,0 +1,224 @@
+"""The reactive worker live in ROS, as one function (the demo's ``react`` stage).
+
+:class:`ReactiveStack` brings up, in one rclpy context of this process, the synthesis
+node, one worker's reactive player (namespace ``/human_<id>``) and, optionally, the
+worker's occupancy node (reading the player) and a coexistence node. Requests and
+observations go through a client node in its own context, so every call crosses DDS.
+
+:func:`run_react_demo`:
+
+1. calls ``/synthesize_motion`` with the reactive specification
+   (:data:`~ltl_human_motion.tasks.reactive.DEMO_SPEC`: fetch O1, walk to the bench R1,
+   wait while the robot is in R1, assemble when it has left) and gets a strategy id;
+2. starts the simulated UR5e of ``config/ur_react_r1.yaml`` (its own process, RTDE on
+   127.0.0.1:30004), whose arm works in R1 for about 9 s of each cycle; the coexistence
+   node drives it with the real ur_rtde client and publishes the joint state it reads;
+3. plays the strategy on ``/human_1/play_motion``; the player reads ``robot_in(R1)`` from
+   that joint state and the arm's capsules;
+4. watches ``/human_1/task_state`` until the worker, having waited at the bench while the
+   arm was in R1, starts assembling after it left; writes ``react_demo.json``.
+
+The stage's coexistence node keeps a slider of at least :data:`DEMO_MIN_SLIDER`: with
+the SSM minimum (1 %) an arm beside a worker who waits for it nearly stops, and the
+worker would wait for ever (the robot then breaks the assumption ``G F !robot_in(R1)``;
+see docs/reactive.md).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import rclpy
+from rclpy.context import Context
+from rclpy.parameter import Parameter
+
+from ltl_human_motion.atomic import atomic_write_text
+from ltl_human_motion.msg import TaskState
+from ltl_human_motion.ros.client import ClientSession, wait_until
+from ltl_human_motion.ros.common import SpinThread, stamp_seconds
+from ltl_human_motion.ros.middleware import apply_middleware_defaults
+from ltl_human_motion.ros.motion_store import MotionStore
+from ltl_human_motion.ros.reactive_player import ReactivePlayer
+from ltl_human_motion.ros.synthesis_node import SynthesisNode
+from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
+
+__all__ = ["DEMO_MIN_SLIDER", "REACT_ROBOT_CONFIG", "ReactiveStack", "run_react_demo"]
+
+ROOT = Path(__file__).resolve().parents[2]
+#: The robot of the stage: its arm works in R1, then away from it.
+REACT_ROBOT_CONFIG = ROOT / "config" / "ur_react_r1.yaml"
+#: Lowest speed slider of the stage's coexistence node.
+DEMO_MIN_SLIDER = 0.5
+
+
+class ReactiveStack:
+    """Synthesis node, reactive player (and occupancy, coexistence nodes) in one context.
+
+    Parameters
+    ----------
+    store_dir : path
+        Folder of the strategies (``<id>.strategy.npz``) and motions.
+    human_id : str
+    playback_rate : float
+    coexistence : dict, optional
+        Parameters of a coexistence node to add (it connects to ``robot_host``); with it
+        an occupancy node streams the worker's occupancy from the player.
+    """
+
+    def __init__(self, store_dir: str | Path, *, human_id: str = "1",
+                 playback_rate: float = 1.0, coexistence: dict[str, Any] | None = None) -> None:
+        apply_middleware_defaults()
+        self.context = Context()
+        rclpy.init(context=self.context)
+        self.nodes: list[Any] = []
+        self.spinner: SpinThread | None = None
+        try:
+            store = MotionStore(store_dir)
+            self.synthesis = SynthesisNode(store=store, context=self.context)
+            self.player = ReactivePlayer(
+                context=self.context, namespace=f"/human_{human_id}", parameter_overrides=[
+                    Parameter("human_id", value=human_id),
+                    Parameter("store_dir", value=str(store.directory)),
+                    Parameter("playback_rate", value=float(playback_rate))])
+            self.nodes = [self.synthesis, self.player]
+            self.coexistence = None
+            if coexistence is not None:
+                from ltl_human_motion.ros.coexistence_node import CoexistenceNode
+                from ltl_human_motion.ros.occupancy_node import OccupancyNode
+                self.nodes.append(OccupancyNode(
+                    playback=self.player.view, context=self.context,
+                    namespace=f"/human_{human_id}",
+                    parameter_overrides=[Parameter("human_id", value=human_id)]))
+                self.coexistence = CoexistenceNode(context=self.context, parameter_overrides=[
+                    Parameter(k, value=v) for k, v in coexistence.items()])
+                self.nodes.append(self.coexistence)
+            self.spinner = SpinThread(self.nodes, self.context, 4)
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Stop spinning, destroy the nodes, shut the context down (idempotent)."""
+        if self.spinner is not None:
+            self.spinner.stop()
+            self.spinner = None
+        for node in reversed(self.nodes):
+            node.destroy_node()
+        self.nodes = []
+        rclpy.try_shutdown(context=self.context)
+
+
+def _inputs(msg: TaskState) -> dict[str, bool]:
+    return dict(zip(msg.input_names, (bool(v) for v in msg.input_values)))
+
+
+def run_react_demo(out_dir: str | Path, *, spec: str | None = None, human_id: str = "1",
+                   playback_rate: float = 3.0, timeout: float = 60.0,
+                   synthesis_timeout: float = 600.0) -> dict[str, Any]:
+    """The reactive stage end to end; returns (and writes to ``react_demo.json``) a
+    summary: ``success``, ``strategy_id``, ``steps`` (task, start on the node clock,
+    inputs), ``waited_s`` (at the bench while the arm was in R1), ``reaction_s`` (from
+    the stamp of the joint state that showed the arm out of R1 to the first frame of the
+    assembly), ``synthesis_wall_time``, ``error``."""
+    from ltl_human_motion.ros.coexistence_demo import (
+        node_parameters_from_robot_config,
+        rtde_port_lock,
+        start_sim_when_free,
+    )
+    from ltl_human_motion.tasks.reactive import DEMO_SPEC
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    spec = spec or DEMO_SPEC
+    ns = f"/human_{human_id}"
+    summary: dict[str, Any] = {"spec": spec, "cell": "paper_cell", "success": False,
+                               "error": "", "robot": str(REACT_ROBOT_CONFIG.relative_to(ROOT)),
+                               "min_slider": DEMO_MIN_SLIDER, "playback_rate": playback_rate}
+    params = node_parameters_from_robot_config(REACT_ROBOT_CONFIG)
+    params.update(min_slider=DEMO_MIN_SLIDER, forget_after=1.0)
+    with rtde_port_lock(timeout=300.0):
+        stack = session = sim = None
+        try:
+            stack = ReactiveStack(out / "store", human_id=human_id,
+                                  playback_rate=playback_rate, coexistence=params)
+            session = ClientSession("react_demo_client")
+            states = session.watch(TaskState, f"{ns}/task_state", keep=1)
+            t0 = time.monotonic()
+            response = session.call(SynthesizeMotion, "/synthesize_motion",
+                                    SynthesizeMotion.Request(spec=spec, cell="paper_cell"),
+                                    timeout=synthesis_timeout,
+                                    resend_after=min(30.0, synthesis_timeout))
+            summary["synthesis_wall_time"] = round(time.monotonic() - t0, 3)
+            if not response.success or not response.strategy_id:
+                summary["error"] = response.error_message or "no strategy id in the answer"
+                return summary
+            summary["strategy_id"] = response.strategy_id
+            summary["tasks"] = response.task_sequences[0]
+            # The robot starts now (its cycle begins with the move into R1), so the arm is
+            # in R1 when the worker reaches the bench.
+            sim = start_sim_when_free(REACT_ROBOT_CONFIG, timeout=60.0)
+            node = stack.coexistence
+            wait_until(lambda: node.latest is not None and node.latest.connected, 20.0,
+                       "the coexistence node to connect to the simulated UR over RTDE")
+            played = session.call(PlayMotion, f"{ns}/play_motion", PlayMotion.Request(
+                command="play", motion_id=response.strategy_id), timeout=20.0,
+                resend_after=5.0)
+            if not played.success:
+                summary["error"] = f"play_motion: {played.message}"
+                return summary
+            summary.update(_watch(stack, states, response.strategy_id, timeout))
+        except Exception as exc:   # the stage reports, the demo goes on
+            summary["error"] = f"{type(exc).__name__}: {exc}"
+        finally:
+            if session is not None:
+                session.close()
+            if stack is not None:
+                stack.close()
+            if sim is not None:
+                sim.stop()
+            atomic_write_text(out / "react_demo.json", json.dumps(summary, indent=2) + "\n")
+    return summary
+
+
+def _watch(stack: ReactiveStack, states: Any, strategy_id: str, timeout: float
+           ) -> dict[str, Any]:
+    """Follow the task state until the worker assembles after a wait at the bench."""
+    steps: list[dict[str, Any]] = []
+    waited_from: float | None = None
+    end = time.monotonic() + timeout
+    result: dict[str, Any] = {"success": False, "steps": steps}
+    while time.monotonic() < end:
+        msg = states.last
+        time.sleep(0.01)
+        if msg is None or msg.strategy_id != strategy_id:
+            continue
+        if not steps or steps[-1]["step"] != msg.strategy_step:
+            steps.append({"step": msg.strategy_step, "task": msg.current_task,
+                          "at": round(stamp_seconds(msg.header.stamp), 3),
+                          "inputs": _inputs(msg), "state": msg.strategy_state})
+            waiting = msg.current_task.startswith("wait(") and _inputs(msg).get("robot_in(R1)")
+            if waiting and waited_from is None:
+                waited_from = stamp_seconds(msg.header.stamp)
+            if msg.current_task == "assemble(R1)" and waited_from is not None:
+                start = stamp_seconds(msg.header.stamp)
+                result["waited_s"] = round(start - waited_from, 3)
+                reactions = [r for r in stack.player.reactions if r[1] >= start - 0.5]
+                if reactions:
+                    result["reaction_s"] = round(reactions[-1][1] - reactions[-1][0], 4)
+                result["success"] = True
+                break
+    compact = []
+    for s in steps:                                  # runs of waits as one entry
+        if compact and s["task"] == compact[-1]["task"] and s["task"].startswith("wait("):
+            compact[-1]["repeats"] = compact[-1].get("repeats", 1) + 1
+        else:
+            compact.append(s)
+    result["steps"] = compact
+    if not result["success"]:
+        result["error"] = (f"within {timeout:g} s the worker did not assemble after waiting "
+                           "at the bench while the arm was in R1 (steps: "
+                           + ", ".join(s["task"] for s in compact) + ")")
+    return result
