@@ -197,7 +197,8 @@ def test_user_source_folder_adds_primitives(tmp_path: Path) -> None:
     folder = tmp_path / "mocap"
     folder.mkdir()
     m = bvh.load(src)
-    bvh.save(type(m)(m.positions[:360], m.fps, m.skeleton, "part"), folder / "part.bvh")
+    bvh.save(type(m)(m.positions[:360], m.fps, m.skeleton, "part"), folder / "part.bvh",
+             translations=True)
     lib = load_library(source=folder, include_default=False, use_cache=False)
     assert lib.stats["candidates"] > 0
     assert all("part.bvh" in mp.source for mp in lib.primitives)

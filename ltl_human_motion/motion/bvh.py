@@ -7,15 +7,32 @@ the joints that correspond to the canonical ones by name (CMU, LAFAN/Mixamo-like
 Motion-Builder style names are known; see :data:`NAME_CANDIDATES`) and retargets onto the
 canonical skeleton (:func:`~ltl_human_motion.motion.retarget.retarget_points`).
 
-:func:`save` writes a canonical-skeleton motion as BVH in which every joint carries
-position channels (its offset from the parent at every frame, no rotations), so that the
-file reproduces the positions exactly; it loads back with :func:`load`.
+:func:`save` writes a canonical-skeleton motion. The hierarchy is the canonical skeleton
+(:mod:`ltl_human_motion.motion.skeleton`) with its rest pose as offsets: 23 ``JOINT``
+entries (the root ``pelvis`` has six channels ``Xposition Yposition Zposition Zrotation
+Yrotation Xrotation``, every other joint three ``Zrotation Yrotation Xrotation``; R = Rz ·
+Ry · Rx, angles in degrees) and an ``End Site`` after each leaf (head, hands, toes). Units
+are metres (``scale`` changes them). By default the file follows the motion-capture
+convention, **y up with the character facing +z** and its left at +x: ``(x, y, z)_ours ->
+(y, z, x)_bvh``, the inverse of what :func:`load` applies, so written files load back.
+Blender's importer (default axes: forward -Z, up Y) shows the worker standing on its
+floor, facing -Y (towards the front view), i.e. our frame turned by -90 degrees about the
+vertical. ``up="z"`` writes our frame unchanged (z up, facing +x; import into Blender
+with forward Y, up Z).
+
+Joint rotations come from the positions (:func:`~ltl_human_motion.motion.bone_rotations.
+joint_rotations`). With rigid bone lengths the file reproduces the joint positions
+exactly; :func:`save` returns the largest reconstruction error. Motions that are not
+rigid (stretching bones, a deforming pelvis) are written exactly with
+``translations=True``, which adds per-joint position channels (displacements from the
+rest offsets, which Blender imports as bone locations).
 """
 
 from __future__ import annotations
 
 import math
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +40,8 @@ import numpy as np
 
 from ltl_human_motion.atomic import atomic_write_text
 from ltl_human_motion.errors import MotionFormatError
-from ltl_human_motion.kernel.rotations import ZUP_FROM_MOCAP
+from ltl_human_motion.kernel.rotations import MOCAP_FROM_ZUP, ZUP_FROM_MOCAP
+from ltl_human_motion.motion.bone_rotations import CHILDREN, joint_rotations, unit_vectors
 from ltl_human_motion.motion.retarget import retarget_points
 from ltl_human_motion.motion.rotations import matrix_from_euler
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton
@@ -395,59 +413,154 @@ def load(path: str | os.PathLike[str], skeleton: Skeleton | None = None) -> Moti
         raise MotionFormatError(f"{path}: {exc}") from None
 
 
-def save(motion: Motion, path: str | os.PathLike[str], precision: int = 6) -> None:
-    """Write a canonical-skeleton motion as BVH (Y up, metres; written atomically).
+# File axes from ours: bvh = C @ ours.
+_UP_FROM_Z = {"z": np.eye(3), "y": MOCAP_FROM_ZUP}
 
-    Every joint has three position channels holding its offset from its parent in world
-    axes and no rotation channels, so the positions are reproduced exactly.
+
+def _fmt(v: float) -> str:
+    s = f"{v:.6f}"
+    return "0.000000" if s == "-0.000000" else s
+
+
+def _hierarchy(rest: np.ndarray, C: np.ndarray, scale: float, translations: bool,
+                   stature: float) -> tuple[list[str], list[int]]:
+    """The HIERARCHY lines of :func:`save` and the joints in their file order.
+
+    ``rest`` is the (J, 3) rest pose, ``C`` the (3, 3) rotation from our frame to the file's.
     """
-    if not isinstance(motion, Motion):
-        raise ValueError(f"motion must be a Motion, got {type(motion).__name__}")
-    pos = motion.positions @ ZUP_FROM_MOCAP          # z-up -> y-up (inverse rotation)
-    rest = motion.skeleton.rest_positions() @ ZUP_FROM_MOCAP
-    children: dict[int, list[int]] = {j: [] for j in range(len(JOINT_NAMES))}
-    for j, p in enumerate(PARENTS):
-        if p >= 0:
-            children[p].append(j)
-    out = ["HIERARCHY"]
-
-    def emit(j: int, depth: int) -> None:
-        pad = "\t" * depth
-        p = PARENTS[j]
-        off = rest[j] - (rest[p] if p >= 0 else 0.0)
-        out.append(f"{pad}{'ROOT' if p < 0 else 'JOINT'} {JOINT_NAMES[j]}")
-        out.append(f"{pad}{{")
-        out.append(f"{pad}\tOFFSET {off[0]:.{precision}f} {off[1]:.{precision}f} "
-                   f"{off[2]:.{precision}f}")
-        out.append(f"{pad}\tCHANNELS 3 Xposition Yposition Zposition")
-        for c in children[j]:
-            emit(c, depth + 1)
-        if not children[j]:
-            out.append(f"{pad}\tEnd Site")
-            out.append(f"{pad}\t{{")
-            out.append(f"{pad}\t\tOFFSET 0 0 0")
-            out.append(f"{pad}\t}}")
-        out.append(f"{pad}}}")
-
-    emit(0, 0)
+    lines = ["HIERARCHY"]
     order: list[int] = []
 
-    def walk(j: int) -> None:
+    def emit(j: int, depth: int) -> None:
         order.append(j)
-        for c in children[j]:
-            walk(c)
+        ind = "  " * depth
+        p = PARENTS[j]
+        offset = (np.zeros(3) if p < 0 else (rest[j] - rest[p]) @ C.T * scale)
+        lines.append(f"{ind}{'ROOT' if p < 0 else 'JOINT'} {JOINT_NAMES[j]}")
+        lines.append(f"{ind}{{")
+        lines.append(f"{ind}  OFFSET {' '.join(_fmt(v) for v in offset)}")
+        if p < 0 or translations:
+            lines.append(f"{ind}  CHANNELS 6 Xposition Yposition Zposition "
+                         "Zrotation Yrotation Xrotation")
+        else:
+            lines.append(f"{ind}  CHANNELS 3 Zrotation Yrotation Xrotation")
+        if CHILDREN[j]:
+            for c in CHILDREN[j]:
+                emit(c, depth + 1)
+        else:
+            tip, _ = unit_vectors(rest[j] - rest[p])
+            end = tip @ C.T * 0.05 * stature * scale
+            lines.append(f"{ind}  End Site")
+            lines.append(f"{ind}  {{")
+            lines.append(f"{ind}    OFFSET {' '.join(_fmt(v) for v in end)}")
+            lines.append(f"{ind}  }}")
+        lines.append(f"{ind}}}")
 
-    walk(0)
-    parents = np.array(PARENTS)
-    local = pos.copy()
-    nonroot = parents >= 0
-    local[:, nonroot] = pos[:, nonroot] - pos[:, parents[nonroot]]
-    # non-root position channels are added to the OFFSET, so store the difference
-    local[:, nonroot] -= (rest[nonroot] - rest[parents[nonroot]])[None]
-    out.append("MOTION")
-    out.append(f"Frames: {motion.n_frames}")
-    out.append(f"Frame Time: {1.0 / motion.fps:.8f}")
-    flat = local[:, order].reshape(motion.n_frames, -1)
-    fmt = f"%.{precision}f"
-    out.extend(" ".join(fmt % v for v in row) for row in flat)
-    atomic_write_text(path, "\n".join(out) + "\n")
+    emit(0, 0)
+    return lines, order
+
+
+def _reconstruction_error(pos: np.ndarray, rest: np.ndarray, euler: np.ndarray,
+                              root: np.ndarray, delta_file: np.ndarray, order: list[int],
+                              C: np.ndarray, scale: float) -> float:
+    """Largest distance (m) between ``pos`` (T, J, 3) and the joints the BVH values give.
+
+    ``euler`` (T, J, 3) degrees ZYX, ``root`` (T, 3) and ``delta_file`` (T, J, 3) as
+    written by :func:`save`, in the file's frame and unit.
+    """
+    from scipy.spatial.transform import Rotation
+
+    T, J = euler.shape[:2]
+    R = Rotation.from_euler("ZYX", euler.reshape(-1, 3), degrees=True).as_matrix()
+    R = C.T @ R.reshape(T, J, 3, 3) @ C
+    world = np.empty_like(R)
+    recon = np.empty((T, J, 3))
+    for j in order:
+        p = PARENTS[j]
+        if p < 0:
+            world[:, j] = R[:, j]
+            recon[:, j] = root @ C / scale
+        else:
+            world[:, j] = world[:, p] @ R[:, j]
+            off = rest[j] - rest[p] + delta_file[:, j] @ C / scale
+            recon[:, j] = recon[:, p] + np.einsum("tij,tj->ti", world[:, p], off)
+    return float(np.max(np.linalg.norm(recon - pos, axis=-1))) if T else 0.0
+
+
+def save(motion: Motion, path: str | os.PathLike[str], up: str = "y", scale: float = 1.0,
+         translations: bool = False) -> float:
+    """Write a BVH file (Blender-compatible) of a canonical-skeleton motion (atomically).
+
+    Parameters
+    ----------
+    motion : Motion
+    path : path-like
+    up : {"y", "z"}
+        ``"y"``: y up, facing +z (the mocap convention, default); ``"z"``: our frame.
+    scale : float
+        Unit scale (1.0 = metres, 100.0 = centimetres).
+    translations : bool
+        Also give every joint ``Xposition Yposition Zposition`` channels holding its
+        per-frame displacement from the rest offset (in the parent's frame), so that
+        motions whose bones stretch or whose pelvis/chest deform are reproduced exactly.
+        Off by default: rotation-only files are what most tools expect.
+
+    Returns
+    -------
+    max_error : float
+        Largest distance (metres) between the input joint positions and the positions
+        the written file reproduces (0 up to rounding with ``translations``; otherwise it
+        measures how far the motion is from rigid).
+    """
+    m = motion
+    if not isinstance(m, Motion):
+        raise ValueError(f"motion must be a Motion, got {type(motion).__name__}")
+    if up not in _UP_FROM_Z:
+        raise ValueError(f"up must be 'y' or 'z', got {up!r}")
+    if not scale > 0:
+        raise ValueError(f"scale must be positive, got {scale!r}")
+    from scipy.spatial.transform import Rotation
+
+    C = _UP_FROM_Z[up]
+    skel = m.skeleton
+    rest = skel.rest_positions()
+    pos = m.positions
+    G = joint_rotations(pos, skel)                                    # (T, J, 3, 3)
+    T, J = G.shape[:2]
+    local = np.empty_like(G)
+    delta = np.zeros((T, J, 3))                  # displacement from the rest offset
+    for j in range(J):
+        p = PARENTS[j]
+        if p < 0:
+            local[:, j] = G[:, j]
+            continue
+        local[:, j] = np.swapaxes(G[:, p], -1, -2) @ G[:, j]
+        if translations:
+            in_parent = np.einsum("tji,tj->ti", G[:, p], pos[:, j] - pos[:, p])
+            delta[:, j] = in_parent - (rest[j] - rest[p])
+    local_file = C @ local @ C.T
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)         # gimbal lock is still exact
+        euler = Rotation.from_matrix(local_file.reshape(-1, 3, 3)).as_euler(
+            "ZYX", degrees=True).reshape(T, J, 3)
+    euler = np.round(euler, 6)
+    root = np.round((pos[:, 0] @ C.T) * scale, 6)
+    delta_file = np.round((delta @ C.T) * scale, 6)
+
+    lines, order = _hierarchy(rest, C, scale, translations, skel.stature)
+    lines.append("MOTION")
+    lines.append(f"Frames: {T}")
+    lines.append(f"Frame Time: {1.0 / m.fps:.8f}")
+    for t in range(T):
+        vals: list[float] = []
+        for j in order:
+            if PARENTS[j] < 0:
+                vals.extend(root[t])
+            elif translations:
+                vals.extend(delta_file[t, j])
+            vals.extend(euler[t, j])
+        lines.append(" ".join(_fmt(v) for v in vals))
+    atomic_write_text(path, "\n".join(lines) + "\n")
+
+    # Reconstruction error of what was written (rounded values included).
+    return _reconstruction_error(pos, rest, euler, root, delta_file, order, C, scale)

@@ -22,7 +22,7 @@ The URDF reproduces the canonical 23-joint skeleton (:mod:`~ltl_human_motion.mot
   names (:func:`joint_names`).
 
 Joint angles per frame (:func:`joint_angles`) come from the motion's positions with the
-BVH exporter's rotations (:func:`~ltl_human_motion.planning.exports.bvh_rotations`: swing
+BVH exporter's rotations (:func:`~ltl_human_motion.motion.bone_rotations.joint_rotations`: swing
 of each bone onto its current direction plus the twist references), corrected by one
 swing per bone so that a parent with several children (pelvis, chest) places each of
 them exactly. The skeleton's bone lengths are fixed, so forward kinematics from these
@@ -56,8 +56,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ltl_human_motion.motion.bone_rotations import (
+    CHILDREN,
+    kabsch_matrices,
+    swing_matrices,
+    twist_matrices,
+    unit_vectors,
+)
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, Skeleton
-from ltl_human_motion.planning.exports import _CHILDREN, _kabsch, _normalize, _swing, _twist
 from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 #: Degrees of slack on every ROM limit (Euler angles of a ball joint vs clinical planes).
@@ -217,7 +223,7 @@ def link_rotations(positions: np.ndarray, skeleton: Skeleton | None = None) -> n
     """World rotation of every joint's link per frame: (T, J, 3, 3) from positions (T, J, 3).
 
     The root's is the BVH exporter's pelvis rotation (a best fit of its three bones,
-    ``planning.exports._kabsch``).
+    ``bone_rotations.kabsch_matrices``).
     Every other link ``c`` (parent ``p``) is ``p``'s turned by the smallest rotation that
     puts the rest bone ``rest[c] - rest[p]`` onto the current one (the exporter's swing),
     then, for the chest, upper arms and thighs, turned about the bone by the exporter's
@@ -229,21 +235,21 @@ def link_rotations(positions: np.ndarray, skeleton: Skeleton | None = None) -> n
     pos = np.asarray(positions, dtype=np.float64)
     rest = skeleton.rest_positions()
     R = np.empty((len(pos), len(JOINT_NAMES), 3, 3))
-    kids = list(_CHILDREN[0])              # the BVH exporter's pelvis rotation
-    R[:, 0] = _kabsch(rest[kids] - rest[0], pos[:, kids] - pos[:, :1])
+    kids = list(CHILDREN[0])              # the BVH exporter's pelvis rotation
+    R[:, 0] = kabsch_matrices(rest[kids] - rest[0], pos[:, kids] - pos[:, :1])
     for c in range(1, len(JOINT_NAMES)):
         p, name = PARENTS[c], JOINT_NAMES[c]
-        rest_dir, _ = _normalize(rest[c] - rest[p])
-        cur_dir, _ = _normalize(pos[:, c] - pos[:, p])
+        rest_dir, _ = unit_vectors(rest[c] - rest[p])
+        cur_dir, _ = unit_vectors(pos[:, c] - pos[:, p])
         moved = np.einsum("tij,j->ti", R[:, p], rest_dir)
-        rot = _swing(moved, cur_dir) @ R[:, p]
+        rot = swing_matrices(moved, cur_dir) @ R[:, p]
         if name in _HINGE_TWIST:
             child, towards = _HINGE_TWIST[name]
             k = JOINT_INDEX[child]
-            rot = _twist(rot, cur_dir, np.array(towards), pos[:, k] - pos[:, c])
+            rot = twist_matrices(rot, cur_dir, np.array(towards), pos[:, k] - pos[:, c])
         elif name in _LINE_TWIST:
             a, b = (JOINT_INDEX[j] for j in _LINE_TWIST[name])
-            rot = _twist(rot, cur_dir, rest[b] - rest[a], pos[:, b] - pos[:, a])
+            rot = twist_matrices(rot, cur_dir, rest[b] - rest[a], pos[:, b] - pos[:, a])
         R[:, c] = rot
     return R
 
@@ -330,7 +336,7 @@ def _capsule_geometry(link: ET.Element, a: np.ndarray, b: np.ndarray, radius: fl
     shapes: list[tuple[np.ndarray, np.ndarray, str, dict[str, str]]] = []
     if length > 1e-9:
         z = axis / length
-        rot = _swing(np.array([0.0, 0.0, 1.0]), z)
+        rot = swing_matrices(np.array([0.0, 0.0, 1.0]), z)
         rpy = Rotation.from_matrix(rot).as_euler("xyz")
         shapes.append(((a + b) / 2, rpy, "cylinder",
                        {"radius": f"{radius:.6g}", "length": f"{length:.6g}"}))
