@@ -80,6 +80,7 @@ class ReceiveLike(Protocol):
 
     def getActualQ(self) -> list[float]: ...
     def getTimestamp(self) -> float: ...
+    def getTargetSpeedFraction(self) -> float: ...
     def isConnected(self) -> bool: ...
     def reconnect(self) -> bool: ...
     def disconnect(self) -> None: ...
@@ -592,6 +593,44 @@ class CoexistenceController:
             elif delay < -10 * period:
                 next_time = time.monotonic()
         return steps
+
+    def hold_minimum(self, timeout: float = 0.5) -> str | None:
+        """Command the minimum slider and wait until the controller reports it.
+
+        What a monitor that stops leaves the arm at (the ROS node's deactivate and
+        shutdown); call it with the control loop stopped. Returns None once the receive side
+        reads ``target_speed_fraction`` within 1e-3 of ``params.min_slider`` in a package
+        the controller sent after the write (a newer ``timestamp``: a frozen controller's
+        last package confirms nothing) within ``timeout`` s, else why not."""
+        target = float(self.params.min_slider)
+        if not self._io_ok:
+            return "not connected to the robot controller"
+        try:
+            written_at = float(self._recv.getTimestamp()) if self._recv_ok else math.nan
+            if not self._io.setSpeedSlider(target):
+                raise RuntimeError("setSpeedSlider returned false")
+        except Exception as exc:            # best effort, whatever ur_rtde raises
+            self._lost("io", exc)
+            return f"the minimum slider was not written ({exc})"
+        with self._lock:
+            self._last_command = target
+        self._last_sent, self._last_sent_time = target, self.clock()
+        if not self._recv_ok:
+            return "written, but the receive side is not connected to confirm it"
+        end = time.monotonic() + timeout
+        stamp, reported = written_at, math.nan
+        while time.monotonic() < end:
+            try:
+                stamp = float(self._recv.getTimestamp())
+                reported = float(self._recv.getTargetSpeedFraction())
+            except Exception as exc:
+                return f"written, but not confirmed ({exc})"
+            if stamp != written_at and abs(reported - target) < 1e-3:
+                return None
+            time.sleep(0.002)
+        frozen = ", its data frozen" if stamp == written_at else ""
+        return (f"written, but not confirmed within {timeout:g} s (the controller reports "
+                f"{reported:.3f}{frozen})")
 
     def close(self) -> None:
         """Disconnect the working interfaces; a broken one is neither disconnected nor

@@ -41,6 +41,18 @@ Publishes (at ``publish_rate``):
 
 Fail-safe behaviour comes from the controller: no or stale occupancy, a lost connection
 or a rejected occupancy never raise the speed (see :mod:`ltl_human_motion.robot.coexistence`).
+
+A lifecycle (managed) node: with ``autostart`` (the default) it configures and activates
+itself at once, with ``autostart: false`` it waits for ``<node>/change_state``.
+*Configure* loads the arm's model (with the tool), its base pose and the distance kernel,
+and connects nothing. *Activate* connects over RTDE, follows the occupancy, runs the
+control loop and publishes (``/tf_static`` once). *Deactivate* (and *shutdown*, an error,
+destroying the node) stops following the occupancy and publishing, then leaves the arm
+at ``min_slider`` -- the slider the node commands when the occupancy goes stale, since
+nothing watches the worker any more -- waits until the controller reports it in
+``target_speed_fraction`` (:attr:`CoexistenceNode.held` says whether it did, and why not)
+and disconnects. The controller keeps that slider until a client writes another one;
+*activate* starts again from the minimum (no occupancy yet). *Cleanup* forgets the model.
 With ``metrics_out`` set, the node keeps every control decision and writes the
 commissioning report (``coexistence.json`` and ``coexistence.png``) there when destroyed.
 """
@@ -58,12 +70,13 @@ from typing import Any
 import numpy as np
 from geometry_msgs.msg import TransformStamped
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
-from rclpy.node import Node
+from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
 from ltl_human_motion.kernel.rotations import quaternion_from_matrix
+from ltl_human_motion.kernel.segments import compiled
 from ltl_human_motion.msg import HumanOccupancy, SafetyStatus
 from ltl_human_motion.robot.coexistence import (
     CoexistenceConfig,
@@ -76,6 +89,7 @@ from ltl_human_motion.robot.coexistence import (
 from ltl_human_motion.robot.fusion import OccupancySample, fuse_occupancies
 from ltl_human_motion.robot.kinematics import (
     UR_MODELS,
+    URModel,
     pose_from_xyz_rpy,
     robot_capsules,
     ur_model,
@@ -85,7 +99,7 @@ from ltl_human_motion.robot.ssm import SLIDER_MIN, SSMParameters
 from ltl_human_motion.ros import conversions as cv
 from ltl_human_motion.ros import ur_frames
 from ltl_human_motion.ros.common import STREAM_QOS, TF_QOS, TF_STATIC_QOS
-from ltl_human_motion.ros.diagnostics import ERROR, OK, Status, attach_diagnostics
+from ltl_human_motion.ros.diagnostics import ERROR, OK, WARN, Status, attach_diagnostics
 from ltl_human_motion.ros.occupancy_decode import decode_human_occupancy, occupancy_from_message
 from ltl_human_motion.ros.params import (
     ParamSpec,
@@ -221,6 +235,8 @@ def coexistence_parameters() -> list[ParamSpec]:
              read_only=True),
         spec("markers_topic", "/robot_markers", "MarkerArray topic", topic_name,
              read_only=True),
+        spec("autostart", True, "Configure and activate at once (false: wait for the "
+             "lifecycle's change_state)", read_only=True),
     ]
 
 
@@ -247,7 +263,7 @@ def _transform(parent: str, child: str, T: np.ndarray, stamp: Any) -> TransformS
 
 
 # ---------------------------------------------------------------------- the node
-class CoexistenceNode(Node):
+class CoexistenceNode(LifecycleNode):
     """Speed and separation monitoring of one UR arm against every human in the cell.
 
     Parameters
@@ -266,6 +282,11 @@ class CoexistenceNode(Node):
                  io_factory: Callable[[], IOLike] | None = None, record: bool | None = None,
                  on_decision: Callable[[ControlDecision], None] | None = None,
                  node_name: str = "coexistence_node", **node_kwargs: Any) -> None:
+        # What destroy_node needs, even when the parameters below are refused (the
+        # context destroys the half-made node at shutdown).
+        self._thread: threading.Thread | None = None
+        self.controller: CoexistenceController | None = None
+        self.metrics_out: Path | None = None
         super().__init__(node_name, **node_kwargs)
         declare_parameters(self, coexistence_parameters())
         p = self.param
@@ -279,35 +300,32 @@ class CoexistenceNode(Node):
         except ValueError as exc:
             raise ValueError(f"{self.get_fully_qualified_name()}: invalid parameters: {exc}") \
                 from None
-        self.model = ur_model(p("model")).with_tool(float(p("tool_length")),
-                                                    float(p("tool_radius")))
-        self.base = pose_from_xyz_rpy((p("base_x"), p("base_y"), p("base_z")),
-                                      (0.0, 0.0, p("base_yaw")))
         self.world_frame: str = p("world_frame")
         self.prefix: str = p("tf_prefix")
         self.joint_names = [p("joint_prefix") + name for name in UR_JOINT_NAMES]
         self.use_prediction = bool(p("use_prediction"))
         self.rate = float(p("rate"))
         self.forget_after = float(p("forget_after"))
+        self.future_tolerance = float(p("future_tolerance"))
         metrics_out = p("metrics_out")
         self.metrics_out = Path(metrics_out) if metrics_out else None
         self.recorder = DecisionRecorder() \
             if (record if record is not None else self.metrics_out is not None) else None
         self._extra_on_decision = on_decision
-        if receive_factory is None or io_factory is None:
-            default_receive, default_io = probed_factories(
-                ur_rtde_factories(p("robot_host")), p("robot_host"), self._report_refusal)
-            receive_factory = receive_factory or default_receive
-            io_factory = io_factory or default_io
-        self.controller = CoexistenceController(
-            receive_factory, io_factory, self.model, self.base, self.params, self.config,
-            on_decision=self._on_decision)
+        self._factories = (receive_factory, io_factory)
+        # Set by configure (model, base, connection factories) and activate (controller).
+        self.model: URModel | None = None
+        self.base: np.ndarray | None = None
+        self._connect_with: tuple[Callable[[], ReceiveLike], Callable[[], IOLike]] | None = None
+        self._active = False
+        self.held: str | None = None
 
-        self.future_tolerance = float(p("future_tolerance"))
         self._humans: dict[str, _Human] = {}
         self._topic_keys: dict[str, str] = {}             # topic -> key of its last sample
         self._humans_lock = threading.Lock()
         self._subscribed: set[str] = set()
+        self._occupancy_subs: list[Any] = []
+        self._active_timers: list[Any] = []
         self._latest: ControlDecision | None = None
         self.steps = 0
         self.messages_received = 0
@@ -318,38 +336,123 @@ class CoexistenceNode(Node):
         self.fault_receipts: deque[float] = deque(maxlen=256)
         self.minimum_since: float | None = None
 
-        self._joint_pub = self.create_publisher(JointState, "/joint_states", STREAM_QOS)
-        self._tf_pub = self.create_publisher(TFMessage, "/tf", TF_QOS)
-        self._tf_static_pub = self.create_publisher(TFMessage, "/tf_static", TF_STATIC_QOS)
-        self._status_pub = self.create_publisher(SafetyStatus, "safety_status", STREAM_QOS)
-        self._marker_pub = self.create_publisher(MarkerArray, p("markers_topic"), STREAM_QOS)
+        publisher = self.create_lifecycle_publisher
+        self._joint_pub = publisher(JointState, "/joint_states", STREAM_QOS)
+        self._tf_pub = publisher(TFMessage, "/tf", TF_QOS)
+        self._tf_static_pub = publisher(TFMessage, "/tf_static", TF_STATIC_QOS)
+        self._status_pub = publisher(SafetyStatus, "safety_status", STREAM_QOS)
+        self._marker_pub = publisher(MarkerArray, p("markers_topic"), STREAM_QOS)
         self._occ_group = MutuallyExclusiveCallbackGroup()
+        self._pub_group = MutuallyExclusiveCallbackGroup()
+        self._stop = threading.Event()
+        attach_diagnostics(self, self.diagnostics)
+        if p("autostart"):
+            for name, trigger in (("configure", self.trigger_configure),
+                                  ("activate", self.trigger_activate)):
+                if trigger() != TransitionCallbackReturn.SUCCESS:
+                    raise ValueError(f"{self.get_fully_qualified_name()}: autostart: the "
+                                     f"{name} transition failed (see the log)")
+
+    # ------------------------------------------------------------------ lifecycle
+    def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Load the arm's model, its place in the cell and the distance kernel; connect
+        nothing yet."""
+        p = self.param
+        try:
+            self.model = ur_model(p("model")).with_tool(float(p("tool_length")),
+                                                        float(p("tool_radius")))
+            self.base = pose_from_xyz_rpy((p("base_x"), p("base_y"), p("base_z")),
+                                          (0.0, 0.0, p("base_yaw")))
+            compiled()
+        except Exception as exc:     # any failure to load: the transition fails, named
+            self.get_logger().error(f"configure failed: {type(exc).__name__}: {exc}")
+            return TransitionCallbackReturn.FAILURE
+        receive_factory, io_factory = self._factories
+        if receive_factory is None or io_factory is None:
+            host = p("robot_host")
+            default_receive, default_io = probed_factories(
+                ur_rtde_factories(host), host, self._report_refusal)
+            receive_factory = receive_factory or default_receive
+            io_factory = io_factory or default_io
+        self._connect_with = (receive_factory, io_factory)
+        return super().on_configure(state)
+
+    def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Connect to the robot, follow the occupancy, run the control loop, publish."""
+        if self.model is None or self._connect_with is None:
+            return TransitionCallbackReturn.FAILURE       # not configured
+        result = super().on_activate(state)
+        p = self.param
+        self.controller = CoexistenceController(
+            *self._connect_with, self.model, self.base, self.params, self.config,
+            on_decision=self._on_decision)
+        self._latest, self.minimum_since, self.held = None, None, None
+        with self._humans_lock:
+            self._humans.clear()
+            self._topic_keys.clear()
+        timers = [(1.0 / p("publish_rate"), self._publish_state, self._pub_group)]
+        if p("marker_rate") > 0:
+            timers.append((1.0 / p("marker_rate"), self._publish_markers, self._pub_group))
         if p("occupancy_topic") == "auto":
             self._discover()
-            self.create_timer(1.0, self._discover)
+            timers.append((1.0, self._discover, None))
         else:
             self._subscribe(p("occupancy_topic"))
-        pub_group = MutuallyExclusiveCallbackGroup()
-        self.create_timer(1.0 / p("publish_rate"), self._publish_state, callback_group=pub_group)
-        if p("marker_rate") > 0:
-            self.create_timer(1.0 / p("marker_rate"), self._publish_markers,
-                              callback_group=pub_group)
+        self._active_timers = [self.create_timer(period, callback, callback_group=group)
+                               for period, callback, group in timers]
         self._publish_static()
-
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._control_loop, name="coexistence-control",
-                                        daemon=True)
+                                        args=(self.controller, self._stop), daemon=True)
+        self._active = True
         self._thread.start()
-        attach_diagnostics(self, self.diagnostics)
         mode = "predictive" if self.use_prediction else "reactive"
         self.get_logger().info(
             f"{self.model.name} at {p('robot_host')}: {mode} SSM at {self.rate:g} Hz, "
             f"S_p = {self.params.protective_distance:.3f} m, occupancy from "
             f"{p('occupancy_topic')}")
+        return result
+
+    def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Stop publishing and following the occupancy; leave the arm at the minimum slider
+        (see :meth:`stop_control`) and disconnect."""
+        result = super().on_deactivate(state)
+        self._stand_down()
+        return result
+
+    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Forget the model and the connection factories (configure loads them again)."""
+        self.model = self.base = self._connect_with = None
+        return super().on_cleanup(state)
+
+    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self._stand_down()
+        return super().on_shutdown(state)
+
+    def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self._stand_down()
+        return super().on_error(state)
+
+    def _stand_down(self) -> None:
+        self._active = False
+        for timer in self._active_timers:
+            self.destroy_timer(timer)
+        for subscription in self._occupancy_subs:
+            self.destroy_subscription(subscription)
+        self._active_timers, self._occupancy_subs = [], []
+        self._subscribed.clear()
+        self.stop_control()
+
+    @property
+    def active(self) -> bool:
+        """True while the node monitors the arm (lifecycle state active)."""
+        return self._active
 
     def diagnostics(self) -> list[Status]:
         """The robot connection for ``/diagnostics``: ERROR when the control thread ended
-        or the controller is not connected (the robot then gets no speed commands)."""
+        or the controller is not connected (the robot then gets no speed commands); WARN
+        while the node is not active (nothing monitors the arm; what it was left at is
+        said)."""
         d = self._latest
         host = self.param("robot_host")
         values = {"robot_host": host, "steps": str(self.steps),
@@ -357,6 +460,10 @@ class CoexistenceNode(Node):
         if d is not None:
             values.update(mode=d.mode, slider=f"{d.slider:.3f}",
                           separation_m=f"{d.separation:.3f}")
+        if not self._active:
+            left = "" if self.held is None else f"; arm {self.held}"
+            return [Status("robot connection", WARN, f"not active (lifecycle): not "
+                           f"monitoring the robot at {host}{left}", values)]
         if not self.control_alive:
             return [Status("robot connection", ERROR, "control loop stopped", values)]
         if d is None or not d.connected:
@@ -381,9 +488,9 @@ class CoexistenceNode(Node):
 
     def _subscribe(self, topic: str) -> None:
         self._subscribed.add(topic)
-        self.create_subscription(HumanOccupancy, topic,
-                                 lambda data, t=topic: self._on_occupancy(t, data), STREAM_QOS,
-                                 callback_group=self._occ_group, raw=True)
+        self._occupancy_subs.append(self.create_subscription(
+            HumanOccupancy, topic, lambda data, t=topic: self._on_occupancy(t, data),
+            STREAM_QOS, callback_group=self._occ_group, raw=True))
         self.get_logger().info(f"following human occupancy on {topic}")
 
     @property
@@ -393,8 +500,11 @@ class CoexistenceNode(Node):
             return sorted(self._humans)
 
     def _on_occupancy(self, topic: str, data: bytes) -> None:
+        controller = self.controller
+        if not self._active or controller is None:
+            return
         self.messages_received += 1
-        ctl_now = self.controller.clock()
+        ctl_now = controller.clock()
         key = self._topic_keys.get(topic, topic)
         try:
             sample = decode_human_occupancy(data)
@@ -407,10 +517,10 @@ class CoexistenceNode(Node):
             fresh_at = ctl_now - max(age, 0.0)
             if ctl_now - fresh_at > self.config.stale_after:
                 self.fault_receipts.append(ctl_now)
-            self.controller.check_occupancy(sample.segments, sample.radii, fresh_at,
-                                            sample.predicted or None)
+            controller.check_occupancy(sample.segments, sample.radii, fresh_at,
+                                       sample.predicted or None)
         except ValueError as exc:
-            self._fault(topic, key, ctl_now, exc)
+            self._fault(controller, topic, key, ctl_now, exc)
             return
         with self._humans_lock:
             self._humans[key] = _Human(ctl_now, fresh_at, sample)
@@ -418,15 +528,16 @@ class CoexistenceNode(Node):
             entries = list(self._humans.items())
         faulty = [k for k, h in entries if h.sample is None or not math.isfinite(h.fresh_at)]
         if faulty:
-            self.controller.invalidate_occupancy(f"human {faulty[0]!r} has no valid occupancy")
+            controller.invalidate_occupancy(f"human {faulty[0]!r} has no valid occupancy")
             return
         fused = fuse_occupancies([(h.fresh_at, h.sample) for _, h in entries],  # type: ignore
                                  self.use_prediction)
-        if not self.controller.update_occupancy(fused.segments, fused.radii, fused.stamp,
-                                                fused.predicted, check_order=False):
+        if not controller.update_occupancy(fused.segments, fused.radii, fused.stamp,
+                                           fused.predicted, check_order=False):
             self.messages_rejected += 1
 
-    def _fault(self, topic: str, key: str, ctl_now: float, exc: Exception) -> None:
+    def _fault(self, controller: CoexistenceController, topic: str, key: str, ctl_now: float,
+               exc: Exception) -> None:
         """A faulty sample of human ``key``: hold them as faulty, drop the occupancy."""
         self.messages_rejected += 1
         self.fault_receipts.append(ctl_now)
@@ -437,7 +548,7 @@ class CoexistenceNode(Node):
             else:
                 human.received, human.fresh_at = ctl_now, -math.inf
             self._forget_silent(ctl_now)
-        self.controller.invalidate_occupancy(f"human {key!r} on {topic}: {exc}")
+        controller.invalidate_occupancy(f"human {key!r} on {topic}: {exc}")
         self.get_logger().warning(f"{topic}: occupancy of human {key!r} rejected ({exc}); "
                                   "slider minimum", throttle_duration_sec=2.0)
 
@@ -463,9 +574,9 @@ class CoexistenceNode(Node):
         if self._extra_on_decision is not None:
             self._extra_on_decision(decision)
 
-    def _control_loop(self) -> None:
+    def _control_loop(self, controller: CoexistenceController, stop: threading.Event) -> None:
         try:
-            self.controller.run(self.rate, should_stop=self._stop.is_set)
+            controller.run(self.rate, should_stop=stop.is_set)
         except Exception as exc:  # never die silently: the slider stays where it was
             self.get_logger().fatal(f"control loop failed: {type(exc).__name__}: {exc}")
             raise
@@ -478,7 +589,7 @@ class CoexistenceNode(Node):
     @property
     def control_alive(self) -> bool:
         """True while the control thread runs."""
-        return self._thread.is_alive()
+        return self._thread is not None and self._thread.is_alive()
 
     # ------------------------------------------------------------------ outputs
     def _publish_static(self) -> None:
@@ -531,11 +642,22 @@ class CoexistenceNode(Node):
 
     # ------------------------------------------------------------------ shutdown
     def stop_control(self, timeout: float = 5.0) -> None:
-        """Stop the control loop and disconnect from the robot (idempotent)."""
-        if not self._stop.is_set():
-            self._stop.set()
-            self._thread.join(timeout)
-            self.controller.close()
+        """Stop the control loop, leave the arm at the minimum slider and disconnect
+        (idempotent). The slider is confirmed by the controller's ``target_speed_fraction``
+        (:meth:`~ltl_human_motion.robot.coexistence.CoexistenceController.hold_minimum`);
+        when it cannot be, :attr:`held` and a warning say why."""
+        thread, controller = self._thread, self.controller
+        if thread is None or controller is None or self._stop.is_set():
+            return
+        self._stop.set()
+        thread.join(timeout)
+        why_not = controller.hold_minimum()
+        slider = f"the minimum slider {self.params.min_slider:g}"
+        self.held = f"left at {slider} (confirmed by the controller)" if why_not is None \
+            else f"not confirmed at {slider}: {why_not}"
+        log = self.get_logger()
+        (log.info if why_not is None else log.warning)(f"control stopped; arm {self.held}")
+        controller.close()
 
     def write_report(self, out_dir: str | Path, name: str = "coexistence",
                      cycle_times: tuple[float, ...] | list[float] = (),
