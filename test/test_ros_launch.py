@@ -234,3 +234,51 @@ def test_bringup_launch_under_a_namespace_keeps_its_wiring_inside(
             assert node.count_publishers("/humans/bodies/h1/joint_states") == 1
     finally:
         _stop(procs)
+
+
+def test_launch_file_and_bringup_agree_under_a_namespace_on_sim_time(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """The in-process bringup's ``namespace`` and ``use_sim_time`` are the launch
+    arguments: the same nodes under the same names, every parameter as rcl hands it to
+    the launched node. The file's ``synthesis_node:`` and ``coexistence_node:`` sections
+    match only a node outside the namespace (rcl), so both carry them over (the
+    synthesis node's ``max_concurrent: 2``, default 4)."""
+    from ltl_human_motion.ros.bringup import Bringup
+
+    stem = "coexistence.launch"
+    config = load_bringup_config(LAUNCH_FILES[stem])
+    values = {"namespace": "cell_b", "use_sim_time": "true", "robot_host": "127.0.0.3",
+              "store_dir": str(tmp_path / "m")}
+    _, nodes = _launch(monkeypatch, stem, values)
+    bringup = Bringup(config, namespace="/cell_b/", use_sim_time=True, overrides={
+        "robot_host": "127.0.0.3", "store_dir": str(tmp_path / "m")})
+    try:
+        started = {n.get_fully_qualified_name(): n for n in bringup.nodes}
+        launched = {f"/{kw['namespace']}/{kw['name']}": kw for kw in nodes}
+        assert set(started) == set(launched) == {
+            "/cell_b/synthesis_node", "/cell_b/human_1/skeleton_publisher",
+            "/cell_b/human_1/occupancy_node", "/cell_b/coexistence_node"}
+        rcl = {fqn: _rcl_parameters(launch_ros_command(kw, tmp_path), kw["name"],
+                                    kw["namespace"]) for fqn, kw in launched.items()}
+        for fqn, got in rcl.items():
+            node = started[fqn]
+            shared = [n for n in got if node.has_parameter(n)]
+            assert len(shared) >= 5, (fqn, shared)
+            assert {n: node.get_parameter(n).value for n in shared} == \
+                {n: got[n] for n in shared}, fqn
+            assert got["use_sim_time"] is True, fqn
+        assert rcl["/cell_b/synthesis_node"]["max_concurrent"] == 2
+        assert rcl["/cell_b/coexistence_node"]["human_speed"] == 1.6
+        coexistence = started["/cell_b/coexistence_node"]
+        assert coexistence.get_parameter("robot_host").value == "127.0.0.3"
+        assert coexistence.get_parameter("markers_topic").value == "/cell_b/robot_markers"
+    finally:
+        bringup.shutdown()
+
+
+def test_a_bad_bringup_namespace_is_refused_before_any_node_starts() -> None:
+    from ltl_human_motion.ros.bringup import Bringup
+
+    with pytest.raises(ValueError, match="bringup namespace: expected a ROS namespace such "
+                                         "as 'cell_a', got '9 lives'"):
+        Bringup(LAUNCH_FILES["bringup.launch"], namespace="9 lives")

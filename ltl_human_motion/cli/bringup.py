@@ -12,6 +12,7 @@ import argparse
 import json
 import signal
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +32,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="stop after S seconds (default: run until Ctrl-C)")
     parser.add_argument("--store-dir", default=None, metavar="DIR",
                         help="override the store_dir parameter (folder of motion npz files)")
+    parser.add_argument("--namespace", default="", metavar="NS",
+                        type=_launch_value("namespace"),
+                        help="run the node set under this namespace, as the launch argument "
+                             "namespace:= (its catalog and marker topics move with it; TF, "
+                             "/humans, /joint_states and /diagnostics stay global; default: "
+                             "none)")
+    parser.add_argument("--use-sim-time", default=None, metavar="true|false",
+                        type=_launch_value("use_sim_time"),
+                        help="every node on /clock (true) or the system clock (false), as "
+                             "the launch argument use_sim_time:= (default: the file's)")
+
+
+def _launch_value(argument: str) -> Callable[[str], Any]:
+    """The argparse type of launch argument ``argument``: its text checked and converted as
+    the launch files do (their ValueError is argparse's message)."""
+    def convert(text: str) -> Any:
+        from ltl_human_motion.ros.bringup_config import check_namespace, launch_bool
+
+        try:
+            return check_namespace(text, "") if argument == "namespace" else launch_bool(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+    return convert
 
 
 class _StopSignals:
@@ -97,7 +121,8 @@ def _run(args: argparse.Namespace, stop: _StopSignals) -> int:
         print(f"ltl-human-motion bringup: error: {exc}", file=sys.stderr)
         return 2
     overrides = {"store_dir": str(args.store_dir)} if args.store_dir is not None else None
-    node_set = Bringup(config, record=args.record, overrides=overrides)
+    node_set = Bringup(config, record=args.record, overrides=overrides,
+                       namespace=args.namespace, use_sim_time=args.use_sim_time)
     stop.node_set = node_set
     if stop.requested:                       # a signal during start-up that was swallowed
         node_set.shutdown()

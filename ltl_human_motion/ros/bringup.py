@@ -22,7 +22,14 @@ from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from ltl_human_motion.ros.bringup_config import BringupConfig, NodeSpec, load_bringup_config
+from ltl_human_motion.ros.bringup_config import (
+    BringupConfig,
+    NodeSpec,
+    check_namespace,
+    load_bringup_config,
+    namespace_overrides,
+    node_namespace,
+)
 from ltl_human_motion.ros.common import SpinThread
 from ltl_human_motion.ros.middleware import apply_middleware_defaults
 from ltl_human_motion.ros.motion_store import MotionStore
@@ -48,14 +55,25 @@ class Bringup:
         Replaces ``planning.synthesize`` in the synthesis node.
     context : rclpy Context, optional
         An initialized context to use; by default the bringup makes and owns one.
+    namespace : str, optional
+        Run the node set under this namespace ('' = none), as the launch argument
+        ``namespace:=`` does: its own catalog and marker topics move with it
+        (:func:`~ltl_human_motion.ros.bringup_config.namespace_overrides`); TF,
+        ``/humans/...``, ``/joint_states`` and ``/diagnostics`` stay global.
+    use_sim_time : bool, optional
+        Every node on ``/clock`` (True) or the system clock (False), as the launch argument
+        ``use_sim_time:=``; None keeps the file's value.
     """
 
     def __init__(self, config: BringupConfig | str | Path | None = None, *,
                  record: str | Path | None = None, overrides: Mapping[str, Any] | None = None,
                  synthesize_fn: Callable[..., list] | None = None,
-                 context: Context | None = None) -> None:
+                 context: Context | None = None, namespace: str = "",
+                 use_sim_time: bool | None = None) -> None:
         self.config = config if isinstance(config, BringupConfig) \
             else load_bringup_config(config)
+        self.namespace = check_namespace(namespace, "bringup namespace")
+        self.use_sim_time = use_sim_time
         self._owns_context = context is None
         if context is None:
             apply_middleware_defaults()
@@ -80,7 +98,7 @@ class Bringup:
             for spec in self.config.node_specs():
                 self.nodes.append(self._make(spec, synthesize_fn))
             if self.recorder is not None:
-                self.recorder.follow(self.config.topics())
+                self.recorder.follow(self.config.topics(self.namespace))
             if any(isinstance(n, OccupancyNode) for n in self.nodes):
                 # The occupancy stream thread waits less for the GIL, and what exists now
                 # stays out of the collector's full passes (which hold the GIL).
@@ -91,8 +109,12 @@ class Bringup:
             raise
 
     def _kwargs(self, spec: NodeSpec) -> dict[str, Any]:
-        values = {**self.overrides, **spec.parameters}
-        return {"namespace": spec.namespace or None, "context": self.context,
+        values = {**namespace_overrides(self.config, spec, self.namespace), **self.overrides,
+                  **spec.parameters}
+        if self.use_sim_time is not None:
+            values["use_sim_time"] = bool(self.use_sim_time)
+        return {"namespace": node_namespace(self.namespace, spec) or None,
+                "context": self.context,
                 "parameter_overrides": [Parameter(k, value=v) for k, v in values.items()]}
 
     def _make(self, spec: NodeSpec, synthesize_fn: Callable[..., list] | None) -> Node:

@@ -111,19 +111,25 @@ class BringupConfig:
         """Command-line arguments that hand this file to every node of a context."""
         return ["--ros-args", "--params-file", str(self.path)]
 
-    def topics(self) -> dict[str, str]:
-        """The topics the node set publishes, name -> type (for recording)."""
+    def topics(self, namespace: str = "") -> dict[str, str]:
+        """The topics the node set publishes, name -> type (for recording), run under
+        ``namespace`` ('' = none; see :func:`namespace_overrides`)."""
+        root = check_namespace(namespace)
         out: dict[str, str] = {"/diagnostics": "diagnostic_msgs/msg/DiagnosticArray"}
         specs = self.node_specs()
         if any(s.executable == "synthesis_node" for s in specs):
-            out["/motion_catalog"] = f"{PACKAGE}/msg/MotionCatalog"
+            out[f"/{root}/motion_catalog" if root else "/motion_catalog"] = \
+                f"{PACKAGE}/msg/MotionCatalog"
         for spec in specs:
-            ns = f"/{spec.namespace}" if spec.namespace else ""
+            node_ns = node_namespace(root, spec)
+            ns = f"/{node_ns}" if node_ns else ""
+            markers = namespace_overrides(self, spec, root).get("markers_topic") or \
+                self.parameter(spec, "markers_topic",
+                               SET_TOPICS.get(spec.executable, {}).get("markers_topic"))
             if spec.executable == "skeleton_publisher":
                 out["/tf"] = "tf2_msgs/msg/TFMessage"
                 out["/tf_static"] = "tf2_msgs/msg/TFMessage"
-                out[self.parameter(spec, "markers_topic", _markers(spec))] = \
-                    "visualization_msgs/msg/MarkerArray"
+                out[markers] = "visualization_msgs/msg/MarkerArray"
                 out[f"{ns}/task_state"] = f"{PACKAGE}/msg/TaskState"
                 if self.parameter(spec, "rep155", True):
                     from ltl_human_motion.motion.urdf import body_id
@@ -137,38 +143,31 @@ class BringupConfig:
             elif spec.executable == "occupancy_node":
                 out[f"{ns}/occupancy"] = f"{PACKAGE}/msg/HumanOccupancy"
                 if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
-                    out[self.parameter(spec, "markers_topic", _markers(spec))] = \
-                        "visualization_msgs/msg/MarkerArray"
+                    out[markers] = "visualization_msgs/msg/MarkerArray"
             elif spec.executable == "ergonomics_node":
                 out[f"{ns}/ergonomics"] = f"{PACKAGE}/msg/ErgonomicsState"
-                out[self.parameter(spec, "markers_topic", _markers(spec))] = \
-                    "visualization_msgs/msg/MarkerArray"
+                out[markers] = "visualization_msgs/msg/MarkerArray"
             elif spec.executable == "coexistence_node":
                 out["/tf"] = out["/tf_static"] = "tf2_msgs/msg/TFMessage"
                 out["/joint_states"] = "sensor_msgs/msg/JointState"
-                out["/safety_status"] = f"{PACKAGE}/msg/SafetyStatus"
+                out[f"{ns}/safety_status"] = f"{PACKAGE}/msg/SafetyStatus"
                 if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
-                    out[self.parameter(spec, "markers_topic", _markers(spec))] = \
-                        "visualization_msgs/msg/MarkerArray"
+                    out[markers] = "visualization_msgs/msg/MarkerArray"
         return out
 
 
-def _markers(spec: NodeSpec) -> str:
-    return SET_TOPICS[spec.executable]["markers_topic"]
-
-
-def check_namespace(namespace: str) -> str:
+def check_namespace(namespace: str, what: str = "launch argument namespace") -> str:
     """``namespace`` without its slashes at either end ('' for none).
 
     Raises
     ------
     ValueError
         If it is no ROS namespace (tokens of letters, digits and '_', not starting with
-        a digit, separated by '/').
+        a digit, separated by '/'); the message starts with ``what`` (when not '').
     """
     ns = namespace.strip().strip("/")
     if ns and not _NAMESPACE.match(ns):
-        raise ValueError(f"launch argument namespace: expected a ROS namespace such as "
+        raise ValueError(f"{what}: " * bool(what) + f"expected a ROS namespace such as "
                          f"'cell_a', got {namespace!r}")
     return ns
 
@@ -179,15 +178,26 @@ def node_namespace(namespace: str, node: NodeSpec) -> str:
 
 
 def namespace_overrides(config: BringupConfig, node: NodeSpec, namespace: str
-                        ) -> dict[str, str]:
-    """Topic parameters of ``node`` moved under ``namespace`` (those of
-    :data:`SET_TOPICS` whose value in ``config`` is absolute), so that node sets in
-    different namespaces keep their catalogs and markers apart. TF, REP 155's
-    ``/humans/...``, ``/joint_states`` and ``/diagnostics`` stay global."""
+                        ) -> dict[str, Any]:
+    """What ``node`` needs on top of ``config`` to run under ``namespace``.
+
+    Its topic parameters moved under ``namespace`` (those of :data:`SET_TOPICS` whose
+    value in ``config`` is absolute), so that node sets in different namespaces keep
+    their catalogs and markers apart; TF, REP 155's ``/humans/...``, ``/joint_states``
+    and ``/diagnostics`` stay global. And the parameters of the file's sections named
+    after the node's own full name (``synthesis_node:``, ``coexistence_node:``,
+    ``/human_1/skeleton_publisher:``): rcl matches such a section only to the node
+    outside the namespace, so under it they would be lost (the ``/**`` and
+    ``/**/<name>`` sections still apply)."""
     ns = check_namespace(namespace)
     if not ns:
         return {}
-    out = {}
+    out: dict[str, Any] = {}
+    fqn = node.fully_qualified_name
+    for key in dict.fromkeys((fqn.lstrip("/"), fqn)):
+        section = config.params.get(key)
+        if isinstance(section, dict):
+            out.update(section.get("ros__parameters") or {})
     for param, default in SET_TOPICS.get(node.executable, {}).items():
         value = config.parameter(node, param, default)
         if isinstance(value, str) and value.startswith("/"):
