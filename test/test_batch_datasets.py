@@ -204,7 +204,7 @@ import json, sys
 from ltl_human_motion.batch import ItemParams, cell_for_item, load_specs
 from ltl_human_motion.batch.worker import BatchJob, _arrays, motion_sha256
 from ltl_human_motion.planning.pipeline import synthesize
-from ltl_human_motion.scene.cell import cell_by_name
+from ltl_human_motion.scene.cell_yaml import cell_by_name
 r = json.loads(sys.argv[1])
 specs = load_specs(sys.argv[2])
 p = r["params"]

@@ -23,6 +23,7 @@ import numpy as np
 
 from ltl_human_motion.batch.items import ItemParams, cell_for_item
 from ltl_human_motion.batch.memory import keep_freed_memory
+from ltl_human_motion.kernel.cache import BoundedCache
 
 __all__ = ["ARRAY_NAMES", "LABEL_NAMES", "STORED_NAMES", "BatchJob", "ItemResult",
            "labels_sha256", "motion_sha256", "pool_initializer", "prepare_worker",
@@ -141,25 +142,35 @@ class ItemResult:
 
 # --------------------------------------------------------------------------- worker state
 
-_CELLS: dict[str, Any] = {}
-_OPTIONS: dict[str, Any] = {}
-_NAMES: dict[str, Any] = {}
+@dataclass(frozen=True)
+class _PreparedCell:
+    """A job's cell, parsed once per process, with its synthesis options and the names
+    its captions use."""
+
+    cell: Any
+    options: Any
+    names: Any
+
+
+#: The prepared cells of this process, by job fingerprint.
+_PREPARED: BoundedCache[_PreparedCell] = BoundedCache(5)
+
+
+def _prepared(job: BatchJob) -> _PreparedCell:
+    def build() -> _PreparedCell:
+        from ltl_human_motion.batch.captions import CellNames
+        from ltl_human_motion.scene.cell_yaml import cell_from_yaml
+        cell = cell_from_yaml(job.cell_yaml, source=job.cell_source,
+                              base_dir=job.cell_base_dir)
+        return _PreparedCell(cell, job.synthesis_options(),
+                             CellNames.from_cell(cell, job.descriptions))
+
+    return _PREPARED.get_or_build(job.fingerprint(), build)
 
 
 def _cell_and_options(job: BatchJob) -> tuple[Any, Any]:
-    key = job.fingerprint()
-    if key not in _CELLS:
-        from ltl_human_motion.batch.captions import CellNames
-        from ltl_human_motion.scene.cell_yaml import cell_from_yaml
-        if len(_CELLS) > 4:
-            _CELLS.clear()
-            _OPTIONS.clear()
-            _NAMES.clear()
-        _CELLS[key] = cell_from_yaml(job.cell_yaml, source=job.cell_source,
-                                     base_dir=job.cell_base_dir)
-        _OPTIONS[key] = job.synthesis_options()
-        _NAMES[key] = CellNames.from_cell(_CELLS[key], job.descriptions)
-    return _CELLS[key], _OPTIONS[key]
+    prepared = _prepared(job)
+    return prepared.cell, prepared.options
 
 
 def prepare_worker(job: BatchJob) -> None:
@@ -294,11 +305,12 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
     timing: dict[str, Any] = {"worker": f"{socket.gethostname()}:{os.getpid()}"}
     arrays = None
     try:
-        base_cell, options = _cell_and_options(job)
-        cell = cell_for_item(base_cell, item)
-        library = get_library(float(item.stature), options.library_source)
+        prepared = _prepared(job)
+        cell = cell_for_item(prepared.cell, item)
+        library = get_library(float(item.stature), prepared.options.library_source)
         synth = synthesize(item.spec, cell, library=library, variants=1, seed=item.seed,
-                           cycles=item.cycles, stature=item.stature, options=options)[0]
+                           cycles=item.cycles, stature=item.stature,
+                           options=prepared.options)[0]
     except Exception as exc:
         message = str(exc)
         if _SECONDS_IN_MESSAGE.search(message):
@@ -324,7 +336,7 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
     if verified or job.keep_unverified:
         arrays = _arrays(synth, job.dtype)
         record["motion_sha256"] = motion_sha256(arrays)
-        arrays.update(_annotate(synth, _NAMES[job.fingerprint()], record))
+        arrays.update(_annotate(synth, prepared.names, record))
         record["labels_sha256"] = labels_sha256(arrays)
         record["status"] = "ok" if verified else "unverified"
     if not verified:

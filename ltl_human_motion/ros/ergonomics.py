@@ -33,6 +33,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from ltl_human_motion.assess import assess_motion
 from ltl_human_motion.assess import reba as reba_mod
 from ltl_human_motion.assess import rula as rula_mod
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.msg import ErgonomicsState
 from ltl_human_motion.ros import conversions as cv
@@ -118,7 +119,7 @@ class ErgonomicsNode(Node):
                                          self.param("task_state_topic"),
                                          self.param("catalog_topic"))
         self.following, self.playback = self.follower.following, self.follower.playback
-        self._scores: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+        self._scores: BoundedCache[tuple[np.ndarray, ...]] = BoundedCache(16)
         self.messages_published = 0
         self._pub = self.create_publisher(ErgonomicsState, "ergonomics", STREAM_QOS)
         self._marker_pub = self.create_publisher(MarkerArray, self.param("markers_topic"),
@@ -134,12 +135,11 @@ class ErgonomicsNode(Node):
     def scores(self, motion_id: str, motion: Any
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Per-frame REBA, RULA, load (kg) and trunk flexion (deg) of a motion (cached)."""
-        if motion_id not in self._scores:
+        def build() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
             rep = assess_motion(motion, cell_masses(self.param("cell")))
-            if len(self._scores) > 16:
-                self._scores.clear()
-            self._scores[motion_id] = (rep.reba, rep.rula, rep.load, rep.angles.trunk_flexion)
-        return self._scores[motion_id]
+            return rep.reba, rep.rula, rep.load, rep.angles.trunk_flexion
+
+        return self._scores.get_or_build(motion_id, build)
 
     def _tick(self) -> None:
         now = self.get_clock().now()
