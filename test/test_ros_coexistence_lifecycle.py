@@ -10,6 +10,9 @@ which RTDE connections the node holds.
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -287,3 +290,43 @@ def test_deactivation_without_a_robot_says_the_arm_was_not_reached(context: Cont
     finally:
         spinner.stop()
         node.destroy_node()
+
+
+def test_ctrl_c_leaves_the_arm_at_the_minimum_and_logs_without_rosout(
+        sim: URSimHandle) -> None:
+    """The node's own process (``ros2 run ltl_human_motion coexistence_node``) at full
+    speed for a far worker, then Ctrl-C: exit 0, the arm at the minimum, and the last log
+    lines printed without "Failed to publish log message to rosout" (the context is shut
+    down before the node is destroyed)."""
+    ns = f"{NS}_ctrl_c"
+    params = {**node_parameters_from_robot_config(), "robot_host": HOST,
+              "occupancy_topic": f"{ns}/far_worker/occupancy"}
+    code = ("import sys; from ltl_human_motion.ros.entry_points import coexistence_node as m; "
+            "sys.exit(m(sys.argv))")
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, "--ros-args", "-r", f"__ns:={ns}",
+         *[arg for k, v in params.items() for arg in ("-p", f"{k}:={v}")]],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    readback = rtde_receive.RTDEReceiveInterface(HOST)
+    try:
+        _wait(lambda: readback.getTargetSpeedFraction() == pytest.approx(MIN), 60.0,
+              "the node's process in control (the minimum: no worker yet)")
+        with ClientSession("coexistence_lifecycle_ctrl_c") as session:
+            worker = _FarWorker(session, ns)
+            try:
+                _wait(lambda: readback.getTargetSpeedFraction() == pytest.approx(MAX), 60.0,
+                      "the node's process to run the arm at full speed")
+            finally:
+                worker.stop()
+        proc.send_signal(signal.SIGINT)
+        output, _ = proc.communicate(timeout=30.0)
+        assert proc.returncode == 0, output[-3000:]
+        assert "Failed to publish log message to rosout" not in output, output[-3000:]
+        assert "arm left at the minimum slider 0.01 (confirmed by the controller)" in output, \
+            output[-3000:]
+        assert readback.getTargetSpeedFraction() == pytest.approx(MIN)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+        readback.disconnect()

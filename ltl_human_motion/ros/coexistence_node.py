@@ -68,8 +68,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import rclpy.logging
 from geometry_msgs.msg import TransformStamped
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.impl.rcutils_logger import RcutilsLogger
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
@@ -471,6 +473,14 @@ class CoexistenceNode(LifecycleNode):
                            f"not connected to the robot controller at {host}", values)]
         return [Status("robot connection", OK, f"connected to {host} ({d.mode})", values)]
 
+    def _live_logger(self) -> RcutilsLogger:
+        """The node's logger; once its context is shut down (Ctrl-C, before the node is
+        destroyed), one of another name that only prints: the rosout publisher is gone
+        ("Failed to publish log message to rosout")."""
+        if self.context.ok():
+            return self.get_logger()
+        return rclpy.logging.get_logger(f"{self.get_logger().name}.shutdown")
+
     def _report_refusal(self, message: str) -> None:
         """ur_rtde's bare "connect: Connection refused", as a throttled ROS warning."""
         self.get_logger().warning(f"{message}; retrying (is the robot, URSim or "
@@ -578,7 +588,7 @@ class CoexistenceNode(LifecycleNode):
         try:
             controller.run(self.rate, should_stop=stop.is_set)
         except Exception as exc:  # never die silently: the slider stays where it was
-            self.get_logger().fatal(f"control loop failed: {type(exc).__name__}: {exc}")
+            self._live_logger().fatal(f"control loop failed: {type(exc).__name__}: {exc}")
             raise
 
     @property
@@ -655,7 +665,7 @@ class CoexistenceNode(LifecycleNode):
         slider = f"the minimum slider {self.params.min_slider:g}"
         self.held = f"left at {slider} (confirmed by the controller)" if why_not is None \
             else f"not confirmed at {slider}: {why_not}"
-        log = self.get_logger()
+        log = self._live_logger()
         (log.info if why_not is None else log.warning)(f"control stopped; arm {self.held}")
         controller.close()
 
@@ -678,8 +688,8 @@ class CoexistenceNode(LifecycleNode):
             try:
                 paths = self.write_report(self.metrics_out)
                 if paths is not None:
-                    self.get_logger().info(f"commissioning report: {paths[0]}, {paths[1]}")
+                    self._live_logger().info(f"commissioning report: {paths[0]}, {paths[1]}")
             except (OSError, ValueError) as exc:
-                self.get_logger().error(f"cannot write the commissioning report: {exc}")
+                self._live_logger().error(f"cannot write the commissioning report: {exc}")
         super().destroy_node()
 
