@@ -147,6 +147,18 @@ def _wait(predicate: Callable[[], Any], timeout: float, what: str) -> None:
     wait_until(lambda: bool(predicate()), timeout, what)
 
 
+def _far_worker_until_full_speed(ns: str, readback: Any, timeout: float = 60.0) -> None:
+    """Stream a far worker (from a client session of its own) until the controller reports
+    the full slider."""
+    with ClientSession(f"far_worker{ns.replace('/', '_')}") as session:
+        worker = _FarWorker(session, ns)
+        try:
+            _wait(lambda: readback.getTargetSpeedFraction() == pytest.approx(MAX), timeout,
+                  f"the full slider (a far worker on {ns})")
+        finally:
+            worker.stop()
+
+
 def test_commissioning_and_deactivation_leave_the_arm_at_the_minimum(
         sim: URSimHandle, context: Context) -> None:
     readback = rtde_receive.RTDEReceiveInterface(HOST)
@@ -255,12 +267,7 @@ def test_an_active_node_destroyed_leaves_the_arm_at_the_minimum(
         assert node.active
         with ClientSession("coexistence_lifecycle_auto") as session:
             assert _state(session, ns) == State.PRIMARY_STATE_ACTIVE
-            worker = _FarWorker(session, ns)
-            try:
-                _wait(lambda: readback.getTargetSpeedFraction() == pytest.approx(MAX), 20.0,
-                      "the full slider")
-            finally:
-                worker.stop()
+        _far_worker_until_full_speed(ns, readback)
     finally:
         spinner.stop()
         node.destroy_node()
@@ -311,13 +318,7 @@ def test_ctrl_c_leaves_the_arm_at_the_minimum_and_logs_without_rosout(
     try:
         _wait(lambda: readback.getTargetSpeedFraction() == pytest.approx(MIN), 60.0,
               "the node's process in control (the minimum: no worker yet)")
-        with ClientSession("coexistence_lifecycle_ctrl_c") as session:
-            worker = _FarWorker(session, ns)
-            try:
-                _wait(lambda: readback.getTargetSpeedFraction() == pytest.approx(MAX), 60.0,
-                      "the node's process to run the arm at full speed")
-            finally:
-                worker.stop()
+        _far_worker_until_full_speed(ns, readback)
         proc.send_signal(signal.SIGINT)
         output, _ = proc.communicate(timeout=30.0)
         assert proc.returncode == 0, output[-3000:]
