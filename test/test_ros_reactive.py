@@ -15,30 +15,29 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
 
 rclpy = pytest.importorskip("rclpy")
 
 from ltl_human_motion.msg import TaskState  # noqa: E402
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion  # noqa: E402
-from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Bool  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
-from ltl_human_motion.ros.coexistence_node import UR_JOINT_NAMES  # noqa: E402
 from ltl_human_motion.ros.common import STREAM_QOS, stamp_seconds  # noqa: E402
-from ltl_human_motion.ros.react_demo import ReactiveStack  # noqa: E402
+from ltl_human_motion.ros.react_demo import (  # noqa: E402
+    Q_IN,
+    Q_OUT,
+    JointStateStandIn,
+    ReactiveStack,
+)
 from ltl_human_motion.ros.reactive_player import strategy_path  # noqa: E402
 from ltl_human_motion.tasks.reactive import DEMO_SPEC  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
 ROOT = Path(__file__).resolve().parents[1]
-#: Joint positions (rad) of the UR5e of config/ur_react_r1.yaml: arm in R1, and away.
-Q_IN = np.radians([-4, -100, -100, -70, 90, 0])
-Q_OUT = np.radians([-70, -90, -90, -90, 90, 0])
 DOOR_CELL = (ROOT / "config" / "paper_cell.yaml").read_text() \
     + "\ninputs:\n  door_open: /cell/door_open\n"
 DOOR_SPEC = ("(G F !door_open & G F offered(O1)) -> (G(door_open -> X !assemble(R1)) & "
@@ -53,39 +52,6 @@ def wait_for(predicate: Callable[[], Any], timeout: float, what: str) -> Any:
     except TimeoutError as exc:
         pytest.fail(str(exc))
     return found[-1]
-
-
-class RobotStandIn:
-    """Publishes the arm's joint state on /joint_states at 50 Hz, as the coexistence node
-    does with what it reads over RTDE (stamped when published)."""
-
-    def __init__(self, session: ClientSession) -> None:
-        self.node = session.node
-        self.pub = self.node.create_publisher(JointState, "/joint_states", STREAM_QOS)
-        self.q = Q_IN
-        self.changed: float | None = None        # stamp of the first message of a new q
-        self._lock = threading.Lock()
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
-
-    def move(self, q: np.ndarray) -> None:
-        with self._lock:
-            self.q, self.changed = q, None
-
-    def _run(self) -> None:
-        while not self._stop.is_set():
-            with self._lock:
-                msg = JointState(name=list(UR_JOINT_NAMES), position=[float(v) for v in self.q])
-                msg.header.stamp = self.node.get_clock().now().to_msg()
-                if self.changed is None:
-                    self.changed = stamp_seconds(msg.header.stamp)
-                self.pub.publish(msg)
-            time.sleep(0.02)
-
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(2.0)
 
 
 @pytest.fixture(scope="module")
@@ -142,7 +108,7 @@ def test_the_waiting_worker_reacts_to_the_robot_leaving_r1(live):
     stack, session = live
     states = session.watch(TaskState, "/human_1/task_state", keep=400)
     tf = session.watch(TFMessage, "/tf", keep=400)
-    robot = RobotStandIn(session)
+    robot = JointStateStandIn(session.node, Q_IN)
     try:
         response = synthesize(session, DEMO_SPEC)
         assert response.success, response.error_message

@@ -27,31 +27,87 @@ see docs/reactive.md).
 from __future__ import annotations
 
 import json
+import threading
 import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import rclpy
 from rclpy.context import Context
 from rclpy.parameter import Parameter
+from sensor_msgs.msg import JointState
 
 from ltl_human_motion.atomic import atomic_write_text
 from ltl_human_motion.msg import TaskState
 from ltl_human_motion.ros.client import ClientSession, wait_until
-from ltl_human_motion.ros.common import SpinThread, stamp_seconds
+from ltl_human_motion.ros.coexistence_node import UR_JOINT_NAMES
+from ltl_human_motion.ros.common import STREAM_QOS, SpinThread, stamp_seconds
 from ltl_human_motion.ros.middleware import apply_middleware_defaults
 from ltl_human_motion.ros.motion_store import MotionStore
 from ltl_human_motion.ros.reactive_player import ReactivePlayer
 from ltl_human_motion.ros.synthesis_node import SynthesisNode
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 
-__all__ = ["DEMO_MIN_SLIDER", "REACT_ROBOT_CONFIG", "ReactiveStack", "run_react_demo"]
+__all__ = ["DEMO_MIN_SLIDER", "Q_IN", "Q_OUT", "REACT_ROBOT_CONFIG", "JointStateStandIn",
+           "ReactiveStack", "run_react_demo"]
 
 ROOT = Path(__file__).resolve().parents[2]
 #: The robot of the stage: its arm works in R1, then away from it.
 REACT_ROBOT_CONFIG = ROOT / "config" / "ur_react_r1.yaml"
 #: Lowest speed slider of the stage's coexistence node.
 DEMO_MIN_SLIDER = 0.5
+#: Joint positions (6,) rad of the UR5e of :data:`REACT_ROBOT_CONFIG`: the arm in R1
+#: (``in_r1``), and away from it (``away``).
+Q_IN = np.radians([-4.0, -100.0, -100.0, -70.0, 90.0, 0.0])
+Q_OUT = np.radians([-70.0, -90.0, -90.0, -90.0, 90.0, 0.0])
+
+
+class JointStateStandIn:
+    """Publishes a UR's joint state on ``/joint_states`` at ``rate`` Hz, stamped when
+    published, as the coexistence node does with what it reads over RTDE (for tests and
+    benchmarks that choose when the robot moves).
+
+    Parameters
+    ----------
+    node : rclpy Node
+        Publishes (spun elsewhere, e.g. a ClientSession's node).
+    q : ndarray, shape (6,)
+        Joint positions to start with, rad.
+    """
+
+    def __init__(self, node: Any, q: np.ndarray, rate: float = 50.0) -> None:
+        self._names = list(UR_JOINT_NAMES)
+        self.node = node
+        self.pub = node.create_publisher(JointState, "/joint_states", STREAM_QOS)
+        self.period = 1.0 / rate
+        self.q = np.asarray(q, dtype=np.float64)
+        #: Stamp (s) of the first message with the latest ``q`` (None until sent).
+        self.changed: float | None = None
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="joint-states", daemon=True)
+        self._thread.start()
+
+    def move(self, q: np.ndarray) -> None:
+        """Publish ``q`` (6,) rad from the next message on."""
+        with self._lock:
+            self.q, self.changed = np.asarray(q, dtype=np.float64), None
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            with self._lock:
+                msg = JointState(name=self._names, position=[float(v) for v in self.q])
+                msg.header.stamp = self.node.get_clock().now().to_msg()
+                self.pub.publish(msg)
+                if self.changed is None:
+                    self.changed = stamp_seconds(msg.header.stamp)
+            time.sleep(self.period)
+
+    def close(self) -> None:
+        """Stop publishing."""
+        self._stop.set()
+        self._thread.join(2.0)
 
 
 class ReactiveStack:
@@ -88,6 +144,7 @@ class ReactiveStack:
             if coexistence is not None:
                 from ltl_human_motion.ros.coexistence_node import CoexistenceNode
                 from ltl_human_motion.ros.occupancy_node import OccupancyNode
+
                 self.nodes.append(OccupancyNode(
                     playback=self.player.view, context=self.context,
                     namespace=f"/human_{human_id}",
