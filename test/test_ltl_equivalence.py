@@ -97,7 +97,11 @@ _RULES = ["F F a", "G G a", "F(a U b)", "F(a M b)", "G(a R b)", "G(a W b)", "F G
           "a & !a | b", "X true U a", "!(a <-> b) xor (a -> b)", "a U (b | G a)",
           "a U (a & b)", "a R (b & F a)", "a R (a | b)", "(b | X a) U (b | a)",
           "(b | X a) W b", "(b & X a) R (b & a)", "(b & X a) M b", "X a & X b & a",
-          "a U (X b | G a) | X a"]
+          "a U (X b | G a) | X a",
+          # an & (|) whose operands simplify to one | (&) keeps that one's rules: these
+          # three became "a U b", "a W b" and "X(a & b)" before issue 39
+          "(b R true) & ((a W b) | F b)", "(b M false) | ((a U b) & G a)",
+          "(b R true) & (X a | X b)"]
 
 
 def _all_lassos(max_prefix: int = 2, max_cycle: int = 2):

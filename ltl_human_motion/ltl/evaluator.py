@@ -15,7 +15,7 @@ operators are evaluated through the equalities of Sec. II-A (``F``, ``G``, ``R``
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 from ltl_human_motion.ltl.formula import (
     And,
@@ -51,6 +51,76 @@ def _letters(seq: Iterable[Iterable[str]]) -> list[frozenset[str]]:
     return out
 
 
+class _Lasso:
+    """The positions of a lasso word ``prefix . cycle^omega``: one per distinct suffix
+    (``n`` prefix letters, then the cycle's; the successor of the last is ``n``). A
+    truth value over the word is a list of bool, one per position."""
+
+    def __init__(self, word: list[frozenset[str]], n: int) -> None:
+        self.total = total = len(word)
+        self.succ = [i + 1 if i + 1 < total else n for i in range(total)]
+        self.always = [True] * total
+        self._windows: list[list[int]] = []
+
+    def windows(self) -> list[list[int]]:
+        """For each position ``i``: ``i`` and the positions after it, up to every distinct
+        suffix reachable from ``i``."""
+        if not self._windows:
+            for i in range(self.total):
+                out, k = [], i
+                for _ in range(self.total):
+                    out.append(k)
+                    k = self.succ[k]
+                self._windows.append(out)
+        return self._windows
+
+    def until(self, a: list[bool], b: list[bool]) -> list[bool]:
+        result = []
+        for window in self.windows():
+            holds = False
+            for j in window:
+                if b[j]:
+                    holds = True
+                    break
+                if not a[j]:
+                    break
+            result.append(holds)
+        return result
+
+    def next(self, a: list[bool]) -> list[bool]:
+        return [a[j] for j in self.succ]
+
+    def eventually(self, a: list[bool]) -> list[bool]:
+        return self.until(self.always, a)
+
+    def globally(self, a: list[bool]) -> list[bool]:
+        return _no(self.eventually(_no(a)))
+
+
+def _no(a: list[bool]) -> list[bool]:
+    return [not x for x in a]
+
+
+#: Each operator's truth over the positions, from its operands'; the derived operators
+#: through the equalities of Sec. II-A: ``F a = true U a``, ``G a = !F !a``,
+#: ``a R b = !(!a U !b)``, ``a W b = (a U b) | G a``, ``a M b = b U (a & b)``.
+_OPERATORS: dict[type, Callable[..., list[bool]]] = {
+    Not: lambda _w, a: _no(a),
+    And: lambda _w, *parts: [all(column) for column in zip(*parts)],
+    Or: lambda _w, *parts: [any(column) for column in zip(*parts)],
+    Implies: lambda _w, a, b: [(not x) or y for x, y in zip(a, b)],
+    Equiv: lambda _w, a, b: [x == y for x, y in zip(a, b)],
+    Xor: lambda _w, a, b: [x != y for x, y in zip(a, b)],
+    Next: _Lasso.next,
+    Until: _Lasso.until,
+    Finally: _Lasso.eventually,
+    Globally: _Lasso.globally,
+    Release: lambda w, a, b: _no(w.until(_no(a), _no(b))),
+    WeakUntil: lambda w, a, b: [x or y for x, y in zip(w.until(a, b), w.globally(a))],
+    StrongRelease: lambda w, a, b: w.until(b, [x and y for x, y in zip(a, b)]),
+}
+
+
 def evaluate_positions(formula: Formula, prefix: Sequence[Iterable[str]],
                        cycle: Sequence[Iterable[str]]) -> list[bool]:
     """Truth of ``formula`` at every distinct suffix of ``prefix . cycle^omega``.
@@ -68,83 +138,19 @@ def evaluate_positions(formula: Formula, prefix: Sequence[Iterable[str]],
     word = _letters(prefix) + _letters(cycle)
     if not cycle:
         raise ValueError("a lasso needs at least one cycle letter, got an empty cycle")
-    n, total = len(prefix), len(word)
+    lasso = _Lasso(word, len(prefix))
 
-    def succ(i: int) -> int:
-        return i + 1 if i + 1 < total else n
-
-    def window(i: int) -> list[int]:
-        """The positions i, i+1, ... covering every distinct suffix reachable from i."""
-        out, k = [], i
-        for _ in range(total):
-            out.append(k)
-            k = succ(k)
-        return out
-
-    memo: dict[Formula, list[bool]] = {}
-
-    def until(a: list[bool], b: list[bool]) -> list[bool]:
-        result = []
-        for i in range(total):
-            holds = False
-            for j in window(i):
-                if b[j]:
-                    holds = True
-                    break
-                if not a[j]:
-                    break
-            result.append(holds)
-        return result
-
-    def ev(f: Formula) -> list[bool]:
-        if f in memo:
-            return memo[f]
+    def value(f: Formula, children: list[list[bool]]) -> list[bool]:
         if isinstance(f, Const):
-            r = [f.value] * total
-        elif isinstance(f, Atom):
-            r = [f.key in letter for letter in word]
-        elif isinstance(f, Not):
-            r = [not x for x in ev(f.arg)]
-        elif isinstance(f, And):
-            parts = [ev(g) for g in f.args]
-            r = [all(p[i] for p in parts) for i in range(total)]
-        elif isinstance(f, Or):
-            parts = [ev(g) for g in f.args]
-            r = [any(p[i] for p in parts) for i in range(total)]
-        elif isinstance(f, Implies):
-            a, b = ev(f.left), ev(f.right)
-            r = [(not x) or y for x, y in zip(a, b)]
-        elif isinstance(f, Equiv):
-            a, b = ev(f.left), ev(f.right)
-            r = [x == y for x, y in zip(a, b)]
-        elif isinstance(f, Xor):
-            a, b = ev(f.left), ev(f.right)
-            r = [x != y for x, y in zip(a, b)]
-        elif isinstance(f, Next):
-            a = ev(f.arg)
-            r = [a[succ(i)] for i in range(total)]
-        elif isinstance(f, Until):
-            r = until(ev(f.left), ev(f.right))
-        elif isinstance(f, Finally):  # F phi = true U phi
-            r = until([True] * total, ev(f.arg))
-        elif isinstance(f, Globally):  # G phi = !F !phi
-            r = [not x for x in until([True] * total, [not y for y in ev(f.arg)])]
-        elif isinstance(f, Release):  # a R b = !(!a U !b)
-            a, b = ev(f.left), ev(f.right)
-            r = [not x for x in until([not y for y in a], [not y for y in b])]
-        elif isinstance(f, WeakUntil):  # a W b = (a U b) | G a
-            a, b = ev(f.left), ev(f.right)
-            ga = [not x for x in until([True] * total, [not y for y in a])]
-            r = [x or y for x, y in zip(until(a, b), ga)]
-        elif isinstance(f, StrongRelease):  # a M b = b U (a & b)
-            a, b = ev(f.left), ev(f.right)
-            r = until(b, [x and y for x, y in zip(a, b)])
-        else:
+            return [f.value] * lasso.total
+        if isinstance(f, Atom):
+            return [f.key in letter for letter in word]
+        op = _OPERATORS.get(type(f))
+        if op is None:
             raise TypeError(f"not a formula node: {f!r}")
-        memo[f] = r
-        return r
+        return op(lasso, *children)
 
-    return ev(formula)
+    return formula.fold(value)
 
 
 def evaluate_lasso(formula: Formula, prefix_letters: Sequence[Iterable[str]],
@@ -170,27 +176,24 @@ def evaluate_lasso(formula: Formula, prefix_letters: Sequence[Iterable[str]],
 def propositional_letters(f: Formula, letters: Sequence[frozenset[str]]
                           ) -> tuple[int, ...] | None:
     """Indices of the letters on which the propositional ``f`` holds (None: temporal)."""
+    if not letters:
+        return ()
+    every = frozenset(range(len(letters)))
 
-    def ev(g: Formula, letter: frozenset[str]) -> bool | None:
+    def holds(g: Formula, children: list[frozenset[int] | None]) -> frozenset[int] | None:
         if isinstance(g, Atom):
-            return g.key in letter
+            return frozenset(i for i, letter in enumerate(letters) if g.key in letter)
         if isinstance(g, Const):
-            return g.value
+            return every if g.value else frozenset()
+        if None in children:
+            return None
         if isinstance(g, Not):
-            v = ev(g.arg, letter)
-            return None if v is None else not v
-        if isinstance(g, (And, Or)):
-            vals = [ev(a, letter) for a in g.args]
-            if any(v is None for v in vals):
-                return None
-            return all(vals) if isinstance(g, And) else any(vals)
+            return every - children[0]
+        if isinstance(g, And):
+            return frozenset.intersection(*children)
+        if isinstance(g, Or):
+            return frozenset.union(*children)
         return None
 
-    out = []
-    for i, letter in enumerate(letters):
-        v = ev(f, letter)
-        if v is None:
-            return None
-        if v:
-            out.append(i)
-    return tuple(out)
+    found = f.fold(holds)
+    return None if found is None else tuple(sorted(found))

@@ -7,19 +7,28 @@ quoted, e.g. ``"grasp(O1)"``) so a formula can be pasted into Spot's tools.
 Binding strength, weakest first (the paper's Sec. II-A rules, which agree with Spot):
 ``-> <->`` (right associative), ``|``, ``xor``, ``&``, ``U R W M`` (right associative),
 unary ``! X F G``.
+
+A pass over formulas is written with the generic walks of :class:`Formula`, as with
+Spot's Python API: :meth:`~Formula.map` rebuilds a node over new children (through
+:meth:`~Formula.make`, which flattens ``&`` and ``|``), and :meth:`~Formula.fold`
+computes a value bottom-up, once per distinct subformula.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TypeVar
 
 __all__ = [
     "FALSE", "TRUE", "And", "Atom", "Const", "Equiv", "Finally", "Formula", "Globally",
     "Implies", "Next", "Not", "Or", "Release", "StrongRelease", "Until", "WeakUntil", "Xor",
     "atoms", "conj", "disj", "neg", "size", "to_spot", "top_level_conjuncts",
 ]
+
+T = TypeVar("T")
 
 _PLAIN_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*\Z")
 _RESERVED = frozenset({"U", "R", "W", "M", "X", "F", "G", "true", "false", "xor",
@@ -36,6 +45,32 @@ class Formula:
     def children(self) -> tuple[Formula, ...]:
         """The direct subformulas."""
         return ()
+
+    @classmethod
+    def make(cls, *children: Formula) -> Formula:
+        """A node of this kind over ``children`` (``And`` and ``Or`` flatten, drop
+        duplicates and constants: :func:`conj`, :func:`disj`)."""
+        return cls(*children)
+
+    def map(self, fn: Callable[[Formula], Formula]) -> Formula:
+        """This kind of node over ``fn`` of each child (Spot's ``formula.map``); a
+        constant or an atom is returned as it is."""
+        children = self.children()
+        return type(self).make(*[fn(c) for c in children]) if children else self
+
+    def fold(self, fn: Callable[[Formula, list], T], memo: dict | None = None) -> T:
+        """``fn(node, [values of its children])`` bottom-up, once per distinct subformula
+        (``memo`` maps each to its value and may be shared between calls). Recursive:
+        parsed formulas nest at most ``limits.MAX_NESTING`` deep."""
+        memo = {} if memo is None else memo
+
+        def value(f: Formula) -> T:
+            if f in memo:
+                return memo[f]
+            out = memo[f] = fn(f, [value(c) for c in f.children()])
+            return out
+
+        return value(self)
 
     def _key(self) -> tuple:
         return tuple(self.__dict__[name] for name in self.__dataclass_fields__)
@@ -154,6 +189,10 @@ class And(Formula):
     def children(self) -> tuple[Formula, ...]:
         return self.args
 
+    @classmethod
+    def make(cls, *children: Formula) -> Formula:
+        return conj(*children)
+
 
 @dataclass(frozen=True, eq=False)
 class Or(Formula):
@@ -163,6 +202,10 @@ class Or(Formula):
 
     def children(self) -> tuple[Formula, ...]:
         return self.args
+
+    @classmethod
+    def make(cls, *children: Formula) -> Formula:
+        return disj(*children)
 
 
 @dataclass(frozen=True, eq=False)

@@ -103,20 +103,17 @@ def _as_ltl(c: Gr1Conjunct) -> Formula:
 
 def _temporal_depth(f: Formula) -> tuple[int, bool]:
     """(nesting depth of X, whether another temporal operator occurs)."""
-    if isinstance(f, (Atom, Const)):
-        return 0, False
-    if isinstance(f, Next):
-        d, other = _temporal_depth(f.arg)
-        return d + 1, other
-    if isinstance(f, Not):
-        return _temporal_depth(f.arg)
-    if isinstance(f, (And, Or)):
-        parts = [_temporal_depth(g) for g in f.args]
-        return max(p[0] for p in parts), any(p[1] for p in parts)
-    if isinstance(f, (Implies, Equiv, Xor)):
-        a, b = _temporal_depth(f.left), _temporal_depth(f.right)
-        return max(a[0], b[0]), a[1] or b[1]
-    return 0, True
+
+    def depth(g: Formula, children: list[tuple[int, bool]]) -> tuple[int, bool]:
+        if isinstance(g, (Atom, Const)):
+            return 0, False
+        if isinstance(g, Next):
+            return children[0][0] + 1, children[0][1]
+        if isinstance(g, (Not, And, Or, Implies, Equiv, Xor)):
+            return max(d for d, _ in children), any(o for _, o in children)
+        return 0, True
+
+    return f.fold(depth)
 
 
 def plain_text(f: Formula) -> str:

@@ -6,10 +6,16 @@ result uses only atoms, negated atoms, ``& | X F G U R W M`` and constants.
 ``true U a = F a``, ``a & !a = false``, ``a U (b | G a) = a W b``,
 ``a R (a | b) = b W a``; each rule is an LTL equivalence, and the
 property tests check the translator (which runs both) against the evaluator.
+
+Both passes rebuild nodes with :meth:`~ltl_human_motion.ltl.formula.Formula.make`:
+:func:`nnf` makes each node's dual under a negation (:data:`_DUAL`), :func:`simplify`
+simplifies a node's operands (:meth:`~ltl_human_motion.ltl.formula.Formula.map`), then
+applies the rules of its kind (:data:`_RULES`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
 
 from ltl_human_motion.ltl.formula import (
@@ -38,6 +44,13 @@ from ltl_human_motion.ltl.formula import (
 __all__ = ["nnf", "simplify"]
 
 
+#: The kind of ``!(a op b)`` pushed inside: ``!(a U b) = !a R !b``, ``!X a = X !a``, ...
+_DUAL: dict[type, type] = {
+    And: Or, Or: And, Next: Next, Finally: Globally, Globally: Finally,
+    Until: Release, Release: Until, WeakUntil: StrongRelease, StrongRelease: WeakUntil,
+}
+
+
 @lru_cache(maxsize=4096)
 def nnf(f: Formula, negate: bool = False) -> Formula:
     """Negation normal form of ``f`` (of ``!f`` if ``negate``)."""
@@ -47,12 +60,6 @@ def nnf(f: Formula, negate: bool = False) -> Formula:
         return Not(f) if negate else f
     if isinstance(f, Not):
         return nnf(f.arg, not negate)
-    if isinstance(f, And):
-        parts = [nnf(g, negate) for g in f.args]
-        return disj(*parts) if negate else conj(*parts)
-    if isinstance(f, Or):
-        parts = [nnf(g, negate) for g in f.args]
-        return conj(*parts) if negate else disj(*parts)
     if isinstance(f, Implies):
         return nnf(Or((Not(f.left), f.right)), negate)
     if isinstance(f, Equiv):
@@ -62,45 +69,36 @@ def nnf(f: Formula, negate: bool = False) -> Formula:
         return disj(conj(nnf(a), nnf(b)), conj(nnf(a, True), nnf(b, True)))
     if isinstance(f, Xor):
         return nnf(Equiv(f.left, f.right), not negate)
-    if isinstance(f, Next):
-        return Next(nnf(f.arg, negate))
-    if isinstance(f, Finally):
-        return Globally(nnf(f.arg, True)) if negate else Finally(nnf(f.arg))
-    if isinstance(f, Globally):
-        return Finally(nnf(f.arg, True)) if negate else Globally(nnf(f.arg))
-    a, b = nnf(f.left, negate), nnf(f.right, negate)
-    if isinstance(f, Until):
-        return Release(a, b) if negate else Until(a, b)
-    if isinstance(f, Release):
-        return Until(a, b) if negate else Release(a, b)
-    if isinstance(f, WeakUntil):
-        return StrongRelease(a, b) if negate else WeakUntil(a, b)
-    if isinstance(f, StrongRelease):
-        return WeakUntil(a, b) if negate else StrongRelease(a, b)
-    raise TypeError(f"not a formula node: {f!r}")
+    kind = _DUAL.get(type(f))
+    if kind is None:
+        raise TypeError(f"not a formula node: {f!r}")
+    return (kind if negate else type(f)).make(*[nnf(g, negate) for g in f.children()])
 
 
-def _merge_weak(args: tuple[Formula, ...], items: set[Formula],
-                is_and: bool) -> Formula | None:
-    """``(a U b) | G a = a W b``, ``(a M b) | G b = a R b``, ``(a W b) & F b = a U b``,
-    ``(a R b) & F a = a M b``; None if no rule applies."""
-    for g in args:
-        if is_and:
-            if isinstance(g, WeakUntil) and Finally(g.right) in items:
-                new, used = Until(g.left, g.right), Finally(g.right)
-            elif isinstance(g, Release) and Finally(g.left) in items:
-                new, used = StrongRelease(g.left, g.right), Finally(g.left)
-            else:
-                continue
-        else:
-            if isinstance(g, Until) and Globally(g.left) in items:
-                new, used = WeakUntil(g.left, g.right), Globally(g.left)
-            elif isinstance(g, StrongRelease) and Globally(g.right) in items:
-                new, used = Release(g.left, g.right), Globally(g.right)
-            else:
-                continue
-        rest = [h for h in args if h is not g and h != used]
-        return conj(new, *rest) if is_and else disj(new, *rest)
+#: ``(a W b) & F b = a U b``, ``(a R b) & F a = a M b``: for an operand's kind, the
+#: conjunct it absorbs and the kind it becomes.
+_AND_MERGES: dict[type, tuple[Callable[[Formula], Formula], type]] = {
+    WeakUntil: (lambda g: Finally(g.right), Until),
+    Release: (lambda g: Finally(g.left), StrongRelease),
+}
+#: ``(a U b) | G a = a W b``, ``(a M b) | G b = a R b``: the same for disjunctions.
+_OR_MERGES: dict[type, tuple[Callable[[Formula], Formula], type]] = {
+    Until: (lambda g: Globally(g.left), WeakUntil),
+    StrongRelease: (lambda g: Globally(g.right), Release),
+}
+
+
+def _merge_weak(f: And | Or) -> Formula | None:
+    """``f`` with the first operand that absorbs another (:data:`_AND_MERGES`,
+    :data:`_OR_MERGES`) merged with it; None if no rule applies."""
+    merges = _AND_MERGES if isinstance(f, And) else _OR_MERGES
+    items = set(f.args)
+    for g in f.args:
+        merge = merges.get(type(g))
+        if merge is None or (used := merge[0](g)) not in items:
+            continue
+        rest = [h for h in f.args if h is not g and h != used]
+        return type(f).make(merge[1](g.left, g.right), *rest)
     return None
 
 
@@ -123,8 +121,7 @@ def _has_operand(f: Formula, g: Formula, kind: type) -> bool:
 
 def _without(f: Formula, g: Formula, kind: type) -> Formula:
     """``f`` (an ``And``/``Or`` node or a single operand) without the operand ``g``."""
-    rest = [h for h in _operands(f, kind) if h != g]
-    return conj(*rest) if kind is And else disj(*rest)
+    return kind.make(*(h for h in _operands(f, kind) if h != g))
 
 
 def _drop_disjuncts(a: Formula, b: Formula) -> Formula | None:
@@ -156,97 +153,134 @@ def simplify(f: Formula) -> Formula:
 def _simp(f: Formula) -> Formula:
     if isinstance(f, (Const, Atom, Not)):
         return f
-    if isinstance(f, (And, Or)):
-        is_and = isinstance(f, And)
-        parts = [_simp(g) for g in f.args]
-        out = conj(*parts) if is_and else disj(*parts)
-        if isinstance(out, (And, Or)):
-            items = set(out.args)
-            for g in out.args:
-                c = _complement(g)
-                if c is not None and c in items:
-                    return FALSE if is_and else TRUE
-            merged = _merge_weak(out.args, items, is_and)
-            if merged is not None:
-                return _simp(merged)
-            nexts = [g for g in out.args if isinstance(g, Next)]
-            if is_and and len(nexts) > 1:  # X a & X b = X(a & b); not for "|", where
-                # X a | X b gives two smaller successor states instead of one
-                rest = [g for g in out.args if not isinstance(g, Next)]
-                return _simp(conj(Next(conj(*(g.arg for g in nexts))), *rest))
-        return out
-    if isinstance(f, Next):
-        a = _simp(f.arg)
-        return a if isinstance(a, Const) else Next(a)
-    if isinstance(f, Finally):
-        a = _simp(f.arg)
-        if isinstance(a, Const) or isinstance(a, Finally):
-            return a
-        if isinstance(a, Until):  # F(a U b) = F b
-            return _simp(Finally(a.right))
-        if isinstance(a, StrongRelease):  # F(a M b) = F(a & b)
-            return _simp(Finally(conj(a.left, a.right)))
-        if isinstance(a, Or):  # F(a | b) = F a | F b
-            return disj(*[_simp(Finally(g)) for g in a.args])
-        if isinstance(a, Globally) and isinstance(a.arg, Finally):  # F G F a = G F a
-            return a
-        return Finally(a)
-    if isinstance(f, Globally):
-        a = _simp(f.arg)
-        if isinstance(a, Const) or isinstance(a, Globally):
-            return a
-        if isinstance(a, Release):  # G(a R b) = G b
-            return _simp(Globally(a.right))
-        if isinstance(a, WeakUntil):  # G(a W b) = G(a | b)
-            return _simp(Globally(disj(a.left, a.right)))
-        if isinstance(a, And):  # G(a & b) = G a & G b
-            return conj(*[_simp(Globally(g)) for g in a.args])
-        if isinstance(a, Finally) and isinstance(a.arg, Globally):  # G F G a = F G a
-            return a
-        return Globally(a)
-    a, b = _simp(f.left), _simp(f.right)
-    if isinstance(f, (Until, WeakUntil)):
-        trimmed = _drop_disjuncts(a, b)
-        if trimmed is not None:  # (c | a) U (c | b) = a U (c | b), the same for W
-            return _simp(type(f)(trimmed, b))
-    if isinstance(f, (Release, StrongRelease)):
-        trimmed = _drop_conjuncts(a, b)
-        if trimmed is not None:  # (c & a) R (c & b) = a R (c & b), the same for M
-            return _simp(type(f)(trimmed, b))
-    if isinstance(f, Until):
-        if b == TRUE or b == FALSE or a == FALSE or a == b:
-            return b
-        if a == TRUE:
-            return _simp(Finally(b))
-        if _has_operand(b, Globally(a), Or):  # a U (b | G a) = a W b
-            return _simp(WeakUntil(a, _without(b, Globally(a), Or)))
-        if _has_operand(b, a, And):  # a U (a & b) = b M a
-            return _simp(StrongRelease(_without(b, a, And), a))
-        return Until(a, b)
-    if isinstance(f, Release):
-        if b == TRUE or b == FALSE or a == TRUE or a == b:
-            return b
-        if a == FALSE:
-            return _simp(Globally(b))
-        if _has_operand(b, Finally(a), And):  # a R (b & F a) = a M b
-            return _simp(StrongRelease(a, _without(b, Finally(a), And)))
-        if _has_operand(b, a, Or):  # a R (a | b) = b W a
-            return _simp(WeakUntil(_without(b, a, Or), a))
-        return Release(a, b)
-    if isinstance(f, WeakUntil):
-        if b == TRUE or a == b or a == FALSE:
-            return b
-        if a == TRUE:
-            return TRUE
-        if b == FALSE:
-            return _simp(Globally(a))
-        return WeakUntil(a, b)
-    if isinstance(f, StrongRelease):
-        if b == FALSE or a == b or a == TRUE:
-            return b
-        if a == FALSE:
-            return FALSE
-        if b == TRUE:
-            return _simp(Finally(a))
-        return StrongRelease(a, b)
-    raise TypeError(f"not an NNF formula node: {f!r}")
+    rule = _RULES.get(type(f))
+    if rule is None:
+        raise TypeError(f"not an NNF formula node: {f!r}")
+    g = f.map(_simp)
+    # an And or Or whose simplified operands merged into one (or a constant): that one
+    # is simplified already, and the rules of f's kind are not its rules
+    return rule(g) if type(g) is type(f) else g
+
+
+def _junction(f: And | Or) -> Formula:
+    """``a & !a = false``, the merges of :func:`_merge_weak`, ``X a & X b = X(a & b)``."""
+    is_and = isinstance(f, And)
+    items = set(f.args)
+    for g in f.args:
+        c = _complement(g)
+        if c is not None and c in items:
+            return FALSE if is_and else TRUE
+    merged = _merge_weak(f)
+    if merged is not None:
+        return _simp(merged)
+    nexts = [g for g in f.args if isinstance(g, Next)]
+    if is_and and len(nexts) > 1:  # not for "|", where X a | X b gives two smaller
+        # successor states instead of one
+        rest = [g for g in f.args if not isinstance(g, Next)]
+        return _simp(conj(Next(conj(*(g.arg for g in nexts))), *rest))
+    return f
+
+
+def _next(f: Next) -> Formula:
+    return f.arg if isinstance(f.arg, Const) else f
+
+
+def _finally(f: Finally) -> Formula:
+    a = f.arg
+    if isinstance(a, (Const, Finally)):
+        return a
+    if isinstance(a, Until):  # F(a U b) = F b
+        return _simp(Finally(a.right))
+    if isinstance(a, StrongRelease):  # F(a M b) = F(a & b)
+        return _simp(Finally(conj(a.left, a.right)))
+    if isinstance(a, Or):  # F(a | b) = F a | F b
+        return disj(*[_simp(Finally(g)) for g in a.args])
+    if isinstance(a, Globally) and isinstance(a.arg, Finally):  # F G F a = G F a
+        return a
+    return f
+
+
+def _globally(f: Globally) -> Formula:
+    a = f.arg
+    if isinstance(a, (Const, Globally)):
+        return a
+    if isinstance(a, Release):  # G(a R b) = G b
+        return _simp(Globally(a.right))
+    if isinstance(a, WeakUntil):  # G(a W b) = G(a | b)
+        return _simp(Globally(disj(a.left, a.right)))
+    if isinstance(a, And):  # G(a & b) = G a & G b
+        return conj(*[_simp(Globally(g)) for g in a.args])
+    if isinstance(a, Finally) and isinstance(a.arg, Globally):  # G F G a = F G a
+        return a
+    return f
+
+
+def _trimmed(f: Until | Release | WeakUntil | StrongRelease) -> Formula | None:
+    """``(c | a) U (c | b) = a U (c | b)``, the same for ``W``, and ``(c & a) R (c & b) =
+    a R (c & b)``, the same for ``M``; None if ``a`` keeps every operand."""
+    drop = _drop_disjuncts if isinstance(f, (Until, WeakUntil)) else _drop_conjuncts
+    trimmed = drop(f.left, f.right)
+    return None if trimmed is None else _simp(type(f)(trimmed, f.right))
+
+
+def _until(f: Until) -> Formula:
+    if (trimmed := _trimmed(f)) is not None:
+        return trimmed
+    a, b = f.left, f.right
+    if b == TRUE or b == FALSE or a == FALSE or a == b:
+        return b
+    if a == TRUE:
+        return _simp(Finally(b))
+    if _has_operand(b, Globally(a), Or):  # a U (b | G a) = a W b
+        return _simp(WeakUntil(a, _without(b, Globally(a), Or)))
+    if _has_operand(b, a, And):  # a U (a & b) = b M a
+        return _simp(StrongRelease(_without(b, a, And), a))
+    return f
+
+
+def _release(f: Release) -> Formula:
+    if (trimmed := _trimmed(f)) is not None:
+        return trimmed
+    a, b = f.left, f.right
+    if b == TRUE or b == FALSE or a == TRUE or a == b:
+        return b
+    if a == FALSE:
+        return _simp(Globally(b))
+    if _has_operand(b, Finally(a), And):  # a R (b & F a) = a M b
+        return _simp(StrongRelease(a, _without(b, Finally(a), And)))
+    if _has_operand(b, a, Or):  # a R (a | b) = b W a
+        return _simp(WeakUntil(_without(b, a, Or), a))
+    return f
+
+
+def _weak_until(f: WeakUntil) -> Formula:
+    if (trimmed := _trimmed(f)) is not None:
+        return trimmed
+    a, b = f.left, f.right
+    if b == TRUE or a == b or a == FALSE:
+        return b
+    if a == TRUE:
+        return TRUE
+    if b == FALSE:
+        return _simp(Globally(a))
+    return f
+
+
+def _strong_release(f: StrongRelease) -> Formula:
+    if (trimmed := _trimmed(f)) is not None:
+        return trimmed
+    a, b = f.left, f.right
+    if b == FALSE or a == b or a == TRUE:
+        return b
+    if a == FALSE:
+        return FALSE
+    if b == TRUE:
+        return _simp(Finally(a))
+    return f
+
+
+#: The rules of each NNF kind, applied to a node whose operands are simplified.
+_RULES: dict[type, Callable[[Formula], Formula]] = {
+    And: _junction, Or: _junction, Next: _next, Finally: _finally, Globally: _globally,
+    Until: _until, Release: _release, WeakUntil: _weak_until, StrongRelease: _strong_release,
+}
