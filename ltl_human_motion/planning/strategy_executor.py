@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ltl_human_motion.errors import SpecError
 from ltl_human_motion.planning.strategy_motion import START, StepClip, StrategyProgram
 
 __all__ = ["BLEND_MAX", "BLEND_MIN", "BLEND_SPEED", "LiveFrame", "StrategyExecutor",
@@ -156,6 +157,8 @@ class StrategyExecutor:
         self._blend = BLEND_MIN
         self._reacted_at: float | None = None
         self._stopped = False
+        #: Why the run stopped by itself (the inputs broke an assumption), else None.
+        self.error: str | None = None
         #: Tasks of the latest moves started (at most 1000).
         self.steps_done: deque[str] = deque(maxlen=1000)
         self._begin(float(start), None, 0.0)
@@ -198,7 +201,8 @@ class StrategyExecutor:
 
     # -- queries ---------------------------------------------------------------------
     def state(self, now: float) -> str:
-        """``"playing"``, or ``"stopped"`` after :meth:`stop`."""
+        """``"playing"``, or ``"stopped"`` after :meth:`stop` or when the inputs broke an
+        assumption (:attr:`error` says how)."""
         return STOPPED if self._stopped else PLAYING
 
     def status(self, now: float) -> StrategyStatus:
@@ -284,7 +288,12 @@ class StrategyExecutor:
         positions, yaw = self._pose(np.array([(at - self._start) * self.rate]))
         self._strategy.observe(self._inputs)
         self._source = self._clip.move.target
-        self._begin(at, positions[0], float(yaw[0]))
+        try:
+            self._begin(at, positions[0], float(yaw[0]))
+        except SpecError as exc:
+            self._stopped = True
+            self.error = (f"step {self._step + 1}: {exc} (inputs "
+                          + ", ".join(f"{k}={v}" for k, v in self._inputs.items()) + ")")
 
     def _begin(self, at: float, pose: np.ndarray | None, yaw: float) -> None:
         task = self._strategy.choose()

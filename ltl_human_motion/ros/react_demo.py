@@ -50,7 +50,7 @@ from ltl_human_motion.ros.synthesis_node import SynthesisNode
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 
 __all__ = ["DEMO_MIN_SLIDER", "Q_IN", "Q_OUT", "REACT_ROBOT_CONFIG", "JointStateStandIn",
-           "ReactiveStack", "run_react_demo"]
+           "ReactiveStack", "RobotInR1Run", "run_react_demo"]
 
 ROOT = Path(__file__).resolve().parents[2]
 #: The robot of the stage: its arm works in R1, then away from it.
@@ -172,6 +172,79 @@ def _inputs(msg: TaskState) -> dict[str, bool]:
     return dict(zip(msg.input_names, (bool(v) for v in msg.input_values)))
 
 
+class RobotInR1Run:
+    """The live loop with the simulated UR5e of :data:`REACT_ROBOT_CONFIG` (a context
+    manager): holds the machine-wide lock of port 30004, brings up a
+    :class:`ReactiveStack` with a coexistence node (slider at least
+    :data:`DEMO_MIN_SLIDER`) and a client session; :meth:`start_robot` starts the
+    simulated controller (its cycle begins with the move into R1) once the strategy is
+    made, so that the arm is in R1 when the worker reaches the bench.
+    """
+
+    def __init__(self, store_dir: str | Path, *, human_id: str = "1",
+                 playback_rate: float = 3.0, client_name: str = "react_client") -> None:
+        self.store_dir, self.human_id = Path(store_dir), human_id
+        self.playback_rate, self.client_name = playback_rate, client_name
+        self.stack: ReactiveStack | None = None
+        self.session: ClientSession | None = None
+        self.sim: Any = None
+        self._lock: Any = None
+
+    def __enter__(self) -> RobotInR1Run:
+        from ltl_human_motion.ros.coexistence_demo import (
+            node_parameters_from_robot_config,
+            rtde_port_lock,
+        )
+
+        params = node_parameters_from_robot_config(REACT_ROBOT_CONFIG)
+        params.update(min_slider=DEMO_MIN_SLIDER, forget_after=1.0)
+        self._lock = rtde_port_lock(timeout=300.0)
+        self._lock.__enter__()
+        try:
+            self.stack = ReactiveStack(self.store_dir, human_id=self.human_id,
+                                       playback_rate=self.playback_rate, coexistence=params)
+            self.session = ClientSession(self.client_name)
+        except BaseException:
+            self.__exit__(None, None, None)
+            raise
+        return self
+
+    def synthesize(self, spec: str, timeout: float = 600.0) -> SynthesizeMotion.Response:
+        """Call ``/synthesize_motion`` on the paper cell."""
+        return self.session.call(SynthesizeMotion, "/synthesize_motion",
+                                 SynthesizeMotion.Request(spec=spec, cell="paper_cell"),
+                                 timeout=timeout, resend_after=min(30.0, timeout))
+
+    def start_robot(self) -> None:
+        """Start the simulated UR; return once the coexistence node reads it over RTDE."""
+        from ltl_human_motion.ros.coexistence_demo import start_sim_when_free
+
+        self.sim = start_sim_when_free(REACT_ROBOT_CONFIG, timeout=60.0)
+        node = self.stack.coexistence
+        wait_until(lambda: node.latest is not None and node.latest.connected, 20.0,
+                   "the coexistence node to connect to the simulated UR over RTDE")
+
+    def play(self, strategy_id: str) -> PlayMotion.Response:
+        """Play ``strategy_id`` on ``/human_<id>/play_motion``."""
+        return self.session.call(PlayMotion, f"/human_{self.human_id}/play_motion",
+                                 PlayMotion.Request(command="play", motion_id=strategy_id),
+                                 timeout=20.0, resend_after=5.0)
+
+    def __exit__(self, *exc: object) -> None:
+        if self.session is not None:
+            self.session.close()
+            self.session = None
+        if self.stack is not None:
+            self.stack.close()
+            self.stack = None
+        if self.sim is not None:
+            self.sim.stop()
+            self.sim = None
+        if self._lock is not None:
+            self._lock.__exit__(None, None, None)
+            self._lock = None
+
+
 def run_react_demo(out_dir: str | Path, *, spec: str | None = None, human_id: str = "1",
                    playback_rate: float = 3.0, timeout: float = 60.0,
                    synthesis_timeout: float = 600.0) -> dict[str, Any]:
@@ -180,63 +253,36 @@ def run_react_demo(out_dir: str | Path, *, spec: str | None = None, human_id: st
     inputs), ``waited_s`` (at the bench while the arm was in R1), ``reaction_s`` (from
     the stamp of the joint state that showed the arm out of R1 to the first frame of the
     assembly), ``synthesis_wall_time``, ``error``."""
-    from ltl_human_motion.ros.coexistence_demo import (
-        node_parameters_from_robot_config,
-        rtde_port_lock,
-        start_sim_when_free,
-    )
     from ltl_human_motion.tasks.reactive import DEMO_SPEC
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     spec = spec or DEMO_SPEC
-    ns = f"/human_{human_id}"
     summary: dict[str, Any] = {"spec": spec, "cell": "paper_cell", "success": False,
                                "error": "", "robot": str(REACT_ROBOT_CONFIG.relative_to(ROOT)),
                                "min_slider": DEMO_MIN_SLIDER, "playback_rate": playback_rate}
-    params = node_parameters_from_robot_config(REACT_ROBOT_CONFIG)
-    params.update(min_slider=DEMO_MIN_SLIDER, forget_after=1.0)
-    with rtde_port_lock(timeout=300.0):
-        stack = session = sim = None
-        try:
-            stack = ReactiveStack(out / "store", human_id=human_id,
-                                  playback_rate=playback_rate, coexistence=params)
-            session = ClientSession("react_demo_client")
-            states = session.watch(TaskState, f"{ns}/task_state", keep=1)
+    try:
+        with RobotInR1Run(out / "store", human_id=human_id, playback_rate=playback_rate,
+                          client_name="react_demo_client") as run:
+            states = run.session.watch(TaskState, f"/human_{human_id}/task_state", keep=1)
             t0 = time.monotonic()
-            response = session.call(SynthesizeMotion, "/synthesize_motion",
-                                    SynthesizeMotion.Request(spec=spec, cell="paper_cell"),
-                                    timeout=synthesis_timeout,
-                                    resend_after=min(30.0, synthesis_timeout))
+            response = run.synthesize(spec, synthesis_timeout)
             summary["synthesis_wall_time"] = round(time.monotonic() - t0, 3)
             if not response.success or not response.strategy_id:
                 summary["error"] = response.error_message or "no strategy id in the answer"
                 return summary
             summary["strategy_id"] = response.strategy_id
             summary["tasks"] = response.task_sequences[0]
-            # The robot starts now (its cycle begins with the move into R1), so the arm is
-            # in R1 when the worker reaches the bench.
-            sim = start_sim_when_free(REACT_ROBOT_CONFIG, timeout=60.0)
-            node = stack.coexistence
-            wait_until(lambda: node.latest is not None and node.latest.connected, 20.0,
-                       "the coexistence node to connect to the simulated UR over RTDE")
-            played = session.call(PlayMotion, f"{ns}/play_motion", PlayMotion.Request(
-                command="play", motion_id=response.strategy_id), timeout=20.0,
-                resend_after=5.0)
+            run.start_robot()
+            played = run.play(response.strategy_id)
             if not played.success:
                 summary["error"] = f"play_motion: {played.message}"
                 return summary
-            summary.update(_watch(stack, states, response.strategy_id, timeout))
-        except Exception as exc:   # the stage reports, the demo goes on
-            summary["error"] = f"{type(exc).__name__}: {exc}"
-        finally:
-            if session is not None:
-                session.close()
-            if stack is not None:
-                stack.close()
-            if sim is not None:
-                sim.stop()
-            atomic_write_text(out / "react_demo.json", json.dumps(summary, indent=2) + "\n")
+            summary.update(_watch(run.stack, states, response.strategy_id, timeout))
+    except Exception as exc:   # the stage reports, the demo goes on
+        summary["error"] = f"{type(exc).__name__}: {exc}"
+    finally:
+        atomic_write_text(out / "react_demo.json", json.dumps(summary, indent=2) + "\n")
     return summary
 
 

@@ -35,6 +35,7 @@ strategy id (``<store_dir>/<id>.strategy.npz``, or a program shared in this proc
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
@@ -48,6 +49,7 @@ from std_msgs.msg import Bool
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
+from ltl_human_motion.errors import LtlHumanMotionError
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, PARENTS
 from ltl_human_motion.msg import TaskState
 from ltl_human_motion.planning.strategy_executor import (
@@ -139,7 +141,10 @@ class ReactivePlayer(Node):
         self._last_joints: tuple[float, np.ndarray] | None = None
         self._input_subs: list[Any] = []
         self.frames_published = 0
-        self.reactions: list[tuple[float, float]] = []   # (input stamp, frame stamp), s
+        self._error_logged = False
+        #: (input stamp, stamp of the reaction's first frame), s, of the latest 1000 waits
+        #: ended by an input.
+        self.reactions: deque[tuple[float, float]] = deque(maxlen=1000)
 
         self._group = MutuallyExclusiveCallbackGroup()
         self._tf_pub = self.create_publisher(TFMessage, "/tf", TF_QOS)
@@ -153,7 +158,7 @@ class ReactivePlayer(Node):
         if p("strategy_id"):
             try:
                 self.play(p("strategy_id"))
-            except (KeyError, ValueError, OSError) as exc:
+            except (KeyError, ValueError, OSError, LtlHumanMotionError) as exc:
                 self.get_logger().error(f"cannot play {p('strategy_id')!r}: {exc}")
 
     def param(self, name: str) -> Any:
@@ -191,6 +196,7 @@ class ReactivePlayer(Node):
                     Bool, topic, lambda msg, k=key: self._on_bool(k, msg), STREAM_QOS,
                     callback_group=self._group))
         self._last_joints = None
+        self._error_logged = False
         self.executor_ = StrategyExecutor(program, now_seconds(self),
                                           rate=float(self.param("playback_rate")))
         self.get_logger().info(f"playing strategy {strategy_id} ({len(program.clips)} moves; "
@@ -208,7 +214,7 @@ class ReactivePlayer(Node):
             response.message = self._command(request.command.strip().lower(),
                                              request.motion_id)
             response.success = True
-        except (KeyError, ValueError, OSError) as exc:
+        except (KeyError, ValueError, OSError, LtlHumanMotionError) as exc:
             response.message = str(exc.args[0]) if isinstance(exc, KeyError) else str(exc)
             self.get_logger().warning(f"play_motion {request.command}: {response.message}")
         return response
@@ -269,6 +275,9 @@ class ReactivePlayer(Node):
         stamp = stamp_time.to_msg()
         frame = executor.frame_at(stamp_time.nanoseconds * 1e-9) \
             if executor is not None else None
+        if executor is not None and executor.error is not None and not self._error_logged:
+            self._error_logged = True
+            self.get_logger().error(f"strategy {executor.motion_id} stopped: {executor.error}")
         if frame is not None:
             self._tf_pub.publish(TFMessage(transforms=cv.skeleton_transforms(
                 frame.positions, frame.yaw, self.human_id, self.world_frame, stamp)))
