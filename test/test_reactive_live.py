@@ -130,3 +130,27 @@ def test_junctions_are_blended_within_bounds(program):
 def test_executor_refuses_a_bad_rate(program):
     with pytest.raises(ValueError, match="playback rate"):
         StrategyExecutor(program, 0.0, rate=0.0)
+
+
+
+
+def test_robot_inputs_of_one_joint_state():
+    from ltl_human_motion.robot.events import robot_inputs
+    from ltl_human_motion.robot.kinematics import pose_from_xyz_rpy, ur_model
+
+    model = ur_model("ur5e").with_tool(0.15, 0.05)
+    base = pose_from_xyz_rpy((1.45, -1.3, 0.85), (0.0, 0.0, 2.62))   # config/ur_react_r1.yaml
+    r1 = resolve_cell("paper_cell").regions["R1"]
+    regions = {"R1": (np.asarray(r1.lo, dtype=float), np.asarray(r1.hi, dtype=float))}
+    keys = ("robot_in(R1)", "robot_moving")
+    q_in = np.radians([-4.0, -100.0, -100.0, -70.0, 90.0, 0.0])
+    q_out = np.radians([-70.0, -90.0, -90.0, -90.0, 90.0, 0.0])
+    still, turning = np.zeros(6), np.array([0.0, 0.0, 0.2, 0.0, 0.0, 0.0])
+    assert robot_inputs(q_in, still, model, base, regions, keys) == {
+        "robot_in(R1)": True, "robot_moving": False}
+    assert robot_inputs(q_out, turning, model, base, regions, keys) == {
+        "robot_in(R1)": False, "robot_moving": True}
+    assert robot_inputs(q_out, turning, model, base, regions, keys, moving_threshold=0.3) == {
+        "robot_in(R1)": False, "robot_moving": False}
+    # Without joint speeds robot_moving is not reported (the player differences positions).
+    assert robot_inputs(q_in, None, model, base, regions, keys) == {"robot_in(R1)": True}
