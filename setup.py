@@ -40,6 +40,7 @@ setup(
             "occupancy_node = ltl_human_motion.ros.entry_points:occupancy_node",
             "ergonomics_node = ltl_human_motion.ros.entry_points:ergonomics_node",
             "coexistence_node = ltl_human_motion.ros.entry_points:coexistence_node",
+            "reactive_player = ltl_human_motion.ros.entry_points:reactive_player",
         ],
     },
 )

@@ -9,6 +9,9 @@ the real coexistence node and the simulated UR over RTDE. No mocks of ROS.
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -208,3 +211,28 @@ def test_offered_and_cell_inputs_are_read_from_their_bool_topics(live):
         assert play(session, sid, "stop").success
     finally:
         inputs.close()
+
+
+def test_a_player_in_its_own_process_plays_a_strategy_from_its_file(live):
+    stack, session = live
+    response = synthesize(session, DEMO_SPEC)
+    assert response.success, response.error_message
+    states = session.watch(TaskState, "/human_2/task_state", keep=1)
+    code = ("import sys; from ltl_human_motion.ros.entry_points import reactive_player; "
+            "sys.exit(reactive_player(sys.argv))")
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, "--ros-args", "-r", "__ns:=/human_2",
+         "-p", "human_id:=2", "-p", f"store_dir:={stack.synthesis.store.directory}",
+         "-p", f"strategy_id:={response.strategy_id}"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        msg = wait_for(lambda: (m := states.last) is not None
+                       and m.strategy_id == response.strategy_id and m, 60.0,
+                       "the player process's task state")
+        assert msg.human_id == "2" and msg.current_task == "grasp(O1)"
+        assert list(msg.input_names) == ["robot_in(R1)"]
+    finally:
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=20.0)
+    assert proc.returncode == 0, out
+    assert f"playing strategy {response.strategy_id}" in out

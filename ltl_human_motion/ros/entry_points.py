@@ -140,3 +140,12 @@ def coexistence_node(args: list[str] | None = None) -> int:
 
     sys.setswitchinterval(CONTROL_SWITCH_INTERVAL)   # the 125 Hz loop waits less for the GIL
     return _run_node(CoexistenceNode, args)
+
+
+@quiet_on_interrupt
+def reactive_player(args: list[str] | None = None) -> int:
+    """Play a reactive worker's strategy live (``play_motion`` with a strategy id, or the
+    ``strategy_id`` parameter), reading the robot's events from their topics."""
+    from ltl_human_motion.ros.reactive_player import ReactivePlayer
+
+    return _run_node(ReactivePlayer, args)
