@@ -9,10 +9,13 @@ waiting worker is interruptible: when an input changes during a ``wait`` step, t
 ends at once and the next move starts at the time of the change. Tasks under way finish.
 
 Consecutive clips were planned from the same worker state but through different
-histories, so a clip's first pose differs a little from the pose the worker is in; the
-difference is blended out over the clip's first :func:`blend_seconds` (offset blending,
-as at the junctions of the pipeline). The executor is duck-compatible with
-:class:`~ltl_human_motion.ros.playback.Playback` where an occupancy stream reads it
+histories, so a clip's first pose differs from the pose the worker is in (its heading by
+up to 2 rad where the worker reached a part from the other side); the difference is
+blended out over the clip's first :func:`blend_seconds`: its rigid part (a turn about the
+vertical through the clip's first pelvis, and a shift) as a turn and a shift, what is left
+of the posture as an offset (offset blending, as at the junctions of the pipeline).
+The executor is duck-compatible with :class:`~ltl_human_motion.ros.playback.Playback`
+where an occupancy stream reads it
 (``state``, ``stature``, ``motion_id``, ``positions_ahead``, ``sample_ahead``).
 """
 
@@ -26,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ltl_human_motion.errors import SpecError
+from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.planning.strategy_motion import START, StepClip, StrategyProgram
 
 __all__ = ["BLEND_MAX", "BLEND_MIN", "BLEND_SPEED", "LiveFrame", "StrategyExecutor",
@@ -37,6 +41,7 @@ BLEND_MAX = 1.0
 #: Speed (m/s) at which a joint's junction offset is blended out.
 BLEND_SPEED = 1.5
 
+PELVIS = JOINT_INDEX["pelvis"]
 PLAYING = "playing"
 STOPPED = "stopped"
 
@@ -152,7 +157,9 @@ class StrategyExecutor:
         self._source = START
         self._clip: StepClip | None = None
         self._start = float(start)
-        self._offset = np.zeros((0, 3))
+        self._residual = np.zeros((0, 3))
+        self._pivot = np.zeros(3)
+        self._shift = np.zeros(3)
         self._yaw_offset = 0.0
         self._blend = BLEND_MIN
         self._reacted_at: float | None = None
@@ -269,8 +276,15 @@ class StrategyExecutor:
         yaw = clip.yaw[i0] * (1 - w) + clip.yaw[i1] * w
         u = np.clip(t / self._blend, 0.0, 1.0)
         fade = 1.0 - u * u * (3.0 - 2.0 * u)                          # smoothstep down
-        if self._offset.shape == pos.shape[1:]:
-            pos = pos + fade[:, None, None] * self._offset[None]
+        if self._residual.shape == pos.shape[1:]:
+            # The junction's rigid part (a turn about z through the clip's first pelvis and
+            # a shift), then what is left of the posture, both faded out.
+            a = fade * self._yaw_offset
+            c, sn = np.cos(a)[:, None], np.sin(a)[:, None]
+            rel = pos - self._pivot
+            pos = np.stack([c * rel[..., 0] - sn * rel[..., 1],
+                            sn * rel[..., 0] + c * rel[..., 1], rel[..., 2]], axis=-1)
+            pos = pos + self._pivot + fade[:, None, None] * (self._shift + self._residual)
         return pos, yaw + fade * self._yaw_offset
 
     def _advance(self, now: float) -> None:
@@ -303,11 +317,20 @@ class StrategyExecutor:
                            f"worker state {self._source} has no motion in the program")
         self._clip, self._start, self._step = clip, float(at), self._step + 1
         if pose is None:
-            self._offset, self._yaw_offset, self._blend = np.zeros((0, 3)), 0.0, BLEND_MIN
+            self._residual, self._yaw_offset, self._blend = np.zeros((0, 3)), 0.0, BLEND_MIN
         else:
-            self._offset = pose - clip.positions[0]
+            first = clip.positions[0]
             self._yaw_offset = float(np.angle(np.exp(1j * (yaw - clip.yaw[0]))))
-            self._blend = blend_seconds(float(np.max(np.linalg.norm(self._offset, axis=1))))
+            self._pivot = np.array([*first[PELVIS, :2], 0.0])
+            self._shift = pose[PELVIS] - first[PELVIS]
+            c, sn = np.cos(self._yaw_offset), np.sin(self._yaw_offset)
+            rel = first - self._pivot
+            turned = np.stack([c * rel[:, 0] - sn * rel[:, 1], sn * rel[:, 0] + c * rel[:, 1],
+                               rel[:, 2]], axis=-1) + self._pivot + self._shift
+            self._residual = pose - turned
+            # The farthest a joint travels in the blend: the turn, the shift, the posture.
+            travel = np.linalg.norm(pose - first, axis=1)
+            self._blend = blend_seconds(float(np.max(travel)))
         self.steps_done.append(clip.task)
         if self._on_step is not None:
             self._on_step(self._status())
