@@ -160,7 +160,7 @@ def run(args: argparse.Namespace) -> int:
             line += (f"  -> {args.out / 'react' / 'react_demo.json'} (waited "
                      f"{res.get('waited_s', 0.0):.1f} s at the bench while the arm was in R1; "
                      f"assembly {1e3 * res.get('reaction_s', float('nan')):.0f} ms after it "
-                     "left)")
+                     f"left; SSM slider down to {res.get('min_slider', float('nan')):.2f})")
         elif name == "study" and res["ok"]:
             counts = ", ".join(f"{k}: {n} motions" + (f" ({res['failed'][k]} failed: "
                                                          "the report says why)"

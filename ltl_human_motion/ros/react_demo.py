@@ -27,6 +27,7 @@ see docs/reactive.md).
 from __future__ import annotations
 
 import json
+import math
 import threading
 import time
 from pathlib import Path
@@ -252,7 +253,8 @@ def run_react_demo(out_dir: str | Path, *, spec: str | None = None, human_id: st
     summary: ``success``, ``strategy_id``, ``steps`` (task, start on the node clock,
     inputs), ``waited_s`` (at the bench while the arm was in R1), ``reaction_s`` (from
     the stamp of the joint state that showed the arm out of R1 to the first frame of the
-    assembly), ``synthesis_wall_time``, ``error``."""
+    assembly), ``min_separation_m`` and ``min_slider`` (the coexistence node's, while the
+    worker played), ``synthesis_wall_time``, ``error``."""
     from ltl_human_motion.tasks.reactive import DEMO_SPEC
 
     out = Path(out_dir)
@@ -260,7 +262,7 @@ def run_react_demo(out_dir: str | Path, *, spec: str | None = None, human_id: st
     spec = spec or DEMO_SPEC
     summary: dict[str, Any] = {"spec": spec, "cell": "paper_cell", "success": False,
                                "error": "", "robot": str(REACT_ROBOT_CONFIG.relative_to(ROOT)),
-                               "min_slider": DEMO_MIN_SLIDER, "playback_rate": playback_rate}
+                               "slider_floor": DEMO_MIN_SLIDER, "playback_rate": playback_rate}
     try:
         with RobotInR1Run(out / "store", human_id=human_id, playback_rate=playback_rate,
                           client_name="react_demo_client") as run:
@@ -293,9 +295,15 @@ def _watch(stack: ReactiveStack, states: Any, strategy_id: str, timeout: float
     waited_from: float | None = None
     end = time.monotonic() + timeout
     result: dict[str, Any] = {"success": False, "steps": steps}
+    separation, slider = float("inf"), 1.0
     while time.monotonic() < end:
         msg = states.last
         time.sleep(0.01)
+        decision = stack.coexistence.latest if stack.coexistence is not None else None
+        if decision is not None and decision.connected:
+            if math.isfinite(decision.separation):
+                separation = min(separation, decision.separation)
+            slider = min(slider, decision.slider)
         if msg is None or msg.strategy_id != strategy_id:
             continue
         if not steps or steps[-1]["step"] != msg.strategy_step:
@@ -313,6 +321,9 @@ def _watch(stack: ReactiveStack, states: Any, strategy_id: str, timeout: float
                     result["reaction_s"] = round(reactions[-1][1] - reactions[-1][0], 4)
                 result["success"] = True
                 break
+    if math.isfinite(separation):
+        result["min_separation_m"] = round(separation, 3)
+        result["min_slider"] = round(slider, 3)
     compact = []
     for s in steps:                                  # runs of waits as one entry
         if compact and s["task"] == compact[-1]["task"] and s["task"].startswith("wait("):
