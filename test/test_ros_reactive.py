@@ -231,8 +231,10 @@ def test_a_player_in_its_own_process_plays_a_strategy_from_its_file(live):
                        "the player process's task state")
         assert msg.human_id == "2" and msg.current_task == "grasp(O1)"
         assert list(msg.input_names) == ["robot_in(R1)"]
+        time.sleep(1.5)                  # nobody publishes /joint_states here: a warning
     finally:
         proc.send_signal(signal.SIGINT)
         out, _ = proc.communicate(timeout=20.0)
     assert proc.returncode == 0, out
     assert f"playing strategy {response.strategy_id}" in out
+    assert "no joint state on /joint_states for over 1 s: robot_in(R1) keep" in out

@@ -13,7 +13,9 @@ Plays a strategy the synthesis service made from a reactive specification (its
 * the cell's own inputs from the topics the cell names (``inputs: {door_open:
   /cell/door_open}``, std_msgs/Bool).
 
-An input message counts from its stamp (JointState) or its receipt (Bool). When it
+An input message counts from its stamp (JointState) or its receipt (Bool). Every input is
+false until its first message and keeps its last value; the player warns when no joint
+state came for :data:`JOINT_STATES_SILENCE` s. When it
 changes an input during a wait, the wait ends at once and the frame of the next move goes
 out on TF from the same callback, so a waiting worker reacts within a few tens of ms of
 the message (bench/react_latency.py).
@@ -74,9 +76,12 @@ from ltl_human_motion.ros.params import (
 from ltl_human_motion.ros.skeleton_publisher import skeleton_parameters
 from ltl_human_motion.srv import PlayMotion
 
-__all__ = ["ROBOT_PARAMETERS", "ReactivePlayer", "reactive_player_parameters",
-           "strategy_path"]
+__all__ = ["JOINT_STATES_SILENCE", "ROBOT_PARAMETERS", "ReactivePlayer",
+           "reactive_player_parameters", "strategy_path"]
 
+#: Seconds without a joint state after which the player warns (the robot's inputs then
+#: keep their last values).
+JOINT_STATES_SILENCE = 1.0
 #: The coexistence node's parameters that place the robot's capsules.
 ROBOT_PARAMETERS = ("model", "tool_length", "tool_radius", "base_x", "base_y", "base_z",
                     "base_yaw", "joint_prefix")
@@ -139,6 +144,7 @@ class ReactivePlayer(Node):
         self._regions: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._robot_keys: tuple[str, ...] = ()
         self._last_joints: tuple[float, np.ndarray] | None = None
+        self._joints_at = 0.0                   # node clock: the latest joint state (or play)
         self._input_subs: list[Any] = []
         self.frames_published = 0
         self._error_logged = False
@@ -197,6 +203,7 @@ class ReactivePlayer(Node):
                     callback_group=self._group))
         self._last_joints = None
         self._error_logged = False
+        self._joints_at = now_seconds(self)
         self.executor_ = StrategyExecutor(program, now_seconds(self),
                                           rate=float(self.param("playback_rate")))
         self.get_logger().info(f"playing strategy {strategy_id} ({len(program.clips)} moves; "
@@ -244,6 +251,7 @@ class ReactivePlayer(Node):
                                       throttle_duration_sec=5.0)
             return
         stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        self._joints_at = now_seconds(self)
         qd = None
         if len(msg.velocity) == len(msg.position) and len(msg.velocity) > 0:
             qd = np.array([msg.velocity[index[n]] for n in self.joint_names])
@@ -275,6 +283,13 @@ class ReactivePlayer(Node):
         stamp = stamp_time.to_msg()
         frame = executor.frame_at(stamp_time.nanoseconds * 1e-9) \
             if executor is not None else None
+        if executor is not None and self._robot_keys \
+                and stamp_time.nanoseconds * 1e-9 - self._joints_at > JOINT_STATES_SILENCE:
+            self.get_logger().warning(
+                f"no joint state on {self.param('joint_states_topic')} for over "
+                f"{JOINT_STATES_SILENCE:g} s: {', '.join(self._robot_keys)} keep their last "
+                "values (false before the first message); is the coexistence node running?",
+                throttle_duration_sec=10.0)
         if executor is not None and executor.error is not None and not self._error_logged:
             self._error_logged = True
             self.get_logger().error(f"strategy {executor.motion_id} stopped: {executor.error}")
