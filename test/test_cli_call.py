@@ -99,6 +99,17 @@ def test_call_json_with_variants(bringup: subprocess.Popen, store: Path) -> None
     assert all(1 <= r <= 15 for r in result["reba_max"])
 
 
+def test_call_with_a_reactive_spec_prints_its_strategy(bringup: subprocess.Popen,
+                                                        store: Path) -> None:
+    spec = "(G F !robot_in(R1)) -> (G(robot_in(R1) -> X !assemble(R1)) & G F assemble(R1))"
+    done = _call("--spec", spec, "--cell", "paper_cell", "--wait", "120")
+    assert done.returncode == 0, done.stderr[-3000:]
+    m = re.match(r"strategy: (strategy_[0-9a-f]{12}) over (.+) \(a reactive", done.stdout)
+    assert m, done.stdout
+    assert "assemble(R1)" in m.group(2) and "wait(0.15)" in m.group(2)
+    assert (store / f"{m.group(1)}.strategy.npz").is_file()
+
+
 def test_a_refused_spec_is_a_clear_error(bringup: subprocess.Popen) -> None:
     done = _call("--spec", "F grasp(O9)", "--cell", "paper_cell", "--wait", "120")
     assert done.returncode == 2

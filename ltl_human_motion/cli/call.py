@@ -72,12 +72,15 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps({"motion_ids": result.motion_ids, "sequences": result.sequences,
                           "durations": result.durations, "cycle_times": result.cycle_times,
                           "reba_max": result.reba_max, "rula_max": result.rula_max,
-                          "wall_time": round(result.wall_time, 3), "played": result.played},
-                         indent=1))
+                          "wall_time": round(result.wall_time, 3), "played": result.played,
+                          "strategy_id": result.strategy_id}, indent=1))
         return 0
     for i, (mid, seq, dur) in enumerate(zip(result.motion_ids, result.sequences,
                                             result.durations)):
         print(f"motion {i}: {mid}  ({dur:.1f} s): {seq}")
+    if result.strategy_id:
+        print(f"strategy: {result.strategy_id} over {result.sequences[0]} (a reactive "
+              "specification: play it on a reactive player, docs/ros.md)")
     print(f"answered in {result.wall_time:.1f} s")
     if result.played:
         print(f"playing {result.played} on {result.player.rsplit('/', 1)[0]} "

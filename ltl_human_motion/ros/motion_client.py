@@ -53,8 +53,9 @@ class SynthesisRequest:
 class CallResult:
     """What the service returned, one entry per motion, and what was played.
 
-    ``durations`` and ``cycle_times`` in s; ``played`` the motion id started on
-    ``player`` (the play service's namespace), or None.
+    ``durations`` and ``cycle_times`` in s; ``played`` the motion (or strategy) id started
+    on ``player`` (the play service's namespace), or None; ``strategy_id`` the strategy of a
+    reactive specification (then there are no motions), else "".
     """
 
     motion_ids: list[str]
@@ -66,6 +67,7 @@ class CallResult:
     wall_time: float = 0.0
     played: str | None = None
     player: str = ""
+    strategy_id: str = ""
 
 
 def call_synthesis(request: SynthesisRequest, *, play: bool = False, human_id: str = "1",
@@ -77,7 +79,8 @@ def call_synthesis(request: SynthesisRequest, *, play: bool = False, human_id: s
     ----------
     request : SynthesisRequest
     play : bool
-        Start the first motion on ``/human_<human_id>/play_motion``.
+        Start the first motion (or the strategy, on a reactive player) on
+        ``/human_<human_id>/play_motion``.
     loop, rate : bool, float
         Playback: repeat the motion; speed (1.0 = real time).
     wait : float
@@ -113,15 +116,17 @@ def call_synthesis(request: SynthesisRequest, *, play: bool = False, human_id: s
             durations=[float(d) for d in response.durations],
             cycle_times=[float(c) for c in response.cycle_times],
             reba_max=[int(r) for r in response.reba_max],
-            rula_max=[int(r) for r in response.rula_max], wall_time=wall)
-        if play and result.motion_ids:
+            rula_max=[int(r) for r in response.rula_max], wall_time=wall,
+            strategy_id=response.strategy_id)
+        target = result.motion_ids[0] if result.motion_ids else result.strategy_id
+        if play and target:
             answer = _call(session, PlayMotion, player, PlayMotion.Request(
-                command="play", motion_id=result.motion_ids[0], loop=loop, rate=rate), wait,
+                command="play", motion_id=target, loop=loop, rate=rate), wait,
                 timeout=max(wait, 10.0))
             if not answer.success:
-                raise ServiceRefusedError(f"{player} refused to play {result.motion_ids[0]}: "
+                raise ServiceRefusedError(f"{player} refused to play {target}: "
                                      f"{answer.message}")
-            result.played, result.player = result.motion_ids[0], player
+            result.played, result.player = target, player
         return result
 
 
