@@ -250,8 +250,9 @@ def build_program(text: str, cell_text: str, cell, library, *, seed: int = 0,
     ------
     SpecError, UnrealizableError
         As :func:`~ltl_human_motion.tasks.reactive.reactive_worker` (before any motion).
-    PlanningError, VerificationError
-        A move whose motion cannot be planned (the move is named).
+    PlanningError
+        A move with no verified motion in :data:`MOVE_ATTEMPTS` random draws (the move and
+        each draw's reason are named).
     """
     from ltl_human_motion.planning.pipeline import SynthesisOptions
 
