@@ -82,7 +82,7 @@ class Bringup:
         self.context = context
         self.overrides = dict(overrides or {})
         self.nodes: list[Node] = []
-        self.playbacks: dict[str, Playback] = {}
+        self.playbacks: dict[str, Any] = {}      # per human: a Playback or a player's view
         self.store: MotionStore | None = None
         self.recorder: Recorder | None = None
         self._spinner: SpinThread | None = None
@@ -132,6 +132,14 @@ class Bringup:
             sys.setswitchinterval(CONTROL_SWITCH_INTERVAL)   # its 125 Hz loop shares the GIL
             return CoexistenceNode(node_name=spec.name, **kwargs)
         human = spec.parameters["human_id"]
+        if spec.executable == "reactive_player":
+            from ltl_human_motion.ros.reactive_player import ReactivePlayer
+
+            synthesis = next((n for n in self.nodes if isinstance(n, SynthesisNode)), None)
+            player = ReactivePlayer(programs=synthesis.programs if synthesis else None,
+                                    node_name=spec.name, **kwargs)
+            self.playbacks[human] = player.view      # its occupancy node follows the strategy
+            return player
         playback = self.playbacks.setdefault(human, Playback())
         if spec.executable == "skeleton_publisher":
             return SkeletonPublisher(store=self.store, playback=playback, node_name=spec.name,
@@ -152,7 +160,8 @@ class Bringup:
             wanted = {"synthesis_node": "SynthesisNode", "skeleton_publisher":
                       "SkeletonPublisher", "occupancy_node": "OccupancyNode",
                       "ergonomics_node": "ErgonomicsNode",
-                      "coexistence_node": "CoexistenceNode"}[executable]
+                      "coexistence_node": "CoexistenceNode",
+                      "reactive_player": "ReactivePlayer"}[executable]
             if kind == wanted and (human_id is None
                                    or getattr(node, "human_id", None) == human_id):
                 return node

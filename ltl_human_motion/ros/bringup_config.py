@@ -33,9 +33,9 @@ from ltl_human_motion.yaml_limits import read_text_file
 
 PACKAGE = "ltl_human_motion"
 #: Node kinds a bringup can start, in start order.
-NODE_KINDS = ("synthesis_node", "skeleton_publisher", "occupancy_node", "ergonomics_node",
-              "coexistence_node")
-PER_HUMAN = ("skeleton_publisher", "occupancy_node", "ergonomics_node")
+NODE_KINDS = ("synthesis_node", "skeleton_publisher", "reactive_player", "occupancy_node",
+              "ergonomics_node", "coexistence_node")
+PER_HUMAN = ("skeleton_publisher", "reactive_player", "occupancy_node", "ergonomics_node")
 DEFAULT_CONFIG = Path(__file__).resolve().parents[2] / "config" / "bringup.yaml"
 #: Topic parameters whose absolute defaults wire a node set together, by node kind: the
 #: ``namespace:=`` launch argument moves them into the namespace (:func:`namespace_overrides`).
@@ -46,6 +46,7 @@ SET_TOPICS: dict[str, dict[str, str]] = {
     "ergonomics_node": {"markers_topic": "/ergonomics_markers",
                         "catalog_topic": "/motion_catalog"},
     "coexistence_node": {"markers_topic": "/robot_markers"},
+    "reactive_player": {"markers_topic": "/markers"},
 }
 _NAMESPACE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$")
 
@@ -140,6 +141,10 @@ class BringupConfig:
                     out[f"{body}/urdf"] = "std_msgs/msg/String"
                     out[f"{body}/position"] = "geometry_msgs/msg/PointStamped"
                     out[f"{body}/velocity"] = "geometry_msgs/msg/TwistStamped"
+            elif spec.executable == "reactive_player":
+                out["/tf"] = "tf2_msgs/msg/TFMessage"
+                out[markers] = "visualization_msgs/msg/MarkerArray"
+                out[f"{ns}/task_state"] = f"{PACKAGE}/msg/TaskState"
             elif spec.executable == "occupancy_node":
                 out[f"{ns}/occupancy"] = f"{PACKAGE}/msg/HumanOccupancy"
                 if float(self.parameter(spec, "marker_rate", 10.0)) > 0:
@@ -236,6 +241,12 @@ def load_bringup_config(path: str | Path | None = None) -> BringupConfig:
                                                for h in humans):
         raise ValueError(f"{path}: bringup.humans must be unique ids of letters, digits or "
                          f"'_'; got {humans!r}")
+    if "reactive_player" in nodes and ("skeleton_publisher" in nodes
+                                       or "ergonomics_node" in nodes):
+        raise ValueError(f"{path}: bringup.nodes: reactive_player plays the worker instead "
+                         "of skeleton_publisher (both would serve play_motion and publish "
+                         "the worker on /tf), and ergonomics_node cannot follow it yet; "
+                         f"got {nodes!r}")
     if any(n in PER_HUMAN for n in nodes) and not humans:
         raise ValueError(f"{path}: bringup.humans is empty but {nodes} need a human")
     threads = values.get("executor_threads", 16)
