@@ -54,9 +54,9 @@ def run_publisher(args: argparse.Namespace) -> int:
     """The publisher process: one occupancy node with its own looped playback."""
     import rclpy
 
+    from ltl_human_motion.planning.playback import Playback
     from ltl_human_motion.ros.common import now_seconds, spin_nodes
     from ltl_human_motion.ros.occupancy_node import OccupancyNode
-    from ltl_human_motion.ros.playback import Playback
     sys.path.insert(0, str(ROOT / "test"))   # the hand-made test motion (test/ros_fakes.py)
     from ros_fakes import make_test_motion
 
@@ -76,7 +76,7 @@ def run_publisher(args: argparse.Namespace) -> int:
 def _node_command(spec: object, config: object, store_dir: str) -> list[str]:
     """The process ``ros2 launch`` starts for one node of the bringup file (same
     ``--ros-args`` as launch_ros builds from launch/bringup.launch.py)."""
-    from ltl_human_motion.ros.bringup_config import launch_parameters
+    from ltl_human_motion.ros.launch_support.bringup_config import launch_parameters
 
     code = (f"import sys; from ltl_human_motion.ros.entry_points import {spec.executable} "
             f"as main; sys.exit(main(sys.argv))")
@@ -100,7 +100,7 @@ def start_layout(layout: str, args: argparse.Namespace, store_dir: str
     if layout == "bringup":
         return [subprocess.Popen([sys.executable, "-m", "ltl_human_motion", "bringup",
                                   str(CONFIG), "--store-dir", store_dir], env=env)]
-    from ltl_human_motion.ros.bringup_config import load_bringup_config
+    from ltl_human_motion.ros.launch_support.bringup_config import load_bringup_config
 
     config = load_bringup_config(CONFIG)
     return [subprocess.Popen(_node_command(spec, config, store_dir), env=env)

@@ -19,7 +19,7 @@ from collections.abc import Iterator
 import pytest
 from hypothesis import settings
 
-from ltl_human_motion.ros.middleware import apply_middleware_defaults
+from ltl_human_motion.ros.launch_support.middleware import apply_middleware_defaults
 
 settings.register_profile("deterministic", derandomize=True, database=None, deadline=None)
 settings.register_profile("explore", deadline=None)

@@ -116,7 +116,7 @@ def test_every_layer_takes_the_task_vocabulary_from_one_module() -> None:
     assert HAND_TASKS is vocabulary.HAND_TASKS
 
 
-@pytest.mark.parametrize("module", ["ros/conversions.py", "ros/playback.py"])
+@pytest.mark.parametrize("module", ["ros/conversions.py", "planning/playback.py"])
 def test_ros_layer_uses_core_types_without_probes(module: str) -> None:
     tree = ast.parse((PACKAGE / module).read_text())
     probes = [n.lineno for n in ast.walk(tree) if isinstance(n, ast.Call)

@@ -40,7 +40,6 @@ from visualization_msgs.msg import MarkerArray  # noqa: E402
 from ltl_human_motion.robot.sim.process import URSimHandle  # noqa: E402
 from ltl_human_motion.ros import conversions as cv  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
-from ltl_human_motion.ros.bringup_config import load_bringup_config  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession  # noqa: E402
 from ltl_human_motion.ros.coexistence_demo import (  # noqa: E402
     rtde_port_lock,
@@ -53,6 +52,7 @@ from ltl_human_motion.ros.coexistence_node import (  # noqa: E402
 )
 from ltl_human_motion.ros.common import TF_STATIC_QOS  # noqa: E402
 from ltl_human_motion.ros.entry_points import coexistence_node  # noqa: E402
+from ltl_human_motion.ros.launch_support.bringup_config import load_bringup_config  # noqa: E402
 from ltl_human_motion.ros.occupancy_cdr import encode_human_occupancy  # noqa: E402
 
 pytestmark = pytest.mark.ros

@@ -18,12 +18,12 @@ from ltl_human_motion.msg import HumanOccupancy, PredictedOccupancy  # noqa: E40
 from rclpy.serialization import deserialize_message  # noqa: E402
 from ros_fakes import make_test_motion  # noqa: E402
 
+from ltl_human_motion.planning.motion_store import MotionStore, check_motion_id  # noqa: E402
+from ltl_human_motion.planning.playback import Playback  # noqa: E402
 from ltl_human_motion.ros import conversions as cv  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
-from ltl_human_motion.ros.bringup_config import load_bringup_config  # noqa: E402
-from ltl_human_motion.ros.motion_store import MotionStore, check_motion_id  # noqa: E402
+from ltl_human_motion.ros.launch_support.bringup_config import load_bringup_config  # noqa: E402
 from ltl_human_motion.ros.occupancy_cdr import encode_human_occupancy  # noqa: E402
-from ltl_human_motion.ros.playback import Playback  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

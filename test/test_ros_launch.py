@@ -34,11 +34,11 @@ from rclpy.context import Context  # noqa: E402
 from rclpy.node import Node  # noqa: E402
 from rclpy.parameter import parameter_value_to_python  # noqa: E402
 
-from ltl_human_motion.ros.bringup_config import (  # noqa: E402
+from ltl_human_motion.ros.client import ClientSession, call_service  # noqa: E402
+from ltl_human_motion.ros.launch_support.bringup_config import (  # noqa: E402
     LAUNCH_ARGUMENTS,
     load_bringup_config,
 )
-from ltl_human_motion.ros.client import ClientSession, call_service  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

@@ -12,7 +12,10 @@ from typing import Any
 
 import pytest
 
-from ltl_human_motion.ros.middleware import FASTDDS_PROFILES_FILE, apply_middleware_defaults
+from ltl_human_motion.ros.launch_support.middleware import (
+    FASTDDS_PROFILES_FILE,
+    apply_middleware_defaults,
+)
 
 NS = {"dds": "http://www.eprosima.com"}
 

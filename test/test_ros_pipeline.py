@@ -13,8 +13,8 @@ from ltl_human_motion.srv import SynthesizeMotion
 from ros_fakes import SYNTHESIS_ONLY_BRINGUP
 
 from ltl_human_motion.ros.bringup import Bringup
-from ltl_human_motion.ros.bringup_config import load_bringup_config
 from ltl_human_motion.ros.client import ClientSession
+from ltl_human_motion.ros.launch_support.bringup_config import load_bringup_config
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 

@@ -18,8 +18,8 @@ from ltl_human_motion.msg import HumanOccupancy, TaskState
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 
 from ltl_human_motion.ros.bringup import Bringup
-from ltl_human_motion.ros.bringup_config import load_bringup_config
 from ltl_human_motion.ros.client import ClientSession, wait_until
+from ltl_human_motion.ros.launch_support.bringup_config import load_bringup_config
 
 pytestmark = pytest.mark.ros
 

@@ -14,8 +14,8 @@ pytest.importorskip("rtde_receive")
 from rclpy.context import Context  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 
+from ltl_human_motion.robot.rtde_probe import RTDE_PORT, probed_factories, refusal  # noqa: E402
 from ltl_human_motion.ros.coexistence_node import CoexistenceNode  # noqa: E402
-from ltl_human_motion.ros.rtde_probe import RTDE_PORT, probed_factories, refusal  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

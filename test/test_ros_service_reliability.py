@@ -234,7 +234,7 @@ def test_sigint_mid_synthesis_exits_within_two_seconds(
 def test_the_motion_store_is_bounded_and_evicts_to_its_folder(tmp_path: Path) -> None:
     from ros_fakes import make_test_motion
 
-    from ltl_human_motion.ros.motion_store import MotionStore, default_store_dir, motion_nbytes
+    from ltl_human_motion.planning.motion_store import MotionStore, default_store_dir, motion_nbytes
 
     motion = make_test_motion()
     size = motion_nbytes(motion)

@@ -48,7 +48,7 @@ def _launch_value(argument: str) -> Callable[[str], Any]:
     """The argparse type of launch argument ``argument``: its text checked and converted as
     the launch files do (their ValueError is argparse's message)."""
     def convert(text: str) -> Any:
-        from ltl_human_motion.ros.bringup_config import check_namespace, launch_bool
+        from ltl_human_motion.ros.launch_support.bringup_config import check_namespace, launch_bool
 
         try:
             return check_namespace(text, "") if argument == "namespace" else launch_bool(text)
@@ -111,8 +111,8 @@ def _run(args: argparse.Namespace, stop: _StopSignals) -> int:
         raise MissingDependencyError(
             f"bringup needs rclpy and the built interfaces ({exc}); run scripts/setup.sh "
             f"and source scripts/env.sh") from None
-    from ltl_human_motion.ros.bringup_config import load_bringup_config
     from ltl_human_motion.ros.entry_points import exit_without_final_collection
+    from ltl_human_motion.ros.launch_support.bringup_config import load_bringup_config
 
     exit_without_final_collection()
     try:

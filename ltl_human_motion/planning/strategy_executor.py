@@ -14,7 +14,7 @@ up to 2 rad where the worker reached a part from the other side); the difference
 blended out over the clip's first :func:`blend_seconds`: its rigid part (a turn about the
 vertical through the clip's first pelvis, and a shift) as a turn and a shift, what is left
 of the posture as an offset (offset blending, as at the junctions of the pipeline).
-The executor is duck-compatible with :class:`~ltl_human_motion.ros.playback.Playback`
+The executor is duck-compatible with :class:`~ltl_human_motion.planning.playback.Playback`
 where an occupancy stream reads it
 (``state``, ``stature``, ``motion_id``, ``positions_ahead``, ``sample_ahead``).
 """

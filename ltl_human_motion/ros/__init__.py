@@ -14,9 +14,10 @@ This package is the only place in ``ltl_human_motion`` that imports ``rclpy``. M
 * :mod:`~ltl_human_motion.ros.hri` -- the REP 155 body interface;
   :mod:`~ltl_human_motion.ros.diagnostics` -- ``/diagnostics`` of the nodes;
   :mod:`~ltl_human_motion.ros.ur_frames` -- the arm's TF frames as ur_description has them.
-* :mod:`~ltl_human_motion.ros.playback`, :mod:`~ltl_human_motion.ros.motion_store` and
-  :mod:`~ltl_human_motion.ros.bringup_config` are plain Python (no rclpy import), so
-  launch files and tools can use them without a ROS context.
+* :mod:`~ltl_human_motion.ros.launch_support` -- plain Python (no rclpy import) for launch
+  files and tools: the bringup file's node set, the launch description, middleware
+  defaults. The playback clock and the motion store the nodes share are core modules
+  (:mod:`~ltl_human_motion.planning.playback`, :mod:`~ltl_human_motion.planning.motion_store`).
 
 Importing this package itself imports nothing from ROS.
 """

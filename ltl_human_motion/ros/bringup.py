@@ -1,7 +1,8 @@
 """Start a whole node set in one process (one multi-threaded executor), optionally recording.
 
-``Bringup`` reads a bringup file (:mod:`~ltl_human_motion.ros.bringup_config`), hands it
-to its rclpy context as ``--params-file`` (as ``ros2 launch`` does for each node), and
+``Bringup`` reads a bringup file
+(:mod:`~ltl_human_motion.ros.launch_support.bringup_config`), hands it to its rclpy
+context as ``--params-file`` (as ``ros2 launch`` does for each node), and
 creates the nodes it lists. In one process the nodes share state instead of copying it:
 the synthesis node's :class:`MotionStore` is the players' store, and each human's skeleton
 publisher and occupancy node share one :class:`Playback` clock.
@@ -22,7 +23,10 @@ from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from ltl_human_motion.ros.bringup_config import (
+from ltl_human_motion.planning.motion_store import MotionStore
+from ltl_human_motion.planning.playback import Playback
+from ltl_human_motion.ros.common import SpinThread
+from ltl_human_motion.ros.launch_support.bringup_config import (
     BringupConfig,
     NodeSpec,
     check_namespace,
@@ -30,11 +34,8 @@ from ltl_human_motion.ros.bringup_config import (
     namespace_overrides,
     node_namespace,
 )
-from ltl_human_motion.ros.common import SpinThread
-from ltl_human_motion.ros.middleware import apply_middleware_defaults
-from ltl_human_motion.ros.motion_store import MotionStore
+from ltl_human_motion.ros.launch_support.middleware import apply_middleware_defaults
 from ltl_human_motion.ros.occupancy_node import STREAM_SWITCH_INTERVAL, OccupancyNode
-from ltl_human_motion.ros.playback import Playback
 from ltl_human_motion.ros.recorder import Recorder
 from ltl_human_motion.ros.skeleton_publisher import SkeletonPublisher
 from ltl_human_motion.ros.synthesis_node import SynthesisNode
@@ -58,7 +59,7 @@ class Bringup:
     namespace : str, optional
         Run the node set under this namespace ('' = none), as the launch argument
         ``namespace:=`` does: its own catalog and marker topics move with it
-        (:func:`~ltl_human_motion.ros.bringup_config.namespace_overrides`); TF,
+        (:func:`~ltl_human_motion.ros.launch_support.bringup_config.namespace_overrides`); TF,
         ``/humans/...``, ``/joint_states`` and ``/diagnostics`` stay global.
     use_sim_time : bool, optional
         Every node on ``/clock`` (True) or the system clock (False), as the launch argument

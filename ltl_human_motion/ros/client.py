@@ -21,7 +21,7 @@ from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message
 
 from ltl_human_motion.ros.common import STREAM_QOS, SpinThread
-from ltl_human_motion.ros.middleware import apply_middleware_defaults
+from ltl_human_motion.ros.launch_support.middleware import apply_middleware_defaults
 
 
 def call_service(client: Client, request: Any, timeout: float,

@@ -97,6 +97,7 @@ from ltl_human_motion.robot.kinematics import (
     ur_model,
 )
 from ltl_human_motion.robot.metrics import DecisionRecorder, write_commissioning_report
+from ltl_human_motion.robot.rtde_probe import probed_factories
 from ltl_human_motion.robot.ssm import SLIDER_MIN, SSMParameters
 from ltl_human_motion.ros import conversions as cv
 from ltl_human_motion.ros import ur_frames
@@ -112,7 +113,6 @@ from ltl_human_motion.ros.params import (
     positive,
     topic_name,
 )
-from ltl_human_motion.ros.rtde_probe import probed_factories
 
 __all__ = ["CONTROL_SWITCH_INTERVAL", "OCCUPANCY_TYPE", "UR_JOINT_NAMES", "CoexistenceNode",
            "OccupancySample", "coexistence_parameters", "decode_human_occupancy",

@@ -21,9 +21,9 @@ from visualization_msgs.msg import MarkerArray
 
 from ltl_human_motion.atomic import atomic_write_text
 from ltl_human_motion.msg import HumanOccupancy, TaskState
+from ltl_human_motion.planning.playback import FINISHED
 from ltl_human_motion.ros.bringup import Bringup
 from ltl_human_motion.ros.client import ClientSession
-from ltl_human_motion.ros.playback import FINISHED
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion
 
 

@@ -52,7 +52,7 @@ def _run_node(factory: Callable[[], Node], args: list[str] | None,
     from rclpy.executors import ExternalShutdownException
 
     from ltl_human_motion.ros.common import DEFAULT_EXECUTOR_THREADS, spin_nodes
-    from ltl_human_motion.ros.middleware import apply_middleware_defaults
+    from ltl_human_motion.ros.launch_support.middleware import apply_middleware_defaults
 
     exit_without_final_collection()
     apply_middleware_defaults()

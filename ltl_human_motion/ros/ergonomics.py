@@ -10,7 +10,7 @@ text on ``markers_topic`` (``/ergonomics_markers``), so an operator sees a red p
 in RViz as it happens.
 
 Playback clock as for the occupancy node: in one process (``ltl-human-motion bringup``)
-it shares the skeleton publisher's :class:`~ltl_human_motion.ros.playback.Playback`;
+it shares the skeleton publisher's :class:`~ltl_human_motion.planning.playback.Playback`;
 alone, it follows ``task_state`` and loads the motion by id from the catalog's folder.
 Scores are computed once per motion (:func:`ltl_human_motion.assess.assess_motion`,
 part masses from the ``cell`` parameter) and looked up per frame.
@@ -36,9 +36,10 @@ from ltl_human_motion.assess import rula as rula_mod
 from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.msg import ErgonomicsState
+from ltl_human_motion.planning.motion_store import MotionStore
+from ltl_human_motion.planning.playback import Playback
 from ltl_human_motion.ros import conversions as cv
 from ltl_human_motion.ros.common import STREAM_QOS
-from ltl_human_motion.ros.motion_store import MotionStore
 from ltl_human_motion.ros.params import (
     ParamSpec,
     declare_parameters,
@@ -47,7 +48,6 @@ from ltl_human_motion.ros.params import (
     positive,
     topic_name,
 )
-from ltl_human_motion.ros.playback import Playback
 from ltl_human_motion.ros.playback_follower import PlaybackFollower
 from ltl_human_motion.scene.cell import Cell
 

@@ -54,9 +54,9 @@ from std_msgs.msg import String
 
 from ltl_human_motion.motion import urdf
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton
+from ltl_human_motion.planning.playback import Frame, Playback
 from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS
 from ltl_human_motion.ros.params import declare_or_set_string
-from ltl_human_motion.ros.playback import Frame, Playback
 
 BODIES = "/humans/bodies"
 TRACKED_TOPIC = f"{BODIES}/tracked"

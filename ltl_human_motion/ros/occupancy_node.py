@@ -13,7 +13,7 @@ offer this, and a robot controller can use it to slow down early. With ``marker_
 Playback clock, so the occupancy never drifts from the skeleton shown on TF:
 
 * In one process (``ltl-human-motion bringup``) the node shares the skeleton publisher's
-  :class:`~ltl_human_motion.ros.playback.Playback` object.
+  :class:`~ltl_human_motion.planning.playback.Playback` object.
 * Standing alone, it follows the skeleton publisher's ``task_state`` topic (same
   namespace): each message gives motion id, motion time at its stamp, rate, loop and
   state; the node re-anchors its own playback on it and extrapolates in between. The
@@ -52,10 +52,11 @@ from rclpy.parameter import Parameter
 from visualization_msgs.msg import MarkerArray
 
 from ltl_human_motion.msg import HumanOccupancy
+from ltl_human_motion.planning.motion_store import MotionStore
+from ltl_human_motion.planning.playback import Playback
 from ltl_human_motion.ros import conversions as cv
 from ltl_human_motion.ros.common import STREAM_QOS
 from ltl_human_motion.ros.diagnostics import OK, WARN, Status, attach_diagnostics
-from ltl_human_motion.ros.motion_store import MotionStore
 from ltl_human_motion.ros.occupancy_cdr import capsule_rows, encode_occupancy_rows
 from ltl_human_motion.ros.params import (
     ParamSpec,
@@ -67,7 +68,6 @@ from ltl_human_motion.ros.params import (
     positive,
     topic_name,
 )
-from ltl_human_motion.ros.playback import Playback
 from ltl_human_motion.ros.playback_follower import PlaybackFollower
 from ltl_human_motion.ros.wall_schedule import WallSchedule
 

@@ -1,7 +1,7 @@
 """The playback a stream node (occupancy, ergonomics) reads.
 
 In one process with the skeleton publisher (``ltl-human-motion bringup``) the node shares
-the publisher's :class:`~ltl_human_motion.ros.playback.Playback`. Standing alone it keeps
+the publisher's :class:`~ltl_human_motion.planning.playback.Playback`. Standing alone it keeps
 its own in step with the publisher's ``task_state`` topic, loading each motion by id from
 its store or from the folder the latched motion catalog names.
 """
@@ -13,9 +13,9 @@ import gc
 from rclpy.node import Node
 
 from ltl_human_motion.msg import MotionCatalog, TaskState
+from ltl_human_motion.planning.motion_store import MotionSource, MotionStore
+from ltl_human_motion.planning.playback import STATES, STOPPED, Playback
 from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS, now_seconds, stamp_seconds
-from ltl_human_motion.ros.motion_store import MotionSource, MotionStore
-from ltl_human_motion.ros.playback import STATES, STOPPED, Playback
 
 __all__ = ["PlaybackFollower"]
 

@@ -41,11 +41,11 @@ from sensor_msgs.msg import JointState
 
 from ltl_human_motion.atomic import atomic_write_text
 from ltl_human_motion.msg import TaskState
+from ltl_human_motion.planning.motion_store import MotionStore
 from ltl_human_motion.ros.client import ClientSession, wait_until
 from ltl_human_motion.ros.coexistence_node import UR_JOINT_NAMES
 from ltl_human_motion.ros.common import STREAM_QOS, SpinThread, stamp_seconds
-from ltl_human_motion.ros.middleware import apply_middleware_defaults
-from ltl_human_motion.ros.motion_store import MotionStore
+from ltl_human_motion.ros.launch_support.middleware import apply_middleware_defaults
 from ltl_human_motion.ros.reactive_player import ReactivePlayer
 from ltl_human_motion.ros.synthesis_node import SynthesisNode
 from ltl_human_motion.srv import PlayMotion, SynthesizeMotion

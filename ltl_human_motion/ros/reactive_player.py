@@ -54,6 +54,7 @@ from visualization_msgs.msg import MarkerArray
 from ltl_human_motion.errors import LtlHumanMotionError
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, PARENTS
 from ltl_human_motion.msg import TaskState
+from ltl_human_motion.planning.motion_store import default_store_dir
 from ltl_human_motion.planning.strategy_executor import (
     LiveFrame,
     StrategyExecutor,
@@ -65,7 +66,6 @@ from ltl_human_motion.robot.kinematics import pose_from_xyz_rpy, ur_model
 from ltl_human_motion.ros import conversions as cv
 from ltl_human_motion.ros.coexistence_node import UR_JOINT_NAMES, coexistence_parameters
 from ltl_human_motion.ros.common import STREAM_QOS, TF_QOS, now_seconds, resolve_cell
-from ltl_human_motion.ros.motion_store import default_store_dir
 from ltl_human_motion.ros.params import (
     ParamSpec,
     declare_parameters,

@@ -28,7 +28,7 @@ Publishes, at ``publish_rate`` (stamps and playback time come from the node cloc
 
 Service ``play_motion`` (ltl_human_motion/srv/PlayMotion): ``play`` (motion_id, loop,
 rate), ``stop``, ``pause``, ``resume``. Motions come from the shared
-:class:`~ltl_human_motion.ros.motion_store.MotionStore` (same process) or from the
+:class:`~ltl_human_motion.planning.motion_store.MotionStore` (same process) or from the
 folder announced on ``catalog_topic`` (``/motion_catalog``) by the synthesis node.
 
 Parameters: ``human_id`` ("1"), ``world_frame`` ("world"), ``publish_rate`` (30.0 Hz),
@@ -54,6 +54,8 @@ from visualization_msgs.msg import MarkerArray
 
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, PARENTS
 from ltl_human_motion.msg import MotionCatalog, TaskState
+from ltl_human_motion.planning.motion_store import MotionSource, MotionStore, check_motion_id
+from ltl_human_motion.planning.playback import PLAYING, STOPPED, Frame, Playback
 from ltl_human_motion.ros import conversions as cv
 from ltl_human_motion.ros.common import (
     LATCHED_QOS,
@@ -65,7 +67,6 @@ from ltl_human_motion.ros.common import (
 )
 from ltl_human_motion.ros.diagnostics import OK, Status, attach_diagnostics
 from ltl_human_motion.ros.hri import BodyInterface
-from ltl_human_motion.ros.motion_store import MotionSource, MotionStore, check_motion_id
 from ltl_human_motion.ros.params import (
     ParamSpec,
     declare_parameters,
@@ -75,7 +76,6 @@ from ltl_human_motion.ros.params import (
     positive,
     topic_name,
 )
-from ltl_human_motion.ros.playback import PLAYING, STOPPED, Frame, Playback
 from ltl_human_motion.srv import PlayMotion
 
 _BONE_PAIRS = np.array([(p, j) for j, p in enumerate(PARENTS) if p >= 0])

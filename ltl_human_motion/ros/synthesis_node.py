@@ -31,7 +31,7 @@ Errors the user caused (any ``LtlHumanMotionError`` or ``ValueError``, e.g. a
 ``error_line``/``error_column``; anything unexpected is logged with its traceback and
 also returned as ``success=false``. The node keeps serving either way.
 
-Motions go into a :class:`~ltl_human_motion.ros.motion_store.MotionStore`: in memory up
+Motions go into a :class:`~ltl_human_motion.planning.motion_store.MotionStore`: in memory up
 to ``max_in_memory`` motions and ``max_memory_mb`` MB (older ones are evicted to
 ``<store_dir>/<id>.npz``, where every motion is saved), and the ids are announced on the
 latched topic ``motion_catalog`` (ltl_human_motion/msg/MotionCatalog). ``store_dir`` ""
@@ -82,11 +82,11 @@ from ltl_human_motion.errors import LtlHumanMotionError, SpecError
 from ltl_human_motion.ltl.limits import MAX_SPEC_CHARS
 from ltl_human_motion.motion.library import MAX_LIBRARY_STATURE, MIN_LIBRARY_STATURE
 from ltl_human_motion.msg import MotionCatalog, PlanningStats
+from ltl_human_motion.planning.motion_store import MotionStore, default_store_dir
+from ltl_human_motion.planning.playback import task_sequence_text
 from ltl_human_motion.ros.common import LATCHED_QOS, resolve_cell
 from ltl_human_motion.ros.diagnostics import OK, WARN, Status, attach_diagnostics
-from ltl_human_motion.ros.motion_store import MotionStore, default_store_dir
 from ltl_human_motion.ros.params import ParamSpec, declare_parameters, positive
-from ltl_human_motion.ros.playback import task_sequence_text
 from ltl_human_motion.ros.reactive_player import strategy_path
 from ltl_human_motion.srv import SynthesizeMotion
 

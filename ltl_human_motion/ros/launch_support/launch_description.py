@@ -3,11 +3,10 @@ only when called, so this module imports without them).
 
 Each node gets the bringup file as ``--params-file``, then a params file with its
 per-node parameters (``human_id``) and the launch arguments of the file
-(:data:`~ltl_human_motion.ros.bringup_config.LAUNCH_ARGUMENTS`), written so that they
-override the bringup file (:func:`~ltl_human_motion.ros.bringup_config.launch_parameters`).
-``namespace:=`` puts every node under a namespace
-(:func:`~ltl_human_motion.ros.bringup_config.node_namespace`) and moves the node set's own
-topics with it (:func:`~ltl_human_motion.ros.bringup_config.namespace_overrides`).
+(:data:`.bringup_config.LAUNCH_ARGUMENTS`), written so that they override the bringup
+file (:func:`.bringup_config.launch_parameters`). ``namespace:=`` puts every node under a
+namespace (:func:`.bringup_config.node_namespace`) and moves the node set's own topics
+with it (:func:`.bringup_config.namespace_overrides`).
 """
 
 from __future__ import annotations
@@ -15,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ltl_human_motion.ros.bringup_config import (
+from ltl_human_motion.ros.launch_support.bringup_config import (
     LAUNCH_ARGUMENTS,
     launch_overrides,
     launch_parameters,

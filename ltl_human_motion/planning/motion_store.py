@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ltl_human_motion.ros.playback import task_sequence_text
+from ltl_human_motion.planning.playback import task_sequence_text
 
 if TYPE_CHECKING:
     from ltl_human_motion.planning.result import SynthesizedMotion

@@ -15,7 +15,7 @@ import os
 from collections.abc import MutableMapping
 from pathlib import Path
 
-FASTDDS_PROFILES_FILE = Path(__file__).with_name("fastdds_profiles.xml")
+FASTDDS_PROFILES_FILE = Path(__file__).parents[1] / "fastdds_profiles.xml"
 
 _PROFILE_VARIABLES = ("FASTDDS_DEFAULT_PROFILES_FILE", "FASTRTPS_DEFAULT_PROFILES_FILE")
 
