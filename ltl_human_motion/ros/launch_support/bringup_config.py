@@ -36,7 +36,7 @@ PACKAGE = "ltl_human_motion"
 NODE_KINDS = ("synthesis_node", "skeleton_publisher", "reactive_player", "occupancy_node",
               "ergonomics_node", "coexistence_node")
 PER_HUMAN = ("skeleton_publisher", "reactive_player", "occupancy_node", "ergonomics_node")
-DEFAULT_CONFIG = Path(__file__).resolve().parents[2] / "config" / "bringup.yaml"
+DEFAULT_CONFIG = Path(__file__).resolve().parents[3] / "config" / "bringup.yaml"
 #: Topic parameters whose absolute defaults wire a node set together, by node kind: the
 #: ``namespace:=`` launch argument moves them into the namespace (:func:`namespace_overrides`).
 SET_TOPICS: dict[str, dict[str, str]] = {

@@ -32,7 +32,7 @@ def default_config(file_name: str) -> str:
         return str(Path(get_package_share_directory("ltl_human_motion")) / "config"
                    / file_name)
     except (ImportError, LookupError):
-        return str(Path(__file__).resolve().parents[2] / "config" / file_name)
+        return str(Path(__file__).resolve().parents[3] / "config" / file_name)
 
 
 def node_set_description(stem: str, config_file: str) -> Any:
