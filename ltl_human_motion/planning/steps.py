@@ -17,6 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import (
@@ -115,7 +116,7 @@ MAX_REROUTES = 2
 
 #: Arm transitions by (stances, stature, rate, blend, carrying before) (see
 #: :meth:`StepExecutor.arm_poses`).
-_ARM_POSES: dict[tuple, np.ndarray] = {}
+_ARM_POSES: BoundedCache[np.ndarray] = BoundedCache(32)
 
 #: How much further back than the ideal spot a standing adjustment may stand when the
 #: step there would touch an obstacle, metres, tried in order (up to a short step).
@@ -289,21 +290,20 @@ class StepExecutor:
         key = (self.ctx.stance(False).tobytes(), self.ctx.stance(True).tobytes(),
                self.ctx.stature, self.ctx.library.fps, self.ctx.overlap,
                bool(carrying_before))
-        hit = _ARM_POSES.get(key)
-        if hit is not None:
-            return hit
-        a, b = self.ctx.stance(carrying_before), self.ctx.stance(not carrying_before)
-        rel = arm_transition_poses(a, b, self.ctx.library.skeleton, self.ctx.library.fps)
-        if len(rel) < self.ctx.overlap + 2:
-            rel = np.concatenate([rel, np.repeat(rel[-1:], self.ctx.overlap + 2 - len(rel), 0)])
-        # The pipeline restores bone lengths after blending, so the transition is checked
-        # as it will be played.
-        rel = enforce_bone_lengths(rel, self.ctx.library.skeleton, rigid_hips=False)
-        rel.flags.writeable = False
-        if len(_ARM_POSES) >= 32:
-            _ARM_POSES.clear()
-        _ARM_POSES[key] = rel
-        return rel
+
+        def build() -> np.ndarray:
+            a, b = self.ctx.stance(carrying_before), self.ctx.stance(not carrying_before)
+            rel = arm_transition_poses(a, b, self.ctx.library.skeleton, self.ctx.library.fps)
+            if len(rel) < self.ctx.overlap + 2:
+                rel = np.concatenate([rel, np.repeat(rel[-1:], self.ctx.overlap + 2 - len(rel),
+                                                     0)])
+            # The pipeline restores bone lengths after blending, so the transition is
+            # checked as it will be played.
+            rel = enforce_bone_lengths(rel, self.ctx.library.skeleton, rigid_hips=False)
+            rel.flags.writeable = False
+            return rel
+
+        return _ARM_POSES.get_or_build(key, build)
 
     def placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = None,
                      world: np.ndarray | None = None) -> bool:
