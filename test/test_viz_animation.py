@@ -73,3 +73,20 @@ def test_bad_arguments_and_missing_pillow(synth, paper, tmp_path, monkeypatch):
     with pytest.raises(MissingDependencyError, match="pip install pillow"):
         render_animation(synth, paper, tmp_path / "c.gif")
     assert not (tmp_path / "c.gif").exists()
+
+
+def test_the_camera_turns_to_see_a_machine_tender_in_front_of_the_machine():
+    """The default view looks at a worker at a machine's door from behind the machine;
+    the chosen azimuth sees every task position (pelvis, head, hands) unhidden."""
+    from ltl_human_motion.planning import synthesize
+    from ltl_human_motion.scenarios.unseen import build_cell
+    from ltl_human_motion.scene.cell_yaml import cell_from_yaml
+    from ltl_human_motion.viz.render import VIEW_AZIMUTHS, clear_view_azimuth
+    built = build_cell("chamber", 0, 1)
+    cell = cell_from_yaml(built.yaml, source=built.name)
+    motion = synthesize("F extract(done, vise_a)", cell, stature=1.75)[0]
+    azim = clear_view_azimuth(motion, cell)
+    assert azim in VIEW_AZIMUTHS and azim != VIEW_AZIMUTHS[0]
+    # the worker stands in front of the door: the camera is on the door's side
+    door = np.asarray(cell.obstacles[0].aabb()[1])[1]         # the machine's front face (y)
+    assert np.sin(np.radians(azim)) > 0.0 and motion.positions[:, 0, 1].max() > door

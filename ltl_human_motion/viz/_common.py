@@ -216,10 +216,14 @@ def box_triangles(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 
 
 def draw_static_cell(ax, cell: Cell, lo: np.ndarray, hi: np.ndarray, labels: bool = True,
-                     grid: float | None = None) -> CellLines:
+                     grid: float | None = None, solids_out: list | None = None) -> CellLines:
     """Floor, obstacles (solid), supports, regions (wire boxes) of ``cell`` on 3D axes ``ax``.
 
     ``grid``: spacing of floor grid lines in metres (for axes drawn without ticks).
+    ``solids_out``: a list that receives the obstacles' and supports' faces as
+    (triangles (F, 3, 3), RGBA (F, 4)) instead of drawing them, for the caller to draw in
+    one collection with the worker (mplot3d orders whole collections by depth: a machine
+    drawn as its own collection was painted over the worker standing in front of it).
     The line work (floor outline, grid, region edges) is returned as a
     :class:`~ltl_human_motion.viz.lines.CellLines`: add more lines to it (a path), then
     call its ``update`` with the worker before the figure is drawn, so that no line is
@@ -228,16 +232,18 @@ def draw_static_cell(ax, cell: Cell, lo: np.ndarray, hi: np.ndarray, labels: boo
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
     z = cell.floor_z
     solids = []
-    for ob in cell.obstacles:
-        tri = np.asarray(ob.to_trimesh().triangles)
+    faces = [(np.asarray(ob.to_trimesh().triangles), ob.color or "0.5", 0.9)
+             for ob in cell.obstacles]
+    faces += [(box_triangles(s_lo, s_hi), SUPPORT_COLOR, 1.0)
+              for s_lo, s_hi in object_supports(cell)]
+    for tri, color, alpha in faces:
         solids.append(tri)
-        ax.add_collection3d(Poly3DCollection(tri, facecolors=shaded(tri, ob.color or "0.5"),
-                                             edgecolors="none", alpha=0.9))
-    for s_lo, s_hi in object_supports(cell):
-        tri = box_triangles(s_lo, s_hi)
-        solids.append(tri)
-        ax.add_collection3d(Poly3DCollection(tri, facecolors=shaded(tri, SUPPORT_COLOR),
-                                             edgecolors="none"))
+        rgba = shaded(tri, color)
+        rgba[:, 3] = alpha
+        if solids_out is not None:
+            solids_out.append((tri, rgba))
+        else:
+            ax.add_collection3d(Poly3DCollection(tri, facecolors=rgba, edgecolors="none"))
     lines = CellLines(ax, np.concatenate(solids) if solids else np.zeros((0, 3, 3)))
     # The floor is an outline, not a filled polygon: mplot3d sorts whole collections by
     # depth, and a big floor would be painted over the worker's legs.

@@ -33,7 +33,7 @@ from ltl_human_motion.viz._common import (
     shaded,
 )
 
-__all__ = ["render_animation", "render_snapshots", "task_snapshot_times"]
+__all__ = ["clear_view_azimuth", "render_animation", "render_snapshots", "task_snapshot_times"]
 
 
 def _frame_title(synth: SynthesizedMotion, frame: int) -> str:
@@ -102,6 +102,63 @@ def task_snapshot_times(synth: SynthesizedMotion, max_panels: int = 9) -> list[f
     return sorted({0.0, *(round(t, 2) for t in mids)})[:max_panels]
 
 
+#: Azimuths (deg) :func:`clear_view_azimuth` chooses from, the default view first, and the
+#: camera's distance (m) along which an obstacle counts as hiding the worker.
+VIEW_AZIMUTHS = tuple(-125.0 + 30.0 * k for k in range(12))
+_VIEW_REACH = 6.0
+
+
+def clear_view_azimuth(synth: SynthesizedMotion, cell: Cell, elev: float = 20.0) -> float:
+    """The view azimuth (deg, matplotlib's) from which the fewest of the worker's pelvis,
+    head and hand positions during its tasks are hidden by an obstacle, of
+    :data:`VIEW_AZIMUTHS` (the default view where it hides none; ties go to the one
+    nearest it): a fixed camera looked at a machine tender's back through the machine.
+    Each point is hidden where the straight line from it towards the camera passes
+    through an obstacle part's box."""
+    if not cell.obstacles:
+        return VIEW_AZIMUTHS[0]
+    working = np.flatnonzero(np.asarray(synth.task_index) >= 0)
+    frames = working if working.size else np.arange(synth.n_frames)
+    frames = frames[np.linspace(0, len(frames) - 1, min(len(frames), 60)).astype(int)]
+    pts = synth.positions[frames][:, [0, 4, 9, 14]].reshape(-1, 3)     # (N, 3)
+    lo, hi = cell.part_set.lo, cell.part_set.hi                          # (P, 3)
+    e = np.radians(elev)
+    hidden = []
+    for azim in VIEW_AZIMUTHS:
+        a = np.radians(azim)
+        d = np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t1 = (lo[None] - pts[:, None]) / d                           # (N, P, 3)
+            t2 = (hi[None] - pts[:, None]) / d
+        near = np.nanmax(np.minimum(t1, t2), axis=2)
+        far = np.nanmin(np.maximum(t1, t2), axis=2)
+        hit = (near <= far) & (far > 0.0) & (near < _VIEW_REACH)
+        hidden.append(int(hit.any(axis=1).sum()))
+    return VIEW_AZIMUTHS[int(np.argmin(hidden))]
+
+
+def _one_collection(faces: list[tuple[np.ndarray, np.ndarray]]):
+    """One collection of faces [(triangles (F, 3, 3), RGBA (F, 4)), ...], ordered by depth
+    face by face (edges in the face colour hide the seams between faces)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    tri, rgba = _joined(faces)
+    return Poly3DCollection(tri, facecolors=rgba, edgecolors=rgba, linewidths=0.3)
+
+
+def _joined(faces: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+    """The faces' triangles (F, 3, 3) and RGBA (F, 4) in one pair of arrays."""
+    if not faces:
+        return np.zeros((0, 3, 3)), np.zeros((0, 4))
+    return np.concatenate([f[0] for f in faces]), np.concatenate([f[1] for f in faces])
+
+
+def _part_faces(tri: np.ndarray, color: str) -> tuple[np.ndarray, np.ndarray]:
+    """A part's faces, shaded and darker than the furniture it rests on (F, 3, 3), (F, 4)."""
+    rgba = shaded(tri, color)
+    rgba[:, :3] *= 0.85
+    return tri, rgba
+
+
 def _stack(polys: dict[str, np.ndarray]) -> np.ndarray:
     """All objects' triangles in one array, shape (F, 3, 3)."""
     return np.concatenate(list(polys.values())) if polys else np.zeros((0, 3, 3))
@@ -109,7 +166,7 @@ def _stack(polys: dict[str, np.ndarray]) -> np.ndarray:
 
 def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float],
                      path: PathLike, ncols: int = 3, capsules: bool = True,
-                     elev: float = 20.0, azim: float = -125.0, dpi: float = 110.0,
+                     elev: float = 20.0, azim: float | None = None, dpi: float = 110.0,
                      body: str = "shaded", panel_size: tuple[float, float] = (4.0, 3.6),
                      title: str | None = None) -> None:
     """Several 3D panels of the worker in the cell at the given times (paper Fig. 2).
@@ -127,7 +184,7 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
     capsules : bool
         With ``body="stick"``: draw the occupancy capsules in addition to the bones.
     elev, azim : float
-        View angles in degrees.
+        View angles in degrees (``azim`` None: :func:`clear_view_azimuth`).
     dpi : float
     body : {"shaded", "stick"}
         A shaded body (default) or the stick figure.
@@ -136,7 +193,6 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
     title : str, optional
         A line above the panels (e.g. the specification and the task sequence).
     """
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
     _check_body(body)
     times = list(times)
     if not times:
@@ -147,6 +203,7 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
     nrows = -(-len(times) // ncols)
     if panel_size[0] <= 0 or panel_size[1] <= 0:
         raise ValueError(f"panel_size must be positive, got {panel_size}")
+    azim = clear_view_azimuth(synth, cell, elev) if azim is None else float(azim)
     fig = new_figure(panel_size[0] * ncols, panel_size[1] * nrows, dpi)
     lo, hi = cell_bounds(cell, synth.positions[:, [0, 4, 9, 14]].reshape(-1, 3))
     path_segments = _path_segments(synth, cell.floor_z + 0.005)
@@ -154,14 +211,18 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
         frame = synth.frame_at(time)
         ax = fig.add_subplot(nrows, ncols, k + 1, projection="3d")
         setup_axes3d(ax, lo, hi, elev, azim)
-        lines = draw_static_cell(ax, cell, lo, hi)
+        solids: list = []
+        lines = draw_static_cell(ax, cell, lo, hi, solids_out=solids)
         lines.add(path_segments, "0.55", 0.6, ":")
         polys = object_polys(cell, synth.objects_at(frame))
-        for name, tri in polys.items():
-            color = cell.objects[name].color or "tab:orange"
-            ax.add_collection3d(Poly3DCollection(tri, facecolors=shaded(tri, color),
-                                                 edgecolors="k", linewidths=0.2))
-        _draw_worker(ax, synth, frame, capsules, body)
+        solids += [_part_faces(tri, cell.objects[name].color or "tab:orange")
+                   for name, tri in polys.items()]
+        if body == "shaded":
+            solids.append(body_triangles(synth.positions[frame],
+                                         synth.motion.skeleton.stature))
+        ax.add_collection3d(_one_collection(solids))
+        if body != "shaded":
+            _draw_worker(ax, synth, frame, capsules, body)
         lines.update(_occluding_capsules(synth, frame, body), _stack(polys))
         ax.set_title(_frame_title(synth, frame), fontsize=8)
     top = 0.95
@@ -174,7 +235,7 @@ def render_snapshots(synth: SynthesizedMotion, cell: Cell, times: Sequence[float
 
 def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: float = 15.0,
                      capsules: bool = False, size: tuple[float, float] = (10.0, 7.5),
-                     dpi: float = 80.0, elev: float = 20.0, azim: float = -125.0,
+                     dpi: float = 80.0, elev: float = 20.0, azim: float | None = None,
                      max_frames: int | None = None, body: str = "shaded") -> int:
     """Write an animated GIF of the motion (offscreen, no display needed).
 
@@ -196,6 +257,7 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
         Figure size in inches (the default, at ``dpi`` 80, makes 800 x 600 pixels).
     dpi : float
     elev, azim : float
+        View angles in degrees (``azim`` None: :func:`clear_view_azimuth`).
     max_frames : int, optional
         Cap on the number of GIF frames (the frame rate is lowered to fit).
     body : {"shaded", "stick"}
@@ -225,21 +287,21 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
     frames = np.clip(np.round(np.arange(n_out) / fps * synth.fps).astype(int), 0,
                      synth.n_frames - 1)
 
+    azim = clear_view_azimuth(synth, cell, elev) if azim is None else float(azim)
     fig = new_figure(size[0], size[1], dpi)
     ax = fig.add_subplot(1, 1, 1, projection="3d")
     lo, hi = cell_bounds(cell, synth.positions[:, [0, 4, 9, 14]].reshape(-1, 3))
     setup_axes3d(ax, lo, hi, elev, azim, zoom=_GIF_ZOOM)
     ax.set_axis_off()                  # ticks and panes cost most of the drawing time
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.94)
-    lines = draw_static_cell(ax, cell, lo, hi, grid=0.5)
+    solids: list = []
+    lines = draw_static_cell(ax, cell, lo, hi, grid=0.5, solids_out=solids)
     lines.add(_path_segments(synth, cell.floor_z + 0.005), "0.55", 0.6, ":")
     stature = synth.motion.skeleton.stature
-    bones = shell = None
-    if body == "shaded":
-        tri, rgba = body_triangles(synth.positions[0], stature, detail=_GIF_DETAIL)
-        shell = Poly3DCollection(tri, facecolors=rgba, edgecolors=rgba, linewidths=0.3)
-        ax.add_collection3d(shell)
-    else:
+    bones = None
+    shell = _one_collection(solids)
+    ax.add_collection3d(shell)
+    if body != "shaded":
         bones = Line3DCollection(bone_segments(synth.positions[0]), colors="#1f3b73",
                                  linewidths=1.8)
         ax.add_collection3d(bones)
@@ -248,35 +310,31 @@ def render_animation(synth: SynthesizedMotion, cell: Cell, path: PathLike, fps: 
         caps = Poly3DCollection(body_quads(synth.positions[0], stature),
                                 facecolors="#4a90d9", edgecolors="none", alpha=0.35)
         ax.add_collection3d(caps)
-    obj_artists = {}
     base = object_polys(cell)
-    for name, tri in base.items():
-        art = Poly3DCollection(tri, facecolors=shaded(tri, cell.objects[name].color
-                                                      or "tab:orange"),
-                               edgecolors="k", linewidths=0.2)
-        ax.add_collection3d(art)
-        obj_artists[name] = art
+    base_rgba = {name: _part_faces(tri, cell.objects[name].color or "tab:orange")[1]
+                 for name, tri in base.items()}
     title = ax.set_title("", fontsize=9)
     canvas = fig.canvas
     images = []
     palette = None
     for frame in frames:
         pose = synth.positions[frame]
-        if shell is not None:
-            tri, rgba = body_triangles(pose, stature, detail=_GIF_DETAIL)
-            shell.set_verts(tri)
-            shell.set_facecolor(rgba)
-            shell.set_edgecolor(rgba)
+        moved = dict(base)
+        for name in base:
+            if name in synth.objects:
+                moved[name] = base[name] + (synth.objects[name][frame]
+                                            - cell.objects[name].position)
+        faces = solids + [(moved[name], base_rgba[name]) for name in base]
+        if body == "shaded":
+            faces.append(body_triangles(pose, stature, detail=_GIF_DETAIL))
+        tri, rgba = _joined(faces)
+        shell.set_verts(tri)
+        shell.set_facecolor(rgba)
+        shell.set_edgecolor(rgba)
         if bones is not None:
             bones.set_segments(bone_segments(pose))
         if caps is not None:
             caps.set_verts(body_quads(pose, stature))
-        moved = dict(base)
-        for name, art in obj_artists.items():
-            if name in synth.objects:
-                shift = synth.objects[name][frame] - cell.objects[name].position
-                moved[name] = base[name] + shift
-                art.set_verts(moved[name])
         lines.update(_occluding_capsules(synth, int(frame), body), _stack(moved))
         title.set_text(_frame_title(synth, int(frame)))
         canvas.draw()
