@@ -134,7 +134,8 @@ def _aisle_planner(failed: dict | None = None):
     cell = resolve_cell(AISLE)
     planner = SequencePlanner(cell.floor_at_zero(), get_library(1.75),
                               np.random.default_rng([0, 0]),
-                              PlannerOptions(refuse_self_penetration=True), failed_before=failed)
+                              PlannerOptions(refuse_self_penetration=True, whole_body=False),
+                              failed_before=failed)
     return cell, planner
 
 
@@ -145,7 +146,8 @@ def _steps(cell, texts: list[tuple[str, tuple[str, ...]]]):
 
 def test_a_step_that_failed_in_the_same_situation_fails_without_a_search() -> None:
     """Holding O1 in the right hand, a 1.75 m worker coming from the aisle's end finds no
-    grasp of O2 on the knee board (every motion hits the rack above); another order
+    grasp of O2 on the knee board without the whole-body program (every goal model's
+    motion hits the rack above; the program, off here, finds one); another order
     that comes to it the same way fails the same way at once, its earlier steps planned
     as before. The hand that holds O1 is part of the situation."""
     tail = [("grasp", ("O1",)), ("walk", ("R1",)), ("grasp", ("O2",))]

@@ -2,7 +2,9 @@
 as a user runs them (unseen-style cells of :mod:`ltl_human_motion.scenarios.unseen`,
 the biomechanical checks on, every frame checked): a machine chamber's insert and
 extract at three statures, the part taken out without passing through the chamber's
-floor, and a part too wide for the door refused before planning."""
+floor, a part too wide for the door refused before planning, a two-handed carton lifted
+off a stand and over a packing table's top, and a part put into the near side of a
+machine bay whose middle no one reaches."""
 
 from __future__ import annotations
 
@@ -57,3 +59,40 @@ def test_a_part_wider_than_the_door_is_refused_before_planning():
     assert step_problems(cell, [("move", ("blank", "R_bay"))], 1.75) == []
     with pytest.raises(PlanningError, match="wide enough"):
         synthesize("F move(casting, R_bay)", cell, stature=1.75)
+
+
+@pytest.mark.parametrize("stature", [1.55, 1.75])
+def test_chamber_extract_from_close_with_the_arms_down(stature):
+    """The second chamber: the vise 0.35 m behind the door's sill, which the raised arms
+    hit from where the reach is possible; the hand comes up in front of the sill and in
+    over it (before: every placement was out of reach or blocked)."""
+    motion = _verified("F extract(done, vise_a)", _cell("chamber", 1), stature)
+    track = np.asarray(motion.objects["done"])
+    assert np.isfinite(track).all(axis=1).any()
+
+
+def test_a_part_goes_into_the_near_side_of_a_deep_bay():
+    """R_bay's middle lies 0.47 m behind the machine's front: the part is put inside the
+    bay near its door (where the worker reaches), not at the middle nor through a side
+    wall."""
+    cell = _cell("chamber", 1)
+    motion = _verified("F move(blank, R_bay)", cell, 1.55)
+    track = np.asarray(motion.objects["blank"])
+    rest = track[np.isfinite(track).all(axis=1)][-1]
+    region = cell.region("R_bay")
+    assert np.all(rest >= np.asarray(region.lo)) and np.all(rest <= np.asarray(region.hi))
+    assert rest[1] > np.mean([region.lo[1], region.hi[1]])       # nearer the door
+
+
+@pytest.mark.parametrize("stature", [1.55, 1.75])
+def test_a_carton_is_lifted_off_its_stand_and_over_the_packing_table(stature):
+    """A two-handed carton on a stand higher than the carry stance holds its bottom is
+    lifted off and stepped back from, then lifted over the packing table's top before the
+    last step in: the carton never meets the stand or the table, and rests in R_pack."""
+    cell = _cell("twohanded", 1)
+    motion = _verified("F(grasp(carton) & F(move(carton, R_pack)))", cell, stature)
+    track = np.asarray(motion.objects["carton"])
+    track = track[np.isfinite(track).all(axis=1)]
+    assert object_clearance(cell, "carton", track).min() >= 0.0
+    region = cell.region("R_pack")
+    assert np.all(track[-1] >= np.asarray(region.lo)) and np.all(track[-1] <= np.asarray(region.hi))

@@ -29,9 +29,17 @@ from ltl_human_motion.motion.goals import (
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import AT_GOAL_NODES, Goal, SearchBudget
+from ltl_human_motion.planning.lift_in import (
+    lift_for_grasp,
+    lift_in,
+    needs_lift,
+    needs_lift_out,
+    settle,
+)
 from ltl_human_motion.planning.plan_state import (
     OTHER_HAND,
     PlanContext,
+    StartArms,
     WorkerState,
     acting_hand,
     grip_frame,
@@ -66,8 +74,10 @@ if TYPE_CHECKING:
 
 #: Blocked goal primitives of a step that the whole-body program remakes, at most.
 WHOLE_BODY_TRIES = 1
-#: Placements (the first of a step's tries, in order) at which the whole-body program
-#: remakes a blocked goal primitive, once every try has failed without it.
+#: Placements at which the whole-body program remakes a blocked goal primitive, once
+#: every try has failed without it: the first ones, in the order tried, where a goal
+#: primitive was made and an obstacle blocked it (where the walk ended out of reach, or
+#: no walk got there, there is nothing to remake).
 WHOLE_BODY_PLACEMENTS = 2
 #: Whole-body programs one plan runs at most (about 0.25 s each): a step that every
 #: placement blocks would otherwise run one per placement.
@@ -244,7 +254,8 @@ class GoalSteps:
                     continue
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
-            clear = self.goal_clear(candidate, grasped)
+            clear = self.goal_clear(candidate, grasped,
+                                    part if kind == "extract" else None)
             through_body = clear and self.ctx.options.refuse_self_penetration \
                 and bool(candidate.meta.get("self_penetrating"))
             if through_body:
@@ -326,6 +337,7 @@ class GoalSteps:
             carry_stance = self.executor.seated_in_carry_stance()
         kwargs = {"rng": self.ctx.rng,
                   "start_pose": self.executor.seated_pose() if seated
+                  else self.state.start_arms.stance if self.state.start_arms is not None
                   else self.ctx.stance(self.state.carrying or carry_stance)}
         hand = acting_hand(self.state, kind, part if kind != "grasp" else grasped)
         if hand is not None:
@@ -353,17 +365,23 @@ class GoalSteps:
         given: the blocked walk to the first placement), with how many other placements
         were tried."""
         first = failure
+        blocked_at: list[int] = []         # placements whose motions an obstacle blocked
         for program in (False, True):
             if program and not (self.ctx.options.whole_body and failure is not None
-                                and failure.reason == "blocked" and self.programs.left > 0):
+                                and self.programs.left > 0 and blocked_at
+                                and (failure.reason == "blocked"
+                                     or failure.reason == "unreachable")):
                 break
-            for k, (target, prepare) in enumerate(
-                    tries[:WHOLE_BODY_PLACEMENTS] if program else tries):
+            order = blocked_at[:WHOLE_BODY_PLACEMENTS] if program else range(len(tries))
+            for k in order:
+                target, prepare = tries[k]
                 mark = self.state.mark()
+                made = False
                 try:
                     walked = prepare() if prepare is not None else 0
                     if callable(target):
                         target = target()          # where the preparation left the worker
+                    made = True
                     seg, mp = self.segment(
                         kind, target, i, text, carry_stance=carrying_before,
                         seconds=float(args[0]) if kind == "wait" and args else None,
@@ -372,7 +390,13 @@ class GoalSteps:
                         and args else None,
                         container=args[1] if kind == "extract" else None,
                         attempts=None if k == 0 or target is None
+                        or self.state.start_arms is not None   # (a try's own stance)
                         else ALTERNATIVE_ATTEMPTS, program=program)
+                    lifted = self.state.start_arms
+                    if lifted is not None and lifted.rise > 0.0 and kind != "grasp":
+                        settle(self, lifted, i, text,
+                               args[0] if kind in ("move", "insert") else None)
+                        self.state.start_arms = None
                     return seg, mp, target, walked
                 except PlanningError as exc:
                     # Blocked, or out of reach from where the walk ended (it came from
@@ -380,7 +404,10 @@ class GoalSteps:
                     # alternative may fail in any way.
                     if k == 0 and exc.reason not in ("blocked", "unreachable"):
                         raise
-                    if failure is None or (program and k == 0 and first is None):
+                    if made and exc.reason == "blocked" and not program:
+                        blocked_at.append(k)
+                    if failure is None or (program and first is None
+                                           and k == blocked_at[0]):
                         failure = exc       # the program's try at the first placement
                     # What a failed try placed (a walk, an arm transition) is taken back.
                     self.state.restore(mark)
@@ -390,17 +417,17 @@ class GoalSteps:
                             task=text, reason=failure.reason)
 
     def alternatives(self, kind: str, args: tuple[str, ...], target: np.ndarray | None,
-                     placement: tuple[float, float] | None, text: str, raised: bool
+                     placement: tuple[float, float] | None, text: str, raised: bool,
+                     raise_back: bool = False
                      ) -> list[tuple[np.ndarray | Callable[[], np.ndarray] | None,
                                      Callable[[], int] | None]]:
         """What to try when the goal primitive is blocked, in order: (target, prepare),
         where ``prepare()`` moves the worker first and returns the primitives walked.
-
         release: other places to let go, then ahead from a roomy spot; bend/stoop/kneel/
-        wait: a roomier spot; tasks with a target: the other ``ALTERNATE_APPROACHES``
-        (further back, other sides), then ``CHECKED_APPROACHES``, then a side where the
-        motion itself is clear (:meth:`motion_room`).
-        """
+        wait: a roomier spot; tasks with a target: :meth:`lift_tries`, the other
+        ``ALTERNATE_APPROACHES`` (further back, other sides), ``CHECKED_APPROACHES``, then a
+        side where the motion itself is clear (:meth:`motion_room`); with ``raise_back``
+        the arms are raised at each of those spots (they stayed down at the first)."""
         if kind == "release":
             # Last, where every place around the worker is in the furniture (a short
             # worker at a shelf it took the part from): from a roomy spot, straight ahead.
@@ -434,8 +461,10 @@ class GoalSteps:
             self.executor.step_out()            # the first try may have left the worker at a rack
             walked = self.approach(target, spot, text, sector=sector, budget=budget,
                                    stand_yaw=stand_yaw)
-            if lowered:
+            if lowered or (raise_back and not self.state.held):
                 self.executor.arm_transition(False, -1)
+                if not lowered:
+                    self.state.start_arms = StartArms(self.ctx.stance(True), 0.0)
             return walked
 
         def approach(turn: float, back: float, other: bool, ahead: float | None = None,
@@ -460,12 +489,48 @@ class GoalSteps:
             side, yaw, spot = found
             return walk_there(spot, (side, MOTION_ROOM_HALF_WIDTH), MOTION_ROOM_BUDGET, yaw)
 
-        return [(target, None)] + [
+        return [(target, None)] + self.lift_tries(kind, args, target, placement, text,
+                                                  raised, raise_back) + [
             (target, functools.partial(approach, turn, back, other))
             for turn, back, other in ALTERNATE_APPROACHES
         ] + [(target, functools.partial(approach, 0.0, 0.0, False, stood + back))] + [
             (target, functools.partial(approach, turn, back, False, checked=True))
             for turn, back in CHECKED_APPROACHES] + [(target, room)]
+
+    def lift_tries(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                   placement: tuple[float, float], text: str, raised: bool,
+                   raise_back: bool) -> list[tuple[np.ndarray, Callable[[], int]]]:
+        """The tries that start the goal motion from raised arms
+        (``WorkerState.start_arms``) after the first: with ``raise_back`` (the arms stayed
+        down because the step back their raise needed put the target out of the goal
+        model's reach), that step back and raise all the same (the whole-body program may
+        still reach from there); where the part in hand, carried or about to be, would
+        meet the furniture at the first placement (:mod:`.lift_in`), a move or insert
+        lifts it over the furniture and steps in, a grasp raises the arms (``raised``:
+        they are up already) and lifts it off."""
+        def raise_arms() -> int:
+            self.executor.arm_transition(False, -1)
+            self.state.start_arms = StartArms(self.ctx.stance(True), 0.0)
+            return 0
+
+        def lift() -> int:
+            walked, self.state.start_arms = lift_in(self, args[0], target, placement, text,
+                                                APPROACH_HALF_WIDTH, ALTERNATIVE_BUDGET)
+            return walked
+
+        def lift_off() -> int:
+            if not raised:                  # (a step back where the furniture is in the way)
+                self.executor.arm_transition(False, -1)
+            self.state.start_arms = lift_for_grasp(self, args[0], target, placement, text)
+            return 0
+
+        tries = [(target, raise_arms)] if raise_back else []
+        if kind in ("move", "insert") and args and args[0] in self.state.held \
+                and needs_lift(self, args[0], target, placement):
+            tries.append((target, lift))
+        if kind == "grasp" and needs_lift_out(self, args[0], target, placement):
+            tries.append((target, lift_off))
+        return tries
 
     def posture_room(self, kind: str, args: tuple[str, ...], target: np.ndarray,
                      placement: tuple[float, float], side: float, back: float,
@@ -539,7 +604,7 @@ class GoalSteps:
                         mp = self.ctx.library.goal(kind, local, **kwargs)
                     except ValueError:
                         continue
-                    if self.goal_clear(mp, grasped):
+                    if self.goal_clear(mp, grasped, part if kind == "extract" else None):
                         return float(sides[k]), float(yaw[k]), spot
         finally:
             self.state.pose = saved
@@ -806,7 +871,7 @@ class GoalSteps:
                     if miss > contact_tolerance(kind) else "it cannot keep every part clear"
                     if result.least_clearance < 0.0 else
                     f"it ends {100 * result.end_miss:.1f} cm from the pose it must end in")
-            elif not self.goal_clear(made, grasped):
+            elif not self.goal_clear(made, grasped, part if kind == "extract" else None):
                 note = "a part in hand still meets an obstacle"
             elif failed:
                 note = f"its motion fails the {', '.join(failed)} check"
@@ -857,20 +922,23 @@ class GoalSteps:
         return HeldPart.box(JOINT_INDEX[joint], to_local @ centre, (hi - lo) / 2,
                             rotation=to_local), start
 
-    def goal_clear(self, mp: MotionPrimitive, grasped: str | None) -> bool:
+    def goal_clear(self, mp: MotionPrimitive, grasped: str | None,
+                   taken: str | None = None) -> bool:
         """Whether the body, the objects already in the hands and the part being grasped
-        (``grasped``, from the frame the hand lifts it, :func:`lift_frame`) keep clear of
-        obstacles."""
+        (``grasped``, from the frame the hand lifts it, :func:`lift_frame`) or taken out
+        of its container (``taken``, an extract's part, from the frame the hand holds it,
+        as the object tracks carry it) keep clear of obstacles."""
         world = world_positions(mp, *self.state.pose)
         if not self.executor.placed_clear(mp, self.state.pose, samples=None, world=world):
             return False
+        grasped = grasped or taken
         if grasped is None:
             return True
         from ltl_human_motion.scene.predicates import object_collides
         joint = holding_joint(mp.meta.get("hand"))
         hand = world[:, JOINT_INDEX[joint]]
-        contact = int(mp.meta.get("contact_frame", 0))
-        lift = lift_frame(mp, hand)
+        contact = grip_frame(mp) if taken is not None else int(mp.meta.get("contact_frame", 0))
+        lift = contact if taken is not None else lift_frame(mp, hand)
         if lift >= len(hand):
             return True
         # The part rests on its support until the hand lifts it; carried from then on.

@@ -116,6 +116,16 @@ class PlanContext:
         return np.asarray(lib.carry_standing_pose if carrying else lib.standing_pose)
 
 
+@dataclass(frozen=True)
+class StartArms:
+    """Arms raised above the carry stance to lift a part over or off furniture
+    (:mod:`.lift_in`): the stance (J, 3) the next goal motion starts and ends in, and the
+    lift (m) it was made with."""
+
+    stance: np.ndarray
+    rise: float
+
+
 @dataclass
 class WorkerState:
     """What the steps of a plan change.
@@ -140,6 +150,9 @@ class WorkerState:
         Parts assembled (a new one comes from the supply when grasped again).
     expanded : int
         A* nodes expanded so far.
+    start_arms : StartArms or None
+        The arms the next goal motion starts from where a try chose them, else None (the
+        walk or carry stance).
     """
 
     segments: list[PlacedSegment] = field(default_factory=list)
@@ -151,21 +164,23 @@ class WorkerState:
     object_at: dict[str, np.ndarray] = field(default_factory=dict)
     consumed: set[str] = field(default_factory=set)
     expanded: int = 0
+    start_arms: StartArms | None = None
 
     @property
     def carrying(self) -> bool:
         """Whether a hand holds a part (the arms are in the carry stance)."""
         return bool(self.held)
 
-    def mark(self) -> tuple[int, Pose, int | None]:
-        """Where the plan stands now, for :meth:`restore`: (segments, pose, gait state)."""
-        return len(self.segments), self.pose, self.gait_state
+    def mark(self) -> tuple[int, Pose, int | None, StartArms | None]:
+        """Where the plan stands now, for :meth:`restore`: (segments, pose, gait state,
+        start arms)."""
+        return len(self.segments), self.pose, self.gait_state, self.start_arms
 
-    def restore(self, mark: tuple[int, Pose, int | None]) -> None:
+    def restore(self, mark: tuple[int, Pose, int | None, StartArms | None]) -> None:
         """Take back every segment placed since ``mark`` (a try that failed); the parts
         in hand are not changed by walks, steps and arm transitions."""
         del self.segments[mark[0]:]
-        self.pose, self.gait_state = mark[1], mark[2]
+        self.pose, self.gait_state, self.start_arms = mark[1], mark[2], mark[3]
 
     def held_offset(self, name: str) -> np.ndarray:
         """The held part's offset from its hand (3,); zero for a part not held."""

@@ -26,6 +26,7 @@ step to them and records what it made (:class:`StepPlan`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -37,6 +38,7 @@ from ltl_human_motion.planning.astar import SearchBudget, SearchOptions
 from ltl_human_motion.planning.blend import PlacedSegment
 from ltl_human_motion.planning.feasibility import reach_envelope
 from ltl_human_motion.planning.goal_steps import GoalSteps
+from ltl_human_motion.planning.lift_in import settle
 from ltl_human_motion.planning.plan_state import (
     PlanContext,
     Pose,
@@ -417,6 +419,8 @@ class SequencePlanner:
             # (Seated, the hands work from the seat.)
             placement, arms_up = self._placement(kind, target, text, args)
             here = self._region_point_here(kind, args, target, placement)
+            if here is None:
+                here = self._region_point_in_reach(kind, args, target, placement)
             if here is not None:
                 target = here
                 placement, arms_up = self._placement(kind, target, text, args)
@@ -425,13 +429,17 @@ class SequencePlanner:
         carrying_before = self.state.carrying
         raised = kind in HAND_TASKS and not carrying_before and self.state.seat is None \
             and arms_up
+        out_of_reach = False
         if raised:
             # Raise the arms to the carry stance first: hands then reach from the chest
             # (and a grasped part comes up to it) instead of swinging up from the thighs
-            # past the edge of the surface in front.
-            self.executor.arm_transition(False, -1)
-            carrying_before = True
-        tries = self.goal_steps.alternatives(kind, args, target, placement, text, raised)
+            # past the edge of the surface in front. Where the raise needs a step back
+            # that puts the target out of reach (a vise 0.35 m behind a machine's sill),
+            # or is blocked even so, the reach starts from the arms down instead.
+            raised, out_of_reach = self._raise_arms(kind, args, target)
+            carrying_before = raised
+        tries = self.goal_steps.alternatives(kind, args, target, placement, text, raised,
+                                             raise_back=out_of_reach)
         seg, mp, target, prepared = self.goal_steps.first_clear_try(
             i, text, kind, args, tries, carrying_before, approach_failed)
         walked += prepared
@@ -442,6 +450,13 @@ class SequencePlanner:
             effect["respawn"] = [args[0]]
         track_objects(self.ctx.cell, self.state, effect, joints,
                       self.state.segments[seg].positions, mp, self.ctx.overlap)
+        if self.state.start_arms is not None:
+            # Made from raised arms: a grasp lifted off (a carton off a stand) steps back
+            # and lowers them to the carry stance, where the others already are.
+            arms, self.state.start_arms = self.state.start_arms, None
+            if arms.rise > 0.0:
+                settle(self.goal_steps, arms, i, text)
+            carrying_before = True
         if self.state.carrying != carrying_before and self.state.seat is None:
             self.executor.arm_transition(carrying_before, i)
         if kind in ("sit", "standUp"):
@@ -488,6 +503,49 @@ class SequencePlanner:
         if float(self.ctx.obstacle_field.distance(inside[None])[0]) <= room:
             return None
         return here + (inside - point)
+
+    def _raise_arms(self, kind: str, args: tuple[str, ...], target: np.ndarray | None
+                    ) -> tuple[bool, bool]:
+        """Raise the arms to the carry stance for a hand task at ``target`` (3,), stepping
+        back first where the furniture in front is in the way. Returns (raised, out of
+        reach): where the raise is blocked even after the step back, or the step back
+        leaves the target out of the goal model's reach (the second flag), nothing is
+        placed and the arms stay down."""
+        mark = self.state.mark()
+        try:
+            self.executor.arm_transition(False, -1)
+        except PlanningError:
+            self.state.restore(mark)
+            return False, False
+        if target is None or self.state.pose == mark[1]:
+            return True, False
+        x, y, yaw = self.state.pose
+        c, s = math.cos(-yaw), math.sin(-yaw)
+        dx, dy = float(target[0]) - x, float(target[1]) - y
+        if self.goal_steps.reaches(kind, args, (c * dx - s * dy, s * dx + c * dy,
+                                                float(target[2])), True):
+            return True, False
+        self.state.restore(mark)
+        return False, True
+
+    def _region_point_in_reach(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                               placement: tuple[float, float]) -> np.ndarray | None:
+        """For a move into a region whose centre no free standing spot is within reach of
+        (``placement`` and the reach tolerance), the hand's point (3,) that puts the part
+        at the region's point nearest such a spot (:func:`.region_point.region_point`);
+        None otherwise."""
+        from ltl_human_motion.planning.region_point import region_point
+        if kind != "move" or self.state.seat is not None \
+                or args[0] not in self.state.held_offsets:
+            return None
+        offset = self.state.held_offsets[args[0]]
+        lo, hi = self.ctx.cell.object(args[0]).shape.aabb()
+        room = float(np.linalg.norm((np.asarray(hi) - np.asarray(lo))[:2]) / 2.0) \
+            + REGION_POINT_MARGIN
+        reach = float(np.hypot(*placement)) + self.ctx.options.reach_tolerance
+        point = region_point(self.ctx, self.ctx.cell.region(args[1]), room,
+                             float(target[2] + offset[2]), reach)
+        return None if point is None else point - offset
 
     def _first_approach(self, kind: str, target: np.ndarray, placement: tuple[float, float],
                         text: str, facing: np.ndarray | None

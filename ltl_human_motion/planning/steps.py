@@ -47,6 +47,37 @@ CLEAR_EXACT = 0.1
 #: clearances near ``PLACED_MARGIN`` decide a check; farther ones may be bounds).
 EXACT_BELOW = 0.01
 
+#: Clearance (m) the search asks of a part in hand at points on its box on its gait
+#: samples, beyond the obstacle field's interpolation allowance: the points are not
+#: inside an obstacle. A shallow corner between them is left to the exact check of the
+#: path (:meth:`StepExecutor.first_collision`), which decides; a margin for their
+#: spacing kept a part in hand from every stop at a table. Without the check a carton
+#: carried at hip height was walked over a packing table's top on every path found.
+HELD_SEARCH_MARGIN = 0.0
+#: Largest spacing (m) of the points a part in hand is read at by the search.
+HELD_POINT_SPACING = 0.05
+
+
+def held_surface(cell, name: str) -> tuple[np.ndarray, float]:
+    """Points on the surface of object ``name``'s bounding box, relative to its centre
+    (P, 3), no further apart than ``HELD_POINT_SPACING`` along each face, and that
+    spacing."""
+    def build() -> tuple[np.ndarray, float]:
+        obj = cell.object(name)
+        lo, hi = obj.shape.aabb()
+        lo, hi = lo - obj.position, hi - obj.position
+        n = np.maximum(np.ceil((hi - lo) / HELD_POINT_SPACING).astype(int), 1) + 1
+        axes = [np.linspace(lo[k], hi[k], n[k]) for k in range(3)]
+        grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+        on_face = np.any(np.isclose(grid, lo) | np.isclose(grid, hi), axis=1)
+        return np.ascontiguousarray(grid[on_face]), float(np.max((hi - lo) / (n - 1)))
+
+    return _HELD_SURFACES.get_or_build(name, build, owner=cell)
+
+
+_HELD_SURFACES: BoundedCache[tuple[np.ndarray, float]] = BoundedCache(64)
+
+
 #: Clearance the search asks of the body on the gait samples between those it keeps
 #: 1 cm on (``gait_index.BODY_SAMPLES``), in units of the obstacle field's resolution
 #: and counted from the field's own interpolation allowance (0.4 resolution): -0.4, the
@@ -224,6 +255,43 @@ class StepExecutor:
                                                  margin=SWEEP_MARGIN * field.res,
                                                  relative=rel, parts=_SWEEP_INDICES)
                 out[sel] = ok
+        if self.state.held and out.any():
+            keep = np.flatnonzero(out)
+            out[keep] = self.held_clear(poses[keep], standing[keep])
+        return out
+
+    def search_options(self):
+        """The search's options, with the body's exact checks (``near_radius``) begun far
+        enough from an obstacle for the parts in hand to be checked too: a carton held
+        0.5 m ahead of the hips reaches past the body's radius."""
+        options = self.ctx.options.search
+        if not self.state.held:
+            return options
+        stance = self.ctx.stance(True)
+        reach = 0.0
+        for name, joint in self.state.held.items():
+            pts, _ = held_surface(self.ctx.cell, name)
+            at = stance[JOINT_INDEX[joint]] + self.state.held_offset(name) + pts
+            reach = max(reach, float(np.hypot(at[:, 0], at[:, 1]).max()))
+        return replace(options, near_radius=max(options.near_radius,
+                                                reach + options.body_radius))
+
+    def held_clear(self, poses: np.ndarray, standing: np.ndarray) -> np.ndarray:
+        """Whether the parts in hand keep ``HELD_SEARCH_MARGIN`` from every obstacle at
+        the sampled poses (M, S, J, 3), by the obstacle field at points on each part's
+        box (:func:`held_surface`); standing primitives (``standing`` (M,)) need only not
+        come closer than at their first sample. Shape (M,)."""
+        field = self.ctx.obstacle_field
+        out = np.ones(len(poses), dtype=bool)
+        if field.empty:
+            return out
+        for name, joint in self.state.held.items():
+            pts, _ = held_surface(self.ctx.cell, name)
+            centre = poses[:, :, JOINT_INDEX[joint]] + self.state.held_offset(name)
+            d = field.distance(centre[:, :, None, :] + pts).min(axis=2)       # (M, S)
+            gap = d - (HELD_SEARCH_MARGIN + field.res * 0.4)
+            allowed = np.where(standing, np.minimum(gap[:, 0], 0.0) - 0.005, 0.0)
+            out &= gap.min(axis=1) >= allowed
         return out
 
     def sit_still(self, seconds: float) -> MotionPrimitive:
@@ -267,7 +335,8 @@ class StepExecutor:
 
         The palms move beside the body on a smooth curve, timed by Fitts' law with a
         bounded peak speed (:func:`~ltl_human_motion.motion.arm_transition.
-        arm_transition_poses`).
+        arm_transition_poses`). Where the transition would hit an obstacle, the worker
+        steps back first.
         """
         rel = self.arm_poses(carrying_before)
         root = np.zeros((len(rel), 4))
@@ -306,11 +375,12 @@ class StepExecutor:
         return _ARM_POSES.get_or_build(key, build)
 
     def placed_clear(self, mp: MotionPrimitive, pose: Pose, samples: int | None = None,
-                     world: np.ndarray | None = None) -> bool:
+                     world: np.ndarray | None = None, put_down: str | None = None) -> bool:
         """Whether ``mp`` placed at ``pose`` keeps the body and the objects held (at their
         hand offsets) clear of every obstacle, checked with the exact distances on
         ``samples`` frames (None: every frame, as the verifier checks). ``world``:
-        ``world_positions(mp, *pose)`` if already made."""
+        ``world_positions(mp, *pose)`` if already made; ``put_down``: a held part the
+        motion before put down (not moved with the hand)."""
         from ltl_human_motion.scene.predicates import body_clearance, object_collides
         if not self.ctx.cell.obstacles:
             return True
@@ -329,6 +399,8 @@ class StepExecutor:
             if np.min(d) <= PLACED_MARGIN:
                 return False
         for name, joint in self.state.held.items():
+            if name == put_down:
+                continue
             step = 1 if samples is None else 2
             centre = world[::step, JOINT_INDEX[joint]] + self.state.held_offset(name)
             if np.any(object_collides(self.ctx.cell, name, centre)):
@@ -517,7 +589,7 @@ class StepExecutor:
             res = astar(self.ctx.index, self.state.pose, goal,
                         start_primitive=self.state.gait_state,
                         clearance=goal.clearance or self.ctx.clearance,
-                        options=self.ctx.options.search, carry=carry,
+                        options=self.search_options(), carry=carry,
                         budget=replace(budget, max_nodes=budget.max_nodes - used),
                         rng=self.ctx.rng, body_clear=self.body_clear,
                         forbidden=frozenset(forbidden), stall_nodes=stall)

@@ -83,6 +83,17 @@ _RISE_LEAST = 0.12
 _RISE_HEAD_CLEAR = 0.155
 
 
+#: Height (m) over the top of furniture below the shoulders at which a palm coming up in
+#: front of its edge turns in over it (:func:`_rise_points`): the hand capsule's radius
+#: and a part's half height in it.
+_RISE_OVER = 0.08
+
+
+#: Least horizontal distance of such a rise from the shoulder, m: the palm comes up
+#: close in front of the chest.
+_RISE_LEAST_LOW = 0.04
+
+
 #: Reach time of the level path over the arc's (its path is about this much longer).
 _LEVEL_TIME = 1.3
 
@@ -156,17 +167,26 @@ def _head_clear_shift(sh1: np.ndarray, k: int, rise: np.ndarray, normal: tuple[f
 
 def _rise_points(targets: np.ndarray, active: tuple, sh1: np.ndarray,
                  support: tuple[float, float, float, float] | None, arm: float,
-                 stature: float = DEFAULT_STATURE, head: np.ndarray | None = None
-                 ) -> np.ndarray | None:
+                 stature: float = DEFAULT_STATURE, head: np.ndarray | None = None,
+                 home: np.ndarray | None = None) -> np.ndarray | None:
     """Shoulder-to-palm points (2, 3) in front of the edge of the furniture under the
     targets (``support`` (nx, ny, offset, top), start frame, :func:`_slab_depth`),
     towards each active hand's target (along the edge to the hand's own side where that
     passes the face, ``_RISE_HEAD_CLEAR``): where the level path's palms rise before they
-    come straight up and in over the furniture. Each is as high above the shoulder as
-    keeps it ``_LEVEL_MIN_EXTENSION`` of ``arm`` from it (the elbow not folded on the
-    way up), and no higher than ``_RISE_BELOW`` under the furniture's top. None unless
-    that top is above every active shoulder of ``sh1`` (2, 3) (below, the palms come
-    down onto it) and each edge leaves ``_RISE_LEAST`` in front of the shoulder."""
+    come straight up and in over the furniture.
+
+    Over furniture above the shoulders each is as high above the shoulder as keeps it
+    ``_LEVEL_MIN_EXTENSION`` of ``arm`` from it (the elbow not folded on the way up), and
+    no higher than ``_RISE_BELOW`` under the furniture's top; each edge must leave
+    ``_RISE_LEAST`` in front of the shoulder. Over furniture below the shoulders whose
+    top is above a hand's start (``home`` (2, 3), start frame: the arms hang beside a
+    machine's sill; given for insert and extract, and for the others where the arms
+    hang), each is ``_RISE_OVER`` above
+    that top, so the palm comes up in front of the edge and then in over it (an arc from
+    the hip to a point in the furniture passes through its face); each edge must leave
+    ``_RISE_LEAST_LOW``.
+    None where neither applies to every active hand (the palms come down onto the
+    furniture, or the arc clears it)."""
     if support is None:
         return None
     nx, ny, offset, top = support
@@ -175,11 +195,16 @@ def _rise_points(targets: np.ndarray, active: tuple, sh1: np.ndarray,
         flat = targets[k, :2] - sh1[k, :2]
         dh = float(np.linalg.norm(flat))
         toward = (nx * flat[0] + ny * flat[1]) / dh if dh > 1e-9 else 0.0
-        if top <= sh1[k, 2] or toward < 0.3:
+        low = top <= sh1[k, 2]
+        if toward < 0.3 or (low and (home is None or top <= home[k, 2])):
             return None
         ahead = (offset - (nx * sh1[k, 0] + ny * sh1[k, 1])) / toward - _RISE_FRONT
-        if ahead < _RISE_LEAST:
+        if ahead < (_RISE_LEAST_LOW if low else _RISE_LEAST):
             return None
+        if low:
+            rise[k, :2] = flat / dh * min(ahead, dh)
+            rise[k, 2] = top + _RISE_OVER - sh1[k, 2]
+            continue
         rise[k, :2] = flat / dh * min(ahead, dh)
         if head is not None:
             rise[k, :2] += _head_clear_shift(sh1, k, rise[k, :2], (nx, ny), head,
@@ -188,6 +213,13 @@ def _rise_points(targets: np.ndarray, active: tuple, sh1: np.ndarray,
         rise[k, 2] = min(np.sqrt(max(least ** 2 - float(np.sum(rise[k, :2] ** 2)), 0.0)),
                          top - sh1[k, 2] - _RISE_BELOW)
     return rise
+
+
+def _with(rel: np.ndarray, active: tuple, points: np.ndarray) -> np.ndarray:
+    """``rel`` (2, 3) with the ``active`` hands' rows from ``points`` (2, 3)."""
+    out = rel.copy()
+    out[list(active)] = points[list(active)]
+    return out
 
 
 def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> float:
@@ -238,6 +270,11 @@ def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
                 (total, rel_home)]
         if level:           # out the straight way it pushed in (PUSH_LEVEL_TASKS)
             keys.insert(-1, (t2 + (1.0 - _PUSH_IN_AT) * (total - t2), rel_pre))
+        if level and rise is not None:     # up in front of the furniture's edge first
+            rel_rise = _with(rel_home, active, rise)
+            keys.insert(1, (0.5 * t1, rel_rise))
+            keys.insert(-1, (t2 + (1.0 - 0.5 * _PUSH_IN_AT) * (total - t2), rel_rise))
+            return keys, t1 + push, frozenset({1, len(keys) - 3})
         return keys, t1 + push, frozenset()
     if task == "extract":
         pull = min(0.5, 0.6 * (t2 - t1))
@@ -245,6 +282,11 @@ def _hand_keys(task: str, targets: np.ndarray, active: tuple, sh1: np.ndarray,
                 (total, rel_home)]
         if level:           # in the straight way it pulls out (PUSH_LEVEL_TASKS)
             keys.insert(1, (_PUSH_IN_AT * t1, rel_pre))
+        if level and rise is not None:     # up in front of the furniture's edge first
+            rel_rise = _with(rel_home, active, rise)
+            keys.insert(1, (0.5 * _PUSH_IN_AT * t1, rel_rise))
+            keys.insert(-1, (t2 + 0.5 * (total - t2), rel_rise))
+            return keys, t2, frozenset({1, len(keys) - 3})
         return keys, t2, frozenset()
     keys = [(0.0, rel_home), (t1, rel_goal), (t2, rel_goal), (total, rel_home)]
     if level and task in LEVEL_REGION_TASKS:

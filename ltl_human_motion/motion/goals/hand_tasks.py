@@ -138,7 +138,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
     travel, pushed = _push_travel(task, target, st, hand, travel, path,
                                   None if furniture is None else furniture[0])
     board = board if task in LEVEL_PATH_TASKS else None
-    support = None if furniture is None or task not in LEVEL_PATH_TASKS else furniture[0]
+    support = None if furniture is None or task not in LEVEL_PATH_TASKS + PUSH_LEVEL_TASKS \
+        else furniture[0]
     ceiling = None if furniture is None or task not in LEVEL_PATH_TASKS else furniture[1]
     # Over furniture above the shoulders every path rises in front of its edge first.
     over = support is not None and support[3] > float(st.shoulders[:, 2].max())
@@ -181,6 +182,12 @@ def _self_penetrates(world: np.ndarray, stature: float) -> bool:
     of ``world`` (T, J, 3) (the verifier's self-penetration check)."""
     from ltl_human_motion.planning.biomechanics import self_penetration
     return bool(np.max(self_penetration(world, stature)[0]) > 0.0)
+
+
+def _hanging(st: _Start) -> bool:
+    """Whether the start pose's hands hang beside the body (below the hips: the arms
+    down, not raised to the carry stance)."""
+    return bool(np.all(st.hands[:, 2] < st.pelvis[2]))
 
 
 def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray,
@@ -227,7 +234,9 @@ def _reach_motion(task: str, skeleton: Skeleton, st: _Start, targets: np.ndarray
             rel_goal[k] = targets[k] - sh1[k]
             rel_pre[k] = targets[k] - travel * approach - sh1[k]
         rise = _rise_points(targets, active, sh1, support, arm, H,
-                            tr[f1, [_J["neck"], _J["head"]]]) if level and board is None else None
+                            tr[f1, [_J["neck"], _J["head"]]],
+                            st.hands if task in PUSH_LEVEL_TASKS or _hanging(st) else None) \
+            if level and board is None else None
         keys, contact_t, straight = _hand_keys(task, targets, active, sh1, rel_home, rel_goal,
                                                rel_pre, (t1, t2, total), level, board, H, arm,
                                                rise)
