@@ -3,6 +3,7 @@ not through ur_rtde's bare ``connect: Connection refused`` on stdout/stderr."""
 
 from __future__ import annotations
 
+import os
 import socket
 import time
 
@@ -29,14 +30,29 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-def test_refusal_names_host_and_port_and_is_empty_when_listening() -> None:
+def test_refusal_names_host_and_port_and_is_empty_when_the_controller_answers() -> None:
+    """Refused, and listening but silent (a controller whose process is stopped: the
+    kernel accepts, nobody answers RTDE), are both named; the simulated controller, which
+    speaks RTDE, answers."""
+    import signal
+
+    from robot_sim import start_sim
     port = _free_port()
     message = refusal("127.0.0.1", port)
     assert f"127.0.0.1:{port}" in message and "refused" in message.lower()
     with socket.socket() as server:
         server.bind(("127.0.0.1", 0))
         server.listen(1)
-        assert refusal("127.0.0.1", server.getsockname()[1]) == ""
+        silent = refusal("127.0.0.1", server.getsockname()[1], timeout=0.3)
+        assert "does not answer" in silent and str(server.getsockname()[1]) in silent
+    sim = start_sim()
+    try:
+        assert refusal("127.0.0.1") == ""
+        os.kill(sim.process.pid, signal.SIGSTOP)           # frozen: socket open, silent
+        assert "does not answer" in refusal("127.0.0.1", timeout=0.3)
+    finally:
+        sim.kill()
+        sim.stop()
 
 
 def test_probed_factories_do_not_call_ur_rtde_when_refused() -> None:

@@ -3,15 +3,17 @@
 Without a robot, ``ur_rtde`` (C++) prints a bare ``connect: Connection refused`` to the
 process's stdout/stderr on every attempt, outside ROS logging, without saying which host.
 The coexistence node therefore wraps its connection factories: before ur_rtde creates or
-reconnects an interface, a plain TCP connect to ``host:port`` (closed at once) checks that
-something listens. When it is refused, the node's logger says so with the host and port
-(throttled), ur_rtde is not called, and the controller backs off as for any failed
-attempt. A robot that appears is connected on the next attempt as before.
+reconnects an interface, a TCP connect to ``host:port`` and RTDE's protocol version
+request check that the controller answers (then the connection is closed). When it does
+not, the node's logger says so with the host and port (throttled), ur_rtde is not called,
+and the controller backs off as for any failed attempt. A robot that appears is
+connected on the next attempt as before.
 """
 
 from __future__ import annotations
 
 import socket
+import struct
 from collections.abc import Callable
 from typing import Any
 
@@ -21,11 +23,26 @@ RTDE_PORT = 30004
 PROBE_TIMEOUT = 1.0
 
 
+#: RTDE's request-protocol-version package: header (size uint16, type ``V``) and version 2
+#: (the RTDE guide's first package of a session; the controller answers at once).
+_VERSION_REQUEST = struct.pack(">HBH", 5, ord("V"), 2)
+
+
 def refusal(host: str, port: int = RTDE_PORT, timeout: float = PROBE_TIMEOUT) -> str:
-    """"" when ``host:port`` accepts a TCP connection, else why not (for a log line)."""
+    """"" when ``host:port`` accepts a TCP connection and answers RTDE's protocol version
+    request within ``timeout`` s, else why not (for a log line). A stopped controller
+    (process frozen, socket open) accepts the connection in the kernel but never answers:
+    ur_rtde's reconnect to it blocked the control loop inside the library, and the
+    process that then stopped crashed on exit."""
     try:
-        with socket.create_connection((host, port), timeout=timeout):
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            sock.settimeout(timeout)
+            sock.sendall(_VERSION_REQUEST)
+            if not sock.recv(3):
+                return f"robot controller {host}:{port} closed the connection"
             return ""
+    except TimeoutError:
+        return f"robot controller {host}:{port} does not answer (within {timeout:g} s)"
     except OSError as exc:
         reason = exc.strerror or type(exc).__name__
         return f"robot controller {host}:{port} not reachable ({reason})"
