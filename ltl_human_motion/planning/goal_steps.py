@@ -44,6 +44,7 @@ from ltl_human_motion.planning.plan_state import (
     acting_hand,
     grip_frame,
     holding_joint,
+    in_start_frame,
     lift_frame,
     object_position,
 )
@@ -324,12 +325,7 @@ class GoalSteps:
         (3,) (None without one), the goal model's keyword arguments (start pose, hand,
         extract travel, furniture, obstacles around, wait duration) and the low board
         (edge, underside, top) over the target, or None."""
-        x, y, yaw = self.state.pose
-        local = None
-        if target is not None:
-            c, s = math.cos(-yaw), math.sin(-yaw)
-            dx, dy = target[0] - x, target[1] - y
-            local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
+        local = None if target is None else in_start_frame(self.state.pose, target)
         seated = self.state.seat is not None and kind != "standUp"
         if kind == "standUp" and self.state.seat is not None:
             # Stand up with the arms as they are on the seat (:meth:`segment` brings them

@@ -10,6 +10,7 @@ share one of each.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -185,6 +186,15 @@ class WorkerState:
     def held_offset(self, name: str) -> np.ndarray:
         """The held part's offset from its hand (3,); zero for a part not held."""
         return self.held_offsets.get(name, np.zeros(3))
+
+
+def in_start_frame(pose: Pose, target: np.ndarray) -> np.ndarray:
+    """``target`` (3,) in the start frame of a worker standing at ``pose`` (x, y, yaw):
+    (ahead, left, height), shape (3,)."""
+    x, y, yaw = pose
+    c, s = math.cos(-yaw), math.sin(-yaw)
+    dx, dy = target[0] - x, target[1] - y
+    return np.array([c * dx - s * dy, s * dx + c * dy, target[2]], dtype=np.float64)
 
 
 def holding_joint(hand: str | None) -> str:

@@ -26,7 +26,6 @@ step to them and records what it made (:class:`StepPlan`).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -46,6 +45,7 @@ from ltl_human_motion.planning.plan_state import (
     acting_hand,
     apply_effects,
     grip_frame,
+    in_start_frame,
     lift_frame,
     track_objects,
 )
@@ -380,10 +380,7 @@ class SequencePlanner:
         away = float(np.hypot(*(np.asarray(target[:2]) - np.asarray(self.state.seat[:2]))))
         if away > envelope.horizontal(float(target[2]), float(target[2])):
             return True
-        x, y, yaw = self.state.pose
-        c, s = np.cos(-yaw), np.sin(-yaw)
-        dx, dy = target[0] - x, target[1] - y
-        local = np.array([c * dx - s * dy, s * dx + c * dy, target[2]])
+        local = in_start_frame(self.state.pose, target)
         hand = acting_hand(self.state, kind, args[0] if kind != "grasp" and args else None)
         try:
             # The model's own reach test (its seeds only vary the timing: a fixed one
@@ -519,11 +516,8 @@ class SequencePlanner:
             return False, False
         if target is None or self.state.pose == mark[1]:
             return True, False
-        x, y, yaw = self.state.pose
-        c, s = math.cos(-yaw), math.sin(-yaw)
-        dx, dy = float(target[0]) - x, float(target[1]) - y
-        if self.goal_steps.reaches(kind, args, (c * dx - s * dy, s * dx + c * dy,
-                                                float(target[2])), True):
+        if self.goal_steps.reaches(kind, args, tuple(in_start_frame(self.state.pose, target)),
+                                   True):
             return True, False
         self.state.restore(mark)
         return False, True
