@@ -214,9 +214,9 @@ def judge(problem: GoalProblem, positions: np.ndarray
     """Palm miss, least clearance (the project's exact capsule distances, body and part in
     hand), feet drift and the biomechanical checks failed (as the planner runs them on a
     remade goal primitive) of ``positions`` (T, J, 3), start frame."""
+    from ltl_human_motion.motion.biomechanics import check_biomechanics
     from ltl_human_motion.motion.goals.constraints import reference_clearance
     from ltl_human_motion.motion.skeleton import JOINT_INDEX
-    from ltl_human_motion.planning.biomechanics import check_biomechanics
     from ltl_human_motion.planning.constrained_goals import PartSetField
     mp = problem.primitive
     ref = world_positions(mp)

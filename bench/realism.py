@@ -48,7 +48,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", default=str(ROOT / "bench" / "results" / "realism.json"))
     args = parser.parse_args(argv)
     from ltl_human_motion.ltl.spec import PAPER_SPECS
-    from ltl_human_motion.planning.biomechanics import foot_skate
+    from ltl_human_motion.motion.biomechanics import foot_skate
     from ltl_human_motion.planning.pipeline import SynthesisOptions, resolve_cell, synthesize
     from ltl_human_motion.planning.verify import VerificationOptions
 

@@ -57,10 +57,15 @@ def main() -> int:
     from ltl_human_motion.assess import assess_motion, cycle_breakdown
     from ltl_human_motion.batch.items import cell_for_item, derive_item
     from ltl_human_motion.batch.runner import make_job
-    from ltl_human_motion.batch.worker import _cell_and_options, prepare_worker, run_item
+    from ltl_human_motion.batch.worker import (
+        ItemAssessment,
+        _cell_and_options,
+        prepare_worker,
+        run_item,
+    )
     from ltl_human_motion.planning.pipeline import get_library, synthesize
     from ltl_human_motion.robot.offline_ssm import run_offline_ssm
-    from ltl_human_motion.study.item import _robot, assess_settings
+    from ltl_human_motion.study.item import _robot, assess_item, assess_settings
     from ltl_human_motion.study.runner import StudyConfig, _specs, run_study
 
     cfg = StudyConfig(cells=["paper_cell"], spec="S2", statures=(1.6, 1.75, 1.9),
@@ -69,7 +74,8 @@ def main() -> int:
     settings = assess_settings(ROBOT)
     job, _ = make_job("paper_cell", specs)
     from dataclasses import replace
-    job = replace(job, assess=settings, statures=(1.6, 1.75, 1.9))
+    job = replace(job, assess=ItemAssessment(assess_item, settings),
+                  statures=(1.6, 1.75, 1.9))
     prepare_worker(job)
     run_item(job, derive_item(specs, 0, 10_000))         # warm-up (caches, imports)
 

@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
-from ltl_human_motion.planning.biomechanics import (
+from ltl_human_motion.motion.biomechanics import (
     BiomechanicsLimits,
     check_biomechanics,
     joint_angles,
     self_penetration,
 )
+from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 
 SK = Skeleton(1.75)
 FPS = 120.0
@@ -163,7 +163,7 @@ def test_hull_distance_matches_qhull_facets() -> None:
     """The all-frames support-polygon distance equals max(n . p + c) over Qhull's facets."""
     from scipy.spatial import ConvexHull
 
-    from ltl_human_motion.planning.biomechanics import _foot_outline, _hull_distance
+    from ltl_human_motion.motion.biomechanics import _foot_outline, _hull_distance
     rng = np.random.default_rng(1)
     n = 400
     zeros = np.zeros((n, 1))
@@ -183,7 +183,7 @@ def test_compiled_hull_distance_equals_the_numpy_path(monkeypatch) -> None:
     """The numba support-polygon distance gives the numpy path's numbers exactly, with
     repeated corners too."""
     from ltl_human_motion.kernel import segments
-    from ltl_human_motion.planning import biomechanics
+    from ltl_human_motion.motion import biomechanics
     rng = np.random.default_rng(2)
     poly = rng.normal(size=(300, 8, 2)) * 0.2
     poly[:20, 4:] = poly[:20, :4]

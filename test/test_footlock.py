@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ltl_human_motion.motion.biomechanics import foot_skate
 from ltl_human_motion.motion.skeleton import JOINT_INDEX as J
 from ltl_human_motion.motion.skeleton import Skeleton
-from ltl_human_motion.planning.biomechanics import foot_skate
 from ltl_human_motion.planning.footlock import lock_feet
 
 FPS = 120.0

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from ltl_human_motion.motion.biomechanics import self_penetration
 from ltl_human_motion.motion.gait import standing_pose
 from ltl_human_motion.motion.goals import (
     GOAL_TASKS,
@@ -20,7 +21,6 @@ from ltl_human_motion.motion.quality import primitive_metrics
 from ltl_human_motion.motion.skeleton import JOINT_INDEX as J
 from ltl_human_motion.motion.skeleton import Skeleton
 from ltl_human_motion.motion.types import world_positions
-from ltl_human_motion.planning.biomechanics import self_penetration
 
 SK = Skeleton(1.75)
 STAND, STAND_Z = standing_pose(SK)
@@ -412,7 +412,7 @@ def test_a_reach_deep_under_a_low_board_kneels_within_the_range_of_motion() -> N
     other), leans forward with the free palm on the floor, and reaches in under the
     board. Every frame keeps the hips and knees within their range, the body clear of
     the board, and each foot still while on the floor, one at a time off it."""
-    from ltl_human_motion.planning.biomechanics import BiomechanicsLimits, joint_angles
+    from ltl_human_motion.motion.biomechanics import BiomechanicsLimits, joint_angles
     for stature in (1.55, 1.75, 1.95):
         sk = Skeleton(stature)
         start = standing_pose(sk)[0]
@@ -454,8 +454,8 @@ def test_without_kneeling_the_reach_under_the_low_board_folds_the_hips(monkeypat
     the pelvis tilted in full, whose hips fold past their 125 degree range of motion
     (the failure the kneel replaces)."""
     from ltl_human_motion.motion import goals
+    from ltl_human_motion.motion.biomechanics import joint_angles
     from ltl_human_motion.motion.goals import postures
-    from ltl_human_motion.planning.biomechanics import joint_angles
     sk = Skeleton(1.75)
     start = standing_pose(sk)[0]
 

@@ -11,8 +11,8 @@ from scipy.spatial.transform import Rotation
 urdf_parser = pytest.importorskip("urdf_parser_py.urdf")
 
 from ltl_human_motion.motion import urdf  # noqa: E402
+from ltl_human_motion.motion.capsules import BODY_CAPSULES, capsule_radii  # noqa: E402
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, N_JOINTS, Skeleton  # noqa: E402
-from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii  # noqa: E402
 
 #: Issue 14: FK from the joint states reproduces our joint positions within 1 mm.
 FK_TOLERANCE = 1e-3

@@ -114,8 +114,8 @@ def test_clear_samples_equals_clear_of_the_selection(paper, compiled, monkeypatc
     """The search's one-call test of some candidates at some samples (with the bounding
     box pre-test in the compiled loop) answers as :meth:`ObstacleField.clear` of the
     selected poses, for the whole body and for the arms with the sweep margin."""
+    from ltl_human_motion.motion.capsules import part_indices
     from ltl_human_motion.planning.steps import SWEEP_MARGIN, SWEEP_PARTS
-    from ltl_human_motion.scene.occupancy import part_indices
     field = _field_on_path(paper, compiled, monkeypatch)
     rng = np.random.default_rng(5)
     poses = _scattered_poses(rng, 80, 9, 0.03)

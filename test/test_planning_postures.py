@@ -93,7 +93,7 @@ def test_sit_on_the_seat_already_sat_on_stays_seated(stature: float) -> None:
 def test_biomechanics_reads_the_task_of_a_step_with_arguments() -> None:
     """Timeline tasks are written with their arguments ("sit(stool)"): the seated frames
     run from the start of the sit, and sit frames get the posture-transition knee limit."""
-    from ltl_human_motion.planning.biomechanics import (
+    from ltl_human_motion.motion.biomechanics import (
         BiomechanicsLimits,
         _speed_limits,
         seated_frames,
@@ -121,8 +121,8 @@ def test_floor_reach_postures_keep_the_hips_and_knees_in_range(stature: float) -
     its range of motion (a floor grasp's stoop flexed the hip to 129 degrees), and a
     part on the floor (3 cm) is still within reach from a standing place."""
     from ltl_human_motion.motion import goals
+    from ltl_human_motion.motion.biomechanics import BiomechanicsLimits, joint_angles
     from ltl_human_motion.motion.skeleton import Skeleton
-    from ltl_human_motion.planning.biomechanics import BiomechanicsLimits, joint_angles
 
     skeleton = Skeleton(stature)
     st = goals._Start(skeleton, None)

@@ -125,12 +125,12 @@ def test_the_posture_clearance_answers_as_the_exact_one_at_the_search_threshold(
     ``POSTURE_EXACT_BELOW`` are those values."""
     from pathlib import Path
 
+    from ltl_human_motion.motion.capsules import BODY_PARTS
     from ltl_human_motion.motion.goals import _OBSTACLE_CLEARANCE
     from ltl_human_motion.planning.pipeline import get_library, resolve_cell
     from ltl_human_motion.planning.planner import SequencePlanner
     from ltl_human_motion.planning.standing import POSTURE_EXACT_BELOW, posture_clearance
     from ltl_human_motion.scene.geometry import point_bounds
-    from ltl_human_motion.scene.occupancy import BODY_PARTS
     from ltl_human_motion.scene.shapes import EXACT_BELOW
 
     cell = resolve_cell(Path(__file__).resolve().parents[1] / "scenarios" / "cells"

@@ -50,10 +50,10 @@ def test_level_path_rejects_unknown_paths() -> None:
 def test_grasp_palm_target_clears_a_flat_parts_support() -> None:
     """A 4 cm disc on a board: the palm target rises until the palm clears the board,
     and the palm there still enters the part (grasp holds)."""
+    from ltl_human_motion.motion.capsules import BODY_PARTS, capsule_radii
     from ltl_human_motion.planning.pipeline import get_library, resolve_cell
     from ltl_human_motion.planning.planner import SequencePlanner
     from ltl_human_motion.planning.standing import PALM_SUPPORT_GAP
-    from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_radii
     cell = resolve_cell("scenarios/cells/kitting.yaml")
     planner = SequencePlanner(cell, get_library(1.75), np.random.default_rng(0))
     point = np.asarray(cell.object("gear").grasp_points_at(cell.object("gear").position)[0])
@@ -69,7 +69,7 @@ def test_grasp_palm_target_clears_a_flat_parts_support() -> None:
 def _board_clearance(world: np.ndarray, board: tuple[float, float, float]) -> float:
     """Smallest distance (m) of the body's capsules (frames (T, J, 3)) from a board beyond
     x = edge between heights bottom and top (``board``), the capsules sampled densely."""
-    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    from ltl_human_motion.motion.capsules import capsule_ends, capsule_radii
     edge, bottom, top = board
     ia, ib = capsule_ends()
     s = np.linspace(0.0, 1.0, 11)[:, None, None, None]

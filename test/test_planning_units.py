@@ -237,8 +237,8 @@ def test_step_back_moves_the_root_back() -> None:
 
 @pytest.mark.parametrize("stature", [1.55, 1.95])
 def test_steps_and_turns_keep_every_body_part_out_of_the_others(stature: float) -> None:
+    from ltl_human_motion.motion.biomechanics import self_penetration
     from ltl_human_motion.motion.gait import standing_pose
-    from ltl_human_motion.planning.biomechanics import self_penetration
     from ltl_human_motion.planning.turns import STEPS, TURN_ANGLES_DEG
 
     sk = Skeleton(stature)

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from ltl_human_motion.errors import PlanningError
+from ltl_human_motion.motion.capsules import capsule_radii
 from ltl_human_motion.planning.pipeline import get_library, resolve_cell, synthesize
 from ltl_human_motion.planning.placement import RegionEntry
-from ltl_human_motion.scene.occupancy import capsule_radii
 from ltl_human_motion.scene.predicates import collision
 
 

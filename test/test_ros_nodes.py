@@ -28,12 +28,12 @@ from ros_fakes import scripted_synthesize  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray  # noqa: E402
 
+from ltl_human_motion.motion.capsules import BODY_PARTS, capsule_radii  # noqa: E402
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import ClientSession, wait_until  # noqa: E402
 from ltl_human_motion.ros.common import TF_STATIC_QOS  # noqa: E402
 from ltl_human_motion.ros.occupancy_node import OccupancyNode  # noqa: E402
-from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_radii  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

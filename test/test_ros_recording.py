@@ -25,11 +25,11 @@ from mcap.reader import make_reader  # noqa: E402
 from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 from ros_fakes import make_test_motion, scripted_synthesize  # noqa: E402
 
+from ltl_human_motion.motion.capsules import BODY_PARTS  # noqa: E402
 from ltl_human_motion.ros.bringup import Bringup  # noqa: E402
 from ltl_human_motion.ros.client import wait_until  # noqa: E402
 from ltl_human_motion.ros.demo_loop import run_ros_demo  # noqa: E402
 from ltl_human_motion.ros.msgdefs import SEPARATOR, message_definition  # noqa: E402
-from ltl_human_motion.scene.occupancy import BODY_PARTS  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

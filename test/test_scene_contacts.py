@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from ltl_human_motion.motion.capsules import BODY_PARTS
 from ltl_human_motion.motion.skeleton import Skeleton
 from ltl_human_motion.scene import capsules_from_positions, cell_from_yaml
 from ltl_human_motion.scene.contacts import Contact, deepest_contact
-from ltl_human_motion.scene.occupancy import BODY_PARTS
 
 REST = Skeleton().rest_positions()
 

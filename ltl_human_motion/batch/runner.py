@@ -28,6 +28,7 @@ from ltl_human_motion.batch.specs import BatchConfigError, BatchSpecs, load_spec
 from ltl_human_motion.batch.store import DATASET_FORMAT, DATASET_VERSION, DatasetStore
 from ltl_human_motion.batch.worker import (
     BatchJob,
+    ItemAssessment,
     ItemResult,
     pool_initializer,
     prepare_worker,
@@ -220,7 +221,7 @@ def run_batch(cell: str | os.PathLike[str], specs: BatchSpecs | str | os.PathLik
               out: str | os.PathLike[str], *, seed: int = 0, workers: int | None = None,
               scheduler: str | None = None, shard_size: int = 100, dtype: str = "float32",
               progress: bool = True, on_item: Callable[[ItemResult], None] | None = None,
-              assess: dict[str, Any] | None = None) -> BatchSummary:
+              assess: ItemAssessment | None = None) -> BatchSummary:
     """Generate (or finish) a dataset of ``count`` items in ``out``.
 
     Parameters
@@ -247,8 +248,8 @@ def run_batch(cell: str | os.PathLike[str], specs: BatchSpecs | str | os.PathLik
         Show a tqdm progress bar (rate and ETA) on stderr.
     on_item : callable, optional
         Called with every stored result (e.g. to stop a test run).
-    assess : dict, optional
-        Per-item assessment settings (:attr:`BatchJob.assess`; used by ``study``).
+    assess : ItemAssessment, optional
+        Per-item assessment (:attr:`BatchJob.assess`; handed over by ``study``).
 
     Returns
     -------
@@ -268,7 +269,7 @@ def run_batch(cell: str | os.PathLike[str], specs: BatchSpecs | str | os.PathLik
         specs = load_specs(specs)
     job, parsed_cell = make_job(cell, specs, dtype)
     if assess is not None:
-        job = replace(job, assess=dict(assess))
+        job = replace(job, assess=assess)
     store = DatasetStore(out, _header(job, specs, parsed_cell, seed, count, shard_size))
     try:
         return _run_store(store, job, specs, seed, count, workers, scheduler, progress,

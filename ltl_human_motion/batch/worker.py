@@ -16,6 +16,7 @@ import re
 import socket
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -25,9 +26,9 @@ from ltl_human_motion.batch.items import ItemParams, cell_for_item
 from ltl_human_motion.batch.memory import keep_freed_memory
 from ltl_human_motion.kernel.cache import BoundedCache
 
-__all__ = ["ARRAY_NAMES", "LABEL_NAMES", "STORED_NAMES", "BatchJob", "ItemResult",
-           "labels_sha256", "motion_sha256", "pool_initializer", "prepare_worker",
-           "run_item"]
+__all__ = ["ARRAY_NAMES", "LABEL_NAMES", "STORED_NAMES", "BatchJob", "ItemAssessment",
+           "ItemResult", "labels_sha256", "motion_sha256", "pool_initializer",
+           "prepare_worker", "run_item"]
 
 #: Per-item motion arrays, in the order they are hashed (``motion_sha256``) and stored.
 ARRAY_NAMES = ("positions", "root_yaw", "task_index", "objects")
@@ -42,6 +43,24 @@ PRELOAD_LIMIT = 8
 # Wall-clock seconds inside error messages (planner budget); moved to the timing part so
 # records of failed items stay identical between runs.
 _SECONDS_IN_MESSAGE = re.compile(r"(\d+ nodes), \d+(?:\.\d+)? s\b")
+
+
+@dataclass(frozen=True)
+class ItemAssessment:
+    """A per-item assessment a higher layer hands the batch (the study's
+    :func:`ltl_human_motion.study.item.assess_item`: ergonomics, cycle time, offline SSM).
+
+    Attributes
+    ----------
+    run : callable
+        ``run(synth, cell, item, settings) -> dict``: the figures of one stored motion
+        (``record["study"]``); a module-level function, so that jobs pickle to workers.
+    settings : dict
+        Its settings (JSON-ready; part of the job's fingerprint).
+    """
+
+    run: Callable[[Any, Any, ItemParams, dict[str, Any]], dict[str, Any]]
+    settings: dict[str, Any]
 
 
 @dataclass(frozen=True)
@@ -67,10 +86,9 @@ class BatchJob:
         The stature grid (libraries are preloaded when it is small).
     descriptions : dict of str to str
         Names captions use for things of the cell (the specs file's ``descriptions``).
-    assess : dict or None
-        Settings of a per-item assessment (:func:`ltl_human_motion.study.item.assess_item`:
-        ergonomics, cycle time, offline SSM) whose figures go into ``record["study"]``;
-        None (the default) for none.
+    assess : ItemAssessment or None
+        The per-item assessment whose figures go into ``record["study"]``; None (the
+        default) for none.
     """
 
     cell_yaml: str
@@ -81,7 +99,7 @@ class BatchJob:
     keep_unverified: bool = False
     dtype: str = "float32"
     statures: tuple[float, ...] = (1.75,)
-    assess: dict[str, Any] | None = None
+    assess: ItemAssessment | None = None
     descriptions: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -94,7 +112,7 @@ class BatchJob:
                 "options": self.options, "sequence_mode": self.sequence_mode,
                 "keep_unverified": self.keep_unverified, "dtype": self.dtype}
         if self.assess is not None:
-            data["assess"] = self.assess
+            data["assess"] = self.assess.settings
         if self.descriptions:
             data["descriptions"] = self.descriptions
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode("utf-8")).hexdigest()
@@ -343,9 +361,8 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
         record["error"] = {"type": "VerificationError", "message": detail,
                            "check": failed_check, "task": None}
     if job.assess is not None and arrays is not None:
-        from ltl_human_motion.study.item import assess_item
         t_assess = time.perf_counter()
-        record["study"] = _plain(assess_item(synth, cell, item, job.assess))
+        record["study"] = _plain(job.assess.run(synth, cell, item, job.assess.settings))
         timing["assess_time"] = time.perf_counter() - t_assess
     timing.update({k: float(v) for k, v in synth.stats.items()
                    if k.endswith("_time") and k != "batch_total_time"})

@@ -172,8 +172,8 @@ def _print_quality(kind: str, q: dict) -> None:
     worst value of each check beside its limit."""
     from dataclasses import asdict
 
+    from ltl_human_motion.motion.biomechanics import BiomechanicsLimits
     from ltl_human_motion.motion.quality import QualityThresholds
-    from ltl_human_motion.planning.biomechanics import BiomechanicsLimits
     t = {**asdict(QualityThresholds()), **q.get("thresholds", {})}
     w = q["worst"]
     print(f"  quality {kind:5s}    {q['passed']:4d}/{q['count']:<4d} primitives within the "

@@ -13,7 +13,7 @@ Checks on every primitive (world positions of the primitive started at the origi
   swing foot of normal walking peaks near 5 m/s and hands in fast reaching reach 5 to
   7 m/s, so the limit is 7 m/s;
 * ``self_penetration``: deepest entry (m) of a body capsule's bone axis into another,
-  non-neighbouring capsule (:func:`~ltl_human_motion.planning.biomechanics.
+  non-neighbouring capsule (:func:`~ltl_human_motion.motion.biomechanics.
   self_penetration`); must be <= 0 (a foot through the other shank, an arm through the
   trunk). Loops whose processing makes the feet cross are dropped by this.
 
@@ -90,7 +90,7 @@ def primitive_metrics(positions: np.ndarray, fps: float, skeleton: Skeleton,
         speed = float((np.linalg.norm(np.diff(p, axis=0), axis=-1) * fps).max())
     else:
         speed = 0.0
-    from ltl_human_motion.planning.biomechanics import self_penetration
+    from ltl_human_motion.motion.biomechanics import self_penetration
     pen = float(self_penetration(p, skeleton.stature)[0].max()) if len(p) else 0.0
     passed = (bone_dev <= thresholds.bone_length and floor >= -thresholds.floor_tolerance
               and skate <= thresholds.foot_skate and speed <= thresholds.joint_speed

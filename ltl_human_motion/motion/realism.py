@@ -4,9 +4,9 @@ For a motion on the canonical skeleton (world positions (T, J, 3), z up) the sam
 six distributions are measured:
 
 * ``hand_speed``, ``knee_speed``, ``foot_speed`` (m/s): joint speeds over 1/30 s
-  (:func:`~ltl_human_motion.planning.biomechanics.joint_speeds`);
+  (:func:`~ltl_human_motion.motion.biomechanics.joint_speeds`);
 * ``knee_angle``, ``hip_angle``, ``elbow_angle``, ``trunk_angle`` (deg): knee, hip and
-  elbow flexion and trunk flexion (:func:`~ltl_human_motion.planning.biomechanics.
+  elbow flexion and trunk flexion (:func:`~ltl_human_motion.motion.biomechanics.
   joint_angles`);
 * ``hand_jerk`` (m/s^3): magnitude of the third derivative of the palm positions
   (central differences on a 30 Hz resampling, so mocap noise at 120 Hz does not dominate);
@@ -14,7 +14,7 @@ six distributions are measured:
   down within the contact height of its rest height after a swing), the distance between
   the feet at each strike and the interval between consecutive strikes of opposite feet;
 * ``foot_skate`` (m/s): horizontal speed of each foot's contact point over its contact
-  frames (the MOJO samples, :func:`~ltl_human_motion.planning.biomechanics.foot_skate`).
+  frames (the MOJO samples, :func:`~ltl_human_motion.motion.biomechanics.foot_skate`).
 
 :func:`compare` gives, per metric, summary statistics of ours and of the real data and
 the 1-Wasserstein distance between the two distributions (``scipy.stats.
@@ -56,7 +56,7 @@ _MAX_STEP = 1.5
 
 def _strikes(p: np.ndarray, fps: float, stature: float, floor_z: float) -> list[tuple[int, int]]:
     """(frame, foot) of every foot strike, foot 0 = left, 1 = right, in time order."""
-    from ltl_human_motion.planning.biomechanics import CONTACT_REST_HEIGHTS
+    from ltl_human_motion.motion.biomechanics import CONTACT_REST_HEIGHTS
     out = []
     for k, s in enumerate("lr"):
         idx = [_J[f"{s}_ankle"], _J[f"{s}_toe"]]
@@ -87,7 +87,7 @@ def motion_samples(positions: np.ndarray, fps: float, stature: float = DEFAULT_S
     -------
     dict of str to ndarray (1-D)
     """
-    from ltl_human_motion.planning.biomechanics import foot_skate, joint_angles, joint_speeds
+    from ltl_human_motion.motion.biomechanics import foot_skate, joint_angles, joint_speeds
     p = np.asarray(positions, dtype=np.float64)
     T = len(p)
     sel = np.ones(T, dtype=bool) if frames is None else np.asarray(frames, dtype=bool)

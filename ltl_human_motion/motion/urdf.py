@@ -63,8 +63,8 @@ from ltl_human_motion.motion.bone_rotations import (
     twist_matrices,
     unit_vectors,
 )
+from ltl_human_motion.motion.capsules import BODY_CAPSULES, capsule_radii
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, Skeleton
-from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 #: Degrees of slack on every ROM limit (Euler angles of a ball joint vs clinical planes).
 LIMIT_MARGIN = 15.0

@@ -101,13 +101,13 @@ def program_options(kind: str, stature: float) -> WholeBodyOptions:
     """The whole-body program's options for goal task ``kind``: the verifier's joint speed
     limits (with :data:`SPEED_ROOM`) and self-penetration pairs (with
     :data:`SELF_MARGIN`) for a worker of ``stature``."""
-    from ltl_human_motion.planning.biomechanics import (
+    from ltl_human_motion.motion.biomechanics import (
         _PAIR_CAPSULES,
         _PAIR_ENDS,
         BiomechanicsLimits,
         _speed_limits,
     )
-    from ltl_human_motion.scene.occupancy import capsule_radii
+    from ltl_human_motion.motion.capsules import capsule_radii
     limits = BiomechanicsLimits()
     speeds = _speed_limits(1, [kind], limits, stature / limits.reference_stature)[0]
     r = capsule_radii(stature)

@@ -28,9 +28,9 @@ import numpy as np
 from scipy.ndimage import maximum_filter1d, uniform_filter1d
 
 from ltl_human_motion.kernel.segments import compiled_module
+from ltl_human_motion.motion.capsules import BODY_CAPSULES, capsule_radii
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
-from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 __all__ = ["lock_feet"]
 
@@ -94,7 +94,7 @@ POLE_SMOOTH = 0.05
 POLE_FORWARD = 0.03
 
 #: Room (m) a swinging foot's bone axis keeps beyond the other leg's shank capsule as it
-#: passes it (the self-penetration check of planning.biomechanics wants the axis outside
+#: passes it (the self-penetration check of motion.biomechanics wants the axis outside
 #: the capsule; blending and foot locking move the feet by millimetres afterwards).
 FOOT_PASS_MARGIN = 0.005
 #: Order of the feet moved clear of the other leg's shank (:func:`_pass_clear`), twice

@@ -945,7 +945,7 @@ class GoalSteps:
 def body_failures(mp: MotionPrimitive, kind: str, stature: float) -> list[str]:
     """The verifier's biomechanical checks (speeds, ranges of motion, self-penetration,
     balance, planted feet) that goal primitive ``mp`` of task ``kind`` fails on its own."""
-    from ltl_human_motion.planning.biomechanics import check_biomechanics
+    from ltl_human_motion.motion.biomechanics import check_biomechanics
     world = world_positions(mp)
     checks = check_biomechanics(world, mp.fps, stature=stature, labels=[kind] * len(world))
     return [name for name, entry in checks.items() if not entry["passed"]]

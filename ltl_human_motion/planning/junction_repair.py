@@ -16,13 +16,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ltl_human_motion.motion.ik import min_jerk
-from ltl_human_motion.planning.biomechanics import (
+from ltl_human_motion.motion.biomechanics import (
     BiomechanicsLimits,
     frame_labels,
     self_penetration,
     speed_excess,
 )
+from ltl_human_motion.motion.ik import min_jerk
 from ltl_human_motion.planning.blend import JUNCTION_FOOT_SPREAD_MAX
 from ltl_human_motion.planning.verify import colliding_frames
 
@@ -70,7 +70,7 @@ def repaired(report: dict, synth, cell, held: dict[str, np.ndarray] | None, stat
     ``wide`` as there), or where none is left to move foot locking is faded out around
     those frames; else the junctions near too fast frames are stretched. None when there
     is nothing left to change. ``limits``: the biomechanical limits verified against
-    (default :class:`~ltl_human_motion.planning.biomechanics.BiomechanicsLimits`)."""
+    (default :class:`~ltl_human_motion.motion.biomechanics.BiomechanicsLimits`)."""
     pos = synth.motion.positions
     fps = synth.motion.fps
     blocked = np.zeros(len(pos), dtype=bool)

@@ -400,7 +400,7 @@ class ObstacleField:
         relative : bool
             For standing primitives that start where the last motion ended.
         parts : ndarray of int, shape (K,), optional
-            Only these body capsules (indices into ``occupancy.BODY_PARTS``); default all.
+            Only these body capsules (indices into ``motion.capsules.BODY_PARTS``); default all.
 
         Returns
         -------
@@ -502,7 +502,7 @@ def _capsule_table(stature: float, parts: tuple[int, ...] | None
     """The capsules :meth:`ObstacleField.clear` reads: end joints (K,), whether each is
     long (not a sphere) and radii (K,) at ``stature``, of ``parts`` (default all).
     Shared: callers must not write to them."""
-    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    from ltl_human_motion.motion.capsules import capsule_ends, capsule_radii
     ia, ib = capsule_ends()
     radii = capsule_radii(stature)
     if parts is not None:

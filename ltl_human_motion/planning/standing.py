@@ -283,7 +283,7 @@ def palm_clear_of_support(cell, stature: float, point: np.ndarray, part) -> np.n
     while the palm still enters the part."""
     if not cell.obstacles:
         return point
-    from ltl_human_motion.scene.occupancy import BODY_PARTS, capsule_radii
+    from ltl_human_motion.motion.capsules import BODY_PARTS, capsule_radii
     radius = float(capsule_radii(stature)[BODY_PARTS.index("r_palm")])
     for rise in np.arange(0.0, radius, PALM_RISE_STEP):
         palm = point + np.array([0.0, 0.0, rise])

@@ -18,6 +18,7 @@ import numpy as np
 
 from ltl_human_motion.errors import PlanningError
 from ltl_human_motion.kernel.cache import BoundedCache
+from ltl_human_motion.motion.capsules import part_indices
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.planning.astar import (
@@ -31,7 +32,6 @@ from ltl_human_motion.planning.blend import PlacedSegment, wrap_angle
 from ltl_human_motion.planning.plan_state import PlanContext, Pose, WorkerState
 from ltl_human_motion.planning.standing import ideal_placement
 from ltl_human_motion.planning.walk_goals import walk_grid
-from ltl_human_motion.scene.occupancy import part_indices
 
 #: Clearance (m) the planner keeps between the body and obstacles on the frames it
 #: checks exactly: the verifier allows none below 0; blends between segments move

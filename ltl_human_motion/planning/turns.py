@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ltl_human_motion.motion.biomechanics import self_penetration
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import MotionPrimitive
-from ltl_human_motion.planning.biomechanics import self_penetration
 
 TURN_ANGLES_DEG = (-180.0, -135.0, -90.0, -45.0, -20.0, 20.0, 45.0, 90.0, 135.0)
 #: Steps on the spot: (forward, left, turn in degrees). The short ones let a walk end
@@ -56,7 +56,7 @@ def _progress(t: np.ndarray, a: float, b: float) -> np.ndarray:
 
 
 #: Clearance (m) the hanging arms keep from the thighs of the stepping legs, over the
-#: self-penetration check of planning.biomechanics. 2 cm: foot locking (planning.footlock)
+#: self-penetration check of motion.biomechanics. 2 cm: foot locking (planning.footlock)
 #: turns a thigh of a step by up to 1 cm towards its hand (1 cm left the hand 2 mm inside
 #: the thigh in the steps back of a 1.55 m worker).
 ARM_CLEARANCE = 0.02

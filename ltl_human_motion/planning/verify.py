@@ -14,7 +14,7 @@ Checks (each a key of the report):
                  biomechanical plausibility of the whole blended motion (per-joint speed
                  limits by body part and activity, anatomical range of motion, no body
                  part through another, static balance, foot skate): see
-                 :mod:`~ltl_human_motion.planning.biomechanics` for the limits and their
+                 :mod:`~ltl_human_motion.motion.biomechanics` for the limits and their
                  sources. On by default (``VerificationOptions.biomechanics``).
 """
 
@@ -25,15 +25,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ltl_human_motion.errors import VerificationError
-from ltl_human_motion.motion.skeleton import JOINT_INDEX, MAX_STATURE
-from ltl_human_motion.planning.biomechanics import (
+from ltl_human_motion.motion.biomechanics import (
     BiomechanicsLimits,
     check_biomechanics,
     frame_labels,
     seated_frames,
 )
+from ltl_human_motion.motion.capsules import capsule_radii
+from ltl_human_motion.motion.skeleton import JOINT_INDEX, MAX_STATURE
 from ltl_human_motion.scene.geometry import point_bounds
-from ltl_human_motion.scene.occupancy import capsule_radii
 
 FOOT_JOINTS = ("l_ankle", "l_toe", "r_ankle", "r_toe")
 
@@ -59,7 +59,7 @@ class VerificationOptions:
         motions of the looser verification of earlier releases: docs/design-notes.md,
         "Human plausibility").
     limits : BiomechanicsLimits
-        Their limits (:mod:`~ltl_human_motion.planning.biomechanics`).
+        Their limits (:mod:`~ltl_human_motion.motion.biomechanics`).
     """
 
     eps: float = 0.05

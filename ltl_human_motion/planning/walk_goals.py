@@ -364,7 +364,7 @@ class WalkGoals:
         heading; none (a region above a bench, beside a wall) makes the region
         unreachable on foot (the caller reaches into it by hand).
         """
-        from ltl_human_motion.scene.occupancy import capsule_radii
+        from ltl_human_motion.motion.capsules import capsule_radii
         stature = self.ctx.stature
         carrying = self.state.carrying
         entry = RegionEntry(region, self.ctx.stance(carrying), self.ctx.library.standing_height,

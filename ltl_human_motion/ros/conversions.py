@@ -123,7 +123,9 @@ def body_capsules(positions: np.ndarray, stature: float) -> tuple[np.ndarray, np
 
 def capsule_part_names() -> list[str]:
     """Part names (K,) of the body capsules, in ``BODY_CAPSULES`` order."""
-    return [str(entry[0]) for entry in _occupancy_module().BODY_CAPSULES]
+    from ltl_human_motion.motion.capsules import BODY_PARTS
+
+    return list(BODY_PARTS)
 
 
 @lru_cache(maxsize=1)

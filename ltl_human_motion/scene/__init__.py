@@ -4,6 +4,13 @@ Core module: no ROS. Everything is z up (REP 103); cells written in the paper's 
 frame are converted once when loaded (:func:`zup_from_yup`).
 """
 
+from ltl_human_motion.motion.capsules import (
+    BODY_CAPSULES,
+    BODY_PARTS,
+    PART_ALIASES,
+    capsule_radii,
+    part_indices,
+)
 from ltl_human_motion.scene.cell import Cell, Obstacle, Region, SceneObject
 from ltl_human_motion.scene.cell_yaml import (
     cell_by_name,
@@ -25,14 +32,9 @@ from ltl_human_motion.scene.geometry import (
     segment_segment_distance,
 )
 from ltl_human_motion.scene.occupancy import (
-    BODY_CAPSULES,
-    BODY_PARTS,
-    PART_ALIASES,
     body_radius_xy,
-    capsule_radii,
     capsules_from_positions,
     occ,
-    part_indices,
 )
 from ltl_human_motion.scene.predicates import (
     body_clearance,

@@ -1,6 +1,6 @@
 """A shaded body for display: a triangle mesh built from the occupancy capsules.
 
-Every capsule of :data:`~ltl_human_motion.scene.occupancy.BODY_CAPSULES` (sized by
+Every capsule of :data:`~ltl_human_motion.motion.capsules.BODY_CAPSULES` (sized by
 stature, as the occupancy is) becomes a smooth capsule: a trimesh UV sphere whose lower
 half is placed at one joint and upper half at the other, so the band between them is
 the capsule's cylinder. The palms and knee spheres duplicate other parts and are left
@@ -17,8 +17,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from ltl_human_motion.motion.capsules import BODY_CAPSULES, capsule_radii
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, N_JOINTS
-from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 __all__ = ["BODY_COLORS", "BODY_DISPLAY_SCALE", "body_mesh", "body_part_names"]
 

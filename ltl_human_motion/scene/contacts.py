@@ -13,9 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ltl_human_motion.motion.capsules import BODY_PARTS
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE
 from ltl_human_motion.scene.cell import Cell
-from ltl_human_motion.scene.occupancy import BODY_PARTS, capsules_from_positions
+from ltl_human_motion.scene.occupancy import capsules_from_positions
 from ltl_human_motion.scene.predicates import body_clearance
 
 __all__ = ["Contact", "deepest_contact"]
@@ -33,7 +34,8 @@ class Contact:
     frame : int
         Frame index in the positions given.
     part : str
-        Body capsule (:data:`~.occupancy.BODY_PARTS`), e.g. ``"head"``, ``"r_lower_arm"``.
+        Body capsule (:data:`~ltl_human_motion.motion.capsules.BODY_PARTS`), e.g. ``"head"``,
+        ``"r_lower_arm"``.
     obstacle : str
         Name of the obstacle in the cell.
     depth : float

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ltl_human_motion.study.item import assess_settings
+from ltl_human_motion.study.item import assess_item, assess_settings
 
 __all__ = ["StudyConfig", "collect_layout", "run_study"]
 
@@ -154,6 +154,7 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
     from tqdm import tqdm
 
     from ltl_human_motion.batch.runner import run_batch
+    from ltl_human_motion.batch.worker import ItemAssessment
     from ltl_human_motion.planning.pipeline import resolve_cell
     from ltl_human_motion.study.report import write_report
     out = Path(cfg.out)
@@ -171,7 +172,7 @@ def run_study(cfg: StudyConfig, progress: bool = True) -> dict[str, Any]:
             summary = run_batch(cell, specs, cfg.count, out / "layouts" / label,
                                 seed=cfg.seed, workers=cfg.workers, scheduler=cfg.scheduler,
                                 progress=False, on_item=lambda _r: bar.update(1),
-                                assess=settings)
+                                assess=ItemAssessment(assess_item, settings))
             bar.update(summary.skipped)
             runs.append(summary.to_dict())
             if not summary.complete:

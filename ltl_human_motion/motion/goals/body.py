@@ -247,7 +247,7 @@ def _legs_in_range(skeleton: Skeleton, st: _Start, pelvis: np.ndarray, pitch: np
     (C, 2, 3)), default the start pose's) stay within the biomechanical range of motion
     less :data:`_ROM_MARGIN` (a deep crouch with a flexed trunk folds the hip past
     125 degrees), shape (C,) of bool."""
-    from ltl_human_motion.planning.biomechanics import BiomechanicsLimits, joint_angles
+    from ltl_human_motion.motion.biomechanics import BiomechanicsLimits, joint_angles
     C = pitch.size
     legs = _standing_legs(st, C) if legs is None else legs
     poses = _body(skeleton, pelvis, pitch, *legs,

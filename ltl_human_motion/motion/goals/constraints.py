@@ -11,13 +11,13 @@ from typing import Protocol
 
 import numpy as np
 
+from ltl_human_motion.motion.capsules import BODY_CAPSULES
 from ltl_human_motion.motion.goals.kinematics import (
     BodyKinematics,
     HeldPart,
     body_capsules,
     point_jacobians,
 )
-from ltl_human_motion.scene.occupancy import BODY_CAPSULES
 
 __all__ = ["ObstacleField", "SelfPairs", "clearance_rows", "reference_clearance",
            "self_rows", "speed_rows"]

@@ -10,9 +10,9 @@ from functools import lru_cache
 
 import numpy as np
 
+from ltl_human_motion.motion.capsules import BODY_CAPSULES, capsule_radii
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES
 from ltl_human_motion.motion.urdf import joint_angles, joint_names, link_name, root_poses
-from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 
 __all__ = ["BODY_ID", "BodyKinematics", "HeldPart", "body_capsules", "body_kinematics",
            "point_jacobians"]

@@ -70,7 +70,7 @@ def _board_depth(poses: np.ndarray, board: tuple[float, float, float],
     (C, J, 3) go into a board beyond x = edge between heights bottom and top
     (``board = (edge, bottom, top)``, start frame), plus ``_BOARD_CLEARANCE``, metres
     (C,); negative: clear."""
-    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    from ltl_human_motion.motion.capsules import capsule_ends, capsule_radii
     edge, bottom, top = board
     ia, ib = capsule_ends()
     radii = capsule_radii(stature)
@@ -124,7 +124,7 @@ def _board_way_blocked(skeleton: Skeleton, st: _Start,
     ``_BOARD_CLEARANCE`` on the way into the posture (:data:`_POSTURE_WAY`), shape (C,)
     of bool. The acting arm follows the level path, which turns before the board's edge
     (:func:`_level_keys`)."""
-    from ltl_human_motion.scene.occupancy import part_indices
+    from ltl_human_motion.motion.capsules import part_indices
     free = tuple(k for k in range(2) if k not in active)
     way = _way_poses(skeleton, st, posture, cap, free, kneel)
     S, C = len(_POSTURE_WAY), posture[0].size
@@ -140,7 +140,7 @@ def _support_depth(poses: np.ndarray, support: tuple[float, float, float, float]
     clear. ``support = (nx, ny, offset, top)`` (start frame): the furniture is where
     ``nx * x + ny * y >= offset`` ((nx, ny) the unit normal into it from its edge), from
     the floor up to height ``top``."""
-    from ltl_human_motion.scene.occupancy import BODY_PARTS
+    from ltl_human_motion.motion.capsules import BODY_PARTS
     keep = np.array([BODY_PARTS.index(name) for name in _SUPPORT_FREE_PARTS])
     return _slab_depth(poses, (*support[:3], -1.0, support[3]), stature, keep)
 
@@ -151,7 +151,7 @@ def _slab_depth(poses: np.ndarray, slab: tuple[float, float, float, float, float
     (C, J, 3) go into ``slab = (nx, ny, offset, bottom, top)`` (start frame: where
     ``nx * x + ny * y >= offset`` between heights bottom and top), plus
     ``_BOARD_CLEARANCE``, metres (C,); negative: clear."""
-    from ltl_human_motion.scene.occupancy import capsule_ends, capsule_radii
+    from ltl_human_motion.motion.capsules import capsule_ends, capsule_radii
     nx, ny, offset, bottom, top = slab
     ia, ib = capsule_ends()
     radii = capsule_radii(stature)
@@ -200,7 +200,7 @@ def _obstacle_blocked(skeleton: Skeleton, st: _Start,
     -------
     ndarray of bool, shape (C,)
     """
-    from ltl_human_motion.scene.occupancy import BODY_PARTS
+    from ltl_human_motion.motion.capsules import BODY_PARTS
     fixed = {f"{_SIDES[k]}_{n}" for k in active for n in ("hand", "palm")} | {"l_foot",
                                                                                "r_foot"}
     whole = tuple(p for p in BODY_PARTS if p not in fixed)

@@ -214,7 +214,7 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
         feasible = feasible & _turns_before_edge(shoulders, active, board)
     idx = np.flatnonzero(feasible)
     if idx.size:
-        from ltl_human_motion.planning.biomechanics import self_penetration
+        from ltl_human_motion.motion.biomechanics import self_penetration
         poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
                                task, cap=capped[idx], kneel=kneel[idx])
         blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE

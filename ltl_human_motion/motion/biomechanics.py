@@ -32,7 +32,7 @@ Limits and where they come from (:class:`BiomechanicsLimits`):
   thoracolumbar flexion 80, extension 25, lateral bending 35, rotation 45; cervical
   flexion 45, extension 45, lateral bending 45.
 * **Self-penetration**: the bone axis of one body capsule
-  (:data:`~ltl_human_motion.scene.occupancy.BODY_CAPSULES`) must not enter another,
+  (:data:`~ltl_human_motion.motion.capsules.BODY_CAPSULES`) must not enter another,
   non-neighbouring capsule (axis distance below the thicker capsule's radius): an arm
   segment through the trunk, head or a thigh, an arm through the other arm, a thigh
   through the other thigh, a shank or foot through the other.
@@ -61,9 +61,9 @@ import numpy as np
 
 from ltl_human_motion.kernel.segments import compiled_module, joint_segment_distances
 from ltl_human_motion.kernel.vectors import cross3, dot3, norm3
+from ltl_human_motion.motion.capsules import BODY_CAPSULES, capsule_radii
 from ltl_human_motion.motion.ik import center_of_mass
 from ltl_human_motion.motion.skeleton import DEFAULT_STATURE, JOINT_INDEX, JOINT_NAMES
-from ltl_human_motion.scene.occupancy import BODY_CAPSULES, capsule_radii
 from ltl_human_motion.vocabulary import HAND_TASKS
 
 __all__ = [
@@ -324,7 +324,7 @@ def _hull_distance(points: np.ndarray, p: np.ndarray) -> np.ndarray:
     """
     P = np.ascontiguousarray(points, dtype=np.float64)
     q = np.ascontiguousarray(p, dtype=np.float64)
-    nb = compiled_module("ltl_human_motion.planning._motion_numba")
+    nb = compiled_module("ltl_human_motion.motion._biomechanics_numba")
     if nb is not None:
         return nb.hull_distance(P, q)
     i, j = np.nonzero(~np.eye(P.shape[1], dtype=bool))        # every ordered pair
