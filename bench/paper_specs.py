@@ -68,9 +68,9 @@ def main(argv: list[str] | None = None) -> int:
             t = time.perf_counter()
             synth = synthesize(name, cell, library=library, seed=seed, cycles=args.cycles)[0]
             wall = time.perf_counter() - t
-            run = {k: synth.stats[k] for k in STAGES}
+            run = {k: getattr(synth.stats, k) for k in STAGES}
             run.update(wall=wall, duration=synth.motion.duration,
-                       nodes=synth.stats["nodes_expanded"],
+                       nodes=synth.stats.nodes_expanded,
                        verified=bool(synth.verification["passed"]))
             runs.append(run)
         med = {k: statistics.median(r[k] for r in runs) for k in (*STAGES, "wall", "duration")}

@@ -39,7 +39,7 @@ def _tab2(results: dict) -> str:
     lines = ["| Spec | Task | Goal centre [x, y, z] in m (z up) | Goal primitive made | "
              "Frames (start → end) |", "|---|---|---|---|---|"]
     for name, synth in results.items():
-        for step, seg in zip(synth.stats["goal_primitives"], synth.timeline):
+        for step, seg in zip(synth.stats.goal_primitives, synth.timeline):
             target = step["target"]
             centre = "–" if target is None else "[" + ", ".join(f"{v:.2f}" for v in target) + "]"
             lines.append(f"| {name} | {seg.task} | {centre} | {step['primitive']} | "
@@ -48,12 +48,12 @@ def _tab2(results: dict) -> str:
 
 
 def _tab3(results: dict) -> tuple[str, dict]:
-    times = {name: {key: float(s.stats[field]) for key, field, _ in STAGES}
+    times = {name: {key: float(getattr(s.stats, field)) for key, field, _ in STAGES}
              for name, s in results.items()}
     for name, s in results.items():
         times[name]["duration"] = float(s.motion.duration)
-        times[name]["real_time_factor"] = float(s.stats["real_time_factor"])
-        times[name]["nodes_expanded"] = int(s.stats["nodes_expanded"])
+        times[name]["real_time_factor"] = float(s.stats.real_time_factor)
+        times[name]["nodes_expanded"] = int(s.stats.nodes_expanded)
     names = list(results)
     head = "| Stage | " + " | ".join(f"{n} ours [ms] | {n} paper [s]" for n in names) + " |"
     lines = [head, "|---|" + "---|---|" * len(names)]

@@ -185,4 +185,4 @@ def demo_synthesized_motion(cell: Cell | None = None, region: str | None = None,
         motion=motion, root_yaw=yaw, task_index=task_index,
         timeline=[TaskSegment(task, n_walk, T, "demo_reach", target)],
         objects=objects, spec=f"F {task}", sequence=[task], seed=0,
-        stats={"generator": "demo_synthesized_motion"}, verification={})
+        verification={})

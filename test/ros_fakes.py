@@ -25,7 +25,7 @@ from ltl_human_motion.motion.types import Motion
 def make_test_motion(duration: float = 2.0, fps: float = 60.0, stature: float = 1.75,
                      name: str = "test_motion") -> Any:
     """A hand-made SynthesizedMotion of ``duration`` seconds (walk, then grasp + carry)."""
-    from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
+    from ltl_human_motion.planning.result import SynthesisStats, SynthesizedMotion, TaskSegment
 
     if not duration > 0 or not fps > 0:
         raise ValueError(f"duration and fps must be positive, got {duration}, {fps}")
@@ -49,7 +49,7 @@ def make_test_motion(duration: float = 2.0, fps: float = 60.0, stature: float = 
         timeline=[TaskSegment("grasp(O1)", half, n, "test_grasp")],
         objects={"O1": o1, "O2": np.tile(np.array([-1.5, 1.2, 0.3]), (n, 1))},
         spec="grasp(O1)", sequence=["grasp(O1)"], seed=0,
-        stats={"total_time": 0.01, "planning_time": 0.005, "nodes_expanded": 7})
+        stats=SynthesisStats(total_time=0.01, planning_time=0.005, nodes_expanded=7))
 
 
 def scripted_synthesize(spec: str, cell: Any, library: Any = None, variants: int = 1,

@@ -6,6 +6,7 @@ import csv
 import json
 import math
 import zipfile
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,7 @@ from ltl_human_motion.planning.exports import (
     save_csv,
     save_json,
     save_npz,
+    to_dict,
 )
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.scene import cell_by_name
@@ -32,7 +34,7 @@ from ltl_human_motion.scene import cell_by_name
 @pytest.fixture(scope="module")
 def synth() -> SynthesizedMotion:
     s = demo_synthesized_motion(cell_by_name("paper_cell"), fps=30.0)
-    s.stats.update({"planning_s": 1.25, "expanded": np.int64(42), "ratio": float("inf")})
+    s.stats = replace(s.stats, nodes_expanded=np.int64(42), realism={"ratio": float("inf")})
     s.verification.update({"passed": np.bool_(True), "collision": {"frames": 0}})
     # Let O1 follow the right hand for the last frames (a carried object).
     s.objects["O1"][-10:] = s.positions[-10:, JOINT_NAMES.index("r_hand")]
@@ -97,7 +99,7 @@ def test_npz_round_trip_and_determinism(synth, tmp_path):
         assert {i.date_time for i in zf.infolist()} == {(1980, 1, 1, 0, 0, 0)}
     back = load_npz(a)
     _assert_same(synth, back)
-    assert back.stats["expanded"] == 42 and math.isinf(back.stats["ratio"])
+    assert back.stats.nodes_expanded == 42 and math.isinf(back.stats.realism["ratio"])
     assert back.verification["passed"] is True
     np.testing.assert_array_equal(back.timeline[0].target, synth.timeline[0].target)
     # Loads without pickles; no temporary files are left behind.
@@ -123,12 +125,21 @@ def test_json_round_trip_is_standard_json(synth, tmp_path):
     def reject(token):
         raise AssertionError(f"non-standard JSON constant {token}")
     data = json.loads(text, parse_constant=reject)
-    assert data["stats"]["ratio"] is None                   # inf -> null
+    assert data["stats"]["realism"]["ratio"] is None        # inf -> null
     assert data["joint_names"] == list(JOINT_NAMES)
     back = load_json(path)
     _assert_same(synth, back)
     save_json(synth, tmp_path / "m2.json")
     assert (tmp_path / "m2.json").read_text() == text
+
+
+def test_a_stats_field_the_format_does_not_know_names_the_file(synth, tmp_path):
+    data = json.loads(json.dumps(to_dict(synth)))
+    data["stats"]["planning_s"] = 1.25
+    path = tmp_path / "odd.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(MotionFormatError, match=r"odd\.json.*unknown stats field.*planning_s"):
+        load_json(path)
 
 
 def test_csv_columns_and_values(synth, tmp_path):

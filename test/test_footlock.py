@@ -113,26 +113,26 @@ def test_synthesis_with_foot_locking_pins_the_feet_or_falls_back_when_it_collide
 
     # with the biomechanical checks (the default) the feet are always locked
     s1 = synthesize(PAPER_SPECS["S1"], resolve_cell("paper_cell"), seed=0)[0]
-    assert s1.verification["passed"] and s1.stats["foot_locking"] is True
+    assert s1.verification["passed"] and s1.stats.foot_locking is True
     assert foot_skate(s1.motion.positions, s1.motion.fps, 1.75)[0].max() < 0.03
     # without them foot locking is an option, with a fallback
     loose = VerificationOptions(biomechanics=False)
     on = SynthesisOptions(foot_locking=True, verification=loose)
     s1 = synthesize(PAPER_SPECS["S1"], resolve_cell("paper_cell"), seed=0, options=on)[0]
-    assert s1.verification["passed"] and s1.stats["foot_locking"] is True
+    assert s1.verification["passed"] and s1.stats.foot_locking is True
     off = synthesize(PAPER_SPECS["S1"], resolve_cell("paper_cell"), seed=0,
                      options=SynthesisOptions(verification=loose))[0]
-    assert off.stats["foot_locking"] is False
+    assert off.stats.foot_locking is False
     # next to the demo cell's table the blend moves a pose into it: its junctions are
     # blended again (junction_repair), and the motion keeps foot locking; without those
     # repairs it is blended again without foot locking, and verified
     spec, demo = "F(grasp(O1) & X release(O1))", resolve_cell("demo_cell")
     m = synthesize(spec, demo, seed=0, options=on)[0]
-    assert m.verification["passed"] and m.stats["foot_locking"] is True
+    assert m.verification["passed"] and m.stats.foot_locking is True
     monkeypatch.setattr(pipeline, "JUNCTION_REPAIRS", 0)
     m = synthesize(spec, demo, seed=0, options=on)[0]
     assert m.verification["passed"] and m.verification["collision"]["passed"]
-    assert m.stats["foot_locking"] is False
+    assert m.stats.foot_locking is False
 
 
 def test_compiled_sequential_passes_equal_the_python_loops() -> None:

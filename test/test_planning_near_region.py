@@ -24,7 +24,7 @@ def test_a_part_carried_into_the_region_the_worker_stands_in_goes_down_in_front(
     cell = load_cell(AISLE)
     synth = synthesize("F carry(O2, R2)", cell, stature=1.75, seed=0)[0]
     assert synth.verification["passed"]
-    assert synth.stats["nodes_expanded"] < 200
+    assert synth.stats.nodes_expanded < 200
     region = cell.region("R2")
     carry = next(s for s in synth.timeline if s.task.startswith("carry"))
     end = synth.objects["O2"][carry.end_frame - 1]
@@ -39,12 +39,12 @@ def test_a_worker_facing_away_turns_on_the_spot_before_stepping_to_the_region() 
     steps there."""
     synth = synthesize("F move(O1, R2)", AISLE, stature=1.95, seed=1)[0]
     assert synth.verification["passed"]
-    names = [name for name, _, _ in synth.stats["segments"]]
+    names = [name for name, _, _ in synth.stats.segments]
     turn = next(i for i, n in enumerate(names) if n.startswith("carry_turn"))
     move = next(i for i, n in enumerate(names) if n.startswith("move_"))
     assert turn < move
     assert all(n.startswith(("carry_step", "carry_turn")) for n in names[turn:move])
-    assert synth.stats["nodes_expanded"] < 1000
+    assert synth.stats.nodes_expanded < 1000
 
 
 def test_the_stature_is_the_library_s() -> None:

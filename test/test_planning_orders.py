@@ -20,6 +20,7 @@ from ltl_human_motion.planning.pipeline import (
     _verified_in_another_order,
     resolve_cell,
 )
+from ltl_human_motion.planning.result import SynthesisStats
 
 KITTING = Path(__file__).resolve().parents[1] / "scenarios" / "cells" / "kitting.yaml"
 SPEC = "F(grasp(bolt) & X insert(bolt, kit_a)) & F(grasp(gear) & X insert(gear, kit_c))"
@@ -40,7 +41,7 @@ class _Made:
     """What a stand-in for the synthesis of one order returns: its tasks and stats."""
 
     def __init__(self, texts: list[str]) -> None:
-        self.texts, self.stats = texts, {}
+        self.texts, self.stats = texts, SynthesisStats()
 
 
 def _works(seq, failed=None) -> _Made:
@@ -81,7 +82,8 @@ def test_other_orders_are_planned_in_turn_and_the_first_failure_is_kept(kitting)
 
     made = _in_another_order(_works, first, failure, lambda: seqs, cell, 1.75)
     assert made.texts == tried[0]
-    assert made.stats == {"orders_failed": 1, "first_failure": "task grasp(gear): blocked"}
+    assert made.stats == SynthesisStats(orders_failed=1,
+                                        first_failure="task grasp(gear): blocked")
 
 
 def test_a_limit_of_the_cell_is_not_tried_in_another_order(kitting) -> None:
@@ -194,8 +196,8 @@ def test_a_motion_that_fails_verification_is_made_in_another_order(kitting) -> N
                               "of the tasks failed too")
 
     made = _verified_in_another_order(_works, first, failure, lambda: seqs, cell, 1.75)
-    assert made.texts == tried[0] and made.stats["orders_failed"] == 1
-    assert made.stats["first_failure"] == str(failure)
+    assert made.texts == tried[0] and made.stats.orders_failed == 1
+    assert made.stats.first_failure == str(failure)
     # no other order: the failure as it was
     with pytest.raises(VerificationError) as err:
         _verified_in_another_order(_works, first, failure, lambda: [first], cell, 1.75)

@@ -56,7 +56,7 @@ def test_body_transition_verifies_and_moves_like_a_person(cell: str, spec: str,
         assert fastest <= MAX_TRANSITION_KNEE_SPEED, (
             f"{seg.task}: knee at {fastest:.2f} m/s")
 
-    for name, a, b in motion.stats["segments"]:
+    for name, a, b in motion.stats.segments:
         if name.startswith("standUp_"):
             seconds = (b - a) / fps
             assert STAND_UP_SECONDS[0] <= seconds <= STAND_UP_SECONDS[1], (

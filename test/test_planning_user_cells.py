@@ -31,7 +31,7 @@ def test_final_region_over_the_bench_is_entered(spec):
     search; now the hand reaches in (or the body, where it fits)."""
     motion = _verified(spec, "demo_cell")
     assert "walk(R1)" in motion.sequence
-    assert motion.stats["nodes_expanded"] < 8000
+    assert motion.stats.nodes_expanded < 8000
 
 
 def test_region_entry_is_the_exact_predicate():
@@ -80,10 +80,10 @@ def test_stand_up_when_standing_is_a_standing_pause(spec):
 
 def test_release_of_a_part_not_in_hand_grasps_it_first():
     motion = _verified("release(O1)", "demo_cell")          # the first task: no grasp before
-    steps = motion.stats["goal_primitives"]
+    steps = motion.stats.goal_primitives
     assert steps[0]["task"] == "release(O1)"
     # The grasp is planned inside the release step: a grasp primitive precedes it.
-    names = [s[0] for s in motion.stats["segments"]]
+    names = [s[0] for s in motion.stats.segments]
     assert names.index(next(n for n in names if n.startswith("grasp_"))) < \
         names.index(next(n for n in names if n.startswith("release_")))
 
@@ -153,7 +153,7 @@ def test_a_hand_task_out_of_reach_of_the_seat_stands_up_and_walks_first():
     motion = _verified("F(sit(stool) & X assemble(R1))", "demo_cell")
     k = motion.sequence.index("sit(stool)")
     assert motion.sequence[k + 1] == "assemble(R1)"
-    names = [seg[0] for seg in motion.stats["segments"]]
+    names = [seg[0] for seg in motion.stats.segments]
     sat = next(i for i, n in enumerate(names) if n.startswith("sit"))
     assert any(n.startswith("standUp") for n in names[sat:])
 

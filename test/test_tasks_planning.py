@@ -278,7 +278,7 @@ def test_kitting_cell_synthesizes_a_verified_motion_end_to_end():
     assert motion.verification["passed"]
     moves = [t for t in motion.sequence if t.startswith("move(")]
     assert sorted(moves) == ["move(P0, R1)", "move(P1, R1)", "move(P5, R1)"]
-    assert motion.stats["sequence_time"] > 0.0
+    assert motion.stats.sequence_time > 0.0
 
 
 def test_inserts_into_the_kit_tray_verify_and_a_flush_tray_is_refused_early(monkeypatch):

@@ -52,7 +52,7 @@ _HAND_TASKS = (*HAND_TASKS, "carry")
 @dataclass(frozen=True)
 class GoalStep:
     """One goal primitive of a motion (a task of the sequence or a grasp the planner
-    added before it), as the pipeline reports it in ``stats["steps"]``.
+    added before it), as the pipeline reports it in ``stats.steps``.
 
     Attributes
     ----------
@@ -143,7 +143,7 @@ def frame_labels(n_frames: int, step_ends: Sequence[int], steps: Sequence[GoalSt
         End frame (exclusive) of each step of the task sequence (its timeline).
     steps : sequence of GoalStep
     segments : sequence of (name, start, end)
-        The placed primitives (``stats["segments"]``); overlaps go to the later one.
+        The placed primitives (``stats.segments``); overlaps go to the later one.
     positions : ndarray, shape (T, J, 3)
         Joint positions, metres.
     fps : float

@@ -271,9 +271,9 @@ def labels_sha256(arrays: dict[str, np.ndarray]) -> str:
 def _annotate(synth, names, record: dict[str, Any]) -> dict[str, np.ndarray]:
     """Captions and goal steps into ``record``; the per-frame label arrays."""
     from ltl_human_motion.batch.captions import GoalStep, captions, frame_labels
-    steps = [GoalStep.from_dict(d) for d in synth.stats.get("steps", [])]
+    steps = [GoalStep.from_dict(d) for d in synth.stats.steps]
     labels = frame_labels(synth.n_frames, [seg.end_frame for seg in synth.timeline], steps,
-                          synth.stats.get("segments", []), synth.positions, synth.fps)
+                          synth.stats.segments, synth.positions, synth.fps)
     record["steps"] = [s.to_dict() for s in steps]
     record["captions"] = captions(synth.sequence, steps, names, int(record["seed"]),
                                   N_CAPTIONS, labels.phase, synth.fps)
@@ -345,12 +345,12 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
     if failed_check is None and report.get("passed", True) is False:
         failed_check, detail = "passed", "the verification report did not pass"
     verified = failed_check is None
-    record.update({"sequence": list(synth.sequence), "lasso": str(synth.stats.get("lasso")),
+    record.update({"sequence": list(synth.sequence), "lasso": str(synth.stats.lasso),
                    "duration": float(synth.duration), "n_frames": int(synth.n_frames),
                    "fps": float(synth.fps), "verified": verified, "verification": report,
-                   "nodes_expanded": int(synth.stats.get("nodes_expanded", 0)),
-                   "start_pose": _plain(synth.stats.get("start_pose")),
-                   "realism": _plain(synth.stats.get("realism"))})
+                   "nodes_expanded": int(synth.stats.nodes_expanded),
+                   "start_pose": _plain(synth.stats.start_pose),
+                   "realism": _plain(synth.stats.realism)})
     if verified or job.keep_unverified:
         arrays = _arrays(synth, job.dtype)
         record["motion_sha256"] = motion_sha256(arrays)
@@ -364,7 +364,7 @@ def run_item(job: BatchJob, item: ItemParams) -> ItemResult:
         t_assess = time.perf_counter()
         record["study"] = _plain(job.assess.run(synth, cell, item, job.assess.settings))
         timing["assess_time"] = time.perf_counter() - t_assess
-    timing.update({k: float(v) for k, v in synth.stats.items()
+    timing.update({k: float(v) for k, v in synth.stats.to_dict().items()
                    if k.endswith("_time") and k != "batch_total_time"})
     timing["compute_time"] = time.perf_counter() - t0
     timing["cpu_time"] = time.process_time() - c0

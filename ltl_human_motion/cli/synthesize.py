@@ -94,22 +94,22 @@ def run(args: argparse.Namespace) -> int:
             written += _render(synth, args.cell, stem, pictures)
         checks = {k: v["passed"] for k, v in synth.verification.items() if isinstance(v, dict)}
         st = synth.stats
-        stages = st["planning_time"] + st["blending_time"] + st["verification_time"]
+        stages = st.planning_time + st.blending_time + st.verification_time
         loading = (f"; the first motion of a process also builds what the others reuse "
                    f"(compiled kernels, gait index, the cell's fields), "
-                   f"{(st['total_time'] - stages) * 1000:.0f} ms"
-                   if i == 0 and st["total_time"] - stages > 0.2 else "")
-        before = (f"\n  (made in another order of the tasks: {st['orders_failed']} failed "
-                  f"before it, the first: {st['first_failure'][:200]})"
-                  if st.get("orders_failed") else "")
+                   f"{(st.total_time - stages) * 1000:.0f} ms"
+                   if i == 0 and st.total_time - stages > 0.2 else "")
+        before = (f"\n  (made in another order of the tasks: {st.orders_failed} failed "
+                  f"before it, the first: {(st.first_failure or '')[:200]})"
+                  if st.orders_failed else "")
         print(f"motion {i}: {' ; '.join(synth.sequence)}  ({synth.motion.duration:.1f} s of "
-              f"motion in {st['total_time'] * 1000:.0f} ms: planning "
-              f"{st['planning_time'] * 1000:.0f} ms, blending {st['blending_time'] * 1000:.0f} "
-              f"ms, verification {st['verification_time'] * 1000:.0f} ms{loading}; verified: "
+              f"motion in {st.total_time * 1000:.0f} ms: planning "
+              f"{st.planning_time * 1000:.0f} ms, blending {st.blending_time * 1000:.0f} "
+              f"ms, verification {st.verification_time * 1000:.0f} ms{loading}; verified: "
               f"{'yes' if all(checks.values()) else 'NO'}){before}")
         summary.append({"files": written, "sequence": synth.sequence,
                         "duration": synth.motion.duration, "verification": checks,
-                        "stats": {k: v for k, v in synth.stats.items()
+                        "stats": {k: v for k, v in synth.stats.to_dict().items()
                                   if isinstance(v, (int, float, str))}})
     print(json.dumps({"motions": summary}, indent=1))
     return 0

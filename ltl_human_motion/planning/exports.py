@@ -25,7 +25,7 @@ from ltl_human_motion.errors import MotionFormatError
 from ltl_human_motion.motion import bvh
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, Skeleton
 from ltl_human_motion.motion.types import Motion
-from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
+from ltl_human_motion.planning.result import SynthesisStats, SynthesizedMotion, TaskSegment
 
 __all__ = [
     "FORMAT_NAME", "FORMAT_VERSION", "from_dict", "load_json", "load_npz",
@@ -74,7 +74,7 @@ def _meta(synth: SynthesizedMotion) -> dict[str, Any]:
         "stature": float(synth.motion.skeleton.stature),
         "joint_names": list(synth.motion.skeleton.names),
         "spec": synth.spec, "sequence": list(synth.sequence), "seed": synth.seed,
-        "stats": {k: v for k, v in synth.stats.items() if not _is_timing(k)},
+        "stats": {k: v for k, v in synth.stats.to_dict().items() if not _is_timing(k)},
         "verification": synth.verification,
         "timeline": [seg.to_dict() for seg in synth.timeline],
         "objects": sorted(synth.objects),
@@ -87,7 +87,7 @@ def to_dict(synth: SynthesizedMotion, finite_only: bool = True) -> dict[str, Any
     Non-finite floats in ``stats``/``verification`` become None when ``finite_only``.
     """
     d = _meta(synth)
-    d["stats"] = dict(synth.stats)
+    d["stats"] = synth.stats.to_dict()
     d["positions"] = synth.positions.tolist()
     d["root_yaw"] = synth.root_yaw.tolist()
     d["task_index"] = synth.task_index.tolist()
@@ -119,7 +119,8 @@ def from_dict(data: dict[str, Any], source: str = "<dict>") -> SynthesizedMotion
             timeline=[TaskSegment.from_dict(s) for s in data.get("timeline", [])],
             objects={k: np.asarray(v, dtype=np.float64) for k, v in objects.items()},
             spec=data.get("spec", ""), sequence=list(data.get("sequence", [])),
-            seed=int(data.get("seed", 0)), stats=dict(data.get("stats", {})),
+            seed=int(data.get("seed", 0)),
+            stats=SynthesisStats.from_dict(dict(data.get("stats", {}))),
             verification=dict(data.get("verification", {})))
     except MotionFormatError:
         raise

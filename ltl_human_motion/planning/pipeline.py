@@ -17,7 +17,7 @@ import math
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -39,10 +39,16 @@ from ltl_human_motion.planning.junction_repair import (
     unlock_weights,
 )
 from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner
-from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
+from ltl_human_motion.planning.result import SynthesisStats, SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, failure_error, verify_motion
 from ltl_human_motion.scene.cell_yaml import resolve_cell
 from ltl_human_motion.vocabulary import task_step, task_text
+
+if TYPE_CHECKING:
+    from ltl_human_motion.ltl.sequences import TaskSequence
+    from ltl_human_motion.ltl.spec import Specification
+    from ltl_human_motion.motion.library import MotionLibrary
+    from ltl_human_motion.scene.cell import Cell
 
 __all__ = ["SynthesisOptions", "get_library", "resolve_cell", "synthesize"]
 
@@ -77,7 +83,7 @@ class SynthesisOptions:
         biomechanical checks (``VerificationOptions.biomechanics``, the default), which
         refuse a skating foot; this option is for verification without them, where a
         motion whose locked feet moved a pose into an obstacle is blended again without
-        it (``stats["foot_locking"]`` says which).
+        it (``stats.foot_locking`` says which).
     """
 
     sequence_mode: str = "all"
@@ -352,17 +358,16 @@ def synthesize(spec: str, cell, library=None, variants: int = 1, seed: int = 0,
     checkpoint("library")
 
     def one(seq, v: int, failed: dict | None = None) -> SynthesizedMotion:
-        rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, v])
-        return _synthesize_one(spec, specification, seq, cell, library, rng, seed, v,
-                               options, t_automaton, t_sequence, t_library, float(stature),
-                               failed)
+        return _synthesize_one(MotionRequest(
+            spec, specification, seq, cell, library, seed, v, options, float(stature),
+            t_automaton, t_sequence, t_library, failed))
     others = functools.partial(_other_sequences, specification, cell,
                                variants + ORDER_CANDIDATES, seed, options, cycles)
     results = [_variant(one, sequences[v % len(sequences)], v, others, cell, float(stature))
                for v in range(variants)]
     total = time.perf_counter() - t_all
     for r in results:
-        r.stats["batch_total_time"] = total
+        r.stats = replace(r.stats, batch_total_time=total)
     return results
 
 
@@ -489,10 +494,9 @@ def _verified_in_another_order(one: Callable[[Any], SynthesizedMotion], seq,
 
 def _after_failures(synth: SynthesizedMotion, failed: int, first: Exception
                     ) -> SynthesizedMotion:
-    """``synth`` with ``stats["orders_failed"]`` (orders of the tasks that failed before
-    its own) and ``stats["first_failure"]`` (why the first did)."""
-    synth.stats["orders_failed"] = failed
-    synth.stats["first_failure"] = str(first)
+    """``synth`` with ``stats.orders_failed`` (orders of the tasks that failed before its
+    own) and ``stats.first_failure`` (why the first did)."""
+    synth.stats = replace(synth.stats, orders_failed=failed, first_failure=str(first))
     return synth
 
 
@@ -581,10 +585,57 @@ def _step_frames(plan: Plan, spans: list[tuple[int, int]]) -> list[dict[str, Any
     return out
 
 
-def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, variant,
-                    options, t_automaton, t_sequence, t_library, stature, failed=None
-                    ) -> SynthesizedMotion:
+@dataclass(frozen=True)
+class MotionRequest:
+    """One motion for :func:`synthesize` to make: a task sequence of the specification,
+    planned, blended and verified in the cell.
+
+    Attributes
+    ----------
+    spec_text : str
+        The specification as the user wrote it (kept in the motion).
+    specification : Specification
+        Its parse, which the motion is verified against.
+    sequence : TaskSequence
+        The tasks in order.
+    cell : Cell
+    library : MotionLibrary
+    seed : int
+    variant : int
+        Which motion of the call; with ``seed`` it seeds the plan's generator.
+    options : SynthesisOptions
+    stature : float
+        The worker's, metres.
+    automaton_time, sequence_time, library_time : float
+        Seconds the call spent on the automaton, the sequences and the library (they
+        count into the motion's ``total_time``).
+    failed : dict, optional
+        Steps that failed in an earlier order of the tasks
+        (:attr:`.planner.SequencePlanner.failed_before`).
+    """
+
+    spec_text: str
+    specification: Specification
+    sequence: TaskSequence
+    cell: Cell
+    library: MotionLibrary
+    seed: int
+    variant: int
+    options: SynthesisOptions
+    stature: float
+    automaton_time: float = 0.0
+    sequence_time: float = 0.0
+    library_time: float = 0.0
+    failed: dict[tuple, PlanningError] | None = None
+
+
+def _synthesize_one(request: MotionRequest) -> SynthesizedMotion:
     t_start = time.perf_counter()
+    spec_text, specification, seq = request.spec_text, request.specification, request.sequence
+    cell, library, seed, variant = request.cell, request.library, request.seed, request.variant
+    options, stature = request.options, request.stature
+    t_automaton, t_sequence = request.automaton_time, request.sequence_time
+    rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, variant])
     written = [(t.name, tuple(t.args)) for t in seq.tasks]        # as verification reads them
     steps = [task_step(t.name, t.args, cell.shorthands, t.key) for t in seq.tasks]
     # Planned on a floor at z = 0; the motion, the parts and the targets are lifted back
@@ -592,7 +643,7 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     floor_cell = cell.floor_at_zero()
     planner = SequencePlanner(floor_cell, library, rng, replace(
         options.planner, refuse_self_penetration=options.verification.biomechanics),
-        failed_before=failed)
+        failed_before=request.failed)
     start = _start_pose(floor_cell, planner.target_of(steps[0].kind, steps[0].args), rng)
     t0 = time.perf_counter()
     plan = planner.plan(steps, start)
@@ -635,23 +686,23 @@ def _synthesize_one(spec_text, specification, seq, cell, library, rng, seed, var
     compute = time.perf_counter() - t_start + t_automaton + t_sequence
     motion, timeline = synth.motion, synth.timeline
     synth.verification = report
-    synth.stats = {
-        "automaton_time": t_automaton, "sequence_time": t_sequence,
-        "library_time": t_library, "planning_time": t_planning, "blending_time": t_blending,
-        "verification_time": t_verify, "total_time": compute,
-        "nodes_expanded": int(plan.expanded), "duration": motion.duration,
-        "real_time_factor": motion.duration / compute if compute > 0 else float("inf"),
-        "variant": variant, "lasso": str(seq),
-        "goal_primitives": [{"task": s.task, "primitive": s.primitive,
-                             "target": None if timeline[i].target is None
-                             else [float(x) for x in timeline[i].target],
-                             "frames": [timeline[i].start_frame, timeline[i].end_frame],
-                             "walk_primitives": s.walk_segments, "expanded": s.expanded}
-                            for i, s in enumerate(plan.steps)],
-        "start_pose": list(plan.start_pose),
-        "steps": _step_frames(plan, spans),
-        "segments": [[seg.name, int(a), int(b)] for seg, (a, b) in zip(plan.segments, spans)],
-        "realism": realism_summary(motion.positions, library.fps, stature, cell.floor_z),
-        "foot_locking": bool(realism),
-    }
+    synth.stats = SynthesisStats(
+        automaton_time=t_automaton, sequence_time=t_sequence,
+        library_time=request.library_time, planning_time=t_planning,
+        blending_time=t_blending, verification_time=t_verify, total_time=compute,
+        nodes_expanded=int(plan.expanded), duration=motion.duration,
+        real_time_factor=motion.duration / compute if compute > 0 else float("inf"),
+        variant=variant, lasso=str(seq),
+        goal_primitives=[{"task": s.task, "primitive": s.primitive,
+                          "target": None if timeline[i].target is None
+                          else [float(x) for x in timeline[i].target],
+                          "frames": [timeline[i].start_frame, timeline[i].end_frame],
+                          "walk_primitives": s.walk_segments, "expanded": s.expanded}
+                         for i, s in enumerate(plan.steps)],
+        start_pose=list(plan.start_pose),
+        steps=_step_frames(plan, spans),
+        segments=[[seg.name, int(a), int(b)] for seg, (a, b) in zip(plan.segments, spans)],
+        realism=realism_summary(motion.positions, library.fps, stature, cell.floor_z),
+        foot_locking=bool(realism),
+    )
     return synth

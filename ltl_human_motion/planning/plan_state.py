@@ -12,10 +12,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ltl_human_motion.motion.automaton import REFERENCE_STATURE
+from ltl_human_motion.motion.library import MotionLibrary
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive
 from ltl_human_motion.planning.blend import PlacedSegment
@@ -26,6 +28,10 @@ from ltl_human_motion.planning.navigation import (
     clearance_maps,
     stand_clearance_map,
 )
+from ltl_human_motion.scene.cell import Cell
+
+if TYPE_CHECKING:
+    from ltl_human_motion.planning.planner import PlannerOptions
 
 Pose = tuple[float, float, float]
 
@@ -62,17 +68,18 @@ class PlanContext:
         Floor clearance of the obstacles' footprints (no allowance for the arms).
     """
 
-    cell: object
-    library: object
+    cell: Cell
+    library: MotionLibrary
     index: GaitIndex
     rng: np.random.Generator
-    options: object
+    options: PlannerOptions
     clearance: ClearanceMap
     obstacle_field: ObstacleField
     stand_map: ClearanceMap
 
     @classmethod
-    def build(cls, cell, library, rng: np.random.Generator, options) -> PlanContext:
+    def build(cls, cell: Cell, library: MotionLibrary, rng: np.random.Generator,
+              options: PlannerOptions) -> PlanContext:
         """The context of a plan in ``cell`` with ``library`` (the maps are cached per cell)."""
         clearance, obstacle_field = clearance_maps(cell)
         return cls(cell, library, gait_index(library), rng, options, clearance,

@@ -8,14 +8,14 @@ Exports live in :mod:`ltl_human_motion.planning.exports`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 
 from ltl_human_motion.motion.types import Motion
 
-__all__ = ["SynthesizedMotion", "TaskSegment"]
+__all__ = ["SynthesisStats", "SynthesizedMotion", "TaskSegment"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -72,6 +72,89 @@ class TaskSegment:
                    target=data.get("target"))
 
 
+@dataclass(frozen=True)
+class SynthesisStats:
+    """What making one motion took and what its plan was.
+
+    Attributes
+    ----------
+    automaton_time, sequence_time, library_time : float
+        Seconds spent on the specification's automaton, the task sequences and the motion
+        library (0 where a cache had them).
+    planning_time, blending_time, verification_time : float
+        Seconds of the motion planner, of blending the segments and of the checks.
+    total_time : float
+        Seconds to make this motion, the automaton and the sequences included.
+    nodes_expanded : int
+        Search nodes the planner expanded.
+    duration : float
+        The motion's length, seconds.
+    real_time_factor : float
+        ``duration / total_time``.
+    variant : int
+        Which motion of the call.
+    lasso : str
+        The task sequence as the product search found it.
+    goal_primitives : list of dict
+        Per task step: ``task``, ``primitive``, ``target`` (3,) or None, ``frames``
+        [start, end), ``walk_primitives``, ``expanded``.
+    start_pose : list of float
+        ``[x, y, yaw]`` the worker starts from (m, m, rad).
+    steps : list of dict
+        Every goal step with its frames (``goal``, ``contact``, ``lift``).
+    segments : list of list
+        ``[primitive name, start frame, end frame]`` of every placed segment.
+    realism : dict
+        :func:`~ltl_human_motion.motion.realism.realism_summary` of the motion.
+    foot_locking : bool
+        Whether the feet were locked (else the motion was blended without it).
+    orders_failed : int or None
+        Orders of the tasks that failed before this motion's own (None: it is the first).
+    first_failure : str or None
+        Why the first of them failed.
+    batch_total_time : float or None
+        Seconds of the whole :func:`~ltl_human_motion.planning.pipeline.synthesize` call.
+    """
+
+    automaton_time: float = 0.0
+    sequence_time: float = 0.0
+    library_time: float = 0.0
+    planning_time: float = 0.0
+    blending_time: float = 0.0
+    verification_time: float = 0.0
+    total_time: float = 0.0
+    nodes_expanded: int = 0
+    duration: float = 0.0
+    real_time_factor: float = 0.0
+    variant: int = 0
+    lasso: str = ""
+    goal_primitives: list[dict[str, Any]] = field(default_factory=list)
+    start_pose: list[float] = field(default_factory=list)
+    steps: list[dict[str, Any]] = field(default_factory=list)
+    segments: list[list] = field(default_factory=list)
+    realism: dict[str, Any] = field(default_factory=dict)
+    foot_locking: bool = False
+    orders_failed: int | None = None
+    first_failure: str | None = None
+    batch_total_time: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain form, in field order; the fields that are None are left out."""
+        return {f.name: getattr(self, f.name) for f in fields(self)
+                if getattr(self, f.name) is not None}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SynthesisStats:
+        """Inverse of :meth:`to_dict`; missing fields take their defaults, a key that is
+        not a field is a ``ValueError`` naming it."""
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(f"unknown stats field(s) {unknown}; expected some of "
+                             f"{sorted(known)}")
+        return cls(**data)
+
+
 @dataclass(eq=False)
 class SynthesizedMotion:
     """A synthesized full-body motion with its tasks and the objects it moves.
@@ -93,8 +176,8 @@ class SynthesizedMotion:
     sequence : list of str
         The task sequence, e.g. ``["grasp(O1)", "assemble(R1)"]``.
     seed : int
-    stats : dict
-        Planning statistics (times, expanded nodes, ...).
+    stats : SynthesisStats
+        What making the motion took (times, expanded nodes, the plan's steps).
     verification : dict
         Results of the verification checks.
     """
@@ -107,7 +190,7 @@ class SynthesizedMotion:
     spec: str = ""
     sequence: list[str] = field(default_factory=list)
     seed: int = 0
-    stats: dict = field(default_factory=dict)
+    stats: SynthesisStats = field(default_factory=SynthesisStats)
     verification: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:

@@ -62,7 +62,7 @@ import queue
 import threading
 import time
 import traceback
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
@@ -74,7 +74,7 @@ from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 if TYPE_CHECKING:
     from ltl_human_motion.planning.pipeline import SynthesisOptions
-    from ltl_human_motion.planning.result import SynthesizedMotion
+    from ltl_human_motion.planning.result import SynthesisStats, SynthesizedMotion
     from ltl_human_motion.planning.strategy_motion import StrategyProgram
 
 from ltl_human_motion.deadline import DEFAULT_MAX_SECONDS, Deadline
@@ -140,17 +140,15 @@ def synthesis_options(options_json: str) -> SynthesisOptions | None:
     return SynthesisOptions.from_dict(values)
 
 
-def stats_message(stats: Mapping[str, Any], duration: float) -> PlanningStats:
-    """PlanningStats from a motion's ``stats`` (:attr:`SynthesizedMotion.stats`; missing or
+def stats_message(stats: SynthesisStats, duration: float) -> PlanningStats:
+    """PlanningStats from a motion's ``stats`` (:attr:`SynthesizedMotion.stats`;
     non-numeric fields are 0)."""
-    get = stats.get
-
     msg = PlanningStats()
     for name in _STATS_FIELDS:
-        value = get(name)
+        value = getattr(stats, name)
         if isinstance(value, int | float):
             setattr(msg, name, float(value))
-    expanded = get("nodes_expanded")
+    expanded = stats.nodes_expanded
     if isinstance(expanded, int | float):
         msg.nodes_expanded = max(int(expanded), 0)
     if msg.real_time_factor == 0.0 and msg.total_time > 0:
