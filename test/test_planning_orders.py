@@ -131,7 +131,8 @@ def _aisle_planner(failed: dict | None = None):
     import numpy as np
 
     from ltl_human_motion.planning.pipeline import get_library
-    from ltl_human_motion.planning.planner import PlannerOptions, SequencePlanner
+    from ltl_human_motion.planning.plan_state import PlannerOptions
+    from ltl_human_motion.planning.planner import SequencePlanner
 
     cell = resolve_cell(AISLE)
     planner = SequencePlanner(cell.floor_at_zero(), get_library(1.75),

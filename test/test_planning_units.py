@@ -263,7 +263,7 @@ def test_steps_and_turns_keep_every_body_part_out_of_the_others(stature: float) 
 
 
 def test_the_planner_and_a_bare_search_use_the_same_search_settings() -> None:
-    from ltl_human_motion.planning.planner import PlannerOptions
+    from ltl_human_motion.planning.plan_state import PlannerOptions
     assert PlannerOptions().search == SearchOptions()
     tuned = PlannerOptions(heuristic_speed=0.4, body_radius=0.2).search
     assert (tuned.heuristic_speed, tuned.body_radius) == (0.4, 0.2)

@@ -10,8 +10,7 @@ import pytest
 from ltl_human_motion.motion.lift import lift_poses, lifted_stance
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.planning.pipeline import get_library
-from ltl_human_motion.planning.plan_state import PlanContext
-from ltl_human_motion.planning.planner import PlannerOptions
+from ltl_human_motion.planning.plan_state import PlanContext, PlannerOptions
 from ltl_human_motion.planning.region_point import region_point, spot_distance
 from ltl_human_motion.scenarios.unseen import build_cell
 from ltl_human_motion.scene.cell_yaml import cell_from_yaml

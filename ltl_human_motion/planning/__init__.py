@@ -12,7 +12,7 @@ from ltl_human_motion.planning.pipeline import (
     resolve_cell,
     synthesize,
 )
-from ltl_human_motion.planning.planner import PlannerOptions
+from ltl_human_motion.planning.plan_state import PlannerOptions
 from ltl_human_motion.planning.result import SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, verify_motion
 

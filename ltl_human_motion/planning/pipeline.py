@@ -38,7 +38,8 @@ from ltl_human_motion.planning.junction_repair import (
     repaired,
     unlock_weights,
 )
-from ltl_human_motion.planning.planner import Plan, PlannerOptions, SequencePlanner
+from ltl_human_motion.planning.plan_state import PlannerOptions
+from ltl_human_motion.planning.planner import Plan, SequencePlanner
 from ltl_human_motion.planning.result import SynthesisStats, SynthesizedMotion, TaskSegment
 from ltl_human_motion.planning.verify import VerificationOptions, failure_error, verify_motion
 from ltl_human_motion.scene.cell_yaml import resolve_cell

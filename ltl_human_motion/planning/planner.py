@@ -33,13 +33,13 @@ import numpy as np
 from ltl_human_motion.errors import PlanningError
 from ltl_human_motion.motion.goals import LEVEL_PATH_TASKS
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
-from ltl_human_motion.planning.astar import SearchBudget, SearchOptions
 from ltl_human_motion.planning.blend import PlacedSegment
 from ltl_human_motion.planning.feasibility import reach_envelope
 from ltl_human_motion.planning.goal_steps import GoalSteps
 from ltl_human_motion.planning.lift_in import settle
 from ltl_human_motion.planning.plan_state import (
     PlanContext,
+    PlannerOptions,
     Pose,
     WorkerState,
     acting_hand,
@@ -82,79 +82,6 @@ REGION_POINT_MARGIN = 0.05
 #: How far from the point in front of the worker that region point may lie (a step
 #: adjusts the stance), metres.
 REGION_POINT_REACH = 0.25
-
-
-@dataclass(frozen=True)
-class PlannerOptions:
-    """Tunable planner settings.
-
-    Attributes
-    ----------
-    heuristic_speed : float
-        Relaxed speed of the A* heuristic, m/s (paper Sec. III-B).
-    turn_rate : float
-        Relaxed turning speed of the heuristic's heading term, rad/s.
-    budget : SearchBudget
-        Node and time limits of each search.
-    cost_noise : float
-        Seeded relative noise on primitive costs: different seeds, different paths.
-    reach_tolerance : float
-        Accepted error of the standing distance to the target, metres.
-    heading_tolerance : float
-        Accepted heading error towards the target, radians.
-    body_radius : float
-        Clearance the walking root keeps from obstacle footprints, metres.
-    grid_resolution : float
-        Cell size of the navigation field behind the heuristic, metres.
-    goal_attempts : int
-        Seeded goal primitives tried before a reach blocked by obstacles fails.
-    adjust_radius : float
-        A walk may end this far from the ideal placement; a model-made step and turn on
-        the spot covers the rest (like the analytic expansion of hybrid A*).
-    turn_clearance : float
-        Floor clearance a walk must end with to turn there by more than the heading
-        tolerance, metres, for the 1.75 m reference worker (a taller one needs
-        proportionally more: :attr:`.plan_state.PlanContext.turn_room`).
-    stand_clearance : float
-        Floor clearance of the spot a goal primitive starts from (hips and a slight
-        forward lean need more room than the walking legs), metres, for the 1.75 m
-        reference worker (:attr:`.plan_state.PlanContext.stand_room`).
-    max_step_back : float
-        How much further from the target than the preferred reach the worker may stand
-        when an obstacle (a bench) is in the way; the goal primitive leans further.
-    refuse_self_penetration : bool
-        Take a goal primitive that takes a limb through the body (the biomechanical
-        self-penetration check) as blocked, so that other placements are tried.
-        Synthesis sets it from ``VerificationOptions.biomechanics``.
-    whole_body : bool
-        Where every seeded goal primitive of a hand task meets an obstacle, remake the
-        first of them with the whole-body program (clearance, range of motion and
-        planted feet as constraints of every frame; :mod:`.constrained_goals`) before
-        other placements are tried.
-    """
-
-    heuristic_speed: float = SearchOptions.heuristic_speed
-    turn_rate: float = SearchOptions.turn_rate
-    budget: SearchBudget = field(default_factory=SearchBudget)
-    cost_noise: float = SearchOptions.cost_noise
-    reach_tolerance: float = 0.15
-    heading_tolerance: float = 0.35
-    body_radius: float = SearchOptions.body_radius
-    goal_attempts: int = 6
-    adjust_radius: float = 0.3
-    turn_clearance: float = 0.26
-    stand_clearance: float = 0.22
-    max_step_back: float = 0.35
-    grid_resolution: float = 0.05
-    refuse_self_penetration: bool = True
-    whole_body: bool = True
-
-    @property
-    def search(self) -> SearchOptions:
-        """The gait-search settings these options give."""
-        return SearchOptions(body_radius=self.body_radius,
-                             heuristic_speed=self.heuristic_speed,
-                             turn_rate=self.turn_rate, cost_noise=self.cost_noise)
 
 
 @dataclass
