@@ -248,6 +248,43 @@ def test_react_cli_writes_the_report(tmp_path, capsys):
     assert "5/5 runs satisfy" in capsys.readouterr().out
 
 
+def test_runs_with_the_same_tasks_share_one_motion_checked_with_their_own_inputs(cell,
+                                                                                 worker):
+    """Two robot behaviours that make the strategy do the same tasks get the same motion
+    (planned and verified once, the same bytes when planned again from scratch); each
+    run's observed letters are checked with its own inputs."""
+    from ltl_human_motion.planning import get_library
+    from ltl_human_motion.planning.reactive import RunMotions
+    from ltl_human_motion.tasks.reactive import JointLasso
+
+    rng = np.random.default_rng(3)
+    runs: dict[tuple, list] = {}
+    while not any(len(v) > 1 and len({str(r.prefix_inputs + r.cycle_inputs) for r in v}) > 1
+                  for v in runs.values()):
+        run = run_strategy(worker, *random_input_lasso(worker, rng))
+        runs.setdefault((run.prefix_tasks, run.cycle_tasks), []).append(run)
+    same = next(v for v in runs.values() if len(v) > 1)
+    library = get_library(1.75)
+    motions = RunMotions(worker, cell, library, seed=5, stature=1.75)
+    first, second = motions.motion(same[0]), motions.motion(same[1])
+    assert first.verified and second.verified
+    assert not first.cached and second.cached and motions.planned == 1
+    assert first.sha256 == second.sha256 and len(first.sha256) == 64
+    fresh = RunMotions(worker, cell, library, seed=5, stature=1.75).motion(same[1])
+    assert fresh.sha256 == first.sha256 and not fresh.cached
+    # The same motion with inputs that break the guarantee: the robot in R1 before each
+    # assembly is caught on the joint trace, not taken from the cache.
+    run = same[0]
+    tasks = [*run.prefix_tasks, *run.cycle_tasks]
+    inputs = [{"robot_in(R1)": worker.tasks[tasks[(i + 1) % len(tasks)]].key
+               == "assemble(R1)"} for i in range(len(tasks))]
+    n = len(run.prefix_tasks)
+    broken = motions.motion(JointLasso(tuple(inputs[:n]), run.prefix_tasks,
+                                       tuple(inputs[n:]), run.cycle_tasks))
+    assert broken.cached and broken.motion_checks and not broken.observed_satisfies
+    assert not broken.verified and broken.failed == ["reactive_ltl"]
+
+
 def test_react_cli_refuses_unrealizable_without_traceback(tmp_path, capsys):
     code = main(["react", "--cell", str(PAPER), "--spec", GUARANTEES, "--traces", "5",
                  "--out", str(tmp_path / "r")])

@@ -2,7 +2,9 @@
 
 Solves the reactive specification on the cell's worker model, draws seeded random robot
 behaviours that keep the assumptions, runs the strategy on each, synthesizes and verifies
-each run's motion, and checks every joint trace against the whole specification. Writes
+each run's motion (once per task sequence: runs with the same tasks get the same motion,
+:class:`~ltl_human_motion.planning.reactive.RunMotions`), and checks every joint trace
+against the whole specification. Writes
 ``DIR/react.json``; an unrealizable specification exits with code 2 and the explanation.
 """
 
@@ -105,8 +107,10 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_motion:
         from ltl_human_motion.planning import get_library
         library = get_library(float(args.stature))
-    from ltl_human_motion.planning.reactive import motion_of_run
+    from ltl_human_motion.planning.reactive import RunMotions
 
+    motions = None if library is None else RunMotions(worker, cell, library, int(args.seed),
+                                                      float(args.stature))
     robot = _robot_events(args.robot, cell, worker.gr1.inputs, args.moving_threshold)
 
     records = []
@@ -124,15 +128,16 @@ def run(args: argparse.Namespace) -> int:
                               for x, t in zip(joint.cycle_inputs, joint.cycle_tasks)]},
             "spec_satisfied": bool(ok),
         }
-        if library is not None:
+        if motions is not None:
             t1 = time.perf_counter()
-            m = motion_of_run(worker, joint, cell, library, seed=int(args.seed) * 100003 + i,
-                              stature=float(args.stature))
+            m = motions.motion(joint)
             verified += m.verified
             record.update({"verified": m.verified, "motion_checks": m.motion_checks,
                            "observed_satisfies": m.observed_satisfies,
                            "duration": m.duration, "reaction_s": m.reaction,
                            "failed": m.failed, "detail": m.detail,
+                           "motion_sha256": m.sha256, "attempts": m.attempts,
+                           "motion_reused": m.cached,
                            "seconds": time.perf_counter() - t1})
         records.append(record)
         motion = ""
@@ -146,6 +151,7 @@ def run(args: argparse.Namespace) -> int:
     result = {"spec": worker.specification.text, "cell": cell.name, "seed": args.seed,
               "realizable": True, "traces": args.traces, "spec_satisfied": satisfied,
               "verified": None if library is None else verified,
+              "motions_planned": None if motions is None else motions.planned,
               "inputs": list(worker.gr1.inputs),
               "tasks": [t.key for t in worker.tasks],
               "assumptions": [c.text for c in worker.gr1.assumptions],
@@ -160,6 +166,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"realizable: strategy over {len(worker.tasks)} tasks, {len(worker.plant.moves)} "
           f"worker states, solved in {t_solve:.2f} s; {satisfied}/{args.traces} runs satisfy "
           "the specification"
-          + ("" if library is None else f", {verified}/{args.traces} motions verified")
+          + ("" if motions is None else f", {verified}/{args.traces} motions verified "
+             f"({motions.planned} task sequences planned)")
           + f"; wrote {args.out / 'react.json'}")
     return 0 if satisfied == args.traces else 1

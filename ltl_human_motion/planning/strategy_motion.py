@@ -195,7 +195,7 @@ def _clip(worker: ReactiveWorker, move: Move, path: list[int], cell, library, se
           stature: float, options, attempt: int) -> StepClip:
     """Plan and verify ``path`` then ``move.task``; keep the move's frames."""
     from ltl_human_motion.ltl.spec import Specification
-    from ltl_human_motion.planning.pipeline import _synthesize_one
+    from ltl_human_motion.planning.pipeline import MotionRequest, _synthesize_one
 
     spec = worker.specification
     # The clip is checked for everything a motion is (collision, feet, biomechanics, the
@@ -206,10 +206,11 @@ def _clip(worker: ReactiveWorker, move: Move, path: list[int], cell, library, se
                                 tasks=worker.tasks, vocabulary=spec.vocabulary)
     prefix = tuple(worker.tasks[k] for k in path)
     seq = TaskSequence(prefix, (worker.tasks[move.task],))
-    rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, 1 + move.task,
-                                 2 + move.source, attempt])
-    synth = _synthesize_one(spec.text, motion_spec, seq, cell, library, rng, seed, attempt,
-                            options, 0.0, 0.0, 0.0, float(stature))
+    # One random draw per move and attempt (the variant seeds the plan's generator).
+    variant = ((2 + move.source) * (len(worker.tasks) + 1) + 1 + move.task) * MOVE_ATTEMPTS \
+        + attempt
+    synth = _synthesize_one(MotionRequest(spec.text, motion_spec, seq, cell, library, seed,
+                                          variant, options, float(stature)))
     timeline = synth.timeline
     n = len(prefix)
     if len(timeline) < n + 1:
