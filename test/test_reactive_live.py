@@ -114,37 +114,99 @@ def test_the_executed_run_keeps_the_safety_guarantees(program):
 
 def test_junctions_add_no_speed_and_keep_the_bones(program):
     """Across the junctions of a live run (the robot in and out of R1 every 9 s), no
-    joint moves faster than inside the verified clips, and no bone changes length."""
+    joint moves faster than inside the verified clips, no bone changes length, and the
+    frames played pass the verifier's checks; every junction was checked before it was
+    played."""
+    from ltl_human_motion.motion.biomechanics import check_biomechanics
     from ltl_human_motion.motion.skeleton import PARENTS
+    from ltl_human_motion.scene.predicates import collision
 
     pairs = np.array([(j, q) for j, q in enumerate(PARENTS) if q >= 0])
 
     def bones(x: np.ndarray) -> np.ndarray:
-        return np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=-1)
+        return np.linalg.norm(x[..., pairs[:, 0], :] - x[..., pairs[:, 1], :], axis=-1)
 
     clip_speed = max(float(np.max(np.linalg.norm(np.diff(c.positions, axis=0), axis=2))) * c.fps
                      for c in program.clips.values() if len(c.positions) > 1)
     reference = bones(next(iter(program.clips.values())).positions[0])
     ex = StrategyExecutor(program, 0.0, IN)
     dt, robot_in = 1 / 120, True
-    prev = ex.frame_at(0.0).positions
-    speed = stretch = 0.0
-    junctions = 0
-    step = 0
+    frames, labels, steps = [ex.frame_at(0.0)], [], []
     for i in range(1, int(120 / dt)):
         t = i * dt
         if i % int(9 / dt) == 0:
             robot_in = not robot_in
             ex.set_inputs({"robot_in(R1)": robot_in}, t, t)
-        frame = ex.frame_at(t)
-        junctions += frame.status.step != step
-        step = frame.status.step
-        speed = max(speed, float(np.max(np.linalg.norm(frame.positions - prev, axis=1))) / dt)
-        stretch = max(stretch, float(np.max(np.abs(bones(frame.positions) - reference))))
-        prev = frame.positions
+        frames.append(ex.frame_at(t))
+    positions = np.array([f.positions for f in frames])
+    labels = [f.status.task for f in frames]
+    steps = [f.status.step for f in frames]
+    junctions = sum(a != b for a, b in itertools.pairwise(steps))
+    speed = float(np.max(np.linalg.norm(np.diff(positions, axis=0), axis=2))) / dt
     assert junctions > 10
     assert speed <= clip_speed * 1.05, (speed, clip_speed)
-    assert stretch < 0.01, stretch
+    assert float(np.max(np.abs(bones(positions) - reference))) < 1e-3
+    # Every junction played was checked first, and passed.
+    assert len(ex.junctions) == max(steps) and ex.junctions_failed == 0
+    assert all(j.passed and j.frames > 0 for j in ex.junctions)
+    # The run as played, through the verifier's own functions: no collision, no foot
+    # below the floor anywhere; around each junction (from the speed window before it to
+    # the end of its blend) joint speeds and ranges within the limits of the task.
+    cell = resolve_cell("paper_cell")
+    assert not collision(positions, cell, stature=program.stature).any()
+    assert positions[:, :, 2].min() > cell.floor_z - 0.02
+    starts = [i for i in range(1, len(steps)) if steps[i] != steps[i - 1]]
+    for i, check in zip(starts, ex.junctions):
+        a, b = i - 4, min(i + int(np.ceil(check.blend / dt)) + 4, len(frames))
+        window = [labels[i - 1]] * 4 + [labels[i]] * (b - i)
+        body = check_biomechanics(positions[a:b], 1 / dt, stature=program.stature,
+                                  labels=window, floor_z=cell.floor_z)
+        for name in ("joint_speed", "range_of_motion", "self_penetration"):
+            assert body[name]["passed"], (check, body[name]["detail"])
+
+
+def test_a_junction_over_a_limit_is_blended_longer(program):
+    """The junction from the grasp into the walk to the bench, with speed limits between
+    what its first blend and a blend twice as long need: the executor finds the first
+    over the limit before playing it and plays the longer one; with limits no blend meets
+    it plays the longest and counts the junction as failed."""
+    from dataclasses import replace
+
+    from ltl_human_motion.motion.biomechanics import BiomechanicsLimits, check_biomechanics
+    from ltl_human_motion.planning.verify import VerificationOptions
+
+    def walk_junction(options=None) -> StrategyExecutor:
+        ex = StrategyExecutor(program, 0.0, OUT, options=options)
+        t = 0.0
+        while ex.status(t).task != "walk(R1)":
+            t += 0.05
+        return ex
+
+    ex = walk_junction()
+    blend = ex.junctions[-1].blend
+
+    def ratio(k: float) -> float:
+        frames = ex.junction_frames(k * blend)
+        entry = check_biomechanics(frames, 120.0, stature=program.stature,
+                                   labels=["walk(R1)"] * len(frames))["joint_speed"]
+        return entry["value"] / entry["limit"]
+
+    r1, r2, r4 = ratio(1.0), ratio(2.0), ratio(4.0)
+    assert r1 > r2 > r4                    # a longer blend of the same offset is slower
+    base = BiomechanicsLimits()
+
+    def stricter(g: float) -> VerificationOptions:        # every speed limit over g
+        return VerificationOptions(limits=replace(
+            base, reference_stature=base.reference_stature * g))
+
+    check = walk_junction(stricter(2.0 / (r1 + r2))).junctions[-1]
+    assert check.passed and check.blend == pytest.approx(2.0 * blend)
+    assert [failed for _, failed in check.tried] == [("joint_speed",), ()]
+    strict = walk_junction(stricter(1.05 / r4))
+    check = strict.junctions[-1]
+    assert not check.passed and check.failed == ("joint_speed",)
+    assert len(check.tried) == 3 and check.blend == pytest.approx(4.0 * blend)
+    assert strict.junctions_failed == 1
 
 
 def test_executor_refuses_a_bad_rate(program):

@@ -29,11 +29,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from ltl_human_motion.errors import SpecError
-from ltl_human_motion.motion.skeleton import JOINT_INDEX
+from ltl_human_motion.kernel.cache import BoundedCache
+from ltl_human_motion.motion.biomechanics import SPEED_WINDOW, check_biomechanics
+from ltl_human_motion.motion.quality import QualityThresholds
+from ltl_human_motion.motion.retarget import enforce_bone_lengths
+from ltl_human_motion.motion.skeleton import JOINT_INDEX, PARENTS, Skeleton
 from ltl_human_motion.planning.strategy_motion import START, StepClip, StrategyProgram
+from ltl_human_motion.planning.verify import FOOT_JOINTS, VerificationOptions
 
-__all__ = ["BLEND_MAX", "BLEND_MIN", "BLEND_SPEED", "LiveFrame", "StrategyExecutor",
-           "StrategyStatus", "blend_seconds"]
+__all__ = ["BLEND_MAX", "BLEND_MIN", "BLEND_SPEED", "JUNCTION_BIOMECHANICS",
+           "JUNCTION_STRETCHES", "JunctionCheck",
+           "LiveFrame", "StrategyExecutor", "StrategyStatus", "blend_seconds",
+           "check_junction"]
 
 #: Shortest and longest blend of a junction, s.
 BLEND_MIN = 0.3
@@ -41,7 +48,17 @@ BLEND_MAX = 1.0
 #: Speed (m/s) at which a joint's junction offset is blended out.
 BLEND_SPEED = 1.5
 
+#: Factors on a junction's blend tried in turn until its frames pass the checks.
+JUNCTION_STRETCHES = (1.0, 2.0, 4.0)
+#: The biomechanical checks of the verifier run on a junction's frames (balance and foot
+#: skate are not: docs/reactive.md).
+JUNCTION_BIOMECHANICS = ("joint_speed", "range_of_motion", "self_penetration")
+#: Junctions whose check is remembered (the same pose into the same move is checked once).
+JUNCTION_CACHE_SIZE = 256
+
 PELVIS = JOINT_INDEX["pelvis"]
+_BONES = np.array([(j, q) for j, q in enumerate(PARENTS) if q >= 0])
+_FEET = [JOINT_INDEX[j] for j in FOOT_JOINTS]
 PLAYING = "playing"
 STOPPED = "stopped"
 
@@ -49,6 +66,106 @@ STOPPED = "stopped"
 def blend_seconds(offset: float) -> float:
     """Blend of a junction whose largest joint offset is ``offset`` m."""
     return float(np.clip(offset / BLEND_SPEED, BLEND_MIN, BLEND_MAX))
+
+
+@dataclass(frozen=True)
+class JunctionCheck:
+    """What the checks said of one junction's frames.
+
+    Attributes
+    ----------
+    step : int
+        Index of the move the junction leads into.
+    task : str
+        Its task key.
+    blend : float
+        Seconds of the blend played.
+    passed : bool
+    failed : tuple of str
+        The checks that failed (of the blend played).
+    detail : str
+    frames : int
+        Frames checked.
+    tried : tuple of (float, tuple of str)
+        Each blend tried (s) and the checks it failed, in order.
+    """
+
+    step: int
+    task: str
+    blend: float
+    passed: bool
+    failed: tuple[str, ...]
+    detail: str
+    frames: int
+    tried: tuple[tuple[float, tuple[str, ...]], ...] = ()
+
+
+def check_junction(positions: np.ndarray, fps: float, labels: list[str], cell,
+                   skeleton: Skeleton, options: VerificationOptions | None = None
+                   ) -> tuple[tuple[str, ...], str]:
+    """The verifier's checks on a junction's frames: :data:`JUNCTION_BIOMECHANICS` (joint
+    speeds by each frame's activity in ``labels``, range of motion, no body part through
+    another), ``smoothness`` (no jump between frames), bone lengths (within
+    :class:`~ltl_human_motion.motion.quality.QualityThresholds`' ``bone_length`` of
+    ``skeleton``'s), collisions of the body with ``cell``'s obstacles, and the feet (none
+    below the floor by more than ``options.floor_tolerance``, no flight longer than
+    ``options.max_flight``). Balance and foot skate are not checked (docs/reactive.md).
+
+    Parameters
+    ----------
+    positions : ndarray, shape (T, J, 3)
+        Frames at ``fps``, world frame, m.
+    fps : float
+    labels : list of str
+        Activity (task key) of each frame.
+    cell : Cell
+    skeleton : Skeleton
+    options : VerificationOptions, optional
+        The verifier's limits (default ones).
+
+    Returns
+    -------
+    failed : tuple of str
+        Names of the failed checks (empty: all passed).
+    detail : str
+    """
+    from ltl_human_motion.scene.predicates import collision
+
+    options = options or VerificationOptions()
+    pos = np.asarray(positions, dtype=np.float64)
+    failed: list[str] = []
+    notes: list[str] = []
+    body = check_biomechanics(pos, fps, stature=skeleton.stature, labels=labels,
+                              floor_z=cell.floor_z, limits=options.limits)
+    for name in JUNCTION_BIOMECHANICS:
+        if not body[name]["passed"]:
+            failed.append(name)
+            notes.append(f"{name}: {body[name]['detail']}")
+    step = np.linalg.norm(np.diff(pos, axis=0), axis=-1) * fps
+    if step.size and float(step.max()) > options.max_joint_speed:
+        failed.append("smoothness")
+        notes.append(f"smoothness: a joint at {float(step.max()):.2f} m/s between frames")
+    lengths = np.linalg.norm(pos[:, _BONES[:, 0]] - pos[:, _BONES[:, 1]], axis=-1)
+    stretch = float(np.max(np.abs(lengths - skeleton.bone_lengths()[_BONES[:, 0]])))
+    if stretch > QualityThresholds().bone_length:
+        failed.append("bone_length")
+        notes.append(f"bone_length: a bone {1e3 * stretch:.1f} mm off its length")
+    hits = collision(pos, cell, stature=skeleton.stature) if cell.obstacles \
+        else np.zeros(len(pos), bool)
+    if hits.any():
+        failed.append("collision")
+        notes.append(f"collision: {int(hits.sum())} frames collide, first "
+                     f"{int(np.argmax(hits))}")
+    feet = pos[:, _FEET, 2] - cell.floor_z
+    flying = np.concatenate([[0], (feet.min(axis=1) > options.flight_height).astype(np.int8),
+                             [0]])
+    edges = np.flatnonzero(np.diff(flying))
+    flight = int(np.max(edges[1::2] - edges[::2])) / fps if edges.size else 0.0
+    if float(feet.min()) < -options.floor_tolerance or flight > options.max_flight:
+        failed.append("feet")
+        notes.append(f"feet: lowest foot joint {float(feet.min()):+.3f} m, flight "
+                     f"{flight:.2f} s")
+    return tuple(failed), "; ".join(notes)
 
 
 @dataclass(frozen=True)
@@ -135,16 +252,35 @@ class StrategyExecutor:
         Called with each new :class:`StrategyStatus` (under the executor's lock).
     rate : float
         Playback rate (1.0 is real time; 2.0 plays each move in half its time).
+    cell : Cell, optional
+        The resolved cell the junctions are checked in (default: resolve ``program.cell``).
+    options : VerificationOptions, optional
+        Limits of the junction checks (default: the verifier's).
     """
 
     def __init__(self, program: StrategyProgram, start: float,
                  inputs: Mapping[str, bool] | None = None,
                  on_step: Callable[[StrategyStatus], None] | None = None,
-                 rate: float = 1.0) -> None:
+                 rate: float = 1.0, cell=None,
+                 options: VerificationOptions | None = None) -> None:
         if not (np.isfinite(rate) and rate > 0):
             raise ValueError(f"playback rate must be a positive number, got {rate!r}")
+        if cell is None:
+            from ltl_human_motion.scene.cell_yaml import resolve_cell
+            cell = resolve_cell(program.cell)
         self.program = program
         self.rate = float(rate)
+        self.cell = cell
+        self.options = options or VerificationOptions()
+        self.skeleton = Skeleton(program.stature)
+        self._checked: BoundedCache[tuple] = BoundedCache(JUNCTION_CACHE_SIZE)
+        #: The check of each junction played (at most 1000), and how many failed.
+        self.junctions: deque[JunctionCheck] = deque(maxlen=1000)
+        self.junctions_failed = 0
+        first = next(iter(program.clips.values()))
+        # The collision test compiles on its first call: here, not in a reaction.
+        check_junction(first.positions[:2], first.fps, [first.task] * 2, cell, self.skeleton,
+                       self.options)
         self._lock = threading.RLock()
         self._inputs = {k: bool((inputs or {}).get(k, False)) for k in program.inputs}
         self._inputs_stamp = 0.0
@@ -285,6 +421,10 @@ class StrategyExecutor:
             pos = np.stack([c * rel[..., 0] - sn * rel[..., 1],
                             sn * rel[..., 0] + c * rel[..., 1], rel[..., 2]], axis=-1)
             pos = pos + self._pivot + fade[:, None, None] * (self._shift + self._residual)
+            blended = fade > 0.0
+            if blended.any():
+                pos[blended] = enforce_bone_lengths(pos[blended], self.skeleton,
+                                                    rigid_hips=False)
         return pos, yaw + fade * self._yaw_offset
 
     def _advance(self, now: float) -> None:
@@ -299,17 +439,23 @@ class StrategyExecutor:
 
     def _next(self, at: float) -> None:
         """End the current move at clock time ``at``: observe the inputs, start the next."""
-        positions, yaw = self._pose(np.array([(at - self._start) * self.rate]))
+        t = (at - self._start) * self.rate
+        fps = self._clip.fps
+        w = max(1, round(SPEED_WINDOW * fps))
+        # The pose at ``at`` and the frames played before it that the speed window reaches.
+        positions, yaw = self._pose(np.concatenate([t - np.arange(w, 0, -1) / fps, [t]]))
         self._strategy.observe(self._inputs)
+        previous = self._clip.task
         self._source = self._clip.move.target
         try:
-            self._begin(at, positions[0], float(yaw[0]))
+            self._begin(at, positions[-1], float(yaw[-1]), positions[:-1], previous)
         except SpecError as exc:
             self._stopped = True
             self.error = (f"step {self._step + 1}: {exc} (inputs "
                           + ", ".join(f"{k}={v}" for k, v in self._inputs.items()) + ")")
 
-    def _begin(self, at: float, pose: np.ndarray | None, yaw: float) -> None:
+    def _begin(self, at: float, pose: np.ndarray | None, yaw: float,
+               before: np.ndarray | None = None, previous: str = "") -> None:
         task = self._strategy.choose()
         clip = self.program.clips.get((self._source, task))
         if clip is None:
@@ -330,7 +476,50 @@ class StrategyExecutor:
             self._residual = pose - turned
             # The farthest a joint travels in the blend: the turn, the shift, the posture.
             travel = np.linalg.norm(pose - first, axis=1)
-            self._blend = blend_seconds(float(np.max(travel)))
+            self._verify_junction(blend_seconds(float(np.max(travel))), pose, yaw,
+                                  np.zeros((0, *pose.shape)) if before is None else before,
+                                  previous)
         self.steps_done.append(clip.task)
         if self._on_step is not None:
             self._on_step(self._status())
+
+    def junction_frames(self, blend: float) -> np.ndarray:
+        """The current move's first frames (n, J, 3) as played with its junction blended
+        out over ``blend`` s: through the blend and the speed window after it (at most
+        the clip), at the clip's frame rate."""
+        with self._lock:
+            clip, kept = self._clip, self._blend
+            w = max(1, round(SPEED_WINDOW * clip.fps))
+            n = min(int(np.ceil(blend * clip.fps)) + w, len(clip.positions) - 1)
+            self._blend = float(blend)
+            try:
+                return self._pose(np.arange(n + 1) / clip.fps)[0]
+            finally:
+                self._blend = kept
+
+    def _verify_junction(self, blend: float, pose: np.ndarray, yaw: float,
+                         before: np.ndarray, previous: str) -> None:
+        """Set the blend of the junction just begun to the first of ``blend`` times
+        :data:`JUNCTION_STRETCHES` whose frames pass :func:`check_junction` (else the
+        longest), and record the check. ``before`` (w, J, 3): the frames played before
+        the junction's pose ``pose`` (J, 3); ``previous``: their move's task."""
+        clip = self._clip
+        key = (clip.move.source, clip.move.task, pose.tobytes(), float(yaw), before.tobytes())
+        hit = self._checked.get(key)
+        if hit is None:
+            tried = []
+            for factor in JUNCTION_STRETCHES:
+                ahead = self.junction_frames(blend * factor)
+                frames = np.concatenate([before, ahead])
+                labels = [previous] * len(before) + [clip.task] * len(ahead)
+                failed, detail = check_junction(frames, clip.fps, labels, self.cell,
+                                                self.skeleton, self.options)
+                tried.append((blend * factor, failed))
+                if not failed:
+                    break
+            hit = self._checked.put(key, (blend * factor, failed, detail, len(frames),
+                                          tuple(tried)))
+        self._blend, failed, detail, n_frames, tried = hit
+        self.junctions.append(JunctionCheck(self._step, clip.task, self._blend, not failed,
+                                            failed, detail, n_frames, tried))
+        self.junctions_failed += bool(failed)

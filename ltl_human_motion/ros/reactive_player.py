@@ -148,6 +148,7 @@ class ReactivePlayer(Node):
         self._input_subs: list[Any] = []
         self.frames_published = 0
         self._error_logged = False
+        self._junctions_warned = 0
         #: (input stamp, stamp of the reaction's first frame), s, of the latest 1000 waits
         #: ended by an input.
         self.reactions: deque[tuple[float, float]] = deque(maxlen=1000)
@@ -204,8 +205,9 @@ class ReactivePlayer(Node):
         self._last_joints = None
         self._error_logged = False
         self._joints_at = now_seconds(self)
+        self._junctions_warned = 0
         self.executor_ = StrategyExecutor(program, now_seconds(self),
-                                          rate=float(self.param("playback_rate")))
+                                          rate=float(self.param("playback_rate")), cell=cell)
         self.get_logger().info(f"playing strategy {strategy_id} ({len(program.clips)} moves; "
                                f"inputs {', '.join(program.inputs)})")
         return program
@@ -290,6 +292,12 @@ class ReactivePlayer(Node):
                 f"{JOINT_STATES_SILENCE:g} s: {', '.join(self._robot_keys)} keep their last "
                 "values (false before the first message); is the coexistence node running?",
                 throttle_duration_sec=10.0)
+        if executor is not None and executor.junctions_failed > self._junctions_warned:
+            self._junctions_warned = executor.junctions_failed
+            bad = next(j for j in reversed(executor.junctions) if not j.passed)
+            self.get_logger().warning(
+                f"junction into {bad.task} (step {bad.step}) fails {', '.join(bad.failed)} "
+                f"even blended over {bad.blend:.2f} s; played so ({bad.detail})")
         if executor is not None and executor.error is not None and not self._error_logged:
             self._error_logged = True
             self.get_logger().error(f"strategy {executor.motion_id} stopped: {executor.error}")
