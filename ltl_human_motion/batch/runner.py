@@ -208,10 +208,12 @@ def _run_dask(scheduler: str, job: BatchJob, items: list[ItemParams], workers: i
 
 
 def _prewarm(statures: set[float], library_source: str | None) -> None:
-    """Build missing libraries once here, so parallel workers do not all build them."""
-    from ltl_human_motion.motion.library import load_library
+    """Build missing libraries once here, so parallel workers do not all build them
+    (one already cached is left to the workers to load)."""
+    from ltl_human_motion.motion.library import library_cached, load_library
     for stature in sorted(statures):
-        load_library(stature=stature, source=library_source)
+        if not library_cached(stature, library_source):
+            load_library(stature=stature, source=library_source)
 
 
 # --------------------------------------------------------------------------- driver

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 from ltl_human_motion.errors import SpecError
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.ltl.formula import (
     And,
     Atom,
@@ -74,13 +75,25 @@ def resolve_spec_text(text: str) -> str:
     return PAPER_SPECS.get(text.strip(), text)
 
 
+def _vocabulary_key(vocab: Vocabulary) -> tuple:
+    """Everything of ``vocab`` a parse reads, as a hashable value."""
+    return (vocab.objects, vocab.regions, tuple(sorted(vocab.shorthands.items())),
+            vocab.final_region, vocab.source, tuple(sorted(vocab.inputs.items())))
+
+
+#: Parsed specifications and shorthand expansions by text and vocabulary (a batch parses
+#: the same few specifications in cells whose parts were moved, not renamed).
+_SPECIFICATIONS: BoundedCache[Specification] = BoundedCache(64)
+_SHORTHAND_ATOMS: BoundedCache[tuple] = BoundedCache(256)
+
+
 def _shorthand_atoms(task: Atom, vocab: Vocabulary) -> tuple[Atom, ...] | None:
     """Atoms of a shorthand's expansion if it is a conjunction of atoms, else None."""
-    formula = parse_spec(task.key, vocab, free_atoms=True).formula
-    parts = top_level_conjuncts(formula)
-    if all(isinstance(p, Atom) for p in parts):
-        return tuple(parts)  # type: ignore[return-value]
-    return None
+    def build() -> tuple:
+        parts = top_level_conjuncts(parse_spec(task.key, vocab, free_atoms=True).formula)
+        return (tuple(parts) if all(isinstance(p, Atom) for p in parts) else None,)
+
+    return _SHORTHAND_ATOMS.get_or_build((task.key, _vocabulary_key(vocab)), build)[0]
 
 
 def letter_of(task: Atom, cell: object = None) -> frozenset[str]:
@@ -185,6 +198,14 @@ def build_specification(text: str, cell: object = None, *, free_atoms: bool = Fa
     """
     vocab = vocabulary_from(cell)
     text = resolve_spec_text(text)
+    return _SPECIFICATIONS.get_or_build(
+        (text, bool(free_atoms), bool(reactive), _vocabulary_key(vocab)),
+        lambda: _specification(text, vocab, free_atoms, reactive))
+
+
+def _specification(text: str, vocab: Vocabulary, free_atoms: bool, reactive: bool
+                   ) -> Specification:
+    """:func:`build_specification` of the resolved ``text`` in ``vocab`` (not cached)."""
     parsed = parse_spec(text, vocab, free_atoms=free_atoms, reactive=reactive)
     tasks: list[Atom] = []
     for task in parsed.tasks:

@@ -7,6 +7,8 @@ object ever reaches the rest of the project.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 from ltl_human_motion.errors import MissingDependencyError
 from ltl_human_motion.ltl.automaton import Automaton
 from ltl_human_motion.ltl.formula import Formula, to_spot
@@ -26,8 +28,10 @@ def _import_spot():
     return spot
 
 
+@lru_cache(maxsize=1)
 def spot_available() -> bool:
-    """True if ``import spot`` works."""
+    """True if ``import spot`` works (asked once per process: a failed import searches
+    the whole path again)."""
     try:
         _import_spot()
     except MissingDependencyError:

@@ -60,6 +60,7 @@ __all__ = [
     "MotionLibrary",
     "build_library",
     "cache_dir",
+    "library_cached",
     "library_key",
     "load_library",
     "load_motion",
@@ -534,6 +535,22 @@ def _load(path: Path, key: str) -> MotionLibrary:
     return lib
 
 
+def _library_path(key: str, folder: str | os.PathLike | None) -> Path:
+    return (Path(folder) if folder is not None else cache_dir()) / f"library-{key}.npz"
+
+
+def library_cached(stature: float = DEFAULT_STATURE, source=None,
+                   delta: float = DEFAULT_LIBRARY_DELTA,
+                   cache_dir: str | os.PathLike | None = None, *,
+                   k_comp: int = DEFAULT_K_COMP, phase_step: int = 4,
+                   include_default: bool = True) -> bool:
+    """Whether :func:`load_library` with these arguments finds its cache file (and so
+    loads instead of building)."""
+    files = (_default_files() if include_default else []) + _source_files(source)
+    return _library_path(library_key(stature, files, delta, k_comp, phase_step,
+                                     include_default), cache_dir).is_file()
+
+
 def load_library(stature: float = DEFAULT_STATURE, source=None,
                  delta: float = DEFAULT_LIBRARY_DELTA, cache_dir: str | os.PathLike | None = None,
                  *, k_comp: int = DEFAULT_K_COMP, phase_step: int = 4,
@@ -577,8 +594,7 @@ def load_library(stature: float = DEFAULT_STATURE, source=None,
         raise ValueError(f"k_comp must be an integer in [1, 20], got {k_comp!r}")
     files = (_default_files() if include_default else []) + _source_files(source)
     key = library_key(stature, files, delta, k_comp, phase_step, include_default)
-    folder = Path(cache_dir) if cache_dir is not None else globals()["cache_dir"]()
-    path = folder / f"library-{key}.npz"
+    path = _library_path(key, cache_dir)
     if use_cache and path.is_file():
         try:
             return _load(path, key)

@@ -410,12 +410,14 @@ class _Tree:
              f: np.ndarray) -> None:
         """Add the successors ``succ`` (M,) of ``node`` ending at ``ends`` (M, 3), with
         costs ``g`` and priorities ``f`` (M,)."""
-        for prim, end, g_k, f_k in zip(succ.tolist(), ends.tolist(), g.tolist(), f.tolist()):
-            self.parents.append(node)
-            self.prims.append(prim)
-            self.poses.append((end[0], end[1], end[2]))
-            self.g_cost.append(g_k)
-            heapq.heappush(self.heap, (f_k, len(self.prims) - 1))
+        first = len(self.prims)
+        self.parents.extend([node] * len(succ))
+        self.prims.extend(succ.tolist())
+        self.poses.extend(map(tuple, ends.tolist()))
+        self.g_cost.extend(g.tolist())
+        heap, push = self.heap, heapq.heappush
+        for k, f_k in enumerate(f.tolist(), first):
+            push(heap, (f_k, k))
 
     def chain(self, node: int, last: int, tail: list[tuple[int, Pose]]
               ) -> tuple[list[int], list[Pose]]:

@@ -41,7 +41,7 @@ from scipy.sparse.csgraph import connected_components
 from ltl_human_motion.errors import PlanningError
 from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
-from ltl_human_motion.planning.navigation import FloorGrid
+from ltl_human_motion.planning.navigation import FloorGrid, layout_key
 
 __all__ = ["FloorMap", "ReachEnvelope", "check_steps", "floor_components", "floor_map",
            "reach_envelope", "step_problems"]
@@ -187,22 +187,41 @@ def _layout_key(cell, stature: float) -> tuple:
 _GRID_CACHE: BoundedCache[tuple] = BoundedCache(32)
 
 
+def _layout_digest(cell) -> tuple[float, str]:
+    """The cell's floor height and the digest of its workspace and obstacles
+    (:func:`.navigation.layout_key`, computed once per obstacles tuple)."""
+    return float(cell.floor_z), layout_key(cell)
+
+
+#: The smallest signed distance of the floor grid's points to the footprints of the
+#: obstacle parts taken (N,), per layout, parts and grid: workers of every stature share
+#: it (only the radius they keep and the parts low enough to block differ).
+_FOOTPRINT_DISTANCES: BoundedCache[np.ndarray] = BoundedCache(16)
+
+
 def floor_components(cell, radius: float, resolution: float, block: float = math.inf
                      ) -> tuple[FloorGrid, np.ndarray]:
     """The floor grid where a body of ``radius`` (m) keeps clear of the workspace's walls
     and of every obstacle part whose underside is less than ``block`` (m) above the floor,
     and the connected component of each grid cell: ``(FloorGrid, labels (nx * ny,))``."""
     floor = float(cell.floor_z)
-    footprints = [part.footprint() for ob in cell.obstacles for part in ob.parts
-                  if part.aabb()[0][2] - floor < block]
+    parts = [part for ob in cell.obstacles for part in ob.parts]
+    taken = tuple(k for k, part in enumerate(parts) if part.aabb()[0][2] - floor < block)
     lo = np.asarray(cell.workspace_lo[:2], dtype=np.float64)
     hi = np.asarray(cell.workspace_hi[:2], dtype=np.float64)
 
+    def nearest(xy: np.ndarray) -> np.ndarray:
+        out = np.full(len(xy), np.inf)
+        for k in taken:
+            np.minimum(out, parts[k].footprint().signed_distance(xy), out=out)
+        out.flags.writeable = False
+        return out
+
     def free(xy: np.ndarray) -> np.ndarray:
         ok = np.all((xy >= lo + radius) & (xy <= hi - radius), axis=-1)
-        for fp in footprints:
-            ok &= fp.signed_distance(xy) > radius
-        return ok
+        key = (_layout_digest(cell), taken, lo.tobytes(), hi.tobytes(), float(resolution),
+               xy.shape)
+        return ok & (_FOOTPRINT_DISTANCES.get_or_build(key, lambda: nearest(xy)) > radius)
 
     grid = FloorGrid(lo, hi, free, resolution)
     _, labels = connected_components(grid.graph, directed=False)
@@ -212,9 +231,7 @@ def floor_components(cell, radius: float, resolution: float, block: float = math
 def _floor_grid(cell, stature: float) -> tuple:
     """``(grid, free_xy (F, 2), free_labels (F,), tree)`` for the cell's obstacle layout."""
     from scipy.spatial import cKDTree
-    key = (hashlib.sha1(pickle.dumps((cell.floor_z, np.asarray(cell.workspace_lo),
-                                      np.asarray(cell.workspace_hi), cell.obstacles))
-                        ).hexdigest(), round(float(stature), 4))
+    key = (_layout_digest(cell), round(float(stature), 4))
     hit = _GRID_CACHE.get(key)
     if hit is not None:
         return hit

@@ -560,14 +560,22 @@ def floor_grid(clearance: ClearanceMap, lo: np.ndarray, hi: np.ndarray, radius: 
 _STAND_CACHE: BoundedCache[ClearanceMap] = BoundedCache(16)
 
 
-def _layout_key(cell) -> str:
-    """A hash of the cell's workspace and obstacles (what the maps depend on)."""
+def layout_key(cell) -> str:
+    """A hash of the cell's workspace and obstacles (what the maps depend on), computed
+    once per obstacles tuple and workspace (the cells of a batch share them)."""
     import hashlib
     import pickle
-    return hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, _code_fingerprint(),
-                                      np.asarray(cell.workspace_lo),
-                                      np.asarray(cell.workspace_hi), cell.obstacles))
-                        ).hexdigest()
+    lo = np.asarray(cell.workspace_lo, dtype=np.float64)
+    hi = np.asarray(cell.workspace_hi, dtype=np.float64)
+    return _LAYOUT_KEYS.get_or_build(
+        (lo.tobytes(), hi.tobytes()),
+        lambda: hashlib.sha1(pickle.dumps((_FIELDS_FORMAT, _code_fingerprint(),
+                                           np.asarray(cell.workspace_lo),
+                                           np.asarray(cell.workspace_hi), cell.obstacles))
+                             ).hexdigest(), owner=cell.obstacles)
+
+
+_LAYOUT_KEYS: BoundedCache[str] = BoundedCache(32)
 
 
 @lru_cache(maxsize=1)
@@ -586,7 +594,7 @@ def stand_clearance_map(cell) -> ClearanceMap:
     walking map (:func:`clearance_maps`) counts tall parts ``tall_extra`` closer. Kept in
     memory per cell (cheap to build).
     """
-    return _STAND_CACHE.get_or_build(_layout_key(cell),
+    return _STAND_CACHE.get_or_build(layout_key(cell),
                                      lambda: ClearanceMap(cell, tall_extra=0.0))
 
 
@@ -601,7 +609,7 @@ def clearance_maps(cell) -> tuple[ClearanceMap, ObstacleField]:
 
     from ltl_human_motion.atomic import atomic_write_with
     from ltl_human_motion.motion.library import cache_dir
-    key = _layout_key(cell)
+    key = layout_key(cell)
     maps = _CLEARANCE_CACHE.get(key)
     if maps is not None:
         return maps
