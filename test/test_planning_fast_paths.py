@@ -289,3 +289,23 @@ def test_fields_with_a_key_are_reused_between_planners(paper) -> None:
     assert fresh is not first
     np.testing.assert_array_equal(fresh.dist, first.dist)
     assert not first.dist.flags.writeable and not first.descent.flags.writeable
+
+
+def test_compiled_field_distances_equal_the_numpy_path(paper, monkeypatch) -> None:
+    """The obstacle field's compiled distances (points near and off its grid) and the least
+    distance over offsets (a part in hand read at points on its box) equal the numpy
+    path's, bit for bit."""
+    from ltl_human_motion.planning import navigation
+    if navigation._compiled_loops() is None:
+        pytest.skip("numba is not in use")
+    field = ObstacleField(paper)
+    rng = np.random.default_rng(5)
+    centres = rng.uniform(field.lo - 0.3, field.lo + field.res * field.shape + 0.3, (40, 7, 3))
+    offsets = rng.normal(scale=0.05, size=(9, 3))
+    compiled = (field.distance(centres), field.least_distance(centres, offsets))
+    monkeypatch.setattr(navigation, "_compiled_loops", lambda: None)
+    numpy = (field.distance(centres), field.distance(centres[..., None, :] + offsets).min(-1))
+    for got, want in zip(compiled, numpy):
+        assert got.shape == want.shape == (40, 7)
+        np.testing.assert_array_equal(got, want)
+    assert (compiled[0] < 0.05).any() and (compiled[0] >= field.far).any()

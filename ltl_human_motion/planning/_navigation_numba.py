@@ -99,6 +99,28 @@ def _field_distance(grid, lo, res, far, p0, p1, p2):
 
 
 @_jit
+def field_distances(grid, lo, res, far, pts, out) -> None:
+    """out[n] = the obstacle field's distance at pts[n] (N, 3), finite
+    (:func:`_field_distance`)."""
+    for n in range(pts.shape[0]):
+        out[n] = _field_distance(grid, lo, res, far, pts[n, 0], pts[n, 1], pts[n, 2])
+
+
+@_jit
+def least_field_distances(grid, lo, res, far, centres, offsets, out) -> None:
+    """out[n] = the least field distance (:func:`_field_distance`) over the points
+    centres[n] + offsets[k], centres (N, 3) and offsets (K, 3) finite, K >= 1."""
+    for n in range(centres.shape[0]):
+        least = np.inf
+        for k in range(offsets.shape[0]):
+            d = _field_distance(grid, lo, res, far, centres[n, 0] + offsets[k, 0],
+                                centres[n, 1] + offsets[k, 1], centres[n, 2] + offsets[k, 2])
+            if d < least or k == 0:
+                least = d
+        out[n] = least
+
+
+@_jit
 def _sample_gaps(grid, lo, res, far, pos, m, s, ia, ib, long, need, used, dj, gaps) -> None:
     """gaps[k] = the field gap of capsule k (joints ia[k], ib[k]) at sample s of candidate
     m: the nearer of its ends' distances (and of its middle's, for a long capsule) less

@@ -380,11 +380,33 @@ class ObstacleField:
         pts = np.asarray(points, dtype=np.float64)
         if self.empty:
             return np.full(pts.shape[:-1], np.inf)
+        nb = _compiled_loops()
+        if nb is not None and np.isfinite(pts).all():
+            out = np.empty(pts.shape[:-1])
+            nb.field_distances(np.ascontiguousarray(self.dist, dtype=np.float64), self.lo,
+                               self.res, float(self.far),
+                               np.ascontiguousarray(pts.reshape(-1, 3)), out.reshape(-1))
+            return out
         u = (pts.reshape(-1, 3) - self.lo) / self.res
         outside = np.any((u < 0) | (u > self.shape - 1), axis=-1)
         out = _trilinear(self.dist, u)
         out = np.where(outside, np.maximum(out, self.far), out)
         return out.reshape(pts.shape[:-1])
+
+    def least_distance(self, centres: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+        """The least :meth:`distance` over the points ``centres[..., None, :] + offsets``:
+        centres (..., 3), offsets (K, 3) with K >= 1; shape (...). One compiled call where
+        the compiled kernel is in use (a part in hand read at points on its box)."""
+        c = np.asarray(centres, dtype=np.float64)
+        o = np.ascontiguousarray(offsets, dtype=np.float64)
+        nb = _compiled_loops()
+        if self.empty or nb is None or not (np.isfinite(c).all() and np.isfinite(o).all()):
+            return self.distance(c[..., None, :] + o).min(axis=-1)
+        out = np.empty(c.shape[:-1])
+        nb.least_field_distances(np.ascontiguousarray(self.dist, dtype=np.float64), self.lo,
+                                 self.res, float(self.far),
+                                 np.ascontiguousarray(c.reshape(-1, 3)), o, out.reshape(-1))
+        return out
 
     def clear(self, poses: np.ndarray, stature: float, margin: float = 0.01,
               relative: bool = False, parts: np.ndarray | None = None) -> np.ndarray:

@@ -288,7 +288,7 @@ class StepExecutor:
         for name, joint in self.state.held.items():
             pts, _ = held_surface(self.ctx.cell, name)
             centre = poses[:, :, JOINT_INDEX[joint]] + self.state.held_offset(name)
-            d = field.distance(centre[:, :, None, :] + pts).min(axis=2)       # (M, S)
+            d = field.least_distance(centre, pts)                             # (M, S)
             gap = d - (HELD_SEARCH_MARGIN + field.res * 0.4)
             allowed = np.where(standing, np.minimum(gap[:, 0], 0.0) - 0.005, 0.0)
             out &= gap.min(axis=1) >= allowed
