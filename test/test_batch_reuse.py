@@ -84,3 +84,18 @@ def test_library_cached_says_whether_load_library_would_build(tmp_path: Path) ->
     get_library(1.75)
     assert library_cached(1.75)
     assert not library_cached(1.75, cache_dir=tmp_path)
+
+
+def test_lasso_truths_are_remembered_per_formula_and_word(cell) -> None:
+    from ltl_human_motion.ltl.evaluator import evaluate_lasso, evaluate_positions
+    spec = build_specification(SPEC, cell)
+    p2, p7 = ({t.key} for t in spec.tasks)
+    words = [([p2], [p7]), ([], [p2, p7]), ([p2], [p2]), ([], [set()])]
+    first = [evaluate_lasso(spec.formula, pre, cyc) for pre, cyc in words]
+    assert first == [evaluate_positions(spec.formula, pre, cyc)[0] for pre, cyc in words]
+    assert first[:2] == [True, True] and first[2:] == [False, False]
+    again = [evaluate_lasso(spec.formula, [list(x) for x in pre], (frozenset(x) for x in cyc))
+             for pre, cyc in words]
+    assert again == first
+    with pytest.raises(ValueError, match="cycle"):
+        evaluate_lasso(spec.formula, [p2], [])

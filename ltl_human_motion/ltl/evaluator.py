@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
 
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.ltl.formula import (
     And,
     Atom,
@@ -170,7 +171,14 @@ def evaluate_lasso(formula: Formula, prefix_letters: Sequence[Iterable[str]],
     ValueError
         If ``cycle_letters`` is empty.
     """
-    return evaluate_positions(formula, prefix_letters, cycle_letters)[0]
+    prefix, cycle = tuple(_letters(prefix_letters)), tuple(_letters(cycle_letters))
+    return _LASSO_TRUTHS.get_or_build(
+        (prefix, cycle), lambda: evaluate_positions(formula, prefix, cycle)[0], owner=formula)
+
+
+#: Truth of a formula (by identity: a specification parsed once) on a lasso word: the
+#: product search of every batch item checks the same few task words again.
+_LASSO_TRUTHS: BoundedCache[bool] = BoundedCache(4096)
 
 
 def propositional_letters(f: Formula, letters: Sequence[frozenset[str]]
