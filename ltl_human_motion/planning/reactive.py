@@ -37,10 +37,12 @@ __all__ = ["MOTION_ATTEMPTS", "RunMotions", "SequenceMotion", "TraceMotion", "mo
 
 #: Random draws of a task sequence's motion tried before it is reported not verified (as
 #: :data:`~ltl_human_motion.planning.strategy_motion.MOVE_ATTEMPTS` for the live player's
-#: moves). 6 of 783 runs' first draws failed ``joint_speed`` at a walk junction: the gait
-#: graph's turn -> forward (1.24 m/s) -> stop transitions leave the swing toe 12-17 cm
-#: off, and its offset ramps add to the forward clip's own 4.47 m/s swing peak (limit
-#: 4.90 m/s); the next draw walks another way.
+#: moves). With one draw per run, 6 of 783 runs failed ``joint_speed``, each at a toe in a
+#: walk: the gait graph's transitions turn -> forward at 1.24 m/s -> stop left the swing
+#: toe 12-17 cm off; with the pipeline's repair (those junctions' ramps stretched) the
+#: blended toe peaks at the forward clip's own 4.47 m/s, and giving the bones their lengths
+#: back carries the knee's shorter ramp down the shin to 4.94 m/s (limit 4.90 m/s). The
+#: next draw walks another way.
 MOTION_ATTEMPTS = 3
 
 #: Task sequences whose motions :class:`RunMotions` keeps.
