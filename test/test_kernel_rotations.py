@@ -14,6 +14,7 @@ from ltl_human_motion.kernel.rotations import (
     MOCAP_FROM_ZUP,
     ZUP_FROM_YUP,
     compact_axis_angle_from_matrix,
+    matrix_from_angle,
     matrix_from_axis_angle,
     matrix_from_compact_axis_angle,
     matrix_from_euler,
@@ -66,6 +67,21 @@ def test_per_row_axes_and_rotation_vectors_from_matrices() -> None:
         matrix_from_unit_axis_angle(np.ones(4), 0.1)
     with pytest.raises(ValueError, match=r"\(\.\.\., 3, 3\)"):
         compact_axis_angle_from_matrix(np.eye(4))
+
+
+def test_rotations_about_a_coordinate_axis() -> None:
+    rng = np.random.default_rng(11)
+    angles = rng.uniform(-np.pi, np.pi, (4, 5))
+    for basis in range(3):
+        R = matrix_from_angle(basis, angles)
+        assert R.shape == (4, 5, 3, 3)
+        np.testing.assert_allclose(R, matrix_from_axis_angle(np.eye(3)[basis], angles),
+                                   atol=1e-12)
+        c = R[..., (basis + 1) % 3, (basis + 1) % 3]
+        np.testing.assert_array_equal(c, np.cos(angles))      # exact, not Rodrigues-rounded
+    np.testing.assert_array_equal(matrix_from_yaw(angles), matrix_from_angle(2, angles))
+    with pytest.raises(ValueError, match=r"0, 1 or 2.*got 3"):
+        matrix_from_angle(3, 0.1)
 
 
 def test_yaw_euler_and_frames() -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion.biomechanics import self_penetration
 from ltl_human_motion.motion.gait import standing_pose
 from ltl_human_motion.motion.goals import (
@@ -467,7 +468,7 @@ def test_without_kneeling_the_reach_under_the_low_board_folds_the_hips(monkeypat
         return tuple(out)
 
     monkeypatch.setattr(postures, "_kneel_set", no_kneel)
-    monkeypatch.setattr(postures, "_GRID_CACHE", {})
+    monkeypatch.setattr(postures, "_GRID_CACHE", BoundedCache(32))
     goals._placement.cache_clear()
     try:
         x, y = reach_placement("grasp", 0.10, sk, board=(0.17, 0.44, 0.46), start_pose=start)

@@ -237,3 +237,26 @@ def test_playback_follower_follows_task_state_and_warns_once_per_missing_motion(
         node.destroy_node()
     finally:
         rclpy.shutdown(context=context)
+
+
+def test_playback_follower_from_the_nodes_declared_parameters() -> None:
+    from rclpy.parameter import Parameter
+
+    from ltl_human_motion.ros.params import declare_parameters
+    from ltl_human_motion.ros.playback_follower import PlaybackFollower, follower_parameters
+
+    context = rclpy.context.Context()
+    rclpy.init(context=context)
+    try:
+        node = rclpy.create_node("follower_params_test", context=context, parameter_overrides=[
+            Parameter("task_state_topic", value="/h2/task_state"),
+            Parameter("catalog_topic", value="/catalog_b")])
+        declare_parameters(node, follower_parameters())
+        follower = PlaybackFollower.from_parameters(node, None, MotionStore())
+        assert follower.following
+        assert node.count_subscribers("/h2/task_state") == 1
+        assert node.count_subscribers("/catalog_b") == 1
+        assert node.count_subscribers("/motion_catalog") == 0
+        node.destroy_node()
+    finally:
+        rclpy.shutdown(context=context)

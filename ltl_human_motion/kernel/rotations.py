@@ -17,6 +17,7 @@ __all__ = [
     "ZUP_FROM_MOCAP",
     "ZUP_FROM_YUP",
     "compact_axis_angle_from_matrix",
+    "matrix_from_angle",
     "matrix_from_axis_angle",
     "matrix_from_compact_axis_angle",
     "matrix_from_euler",
@@ -195,17 +196,40 @@ def compact_axis_angle_from_matrix(R: ArrayLike) -> NDArray[np.float64]:
     return out
 
 
+def matrix_from_angle(basis: int, angle: ArrayLike) -> NDArray[np.float64]:
+    """Rotation matrices about the coordinate axis ``basis`` (0: x, 1: y, 2: z).
+
+    The entries are the angle's cosine and sine themselves (pytransform3d's
+    ``active_matrix_from_angle``), exact where Rodrigues' formula rounds.
+
+    Parameters
+    ----------
+    basis : int
+        0, 1 or 2.
+    angle : array-like, shape (...)
+        Radians.
+
+    Returns
+    -------
+    R : ndarray, shape (..., 3, 3)
+    """
+    if basis not in (0, 1, 2):
+        raise ValueError(f"rotation basis: expected 0, 1 or 2 (x, y, z), got {basis!r}")
+    angle = np.asarray(angle, dtype=np.float64)
+    c, s = np.cos(angle), np.sin(angle)
+    i, j = (basis + 1) % 3, (basis + 2) % 3
+    out = np.zeros((*angle.shape, 3, 3))
+    out[..., basis, basis] = 1.0
+    out[..., i, i] = c
+    out[..., i, j] = -s
+    out[..., j, i] = s
+    out[..., j, j] = c
+    return out
+
+
 def matrix_from_yaw(yaw: ArrayLike) -> NDArray[np.float64]:
     """Rotation matrices about +z, shape (..., 3, 3) for ``yaw`` (radians) of shape (...)."""
-    yaw = np.asarray(yaw, dtype=np.float64)
-    c, s = np.cos(yaw), np.sin(yaw)
-    out = np.zeros((*yaw.shape, 3, 3))
-    out[..., 0, 0] = c
-    out[..., 0, 1] = -s
-    out[..., 1, 0] = s
-    out[..., 1, 1] = c
-    out[..., 2, 2] = 1.0
-    return out
+    return matrix_from_angle(2, yaw)
 
 
 _AXES = {"X": np.array([1.0, 0, 0]), "Y": np.array([0, 1.0, 0]), "Z": np.array([0, 0, 1.0])}

@@ -56,14 +56,15 @@ def _reachable(cell, part: str) -> tuple[np.ndarray, np.ndarray]:
     return _FREE.get_or_build((part,), lambda: _fill(cell, part), owner=cell)
 
 
-def _components(cell, half: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
+def _components(cell, half: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, BoundedCache[np.ndarray]]:
     """The labelled components of the free space (:func:`_free_space`), the grid's origin
-    and a memo of reachable sets per seed labels; built once per obstacle layout,
-    workspace and part size (a part moved to another place of the same cell reuses it)."""
-    def build() -> tuple[np.ndarray, np.ndarray, dict]:
+    and the reachable sets by seed labels; built once per obstacle layout, workspace and
+    part size (a part moved to another place of the same cell reuses it)."""
+    def build() -> tuple[np.ndarray, np.ndarray, BoundedCache[np.ndarray]]:
         from scipy import ndimage
         free, origin = _free_space(cell, half)
-        return ndimage.label(free)[0], origin, {}
+        return ndimage.label(free)[0], origin, BoundedCache(16)
     lo, hi = (np.asarray(v, dtype=np.float64) for v in cell.workspace)
     key = (tuple(lo.tolist()), tuple(hi.tolist()), tuple(half.tolist()))
     return _LABELS.get_or_build(key, build, owner=cell.obstacles)
@@ -78,12 +79,9 @@ def _fill(cell, part: str) -> tuple[np.ndarray, np.ndarray]:
     near = labels[max(k[0] - 1, 0):k[0] + 2, max(k[1] - 1, 0):k[1] + 2,
                   max(k[2] - 1, 0):k[2] + 2]
     seeds = np.unique(near[near > 0])
-    key = tuple(seeds.tolist())
-    if key not in reached:
-        if len(reached) >= 16:
-            reached.clear()
-        reached[key] = np.isin(labels, seeds) if seeds.size else np.ones(labels.shape, bool)
-    return reached[key], origin
+    return reached.get_or_build(
+        tuple(seeds.tolist()),
+        lambda: np.isin(labels, seeds) if seeds.size else np.ones(labels.shape, bool)), origin
 
 
 def can_pass(cell, part: str, lo: np.ndarray, hi: np.ndarray) -> bool:

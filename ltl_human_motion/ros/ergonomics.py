@@ -48,7 +48,7 @@ from ltl_human_motion.ros.params import (
     positive,
     topic_name,
 )
-from ltl_human_motion.ros.playback_follower import PlaybackFollower
+from ltl_human_motion.ros.playback_follower import PlaybackFollower, follower_parameters
 from ltl_human_motion.scene.cell import Cell
 
 __all__ = ["LEVEL_COLORS", "ErgonomicsNode", "cell_masses", "response_figures"]
@@ -87,12 +87,7 @@ def ergonomics_parameters() -> list[ParamSpec]:
         ParamSpec("rate", 10.0, "Ergonomics messages per second", positive, read_only=True),
         ParamSpec("cell", "paper_cell", "Cell whose part masses load the hands",
                   lambda v: None if str(v).strip() else "expected a cell name"),
-        ParamSpec("store_dir", "", "Folder of <motion_id>.npz ('' = use the catalog's)",
-                  read_only=True),
-        ParamSpec("catalog_topic", "/motion_catalog", "Latched MotionCatalog topic",
-                  topic_name, read_only=True),
-        ParamSpec("task_state_topic", "task_state", "TaskState topic to follow when alone",
-                  topic_name, read_only=True),
+        *follower_parameters(),
         ParamSpec("markers_topic", "/ergonomics_markers", "MarkerArray topic", topic_name,
                   read_only=True),
     ]
@@ -115,9 +110,7 @@ class ErgonomicsNode(Node):
         super().__init__(node_name, **node_kwargs)
         declare_parameters(self, ergonomics_parameters())
         self.human_id = str(self.param("human_id"))
-        self.follower = PlaybackFollower(self, playback, store, self.param("store_dir"),
-                                         self.param("task_state_topic"),
-                                         self.param("catalog_topic"))
+        self.follower = PlaybackFollower.from_parameters(self, playback, store)
         self.following, self.playback = self.follower.following, self.follower.playback
         self._scores: BoundedCache[tuple[np.ndarray, ...]] = BoundedCache(16)
         self.messages_published = 0

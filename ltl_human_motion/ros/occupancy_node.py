@@ -68,7 +68,7 @@ from ltl_human_motion.ros.params import (
     positive,
     topic_name,
 )
-from ltl_human_motion.ros.playback_follower import PlaybackFollower
+from ltl_human_motion.ros.playback_follower import PlaybackFollower, follower_parameters
 from ltl_human_motion.ros.wall_schedule import WallSchedule
 
 #: Seconds between two missed-deadline warnings of one node.
@@ -104,16 +104,11 @@ def occupancy_parameters() -> list[ParamSpec]:
         ParamSpec("prediction_step", 0.1, "Seconds between predicted samples", positive),
         ParamSpec("marker_rate", 10.0, "Occupancy marker messages per second (0 = none)",
                   non_negative),
-        ParamSpec("store_dir", "", "Folder of <motion_id>.npz ('' = use the catalog's)",
-                  read_only=True),
         ParamSpec("stream_priority", DEFAULT_STREAM_PRIORITY,
                   "SCHED_FIFO priority of the stream thread (0 = normal scheduling; "
                   "refused without CAP_SYS_NICE/rtprio, then normal)", _priority,
                   read_only=True),
-        ParamSpec("catalog_topic", "/motion_catalog", "Latched MotionCatalog topic",
-                  topic_name, read_only=True),
-        ParamSpec("task_state_topic", "task_state", "TaskState topic to follow when alone",
-                  topic_name, read_only=True),
+        *follower_parameters(),
         ParamSpec("markers_topic", "/occupancy_markers", "MarkerArray topic", topic_name,
                   read_only=True),
     ]
@@ -137,9 +132,7 @@ class OccupancyNode(Node):
         declare_parameters(self, occupancy_parameters())
         self.human_id = str(self.param("human_id"))
         self.world_frame: str = self.param("world_frame")
-        self.follower = PlaybackFollower(self, playback, store, self.param("store_dir"),
-                                         self.param("task_state_topic"),
-                                         self.param("catalog_topic"))
+        self.follower = PlaybackFollower.from_parameters(self, playback, store)
         self.following, self.playback = self.follower.following, self.follower.playback
         self._part_names: list[str] | None = None
         self.messages_published = 0

@@ -3,7 +3,8 @@
 In one process with the skeleton publisher (``ltl-human-motion bringup``) the node shares
 the publisher's :class:`~ltl_human_motion.planning.playback.Playback`. Standing alone it keeps
 its own in step with the publisher's ``task_state`` topic, loading each motion by id from
-its store or from the folder the latched motion catalog names.
+its store or from the folder the latched motion catalog names. The parameters that say
+where (:func:`follower_parameters`) are declared by each such node.
 """
 
 from __future__ import annotations
@@ -16,8 +17,21 @@ from ltl_human_motion.msg import MotionCatalog, TaskState
 from ltl_human_motion.planning.motion_store import MotionSource, MotionStore
 from ltl_human_motion.planning.playback import STATES, STOPPED, Playback
 from ltl_human_motion.ros.common import LATCHED_QOS, STREAM_QOS, now_seconds, stamp_seconds
+from ltl_human_motion.ros.params import ParamSpec, topic_name
 
-__all__ = ["PlaybackFollower"]
+__all__ = ["PlaybackFollower", "follower_parameters"]
+
+
+def follower_parameters() -> list[ParamSpec]:
+    """A following node's ``store_dir``, ``catalog_topic`` and ``task_state_topic``."""
+    return [
+        ParamSpec("store_dir", "", "Folder of <motion_id>.npz ('' = use the catalog's)",
+                  read_only=True),
+        ParamSpec("catalog_topic", "/motion_catalog", "Latched MotionCatalog topic",
+                  topic_name, read_only=True),
+        ParamSpec("task_state_topic", "task_state", "TaskState topic to follow when alone",
+                  topic_name, read_only=True),
+    ]
 
 
 class PlaybackFollower:
@@ -50,6 +64,15 @@ class PlaybackFollower:
                                      STREAM_QOS)
             node.create_subscription(MotionCatalog, catalog_topic, self.source.on_catalog,
                                      LATCHED_QOS)
+
+    @classmethod
+    def from_parameters(cls, node: Node, playback: Playback | None,
+                        store: MotionStore | None) -> PlaybackFollower:
+        """The follower that ``node``'s declared :func:`follower_parameters` describe."""
+        def value(name: str) -> str:
+            return node.get_parameter(name).value
+        return cls(node, playback, store, value("store_dir"), value("task_state_topic"),
+                   value("catalog_topic"))
 
     def on_task_state(self, msg: TaskState) -> None:
         """Re-anchor the playback on a player's ``TaskState``, loading the motion when it

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ltl_human_motion.kernel.rotations import matrix_from_angle
 from ltl_human_motion.motion.goals.tasks import _J, _SIDES, _bones
 from ltl_human_motion.motion.ik import center_of_mass, two_bone_ik
 from ltl_human_motion.motion.skeleton import Skeleton
@@ -25,19 +26,6 @@ _ROM_MARGIN = 3.0
 #: ``_ROM_MARGIN`` (a hand path rising over a shelf's edge close to the shoulder folded a
 #: 1.55 m worker's elbow to 151-164 deg; the wrist stays that far from the shoulder).
 _ELBOW_MAX_FLEXION = float(np.radians(150.0 - _ROM_MARGIN))
-
-
-def _rot_y(angle: np.ndarray) -> np.ndarray:
-    """Rotations about +y, shape (..., 3, 3) for ``angle`` of shape (...)."""
-    angle = np.asarray(angle, dtype=np.float64)
-    c, s = np.cos(angle), np.sin(angle)
-    out = np.zeros((*angle.shape, 3, 3))
-    out[..., 0, 0] = c
-    out[..., 0, 2] = s
-    out[..., 1, 1] = 1.0
-    out[..., 2, 0] = -s
-    out[..., 2, 2] = c
-    return out
 
 
 #: Largest forward tilt of the pelvis in a crouch's trunk flexion, rad (20 degrees): past
@@ -94,10 +82,11 @@ def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
             if name == "spine":                 # the pelvis's own tilt (hip flexion)
                 angle = angle - capped * crouch * np.maximum(angle - PELVIS_TILT_MAX, 0.0)
                 tilt = angle
-            rot[frac] = _rot_y(angle)
+            rot[frac] = matrix_from_angle(1, angle)
         out[:, j] = out[:, p] + rot[frac] @ (rest[j] - rest[p])
     # in a crouch the hips turn with the pelvis's tilt (standing bends keep them level)
-    turn = _rot_y(crouch * tilt * ~np.asarray(kneel, dtype=bool)) if hips is None else None
+    turn = (matrix_from_angle(1, crouch * tilt * ~np.asarray(kneel, dtype=bool))
+            if hips is None else None)
     for k, name in enumerate(("l_hip", "r_hip")):
         out[:, _J[name]] = pelvis + (turn @ (rest[_J[name]] - rest[0]) if hips is None
                                      else hips[k])

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion.goals.body import (
     _KNEE_ON_FLOOR,
     _balance_shift,
@@ -73,7 +74,7 @@ _KNEEL_PITCH_MAX = 1.6
 
 
 #: Target-independent part of :func:`_grid` per (skeleton, start pose); see :func:`_grid_base`.
-_GRID_CACHE: dict[tuple, tuple[np.ndarray, ...]] = {}
+_GRID_CACHE: BoundedCache[tuple[np.ndarray, ...]] = BoundedCache(32)
 
 
 def _grid_base(skeleton: Skeleton, st: _Start, low_board: bool = False
@@ -98,24 +99,19 @@ def _grid_base(skeleton: Skeleton, st: _Start, low_board: bool = False
         Whether the candidate can be taken; whether its pelvis tilt is capped; whether
         it kneels.
     """
-    key = (skeleton, st.pose.tobytes(), low_board)
-    hit = _GRID_CACHE.get(key)
-    if hit is not None:
-        return hit
-    if low_board:
-        full = _grid_set(skeleton, st, False)
-        full[3][:] += _UNCAPPED_COST
-        sets = [_grid_set(skeleton, st, True)] + ([] if st.seated
-                                                  else [_kneel_set(skeleton, st)]) + [full]
-        out = tuple(np.concatenate(arrays) for arrays in zip(*sets))
-    else:
-        out = _grid_set(skeleton, st, True)
-    for arr in out:
-        arr.flags.writeable = False
-    if len(_GRID_CACHE) >= 32:
-        _GRID_CACHE.clear()
-    _GRID_CACHE[key] = out
-    return out
+    def build() -> tuple[np.ndarray, ...]:
+        if low_board:
+            full = _grid_set(skeleton, st, False)
+            full[3][:] += _UNCAPPED_COST
+            sets = [_grid_set(skeleton, st, True)] + ([] if st.seated
+                                                      else [_kneel_set(skeleton, st)]) + [full]
+            out = tuple(np.concatenate(arrays) for arrays in zip(*sets))
+        else:
+            out = _grid_set(skeleton, st, True)
+        for arr in out:
+            arr.flags.writeable = False
+        return out
+    return _GRID_CACHE.get_or_build((skeleton, st.pose.tobytes(), low_board), build)
 
 
 def _grid_set(skeleton: Skeleton, st: _Start, cap: bool) -> tuple[np.ndarray, ...]:
