@@ -52,6 +52,7 @@ from scipy.spatial.transform import Rotation
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 
+from ltl_human_motion.kernel.cache import BoundedCache
 from ltl_human_motion.motion import urdf
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, PARENTS, Skeleton
 from ltl_human_motion.planning.playback import Frame, Playback
@@ -181,7 +182,8 @@ class BodyInterface:
                                for a in urdf.bone_joint(JOINT_NAMES[j]).axes])
         self.description_parameter = f"human_description_{self.body_id}"
         self._urdf_stature: float | None = None
-        self._tables: dict[str, tuple[float, np.ndarray, np.ndarray]] = {}
+        self._tables: BoundedCache[tuple[float, np.ndarray, np.ndarray]] = \
+            BoundedCache(MAX_TABLES)
         self._last_seen: dict[str, float] = {}
         self._subscribed: set[str] = set()
         self.publish_urdf(1.75)
@@ -201,17 +203,14 @@ class BodyInterface:
         """Per-frame tables of ``motion`` (a SynthesizedMotion): stature, link quaternions
         (T, J, 4) and body velocity (T, 6); computed once per motion id and kept (the
         skeleton publisher calls this before it starts the playback clock)."""
-        if motion_id not in self._tables:
+        def build() -> tuple[float, np.ndarray, np.ndarray]:
             body = motion.motion
             stature = float(body.skeleton.stature)
             positions = np.asarray(body.positions, dtype=np.float64)
             quats = link_quaternions(positions, stature)
             origins = body_origins(positions[:, 0], quats[:, 0], stature)
-            velocity = body_velocity(origins, quats[:, 0], float(body.fps))
-            if len(self._tables) >= MAX_TABLES:
-                self._tables.pop(next(iter(self._tables)))
-            self._tables[motion_id] = (stature, quats, velocity)
-        return self._tables[motion_id]
+            return stature, quats, body_velocity(origins, quats[:, 0], float(body.fps))
+        return self._tables.get_or_build(motion_id, build)
 
     def _discover(self) -> None:
         for topic, _ in self.node.get_topic_names_and_types():
@@ -265,12 +264,12 @@ class BodyInterface:
         self._tracked_pub.publish(tracked)
         if frame is None:
             return []
-        if frame.motion_id in self._tables:
-            stature, quats, velocity = self._tables[frame.motion_id]
-        elif playback.motion is not None:        # played by another node of the process
-            stature, quats, velocity = self.prepare(frame.motion_id, playback.motion)
-        else:
+        tables = self._tables.get(frame.motion_id)
+        if tables is None and playback.motion is not None:  # played by another node
+            tables = self.prepare(frame.motion_id, playback.motion)
+        if tables is None:
             return []
+        stature, quats, velocity = tables
         self.publish_urdf(stature)
         rotations = blend_quaternions(quats, frame.time, playback.fps)
         rows = link_transforms(frame.positions, rotations)
