@@ -109,6 +109,36 @@ def test_ros_layer_uses_core_types_without_probes(module: str) -> None:
     assert probes == [], f"{module}: hasattr/getattr at lines {probes}"
 
 
+#: Modules of ros/ that import nothing of ROS: the nodes' support (the HumanOccupancy wire
+#: format, message definitions for the recorder, the arm's TF frames, the stream thread's
+#: schedule). Plain Python the core could use belongs in the core; what launch files read
+#: before a context, in ros/launch_support/.
+_ROS_SUPPORT = {"__init__.py", "msgdefs.py", "occupancy_cdr.py", "ur_frames.py",
+                "wall_schedule.py"}
+
+
+def _imports_ros(path: Path) -> bool:
+    """Whether a module imports ROS: rclpy, launch, a message package, our interfaces or
+    another module of ros/."""
+    roots = {"rclpy", "rcl_interfaces", "builtin_interfaces", "launch", "launch_ros",
+             "tf2_ros"}
+    ours = (f"{PACKAGE.name}.msg", f"{PACKAGE.name}.srv", f"{PACKAGE.name}.ros")
+    return any(m.split(".")[0] in roots or m.split(".")[0].endswith("_msgs")
+               or m in ours or m.startswith(tuple(f"{o}." for o in ours))
+               for m in _imports(path))
+
+
+def test_ros_keeps_nodes_conversions_and_their_support() -> None:
+    plain = {p.name for p in (PACKAGE / "ros").glob("*.py") if not _imports_ros(p)}
+    assert plain == _ROS_SUPPORT, (
+        f"ros/ modules that import nothing of ROS: {sorted(plain - _ROS_SUPPORT)} new, "
+        f"{sorted(_ROS_SUPPORT - plain)} gone (core code goes to the core, launch support to "
+        "ros/launch_support/)")
+    for path in sorted((PACKAGE / "ros" / "launch_support").glob("*.py")):
+        rclpy = sorted(m for m in _imports(path) if m.split(".")[0] == "rclpy")
+        assert not rclpy, f"{path.name} imports {rclpy}: launch support runs before a context"
+
+
 def test_fakes_are_not_in_the_package() -> None:
     for fake in ("viz/demo.py", "ros/testing.py"):
         assert not (PACKAGE / fake).exists(), fake

@@ -18,6 +18,9 @@ This package is the only place in ``ltl_human_motion`` that imports ``rclpy``. M
   files and tools: the bringup file's node set, the launch description, middleware
   defaults. The playback clock and the motion store the nodes share are core modules
   (:mod:`~ltl_human_motion.planning.playback`, :mod:`~ltl_human_motion.planning.motion_store`).
+* Plain-Python support of the nodes: :mod:`~ltl_human_motion.ros.occupancy_cdr` (the
+  HumanOccupancy wire format), :mod:`~ltl_human_motion.ros.msgdefs` (message definitions
+  for the recorder), :mod:`~ltl_human_motion.ros.wall_schedule` (the stream thread's clock).
 
 Importing this package itself imports nothing from ROS.
 """
