@@ -11,6 +11,7 @@ collision afterwards.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import replace
 
@@ -193,6 +194,14 @@ def body_clear_every_frame(world: np.ndarray, cell, stature: float) -> bool:
                                       exact_below=EXACT_BELOW)) > PLACED_MARGIN)
 
 
+@functools.lru_cache(maxsize=8)
+def _sample_sets(n_samples: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The samples :meth:`StepExecutor.body_clear` reads of ``n_samples``: the even ones,
+    the odd ones, and the first with the odd ones (shared: callers must not write; left
+    writeable, as the compiled loops take them)."""
+    return np.arange(0, n_samples, 2), np.arange(1, n_samples, 2), np.r_[0, 1:n_samples:2]
+
+
 class StepExecutor:
     """Places the segments of one plan.
 
@@ -241,22 +250,22 @@ class StepExecutor:
         out = np.ones(len(poses), dtype=bool)
         stature = self.ctx.stature
         field = self.ctx.obstacle_field
-        n_samples = poses.shape[1]
-        for rel in (False, True):
-            sel = np.flatnonzero(standing == rel)
+        even, odd, first_odd = _sample_sets(poses.shape[1])
+        stand = standing.nonzero()[0]
+        groups = ((False, np.arange(len(poses))),) if not stand.size else \
+            ((False, (~standing).nonzero()[0]), (True, stand))
+        for rel, sel in groups:
             if sel.size:
-                ok = field.clear_samples(poses, sel, np.arange(0, n_samples, 2), stature,
-                                         relative=rel)
+                ok = field.clear_samples(poses, sel, even, stature, relative=rel)
                 if ok.any():
                     keep = sel[ok]
                     # (with ``relative``, after the start they are measured from)
-                    between = np.r_[0, 1:n_samples:2] if rel else np.arange(1, n_samples, 2)
-                    ok[ok] = field.clear_samples(poses, keep, between, stature,
-                                                 margin=SWEEP_MARGIN * field.res,
+                    ok[ok] = field.clear_samples(poses, keep, first_odd if rel else odd,
+                                                 stature, margin=SWEEP_MARGIN * field.res,
                                                  relative=rel, parts=_SWEEP_INDICES)
                 out[sel] = ok
         if self.state.held and out.any():
-            keep = np.flatnonzero(out)
+            keep = out.nonzero()[0]
             out[keep] = self.held_clear(poses[keep], standing[keep])
         return out
 
