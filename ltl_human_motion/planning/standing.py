@@ -195,9 +195,9 @@ def ideal_placement(ctx: PlanContext, target: np.ndarray, placement: tuple[float
     pts = np.stack([px, py], axis=-1).reshape(-1, 2)
     free = ctx.stand_map(pts).reshape(px.shape) > ctx.stand_room
     k = np.argmax(free, axis=-1)
-    pick = np.take_along_axis
-    out = (pick(px, k[..., None], -1)[..., 0], pick(py, k[..., None], -1)[..., 0], yaw,
-           free.any(axis=-1))
+    rows = (np.arange(k.size), k.ravel())                   # the first free step back
+    out = (px.reshape(-1, len(back))[rows].reshape(k.shape),
+           py.reshape(-1, len(back))[rows].reshape(k.shape), yaw, free.any(axis=-1))
     if not room:
         return out
     walk_map = ctx.clearance if walk_map is None else walk_map
