@@ -72,6 +72,8 @@ def test_axis_angle_round_trip_including_near_pi() -> None:
     assert np.allclose(matrix_from_compact_axis_angle(back), R, atol=1e-9)
     regular = angles < np.pi - 1e-6
     assert np.allclose(back[regular], v[regular], atol=1e-7)
+    from ltl_human_motion.robot import axis_angle_from_matrix  # the package's old name
+    np.testing.assert_array_equal(axis_angle_from_matrix(R), back)
 
 
 def test_models_and_capsules() -> None:

@@ -65,6 +65,10 @@ from ltl_human_motion.robot.ssm import (
     slider_from_separation,
 )
 
+#: The name :func:`compact_axis_angle_from_matrix` had here before the rotations moved to
+#: :mod:`ltl_human_motion.kernel.rotations` (kept for importers of the package).
+axis_angle_from_matrix = compact_axis_angle_from_matrix
+
 __all__ = [
     "SLIDER_MIN",
     "UR_MODELS",
