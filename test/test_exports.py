@@ -17,6 +17,7 @@ from ltl_human_motion.errors import MotionFormatError
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, Skeleton
 from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.exports import (
+    bvh_rotations,
     load_json,
     load_npz,
     npz_bytes,
@@ -288,6 +289,18 @@ def test_bvh_loads_back_with_the_project_bvh_reader(synth, tmp_path):
     assert fps == pytest.approx(synth.fps)
     idx = [list(skel.names).index(n) for n in JOINT_NAMES]
     assert np.max(np.linalg.norm(pos[:, idx] - synth.positions, axis=-1)) < 0.003
+
+
+def test_bvh_rotations_are_rotations_that_carry_the_rest_offsets(synth):
+    """The old public name of the joints' world rotations (motion.bone_rotations)."""
+    G = bvh_rotations(synth.positions, synth.motion.skeleton)
+    assert G.shape == (*synth.positions.shape[:2], 3, 3)
+    np.testing.assert_allclose(G @ np.swapaxes(G, -1, -2), np.broadcast_to(np.eye(3), G.shape),
+                               atol=1e-9)
+    rest = synth.motion.skeleton.rest_positions()
+    j, k = JOINT_NAMES.index("l_hip"), JOINT_NAMES.index("l_knee")
+    offset = synth.positions[:, k] - synth.positions[:, j]
+    np.testing.assert_allclose(G[:, j] @ (rest[k] - rest[j]), offset, atol=1e-6)
 
 
 def test_bvh_rejects_bad_arguments(synth, tmp_path):

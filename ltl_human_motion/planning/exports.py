@@ -5,7 +5,9 @@ deterministically: identical motions give identical bytes (the NPZ archive is wr
 with fixed entry order and fixed zip timestamps; JSON keys are sorted).
 
 BVH files come from :func:`ltl_human_motion.motion.bvh.save` (:func:`save_bvh` unwraps a
-:class:`SynthesizedMotion`); that module describes the file.
+:class:`SynthesizedMotion`); that module describes the file. :func:`bvh_rotations`, the
+joints' world rotations, is :func:`ltl_human_motion.motion.bone_rotations.joint_rotations`
+(kept here under its old name).
 """
 
 from __future__ import annotations
@@ -23,12 +25,13 @@ import numpy as np
 from ltl_human_motion.atomic import atomic_write_bytes, atomic_write_text
 from ltl_human_motion.errors import MotionFormatError
 from ltl_human_motion.motion import bvh
+from ltl_human_motion.motion.bone_rotations import joint_rotations as bvh_rotations
 from ltl_human_motion.motion.skeleton import JOINT_NAMES, Skeleton
 from ltl_human_motion.motion.types import Motion
 from ltl_human_motion.planning.result import SynthesisStats, SynthesizedMotion, TaskSegment
 
 __all__ = [
-    "FORMAT_NAME", "FORMAT_VERSION", "from_dict", "load_json", "load_npz",
+    "FORMAT_NAME", "FORMAT_VERSION", "bvh_rotations", "from_dict", "load_json", "load_npz",
     "npz_bytes", "save", "save_bvh", "save_csv", "save_json", "save_npz", "to_dict",
 ]
 
