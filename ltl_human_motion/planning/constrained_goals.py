@@ -21,6 +21,7 @@ from ltl_human_motion.motion.goals.optimizer import (
     WholeBodyOptions,
     track_reference,
 )
+from ltl_human_motion.motion.goals.palm_path import PathRoom, clear_palm_path
 from ltl_human_motion.motion.skeleton import JOINT_INDEX
 from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.scene.clearance import PartSet
@@ -130,6 +131,35 @@ def _primitive(mp: MotionPrimitive, world: np.ndarray) -> MotionPrimitive:
                            meta=meta)
 
 
+def _palm_room(stature: float, options: WholeBodyOptions) -> float:
+    """The clearance a palm path keeps: the hand's and forearm's capsule radius and the
+    program's hand margin, m."""
+    from ltl_human_motion.motion.capsules import BODY_CAPSULES, capsule_radii
+    radii = capsule_radii(stature)
+    return float(max(r for c, r in zip(BODY_CAPSULES, radii, strict=True)
+                     if c[0][2:] in ("hand", "palm", "lower_arm"))) + options.hand_margin
+
+
+def clear_palms(ref: np.ndarray, tracked: tuple[str, ...], field_: PartSetField,
+                contact: int, last_hold: int, room: PathRoom) -> np.ndarray | None:
+    """The tracked palms' paths (T, len(tracked), 3) of reference ``ref`` (T, J, 3) with
+    the way to the ``contact`` frame and the way back from the ``last_hold`` frame each
+    remade clear of the obstacles (:func:`.motion.goals.palm_path.clear_palm_path`; the
+    hold itself stays); None where they are clear already or no clear way was found
+    (the program tracks the reference's palms)."""
+    palms = ref[:, [JOINT_INDEX[j] for j in tracked]].copy()
+    changed = False
+    for k in range(len(tracked)):
+        for lo, hi in ((0, contact), (last_hold, len(ref) - 1)):
+            if hi - lo < 2:
+                continue
+            way = clear_palm_path(field_, palms[lo:hi + 1, k], room)
+            if way is not None and not np.array_equal(way, palms[lo:hi + 1, k]):
+                palms[lo:hi + 1, k] = way
+                changed = True
+    return palms if changed else None
+
+
 def constrained_primitive(mp: MotionPrimitive, parts: PartSet,
                           pose: tuple[float, float, float], stature: float,
                           held: HeldPart | None = None, held_from: int = 0
@@ -146,10 +176,12 @@ def constrained_primitive(mp: MotionPrimitive, parts: PartSet,
     tracked = ("l_hand", "r_hand") if mp.meta["hand"] == "both" else (mp.meta["hand"],)
     hold = [int(f) for f in mp.meta.get("hold_frames", [])] \
         + [int(mp.meta.get("contact_frame", len(ref) - 1))]
-    result = track_reference(ref, stature, PartSetField(parts, tuple(map(float, pose))),
-                             tracked=tracked, fps=mp.fps, held=held, held_from=held_from,
-                             release_from=max(hold),
-                             options=program_options(mp.task, stature))
+    field_ = PartSetField(parts, tuple(map(float, pose)))
+    options = program_options(mp.task, stature)
+    result = track_reference(ref, stature, field_, tracked=tracked, fps=mp.fps, held=held,
+                             held_from=held_from, release_from=max(hold), options=options,
+                             palms=clear_palms(ref, tracked, field_, min(hold), max(hold),
+                                               PathRoom(_palm_room(stature, options))))
     miss = max(float(np.linalg.norm(result.positions[f, JOINT_INDEX[j]]
                                      - ref[f, JOINT_INDEX[j]]))
                for f in hold for j in tracked)

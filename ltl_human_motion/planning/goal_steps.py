@@ -36,6 +36,14 @@ from ltl_human_motion.planning.lift_in import (
     needs_lift_out,
     settle,
 )
+from ltl_human_motion.planning.open_sides import (
+    OPEN_SIDE_BUDGET,
+    SIDES,
+    Arc,
+    SideReach,
+    open_arc,
+    side_blocked,
+)
 from ltl_human_motion.planning.plan_state import (
     OTHER_HAND,
     PlanContext,
@@ -368,7 +376,8 @@ class GoalSteps:
                                 and (failure.reason == "blocked"
                                      or failure.reason == "unreachable")):
                 break
-            order = blocked_at[:WHOLE_BODY_PLACEMENTS] if program else range(len(tries))
+            order = [k for k in blocked_at[:WHOLE_BODY_PLACEMENTS] if k != 0] if program \
+                else range(len(tries))
             for k in order:
                 target, prepare = tries[k]
                 mark = self.state.mark()
@@ -387,7 +396,8 @@ class GoalSteps:
                         container=args[1] if kind == "extract" else None,
                         attempts=None if k == 0 or target is None
                         or self.state.start_arms is not None   # (a try's own stance)
-                        else ALTERNATIVE_ATTEMPTS, program=program)
+                        else ALTERNATIVE_ATTEMPTS,
+                        program=program or (k == 0 and self.ctx.options.whole_body))
                     lifted = self.state.start_arms
                     if lifted is not None and lifted.rise > 0.0 and kind != "grasp":
                         settle(self, lifted, i, text,
@@ -449,19 +459,7 @@ class GoalSteps:
             return stood > placement[0] + back and self.reaches(
                 kind, args, (stood + back, placement[1], target[2]), raised)
 
-        def walk_there(spot: tuple[float, float], sector: tuple[float, float],
-                       budget: SearchBudget, stand_yaw: float | None = None) -> int:
-            lowered = raised and not self.state.held
-            if lowered:
-                self.executor.arm_transition(True, -1)
-            self.executor.step_out()            # the first try may have left the worker at a rack
-            walked = self.approach(target, spot, text, sector=sector, budget=budget,
-                                   stand_yaw=stand_yaw)
-            if lowered or (raise_back and not self.state.held):
-                self.executor.arm_transition(False, -1)
-                if not lowered:
-                    self.state.start_arms = StartArms(self.ctx.stance(True), 0.0)
-            return walked
+        walk_there = functools.partial(self.walk_there, target, text, raised, raise_back)
 
         def approach(turn: float, back: float, other: bool, ahead: float | None = None,
                      checked: bool = False) -> int:
@@ -487,11 +485,70 @@ class GoalSteps:
 
         return [(target, None)] + self.lift_tries(kind, args, target, placement, text,
                                                   raised, raise_back) + [
+            (target, functools.partial(self.walk_to_open_arc, text, first, walk_there,
+                                       self.side_reach(kind, args, target, placement,
+                                                       raised)))] + [
             (target, functools.partial(approach, turn, back, other))
             for turn, back, other in ALTERNATE_APPROACHES
         ] + [(target, functools.partial(approach, 0.0, 0.0, False, stood + back))] + [
             (target, functools.partial(approach, turn, back, False, checked=True))
             for turn, back in CHECKED_APPROACHES] + [(target, room)]
+
+    def walk_there(self, target: np.ndarray, text: str, raised: bool, raise_back: bool,
+                   spot: tuple[float, float], sector: tuple[float, float],
+                   budget: SearchBudget, stand_yaw: float | None = None) -> int:
+        """An alternative's walk (:meth:`approach`) to ``spot`` (ahead, left, m) from
+        ``target`` (3,) within ``sector`` and ``budget`` (facing ``stand_yaw``), out of the
+        first try's place; the arms ``raised`` come down for the walk and go up again
+        after it, as with ``raise_back`` (there they stayed down at the first try).
+        Returns the gait primitives walked."""
+        lowered = raised and not self.state.held
+        if lowered:
+            self.executor.arm_transition(True, -1)
+        self.executor.step_out()            # the first try may have left the worker at a rack
+        walked = self.approach(target, spot, text, sector=sector, budget=budget,
+                               stand_yaw=stand_yaw)
+        if lowered or (raise_back and not self.state.held):
+            self.executor.arm_transition(False, -1)
+            if not lowered:
+                self.state.start_arms = StartArms(self.ctx.stance(True), 0.0)
+        return walked
+
+    def side_reach(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                   placement: tuple[float, float], raised: bool) -> SideReach:
+        """Task ``kind`` (``args``) at ``target`` (3,) from ``placement`` as the side tests
+        of :mod:`.open_sides` see it: the acting hand, from the carry stance if ``raised``
+        or a part is held."""
+        return SideReach(kind, target, placement,
+                         acting_hand(self.state, kind, args[0] if args else None),
+                         self.ctx.stance(self.state.carrying or raised))
+
+    def walk_to_open_arc(self, text: str, first: float,
+                         walk_there: Callable[[tuple[float, float], tuple[float, float],
+                                               SearchBudget], int],
+                         reach: SideReach) -> int:
+        """``walk_there`` (a spot, a side, a budget) to the arc of sides open to ``reach``
+        (:func:`.open_sides.open_arc`) nearest the side ``first`` (rad, from the target)
+        the first try stood at, other than it (a rack's aisle, not its back); returns
+        the gait primitives walked. Only where the first try's side is closed (the level
+        line from the target to it passes an obstacle, :func:`.open_sides.side_blocked`):
+        elsewhere the other alternatives come first, as they did."""
+        if not side_blocked(self.ctx, reach.target, self.state.pose):
+            raise PlanningError(f"task {text}: the first side of the target is open to it",
+                                task=text, reason="blocked")
+        arc = open_arc(self.ctx, reach, first, skip=math.pi / SIDES)
+        if arc is None:
+            raise PlanningError(f"task {text}: no other side of the target open to it",
+                                task=text, reason="blocked")
+        return walk_there(reach.placement, (arc.centre, arc.half_width), MOTION_ROOM_BUDGET)
+
+    def approach_arc(self, target: np.ndarray, placement: tuple[float, float], text: str,
+                     arc: Arc | None) -> int:
+        """:meth:`approach` from ``arc`` (within ``OPEN_SIDE_BUDGET``), or from any side."""
+        if arc is None:
+            return self.approach(target, placement, text)
+        return self.approach(target, placement, text, sector=(arc.centre, arc.half_width),
+                             budget=OPEN_SIDE_BUDGET)
 
     def lift_tries(self, kind: str, args: tuple[str, ...], target: np.ndarray,
                    placement: tuple[float, float], text: str, raised: bool,

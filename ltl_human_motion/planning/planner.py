@@ -26,6 +26,7 @@ step to them and records what it made (:class:`StepPlan`).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -37,6 +38,7 @@ from ltl_human_motion.planning.blend import PlacedSegment
 from ltl_human_motion.planning.feasibility import reach_envelope
 from ltl_human_motion.planning.goal_steps import GoalSteps
 from ltl_human_motion.planning.lift_in import settle
+from ltl_human_motion.planning.open_sides import approach_open_side
 from ltl_human_motion.planning.plan_state import (
     PlanContext,
     PlannerOptions,
@@ -49,6 +51,7 @@ from ltl_human_motion.planning.plan_state import (
     lift_frame,
     track_objects,
 )
+from ltl_human_motion.planning.stand_distance import farther_placement
 from ltl_human_motion.planning.standing import (
     low_board,
     palm_clear_of_support,
@@ -348,7 +351,10 @@ class SequencePlanner:
             if here is not None:
                 target = here
                 placement, arms_up = self._placement(kind, target, text, args)
-            walked, approach_failed = self._first_approach(kind, target, placement, text,
+            placement = farther_placement(
+                self.ctx, target, placement,
+                lambda local: self.goal_steps.reaches(kind, args, local, arms_up)) or placement
+            walked, approach_failed = self._first_approach(kind, args, target, placement, text,
                                                            facing)
         carrying_before = self.state.carrying
         raised = kind in HAND_TASKS and not carrying_before and self.state.seat is None \
@@ -468,13 +474,14 @@ class SequencePlanner:
                              float(target[2] + offset[2]), reach)
         return None if point is None else point - offset
 
-    def _first_approach(self, kind: str, target: np.ndarray, placement: tuple[float, float],
-                        text: str, facing: np.ndarray | None
+    def _first_approach(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                        placement: tuple[float, float], text: str, facing: np.ndarray | None
                         ) -> tuple[int, PlanningError | None]:
         """Walk to the placement for ``target`` (3,) (under a low board, or facing
-        ``facing``); returns the gait primitives walked and None. Where that walk is
-        blocked (no place to stop there keeps the body clear), what it placed is taken
-        back and (0, the error) returned: the goal step's alternatives
+        ``facing``; then to a side open to the target if it ended at a closed one,
+        :func:`.open_sides.approach_open_side`); returns the gait primitives walked and
+        None. Where that walk is blocked (no place to stop there keeps the body clear),
+        what it placed is taken back and (0, the error) returned: the goal step's alternatives
         (:meth:`.goal_steps.GoalSteps.alternatives`, from other sides and further back)
         are tried from where the worker stood, and the error is what a refusal names."""
         mark = self.state.mark()
@@ -483,8 +490,14 @@ class SequencePlanner:
                 if kind in LEVEL_PATH_TASKS and facing is None else None
             if walked is None:
                 walked = self.goal_steps.approach_facing(target, placement, text, facing)
+            if facing is None and kind in HAND_TASKS:
+                walked = approach_open_side(
+                    self.ctx, self.state,
+                    self.goal_steps.side_reach(kind, args, target, placement, True),
+                    functools.partial(self.goal_steps.approach_arc, target, placement, text),
+                    walked, mark)
         except PlanningError as exc:
-            if exc.reason != "blocked":
+            if exc.reason not in ("blocked", "budget"):
                 raise
             self.state.restore(mark)
             return 0, exc

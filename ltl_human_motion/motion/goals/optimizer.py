@@ -174,7 +174,8 @@ class _Tracker:
     """The per-frame program of :func:`track_reference`."""
 
     def __init__(self, kin: BodyKinematics, ref: np.ndarray, tracked: tuple[str, ...],
-                 opts: WholeBodyOptions, fps: float) -> None:
+                 opts: WholeBodyOptions, fps: float, palms: np.ndarray | None = None
+                 ) -> None:
         import pinocchio as pin
         from pink.tasks import ComTask, FrameTask, PostureTask
         self.kin, self.ref, self.opts, self.dt = kin, ref, opts, 1.0 / fps
@@ -183,6 +184,12 @@ class _Tracker:
         self.roots = root_poses(ref)
         self.ref_data = kin.model.createData()
         self.tracked = tuple(tracked) + tuple(j.replace("hand", "wrist") for j in tracked)
+        # Where the task points are (T, 2 * len(tracked), 3): the reference's, or the
+        # palms given with their wrists moved along.
+        self.targets = ref[:, [JOINT_INDEX[j] for j in self.tracked]]
+        if palms is not None:
+            moved = np.asarray(palms) - self.targets[:, :len(tracked)]
+            self.targets = self.targets + np.concatenate([moved, moved], axis=1)
         weights = (opts.hand_weight,) * len(tracked) + (opts.wrist_weight,) * len(tracked)
         self.points = [FrameTask(link_name(j, BODY_ID), position_cost=w, orientation_cost=0.0)
                        for j, w in zip(self.tracked, weights, strict=True)]
@@ -222,9 +229,9 @@ class _Tracker:
 
     def set_frame(self, t: int) -> list:
         """Point every task at the reference's frame ``t``; the tasks (soft)."""
-        pin, target = self._pin, self.ref[t]
-        for task, j in zip(self.points, self.tracked, strict=True):
-            task.set_target(pin.SE3(np.eye(3), target[JOINT_INDEX[j]]))
+        pin = self._pin
+        for task, point in zip(self.points, self.targets[t], strict=True):
+            task.set_target(pin.SE3(np.eye(3), point))
         model, data = self.kin.model, self.ref_data
         self.com.set_target(pin.centerOfMass(model, data, self.q_ref[t]))
         pin.updateFramePlacements(model, data)
@@ -291,7 +298,8 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
                     tracked: tuple[str, ...] = ("l_hand", "r_hand"),
                     options: WholeBodyOptions | None = None, fps: float = 30.0,
                     held: HeldPart | None = None, held_from: int = 0,
-                    release_from: int | None = None) -> TrackingResult:
+                    release_from: int | None = None,
+                    palms: np.ndarray | None = None) -> TrackingResult:
     """Positions (T, J, 3) of the worker's model tracking ``reference`` (T, J, 3) under
     the constraints of the module docstring.
 
@@ -299,7 +307,9 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
     part carried by a hand from frame ``held_from`` on, kept clear like the body. From
     frame ``release_from`` (default: the last quarter) the posture term's weight rises
     to :data:`RETURN_WEIGHT` within :data:`RETURN_SECONDS`, so that the motion ends in
-    the reference's last pose, where the next primitive starts.
+    the reference's last pose, where the next primitive starts. ``palms`` (T,
+    len(tracked), 3): the tracked palms' path where it is not the reference's (made
+    clear of the obstacles, :func:`.palm_path.clear_palm_path`; the wrists move along).
     """
     import pink
     import pinocchio as pin
@@ -310,9 +320,16 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
     near = reference_clearance(kin, ref, field_, opts.influence, held, held_from)
     if not np.isfinite(near).any():
         return TrackingResult(ref, False, np.inf)
-    first = max(int(np.argmax(np.isfinite(near))) - _LEAD_FRAMES, 0)
+    first = int(np.argmax(np.isfinite(near)))
+    if palms is not None:
+        moved = np.any(np.abs(np.asarray(palms) - ref[:, [JOINT_INDEX[j] for j in tracked]])
+                       > 0.0, axis=(1, 2))
+        first = min(first, int(np.argmax(moved)) if moved.any() else first)
+    first = max(first - _LEAD_FRAMES, 0)
     last_near = len(ref) - 1 - int(np.argmax(np.isfinite(near[::-1])))
-    tracker = _Tracker(kin, ref, tracked, opts, fps)
+    if palms is not None and moved.any():
+        last_near = max(last_near, len(ref) - 1 - int(np.argmax(moved[::-1])))
+    tracker = _Tracker(kin, ref, tracked, opts, fps, palms)
     release = int(0.75 * len(ref)) if release_from is None else int(release_from)
     conf = pink.Configuration(kin.model, kin.data, tracker.q_ref[first].copy())
     out = ref.copy()
@@ -344,8 +361,8 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
         out = _blend_end(out, ref, int(RETURN_SECONDS * fps))
     final = reference_clearance(kin, out, field_, opts.influence, held, held_from)
     miss = np.zeros(len(ref))
-    for j in tracked:
-        miss = np.maximum(miss, np.linalg.norm(out[:, JOINT_INDEX[j]] - ref[:, JOINT_INDEX[j]],
+    for k, j in enumerate(tracked):
+        miss = np.maximum(miss, np.linalg.norm(out[:, JOINT_INDEX[j]] - tracker.targets[:, k],
                                                axis=-1))
     least = float(final.min())
     return TrackingResult(out, constrained, least, float(miss.max()), int(miss.argmax()),

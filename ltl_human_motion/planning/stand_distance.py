@@ -1,0 +1,64 @@
+"""How far from a target to stand where the placement model's distance is in furniture.
+
+:func:`.standing.standing_offset` gives the distance from which the goal model's
+posture reaches a target best, for the target's height alone: a tall worker's part at
+hip height is best reached standing close over it. A part 0.37 m inside a machine's
+chamber leaves no free spot that close on any side, even with the steps back
+:func:`.standing.ideal_placement` allows, and the walk's search runs its budget out
+looking for one. :func:`farther_placement` moves the placement back in
+``STEP`` increments to the nearest distance where some side of the target has a free
+spot from which the level line to the target passes no obstacle
+(:func:`.open_sides.side_blocked`) and from which the goal model still reaches it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from ltl_human_motion.planning.open_sides import SIDES, side_blocked
+from ltl_human_motion.planning.plan_state import PlanContext
+from ltl_human_motion.planning.standing import ideal_placement
+
+__all__ = ["FURTHEST", "STEP", "farther_placement", "has_spot"]
+
+#: Increment of the distance tried, m.
+STEP = 0.08
+#: Furthest the placement moves back, m.
+FURTHEST = 0.48
+
+
+def has_spot(ctx: PlanContext, target: np.ndarray, placement: tuple[float, float],
+             open_line: bool = False) -> bool:
+    """Whether some side of ``target`` (3,) (``SIDES`` of them) has a free standing spot
+    for ``placement`` (ahead, left, m; :func:`.standing.ideal_placement` with its steps
+    back), with ``open_line`` one whose level line to the target passes no obstacle."""
+    angles = 2.0 * math.pi * np.arange(SIDES) / SIDES
+    far = 2.0 * math.hypot(*placement)
+    px, py, yaw, free = ideal_placement(
+        ctx, target, placement, target[0] + far * np.cos(angles),
+        target[1] + far * np.sin(angles), ctx.options.max_step_back)
+    return any(not open_line or not side_blocked(ctx, target, (float(px[k]), float(py[k]),
+                                                               float(yaw[k])))
+               for k in np.flatnonzero(free))
+
+
+def farther_placement(ctx: PlanContext, target: np.ndarray, placement: tuple[float, float],
+                      reaches: Callable[[tuple[float, float, float]], bool]
+                      ) -> tuple[float, float] | None:
+    """Where no side of ``target`` (3,) has a free spot for ``placement`` (ahead, left,
+    m) whose level line to the target is open (:func:`has_spot`), the nearest placement
+    further back (by ``STEP``, up to ``FURTHEST``) that has one and from which
+    ``reaches((ahead, left, height))`` (the goal model's reach test in the start frame);
+    None where ``placement`` has such a spot, or no placement further back does."""
+    if has_spot(ctx, target, placement, open_line=True):
+        return None
+    d, lat = placement
+    for k in range(1, round(FURTHEST / STEP) + 1):
+        ahead = d + k * STEP
+        if has_spot(ctx, target, (ahead, lat), open_line=True) \
+                and reaches((ahead, lat, float(target[2]))):
+            return ahead, lat
+    return None
