@@ -497,7 +497,7 @@ class SequencePlanner:
                     functools.partial(self.goal_steps.approach_arc, target, placement, text),
                     walked, mark)
         except PlanningError as exc:
-            if exc.reason not in ("blocked", "budget"):
+            if exc.reason != "blocked":
                 raise
             self.state.restore(mark)
             return 0, exc
