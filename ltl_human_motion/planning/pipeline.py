@@ -196,8 +196,8 @@ def _start_pose(cell, first_target: np.ndarray | None, rng: np.random.Generator
     return float(xy[0]), float(xy[1]), yaw
 
 
-def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np.ndarray,
-                   overlap: int) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np.ndarray
+                   ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Per-frame object positions (T, 3) and held masks (T,) from the step effects."""
     T = positions.shape[0]
     tracks: dict[str, np.ndarray] = {}
@@ -211,18 +211,16 @@ def _object_tracks(cell, plan: Plan, spans: list[tuple[int, int]], positions: np
         start = spans[step.goal_segment][0]
         contact = min(start + int(step.contact_frame or 0), T - 1)
         eff = step.objects_effect
-        for name, joint in eff.get("attach", {}).items():
-            if name in eff.get("respawn", ()):      # a fresh part after one was assembled
+        for name, joint in eff.attach:
+            if name in eff.respawn:
                 events.append((spans[step.first_segment][0], order, "respawn", name, None))
             events.append((contact, order, "grip", name, joint))
             # The part rests on its support until the hand lifts it (a grasp's lift frame).
             lift = contact if step.lift_frame is None else \
                 min(start + int(step.lift_frame), T - 1)
             events.append((lift, order, "attach", name, joint))
-        for name in eff.get("detach", []):
+        for name in eff.detach:
             events.append((contact, order, "detach", name, None))
-        for name in eff.get("detach_after", []):
-            events.append((spans[step.goal_segment][1] - overlap, order, "detach", name, None))
     events.sort(key=lambda e: (e[0], e[1]))
     for name in cell.objects:
         pos = np.repeat(supply[name][None], T, axis=0)
@@ -542,7 +540,7 @@ def _blended(plan: Plan, floor_cell, floor_z: float, library, realism: bool,
             w = unlock_weights(repairs.unlock, len(positions), library.fps)[:, None, None]
             positions = enforce_bone_lengths(positions + w * (unlocked - positions),
                                              library.skeleton, rigid_hips=False)
-    tracks, held = _object_tracks(floor_cell, plan, spans, positions, library.overlap)
+    tracks, held = _object_tracks(floor_cell, plan, spans, positions)
     targets = [step.target for step in plan.steps]
     if floor_z:
         lift = np.array([0.0, 0.0, float(floor_z)])

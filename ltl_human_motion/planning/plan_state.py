@@ -329,38 +329,60 @@ def grip_frame(mp: MotionPrimitive) -> int:
     return int(mp.meta.get("contact_frame", mp.n_frames - 1))
 
 
+@dataclass(frozen=True)
+class Effects:
+    """What a goal step does to the parts, as the object tracks follow it.
+
+    Attributes
+    ----------
+    attach : tuple of (str, str)
+        (part, hand joint): the parts the hand takes, held from the grip frame on.
+    detach : tuple of str
+        The parts the hand lets go at the grip frame.
+    consume : tuple of str
+        The parts assembled (gone from the cell).
+    respawn : tuple of str
+        Attached parts that are fresh ones from their supply (one was assembled before).
+    """
+
+    attach: tuple[tuple[str, str], ...] = ()
+    detach: tuple[str, ...] = ()
+    consume: tuple[str, ...] = ()
+    respawn: tuple[str, ...] = ()
+
+
 def apply_effects(state: WorkerState, kind: str, args: tuple[str, ...], hand: str | None,
-                  keep_hold: bool = False) -> dict:
+                  keep_hold: bool = False) -> Effects:
     """Update which parts ``state`` holds after a goal task; returns the effect for the
-    object tracks (``attach``, ``detach``, ``consume``). ``keep_hold``: a held part that
-    a move puts into its region stays in hand (carry)."""
+    object tracks. ``keep_hold``: a held part that a move puts into its region stays in
+    hand (carry)."""
     hand_joint = holding_joint(hand)
     if kind == "grasp":
         state.held[args[0]] = hand_joint
-        return {"attach": {args[0]: hand_joint}}
+        return Effects(attach=((args[0], hand_joint),))
     if kind == "release":
         state.held.pop(args[0], None)
-        return {"detach": [args[0]]}
+        return Effects(detach=(args[0],))
     if kind in ("move", "insert", "extract"):
         if args[0] not in state.held:
             # extract takes the part out of its container and keeps it in hand (move
             # and insert fetch the part first).
             state.held[args[0]] = hand_joint
-            return {"attach": {args[0]: hand_joint}}
+            return Effects(attach=((args[0], hand_joint),))
         if kind == "extract" or keep_hold:
-            return {}
+            return Effects()
         state.held.pop(args[0], None)
-        return {"detach": [args[0]]}
+        return Effects(detach=(args[0],))
     if kind == "assemble":
-        parts = list(state.held)
+        parts = tuple(state.held)
         state.consumed.update(parts)
         state.held.clear()
-        return {"detach": parts, "consume": parts}
-    return {}
+        return Effects(detach=parts, consume=parts)
+    return Effects()
 
 
-def track_objects(cell, state: WorkerState, effect: dict, joints: dict[str, str],
-                  positions: np.ndarray, mp: MotionPrimitive, overlap: int) -> None:
+def track_objects(cell, state: WorkerState, effect: Effects, joints: dict[str, str],
+                  positions: np.ndarray, mp: MotionPrimitive) -> None:
     """Follow a step's effect on the parts as the object tracks will: a part keeps its
     world offset from the hand from the grip frame on, and rests where the hand let it
     go.
@@ -373,26 +395,21 @@ def track_objects(cell, state: WorkerState, effect: dict, joints: dict[str, str]
         The placed goal segment.
     mp : MotionPrimitive
         Its primitive (grip frame, length).
-    overlap : int
-        Blend frames (a ``detach_after`` part rests where the segment hands over).
     """
     contact = min(grip_frame(mp), mp.n_frames - 1)
-    for name, joint in effect.get("attach", {}).items():
+    for name, joint in effect.attach:
         joints[name] = joint
         state.held_offsets[name] = (object_position(cell, state, name)
                                     - positions[contact, JOINT_INDEX[joint]])
-    for names, frame in ((effect.get("detach", ()), contact),
-                         (effect.get("detach_after", ()),
-                          min(max(mp.n_frames - overlap, 0), mp.n_frames - 1))):
-        for name in names:
-            offset = state.held_offsets.pop(name, np.zeros(3))
-            if name in joints:
-                state.object_at[name] = positions[frame, JOINT_INDEX[joints[name]]] + offset
-    for name in effect.get("consume", ()):
+    for name in effect.detach:
+        offset = state.held_offsets.pop(name, np.zeros(3))
+        if name in joints:
+            state.object_at[name] = positions[contact, JOINT_INDEX[joints[name]]] + offset
+    for name in effect.consume:
         state.object_at.pop(name, None)
 
 
-__all__ = ["LIFT_RISE", "OTHER_HAND", "PlanContext", "Pose",
+__all__ = ["LIFT_RISE", "OTHER_HAND", "Effects", "PlanContext", "Pose",
            "WorkerState", "acting_hand", "apply_effects", "grip_frame", "holding_joint",
            "lift_frame",
            "object_position", "track_objects"]

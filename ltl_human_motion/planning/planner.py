@@ -40,6 +40,7 @@ from ltl_human_motion.planning.goal_steps import GoalSteps
 from ltl_human_motion.planning.lift_in import settle
 from ltl_human_motion.planning.open_sides import approach_open_side
 from ltl_human_motion.planning.plan_state import (
+    Effects,
     PlanContext,
     PlannerOptions,
     Pose,
@@ -112,8 +113,8 @@ class StepPlan:
         A* nodes expanded for this step.
     primitive : str
         Name of the goal primitive (or of the last gait primitive for walks).
-    objects_effect : dict
-        What the step does to the objects (``attach``, ``detach``, ...).
+    objects_effect : Effects
+        What the step does to the parts (attached, detached, consumed, respawned).
     sub_steps : list of StepPlan
         Steps the planner added before this one, e.g. the grasp of a part that
         carry/move/insert needs in hand; their effects come first.
@@ -131,7 +132,7 @@ class StepPlan:
     hand: str | None = None
     expanded: int = 0
     primitive: str = ""
-    objects_effect: dict = field(default_factory=dict)
+    objects_effect: Effects = field(default_factory=Effects)
     sub_steps: list[StepPlan] = field(default_factory=list)
 
 
@@ -377,9 +378,9 @@ class SequencePlanner:
         joints = dict(self.state.held)
         effect = apply_effects(self.state, kind, args, hand, keep_hold)
         if respawn:
-            effect["respawn"] = [args[0]]
+            effect = replace(effect, respawn=(args[0],))
         track_objects(self.ctx.cell, self.state, effect, joints,
-                      self.state.segments[seg].positions, mp, self.ctx.overlap)
+                      self.state.segments[seg].positions, mp)
         if self.state.start_arms is not None:
             # Made from raised arms: a grasp lifted off (a carton off a stand) steps back
             # and lowers them to the carry stance, where the others already are.
@@ -392,8 +393,8 @@ class SequencePlanner:
         if kind in ("sit", "standUp"):
             self.state.seat = target if kind == "sit" else None
         lift = None
-        if kind == "grasp" and effect.get("attach"):
-            joint = next(iter(effect["attach"].values()))
+        if kind == "grasp" and effect.attach:
+            joint = effect.attach[0][1]
             lift = lift_frame(mp, self.state.segments[seg].positions[:, JOINT_INDEX[joint]])
         return StepPlan(text, kind, target, walk_segments=walked, goal_segment=seg,
                         contact_frame=grip_frame(mp),
