@@ -185,9 +185,8 @@ def test_verification_rejects_a_motion_with_a_jump(s1, paper_cell) -> None:
                                s1.task_index, s1.timeline, s1.objects, s1.spec, s1.sequence)
     spec = build_specification("S1", paper_cell)
     seq = synthesize_sequences(spec, paper_cell, n=1, mode="all", cycles=2)[0]
-    steps = [(t.name, tuple(t.args)) for t in seq.tasks]
     with pytest.raises(VerificationError, match="smoothness") as info:
-        verify_motion(broken, paper_cell, spec, seq, steps, stature=1.75)
+        verify_motion(broken, paper_cell, spec, seq, stature=1.75)
     assert info.value.check in ("collision", "smoothness")
     assert "fastest joint" in str(info.value)
 

@@ -635,7 +635,6 @@ def _synthesize_one(request: MotionRequest) -> SynthesizedMotion:
     options, stature = request.options, request.stature
     t_automaton, t_sequence = request.automaton_time, request.sequence_time
     rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, variant])
-    written = [(t.name, tuple(t.args)) for t in seq.tasks]        # as verification reads them
     steps = [task_step(t.name, t.args, cell.shorthands, t.key) for t in seq.tasks]
     # Planned on a floor at z = 0; the motion, the parts and the targets are lifted back
     # (_blended) and verified in the user's own cell.
@@ -666,8 +665,8 @@ def _synthesize_one(request: MotionRequest) -> SynthesizedMotion:
             checkpoint("blending")
 
             t0 = time.perf_counter()
-            report = verify_motion(synth, cell, specification, seq, written,
-                                   options.verification, held=held, stature=stature,
+            report = verify_motion(synth, cell, specification, seq, options.verification,
+                                   held=held, stature=stature,
                                    blend_frames=library.overlap, raise_on_failure=False)
             t_verify += time.perf_counter() - t0
             checkpoint("verification")

@@ -20,7 +20,9 @@ Checks (each a key of the report):
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -34,6 +36,11 @@ from ltl_human_motion.motion.biomechanics import (
 from ltl_human_motion.motion.capsules import capsule_radii
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, MAX_STATURE
 from ltl_human_motion.scene.geometry import point_bounds
+
+if TYPE_CHECKING:
+    from ltl_human_motion.ltl.formula import Atom
+    from ltl_human_motion.ltl.sequences import TaskSequence
+    from ltl_human_motion.ltl.spec import Specification
 
 FOOT_JOINTS = ("l_ankle", "l_toe", "r_ankle", "r_toe")
 
@@ -115,7 +122,7 @@ def step_windows(synth, n_steps: int) -> list[tuple[int, int]]:
     return windows
 
 
-def observed_letters(synth, cell, spec, steps: list[tuple[str, tuple[str, ...]]],
+def observed_letters(synth, cell, spec: Specification, steps: Sequence[Atom],
                      termination: list[bool], stature: float) -> list[frozenset[str]]:
     """The letter of each step as observed on the motion.
 
@@ -130,11 +137,10 @@ def observed_letters(synth, cell, spec, steps: list[tuple[str, tuple[str, ...]]]
     regions = list(cell.regions.values())
     body_lo, body_hi = point_bounds(pos)
     letters = []
-    for (name, args), ok, (a, b) in zip(steps, termination, windows):
+    for task, ok, (a, b) in zip(steps, termination, windows):
         letter: set[str] = set()
         if ok:
-            from ltl_human_motion.ltl.formula import Atom
-            letter |= {key for key in letter_of(Atom(name, args), spec.vocabulary)
+            letter |= {key for key in letter_of(task, spec.vocabulary)
                        if not key.startswith("enter(")}
         window = pos[a:b]
         for region in regions:
@@ -148,7 +154,7 @@ def observed_letters(synth, cell, spec, steps: list[tuple[str, tuple[str, ...]]]
     return letters
 
 
-def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str, ...]]],
+def verify_motion(synth, cell, spec: Specification, sequence: TaskSequence,
                   options: VerificationOptions = VerificationOptions(), *,
                   held: dict[str, np.ndarray] | None = None, stature: float = 1.75,
                   blend_frames: int = 0, raise_on_failure: bool = True) -> dict:
@@ -161,9 +167,8 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
     spec : Specification
         With the always-on conjuncts (``spec.formula``).
     sequence : TaskSequence
-        Gives the lasso structure (prefix, cycle, repetitions).
-    steps : list of (name, args)
-        The executed task steps, in order.
+        The executed task steps (``sequence.tasks``, in order) and the lasso structure
+        (prefix, cycle, repetitions).
     options : VerificationOptions
     held : dict of str to ndarray of bool, shape (T,), optional
         Frames at which each object is carried (its occupancy then counts for collision).
@@ -186,6 +191,7 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
 
     pos = synth.motion.positions
     fps = synth.motion.fps
+    steps = sequence.tasks
     report: dict = {}
 
     start_ok = bool(enter(pos[0], cell.start_region, stature=stature))
@@ -194,7 +200,7 @@ def verify_motion(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str,
     report["collision"] = _collision_check(synth, cell, held, stature)
     report["termination"], term_ok = _termination_check(synth, cell, steps, options,
                                                         stature, blend_frames)
-    report["ltl"] = _ltl_check(synth, cell, spec, sequence, steps, term_ok, stature)
+    report["ltl"] = _ltl_check(synth, cell, spec, sequence, term_ok, stature)
     report["smoothness"] = _smoothness_check(synth, options)
     report["feet"] = _feet_check(pos, fps, cell.floor_z, options)
 
@@ -243,7 +249,7 @@ def _collision_check(synth, cell, held: dict[str, np.ndarray] | None,
                   f"{int(np.argmax(hits)) / fps:.2f} s{deepest}", frames=n_hit)
 
 
-def _termination_check(synth, cell, steps: list[tuple[str, tuple[str, ...]]],
+def _termination_check(synth, cell, steps: Sequence[Atom],
                        options: VerificationOptions, stature: float,
                        blend_frames: int) -> tuple[dict, list[bool]]:
     """The ``termination`` entry of :func:`verify_motion` and, per step, whether it held."""
@@ -253,11 +259,11 @@ def _termination_check(synth, cell, steps: list[tuple[str, tuple[str, ...]]],
     windows = step_windows(synth, len(steps))
     term_ok: list[bool] = []
     failed_tasks = []
-    for (name, args), (a, b), seg in zip(steps, windows, synth.timeline):
-        if name == "wait":
+    for task, (a, b), seg in zip(steps, windows, synth.timeline):
+        if task.name == "wait":
             a = seg.start_frame + blend_frames      # t*: the wait starts once blended in
         objects_state = {k: v[a:b] for k, v in synth.objects.items()}
-        holds = termination_series(name, args, pos[a:b], cell, objects_state,
+        holds = termination_series(task.name, task.args, pos[a:b], cell, objects_state,
                                    eps=options.eps, stature=stature, fps=synth.motion.fps)
         ok = bool(np.any(holds))
         term_ok.append(ok)
@@ -268,12 +274,12 @@ def _termination_check(synth, cell, steps: list[tuple[str, tuple[str, ...]]],
                   "termination condition not met: " + ", ".join(failed_tasks)), term_ok
 
 
-def _ltl_check(synth, cell, spec, sequence, steps: list[tuple[str, tuple[str, ...]]],
+def _ltl_check(synth, cell, spec: Specification, sequence: TaskSequence,
                term_ok: list[bool], stature: float) -> dict:
     """The ``ltl`` entry of :func:`verify_motion`: the observed lasso against the formula."""
     from ltl_human_motion.ltl.evaluator import evaluate_lasso
 
-    letters = observed_letters(synth, cell, spec, steps, term_ok, stature)
+    letters = observed_letters(synth, cell, spec, sequence.tasks, term_ok, stature)
     n_pre = len(sequence.prefix) + (sequence.repetitions - 1) * len(sequence.cycle)
     u, v = letters[:n_pre], letters[n_pre:]
     ltl_ok = bool(v) and evaluate_lasso(spec.formula, u, v)
