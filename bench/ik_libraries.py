@@ -139,13 +139,13 @@ def _recording(found: list) -> Iterator[None]:
         self._bench_step = (kind, kw.get("grasped"), kw.get("part"))
         return segment(self, kind, target, label, text, **kw)
 
-    def clear(self, mp, grasped):
-        ok = goal_clear(self, mp, grasped)
+    def clear(self, mp, pose, grasped, taken=None):
+        ok = goal_clear(self, mp, pose, grasped, taken)
         kind, taken, part = getattr(self, "_bench_step", (None, None, None))
         if not ok and mp.task == kind and mp.meta.get("hand") not in (None, "none") \
                 and self.palm_clear(mp):
             held, held_from = self.held_part(mp, kind, taken, part)
-            found.append((mp, self.ctx.cell.part_set, tuple(map(float, self.state.pose)),
+            found.append((mp, self.ctx.cell.part_set, tuple(map(float, pose)),
                           held, held_from))
             raise _FoundError
         return ok

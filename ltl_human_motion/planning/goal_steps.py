@@ -47,6 +47,7 @@ from ltl_human_motion.planning.open_sides import (
 from ltl_human_motion.planning.plan_state import (
     OTHER_HAND,
     PlanContext,
+    Pose,
     StartArms,
     WorkerState,
     acting_hand,
@@ -237,7 +238,8 @@ class GoalSteps:
         one hand holds a part is done by the other hand.
         """
         local, kwargs, board = self.goal_kwargs(kind, target, carry_stance, seconds,
-                                                grasped, part, container)
+                                                grasped, part, container,
+                                                pose=self.state.pose)
         seated = self.state.seat is not None and kind != "standUp"
         hand_fixed = "hand" in kwargs
         mp = None
@@ -263,7 +265,7 @@ class GoalSteps:
                     continue
                 raise PlanningError(f"task {text}: cannot make a {kind} motion for the "
                                     f"target: {exc}", task=text, reason="unreachable") from None
-            clear = self.goal_clear(candidate, grasped,
+            clear = self.goal_clear(candidate, self.state.pose, grasped,
                                     part if kind == "extract" else None)
             through_body = clear and self.ctx.options.refuse_self_penetration \
                 and bool(candidate.meta.get("self_penetrating"))
@@ -300,17 +302,17 @@ class GoalSteps:
             self.executor.arm_transition(not self.state.carrying, label)
         return seg, mp
 
-    def furniture(self, kind: str, target: np.ndarray | None, local: np.ndarray | None
-                  ) -> dict:
+    def furniture(self, kind: str, target: np.ndarray | None, local: np.ndarray | None,
+                  yaw: float) -> dict:
         """The furniture the goal primitive of ``kind`` for ``target`` (world (3,);
-        ``local``: in the start frame) keeps the body clear of, as its keyword arguments:
+        ``local``: in the start frame of a worker facing ``yaw``, rad) keeps the body clear
+        of, as its keyword arguments:
         a low board over the target (``board``, :func:`.standing.board_local`), else any
         board over it (``ceiling``, :func:`.standing.ceiling_local`), and what the target
         rests on or in (``support``, :func:`.standing.support_local`)."""
         out: dict = {}
         if local is None:
             return out
-        yaw = self.state.pose[2]
         if kind in LEVEL_PATH_TASKS:
             board = board_local(self.ctx.cell, target, local, yaw, self.ctx.stature)
             if board is not None:
@@ -327,20 +329,21 @@ class GoalSteps:
 
     def goal_kwargs(self, kind: str, target: np.ndarray | None, carry_stance: bool,
                     seconds: float | None, grasped: str | None, part: str | None,
-                    container: str | None
+                    container: str | None, *, pose: Pose
                     ) -> tuple[np.ndarray | None, dict, tuple[float, float, float] | None]:
-        """What :meth:`segment` makes its primitives from: the target in the start frame
-        (3,) (None without one), the goal model's keyword arguments (start pose, hand,
-        extract travel, furniture, obstacles around, wait duration) and the low board
-        (edge, underside, top) over the target, or None."""
-        local = None if target is None else in_start_frame(self.state.pose, target)
+        """What :meth:`segment` makes its primitives from for a worker standing at
+        ``pose``: the target in the start frame (3,) (None without one), the goal model's
+        keyword arguments (start pose, hand, extract travel, furniture, obstacles around,
+        wait duration) and the low board (edge, underside, top) over the target, or
+        None."""
+        local = None if target is None else in_start_frame(pose, target)
         seated = self.state.seat is not None and kind != "standUp"
         if kind == "standUp" and self.state.seat is not None:
             # Stand up with the arms as they are on the seat (:meth:`segment` brings them
             # to the stance of what the hands hold afterwards).
             carry_stance = self.executor.seated_in_carry_stance()
         kwargs = {"rng": self.ctx.rng,
-                  "start_pose": self.executor.seated_pose() if seated
+                  "start_pose": self.executor.seated_pose(pose) if seated
                   else self.state.start_arms.stance if self.state.start_arms is not None
                   else self.ctx.stance(self.state.carrying or carry_stance)}
         hand = acting_hand(self.state, kind, part if kind != "grasp" else grasped)
@@ -348,10 +351,10 @@ class GoalSteps:
             kwargs["hand"] = hand
         if kind == "extract" and part is not None and container is not None:
             kwargs["travel"] = self.pull_length(part, container)
-        furniture = self.furniture(kind, target, local) if not seated else {}
+        furniture = self.furniture(kind, target, local, pose[2]) if not seated else {}
         kwargs.update(furniture)
         if kind in HAND_TASKS and not seated and self.ctx.cell.obstacles:   # the body clear
-            kwargs["obstacles"] = posture_clearance(self.ctx, self.state.pose)
+            kwargs["obstacles"] = posture_clearance(self.ctx, pose)
         if kind == "wait" and target is None and seconds is not None:
             # Longer than asked by the blends at both ends, so the stillness lasts.
             kwargs["duration"] = (seconds + (2 * self.ctx.overlap + WAIT_EXTRA_FRAMES)
@@ -633,34 +636,29 @@ class GoalSteps:
         grasped = args[0] if kind == "grasp" and args else None
         part = args[0] if kind in ("move", "insert", "release", "extract") and args else None
         container = args[1] if kind == "extract" and len(args) > 1 else None
-        saved = self.state.pose
         stance = self.ctx.stance(self.state.carrying or raised)
-        try:
-            for spot in placements:
-                far = 2.0 * math.hypot(*spot)
-                px, py, yaw, free = ideal_placement(
-                    self.ctx, target, spot, target[0] + far * np.cos(sides),
-                    target[1] + far * np.sin(sides), self.ctx.options.max_step_back)
-                for k in np.flatnonzero(free):
-                    self.state.pose = (float(px[k]), float(py[k]), float(yaw[k]))
-                    local, kwargs, _ = self.goal_kwargs(kind, target, self.state.carrying
-                                                        or raised, None, grasped, part,
-                                                        container)
-                    kwargs["rng"] = np.random.default_rng(0)
-                    # (no obstacles around, or seated: no posture to rule out)
-                    obstacles = kwargs.get("obstacles")
-                    if obstacles is not None and not posture_clear(
-                            kind, local, self.ctx.library.skeleton, obstacles,
-                            start_pose=stance, hand=kwargs.get("hand", "auto")):
-                        continue
-                    try:
-                        mp = self.ctx.library.goal(kind, local, **kwargs)
-                    except ValueError:
-                        continue
-                    if self.goal_clear(mp, grasped, part if kind == "extract" else None):
-                        return float(sides[k]), float(yaw[k]), spot
-        finally:
-            self.state.pose = saved
+        for spot in placements:
+            far = 2.0 * math.hypot(*spot)
+            px, py, yaw, free = ideal_placement(
+                self.ctx, target, spot, target[0] + far * np.cos(sides),
+                target[1] + far * np.sin(sides), self.ctx.options.max_step_back)
+            for k in np.flatnonzero(free):
+                pose = (float(px[k]), float(py[k]), float(yaw[k]))
+                local, kwargs, _ = self.goal_kwargs(kind, target, self.state.carrying or raised,
+                                                    None, grasped, part, container, pose=pose)
+                kwargs["rng"] = np.random.default_rng(0)
+                # (no obstacles around, or seated: no posture to rule out)
+                obstacles = kwargs.get("obstacles")
+                if obstacles is not None and not posture_clear(
+                        kind, local, self.ctx.library.skeleton, obstacles,
+                        start_pose=stance, hand=kwargs.get("hand", "auto")):
+                    continue
+                try:
+                    mp = self.ctx.library.goal(kind, local, **kwargs)
+                except ValueError:
+                    continue
+                if self.goal_clear(mp, pose, grasped, part if kind == "extract" else None):
+                    return float(sides[k]), float(yaw[k]), spot
         return None
 
     def reaches(self, kind: str, args: tuple[str, ...], local: tuple[float, float, float],
@@ -924,7 +922,8 @@ class GoalSteps:
                     if miss > contact_tolerance(kind) else "it cannot keep every part clear"
                     if result.least_clearance < 0.0 else
                     f"it ends {100 * result.end_miss:.1f} cm from the pose it must end in")
-            elif not self.goal_clear(made, grasped, part if kind == "extract" else None):
+            elif not self.goal_clear(made, self.state.pose, grasped,
+                                     part if kind == "extract" else None):
                 note = "a part in hand still meets an obstacle"
             elif failed:
                 note = f"its motion fails the {', '.join(failed)} check"
@@ -975,14 +974,15 @@ class GoalSteps:
         return HeldPart.box(JOINT_INDEX[joint], to_local @ centre, (hi - lo) / 2,
                             rotation=to_local), start
 
-    def goal_clear(self, mp: MotionPrimitive, grasped: str | None,
+    def goal_clear(self, mp: MotionPrimitive, pose: Pose, grasped: str | None,
                    taken: str | None = None) -> bool:
-        """Whether the body, the objects already in the hands and the part being grasped
-        (``grasped``, from the frame the hand lifts it, :func:`lift_frame`) or taken out
-        of its container (``taken``, an extract's part, from the frame the hand holds it,
-        as the object tracks carry it) keep clear of obstacles."""
-        world = world_positions(mp, *self.state.pose)
-        if not self.executor.placed_clear(mp, self.state.pose, samples=None, world=world):
+        """Whether, placed at ``pose``, the body, the objects already in the hands and the
+        part being grasped (``grasped``, from the frame the hand lifts it,
+        :func:`lift_frame`) or taken out of its container (``taken``, an extract's part,
+        from the frame the hand holds it, as the object tracks carry it) keep clear of
+        obstacles."""
+        world = world_positions(mp, *pose)
+        if not self.executor.placed_clear(mp, pose, samples=None, world=world):
             return False
         grasped = grasped or taken
         if grasped is None:

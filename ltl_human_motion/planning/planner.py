@@ -317,7 +317,7 @@ class SequencePlanner:
             # The model's own reach test (its seeds only vary the timing: a fixed one
             # keeps the plan's random stream as it was).
             self.ctx.library.goal(kind, local, rng=np.random.default_rng(0),
-                                  start_pose=self.executor.seated_pose(),
+                                  start_pose=self.executor.seated_pose(self.state.pose),
                                   **({"hand": hand} if hand else {}))
         except ValueError:
             return True

@@ -306,7 +306,7 @@ class StepExecutor:
     def sit_still(self, seconds: float) -> MotionPrimitive:
         """A wait on the seat: the seated pose held (the standing wait model would rebuild
         the legs for standing)."""
-        pose = self.seated_pose()
+        pose = self.seated_pose(self.state.pose)
         n = max(round(seconds * self.ctx.library.fps), self.ctx.overlap + 2)
         root = np.zeros((n, 4))
         root[:, :3] = pose[0]
@@ -315,10 +315,10 @@ class StepExecutor:
                                self.ctx.library.fps, "planner: seated wait",
                                meta={"contact_frame": n - 1, "hand": "none"})
 
-    def seated_pose(self) -> np.ndarray:
-        """The last frame placed (the worker seated), in the start frame of the current
-        pose (root floor point at the origin, facing +x; heights above the floor), (J, 3)."""
-        x, y, yaw = self.state.pose
+    def seated_pose(self, pose: Pose) -> np.ndarray:
+        """The last frame placed (the worker seated), in the start frame of ``pose``
+        (root floor point at the origin, facing +x; heights above the floor), (J, 3)."""
+        x, y, yaw = pose
         last = self.state.segments[-1].positions[-1]
         c, s = math.cos(-yaw), math.sin(-yaw)
         dx, dy = last[:, 0] - x, last[:, 1] - y
