@@ -11,7 +11,7 @@ from __future__ import annotations
 import heapq
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -87,6 +87,16 @@ class SearchBudget:
     max_seconds: float | None = None
     at_goal_nodes: int | None = None
     idle_nodes: int | None = None
+
+    def within(self, limit: SearchBudget) -> SearchBudget:
+        """This budget with its node and time limits no larger than ``limit``'s (a
+        search the planner sizes itself, an alternative's walk, keeps to the plan's
+        budget)."""
+        seconds = self.max_seconds if limit.max_seconds is None else (
+            limit.max_seconds if self.max_seconds is None
+            else min(self.max_seconds, limit.max_seconds))
+        return replace(self, max_nodes=min(self.max_nodes, limit.max_nodes),
+                       max_seconds=seconds)
 
 
 @dataclass

@@ -587,7 +587,8 @@ class StepExecutor:
             self.step_out()
         forbidden: set[tuple[int, int, int, int]] = set()
         noise_state = self.ctx.rng.bit_generator.state
-        budget = budget or self.ctx.options.budget
+        budget = self.ctx.options.budget if budget is None \
+            else budget.within(self.ctx.options.budget)
         if goal.clearance is self.ctx.stand_map:
             budget = replace(budget, idle_nodes=SQUEEZE_NODES)
         used, repairs, reroutes = 0, 0, 0
