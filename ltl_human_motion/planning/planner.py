@@ -198,7 +198,12 @@ class SequencePlanner:
             return palm_clear_of_support(cell, self.ctx.stature, point, obj.occupancy_at(at))
         if kind in ("move",):
             return np.asarray(cell.region(args[1]).center, dtype=np.float64)
-        if kind in ("insert", "extract"):
+        if kind == "extract":
+            # The hand takes the part as a grasp does: off the support under it.
+            obj = cell.object(args[0])
+            return palm_clear_of_support(cell, self.ctx.stature, self.goal_steps.where(args[1]),
+                                         obj.occupancy_at(self.goal_steps.where(args[0])))
+        if kind == "insert":
             return self.goal_steps.where(args[1])
         if kind in ("leftHand", "rightHand", "assemble"):
             return np.asarray(cell.region(args[0]).center, dtype=np.float64)
