@@ -28,11 +28,11 @@ from ltl_human_motion.errors import PlanningError
 from ltl_human_motion.motion.goals import LEVEL_PATH_TASKS, posture_clear
 from ltl_human_motion.planning.astar import SearchBudget
 from ltl_human_motion.planning.blend import wrap_angle
-from ltl_human_motion.planning.plan_state import PlanContext, WorkerState
+from ltl_human_motion.planning.plan_state import PlanContext, WorkerState, in_start_frame
 from ltl_human_motion.planning.standing import board_local, ideal_placement, posture_clearance
 
 __all__ = ["OPEN_SIDE_BUDGET", "SIDES", "Arc", "SideReach", "SideTest", "approach_open_side",
-           "nearest_open_arc", "open_arc", "side_blocked", "side_tests"]
+           "nearest_open_arc", "open_arc", "side_blocked", "side_spots", "side_tests"]
 
 #: Evenly spaced sides of the target tested (every 22.5 degrees).
 SIDES = 16
@@ -55,6 +55,16 @@ class Arc:
     half_width: float
 
 
+def side_spots(ctx: PlanContext, target: np.ndarray, placement: tuple[float, float],
+               angles: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Where the worker stands ``placement`` (ahead, left, m) from ``target`` (3,) on the
+    sides at ``angles`` (N,) (rad, direction from the target), with the steps back from
+    an obstacle of :func:`.standing.ideal_placement`: x, y, yaw and free, each (N,)."""
+    far = 2.0 * math.hypot(*placement)
+    return ideal_placement(ctx, target, placement, target[0] + far * np.cos(angles),
+                           target[1] + far * np.sin(angles), ctx.options.max_step_back)
+
+
 def nearest_open_arc(ctx: PlanContext, target: np.ndarray, placement: tuple[float, float],
                      is_open: SideTest, toward: float, skip: float = 0.0, sides: int = SIDES
                      ) -> Arc | None:
@@ -67,11 +77,7 @@ def nearest_open_arc(ctx: PlanContext, target: np.ndarray, placement: tuple[floa
     step = 2.0 * math.pi / sides
     offsets = step * np.arange(sides)
     offsets = np.where(offsets > math.pi, offsets - 2.0 * math.pi, offsets)
-    angles = toward + offsets
-    far = 2.0 * math.hypot(*placement)
-    px, py, yaw, free = ideal_placement(
-        ctx, target, placement, target[0] + far * np.cos(angles),
-        target[1] + far * np.sin(angles), ctx.options.max_step_back)
+    px, py, yaw, free = side_spots(ctx, target, placement, toward + offsets)
     tested: dict[int, bool] = {}
 
     def open_(k: int) -> bool:
@@ -132,9 +138,7 @@ def _reaches_clear(ctx: PlanContext, reach: SideReach, pose: tuple[float, float,
                    ) -> bool:
     """Whether the posture model reaches the target clear from a worker at ``pose``."""
     kind, target = reach.kind, reach.target
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    dx, dy = float(target[0]) - pose[0], float(target[1]) - pose[1]
-    local = np.array([c * dx + s * dy, -s * dx + c * dy, float(target[2])])
+    local = in_start_frame(pose, target)
     board = board_local(ctx.cell, target, local, pose[2], ctx.stature) \
         if kind in LEVEL_PATH_TASKS else None
     return posture_clear(kind, local, ctx.library.skeleton, posture_clearance(ctx, pose),

@@ -18,9 +18,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ltl_human_motion.planning.open_sides import SIDES, side_blocked
+from ltl_human_motion.planning.open_sides import SIDES, side_blocked, side_spots
 from ltl_human_motion.planning.plan_state import PlanContext
-from ltl_human_motion.planning.standing import ideal_placement
 
 __all__ = ["FURTHEST", "STEP", "farther_placement", "has_spot"]
 
@@ -35,11 +34,8 @@ def has_spot(ctx: PlanContext, target: np.ndarray, placement: tuple[float, float
     """Whether some side of ``target`` (3,) (``SIDES`` of them) has a free standing spot
     for ``placement`` (ahead, left, m; :func:`.standing.ideal_placement` with its steps
     back), with ``open_line`` one whose level line to the target passes no obstacle."""
-    angles = 2.0 * math.pi * np.arange(SIDES) / SIDES
-    far = 2.0 * math.hypot(*placement)
-    px, py, yaw, free = ideal_placement(
-        ctx, target, placement, target[0] + far * np.cos(angles),
-        target[1] + far * np.sin(angles), ctx.options.max_step_back)
+    px, py, yaw, free = side_spots(ctx, target, placement,
+                                   2.0 * math.pi * np.arange(SIDES) / SIDES)
     return any(not open_line or not side_blocked(ctx, target, (float(px[k]), float(py[k]),
                                                                float(yaw[k])))
                for k in np.flatnonzero(free))
