@@ -163,3 +163,33 @@ def test_compiled_sequential_passes_equal_the_python_loops() -> None:
                 if size > 0.01:
                     rows[t] = [p + v * (0.01 / size) for p, v in zip(rows[t - back], d)]
         np.testing.assert_array_equal(nb.rate_limited(x, 0.01), np.array(rows))
+
+
+def test_compiled_pass_kernels_equal_the_numpy_paths() -> None:
+    """The numba kernels of the foot's pass by the other leg (segment gaps, the slower
+    foot joint's speed) give the numpy paths' numbers bit for bit, signed zeros,
+    parallel and point segments included."""
+    from ltl_human_motion.kernel.segments import compiled_module
+    from ltl_human_motion.planning import footlock
+    if compiled_module("ltl_human_motion.planning._motion_numba") is None:
+        import pytest
+        pytest.skip("numba kernels not in use")
+    rng = np.random.default_rng(5)
+    for trial in range(60):
+        n = int(rng.integers(1, 400))
+        pts = rng.normal(size=(n, 6, 3)) * [1e-3, 0.1, 1.0, 100.0][trial % 4]
+        if trial % 3 == 0:
+            pts = np.round(pts, 1)                       # exact zeros, signed zeros
+        if trial % 5 == 0:                               # collinear, overlapping
+            pts[:, 2] = pts[:, 1]
+            pts[:, 3] = pts[:, 0] + 2.0 * (pts[:, 1] - pts[:, 0])
+        if trial % 7 == 0:                               # point segments
+            pts[::3, 1] = pts[::3, 0]
+            pts[:, 0, 2] = -0.0
+        ends = [pts[:, k] for k in range(4)]
+        gap, dist = footlock._segment_gaps(*ends)
+        gap_np, dist_np = footlock._segment_gaps_numpy(*ends)
+        assert gap.tobytes() == gap_np.tobytes() and dist.tobytes() == dist_np.tobytes()
+        speed = footlock._slower_speed(pts[:, 4], pts[:, 5], FPS)
+        assert speed.tobytes() == footlock._slower_speed_numpy(pts[:, 4], pts[:, 5],
+                                                               FPS).tobytes()

@@ -463,6 +463,18 @@ def _segment_gaps(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray]:
     """Closest points of segments [p0, p1] and [q0, q1] (each (T, 3)): the vector (T, 3)
     from the second's closest point to the first's, and its length (T,)."""
+    ends = [np.ascontiguousarray(x, dtype=np.float64) for x in (p0, p1, q0, q1)]
+    nb = _compiled()
+    if nb is not None and all(np.isfinite(x).all() for x in ends):
+        gap, dist = np.empty((len(p0), 3)), np.empty(len(p0))
+        nb.segment_gaps(*ends, gap, dist)
+        return gap, dist
+    return _segment_gaps_numpy(p0, p1, q0, q1)
+
+
+def _segment_gaps_numpy(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_segment_gaps` in numpy (the compiled kernel's reference)."""
     u, v, w = p1 - p0, q1 - q0, p0 - q0
     a, b, c = np.sum(u * u, -1), np.sum(u * v, -1), np.sum(v * v, -1)
     d, e = np.sum(u * w, -1), np.sum(v * w, -1)
@@ -474,6 +486,26 @@ def _segment_gaps(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray
     t = np.clip(t, 0, 1)
     gap = (p0 + sp[:, None] * u) - (q0 + t[:, None] * v)
     return gap, np.linalg.norm(gap, axis=-1)
+
+
+def _slower_speed(ank: np.ndarray, toe: np.ndarray, fps: float) -> np.ndarray:
+    """Horizontal speed (T,) of the slower of ``ank`` and ``toe`` (T, 3) into each frame
+    (0 at the first)."""
+    nb = _compiled()
+    a, t = (np.ascontiguousarray(x, dtype=np.float64) for x in (ank, toe))
+    if nb is not None and np.isfinite(a).all() and np.isfinite(t).all():
+        speed = np.zeros(len(a))
+        nb.slower_foot_speed(a, t, float(fps), speed)
+        return speed
+    return _slower_speed_numpy(a, t, fps)
+
+
+def _slower_speed_numpy(a: np.ndarray, t: np.ndarray, fps: float) -> np.ndarray:
+    """:func:`_slower_speed` in numpy (the compiled kernel's reference)."""
+    speed = np.zeros(len(a))
+    speed[1:] = np.min(np.linalg.norm(np.diff(np.stack([a, t], 1)[:, :, :2], axis=0),
+                                      axis=-1), axis=1) * fps
+    return speed
 
 
 def _pass_clear(p: np.ndarray, s: str, o: str, fps: float, stature: float,
@@ -506,9 +538,7 @@ def _pass_clear(p: np.ndarray, s: str, o: str, fps: float, stature: float,
         lack = np.where(more, need - dist, lack)
         gap[more] = g[more]
     # swinging: heel and ball both move (a push-off's ankle moves about a planted ball)
-    speed = np.zeros(len(p))
-    speed[1:] = np.min(np.linalg.norm(np.diff(np.stack([ank, toe], 1)[:, :, :2], axis=0),
-                                      axis=-1), axis=1) * fps
+    speed = _slower_speed(ank, toe, fps)
     lack = np.where(speed > STANCE_SPEED, lack, 0.0)
     if not np.any(lack > 0):
         return None, None
