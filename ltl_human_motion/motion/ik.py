@@ -40,13 +40,17 @@ def two_bone_ik(base: np.ndarray, target: np.ndarray, l1: float, l2: float,
     base = np.asarray(base, dtype=np.float64)
     target = np.asarray(target, dtype=np.float64)
     pole = np.asarray(pole, dtype=np.float64)
-    v = target - base
-    dist = np.linalg.norm(v, axis=-1, keepdims=True)
-    u = v / np.maximum(dist, 1e-9)
     dmin = abs(l1 - l2) + 1e-6
     if max_flexion is not None:
         dmin = max(dmin, float(np.sqrt(l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * np.cos(max_flexion))))
-    d = np.clip(dist, dmin, max_stretch * (l1 + l2))
+    dmax = max_stretch * (l1 + l2)
+    compiled = _compiled_chains(base, target, pole, l1, l2, dmin, dmax)
+    if compiled is not None:
+        return compiled
+    v = target - base
+    dist = np.linalg.norm(v, axis=-1, keepdims=True)
+    u = v / np.maximum(dist, 1e-9)
+    d = np.clip(dist, dmin, dmax)
     end = base + u * d
     # distance along u of the middle joint, and its offset from the line
     a = (l1 * l1 - l2 * l2 + d * d) / (2 * d)
@@ -62,6 +66,36 @@ def two_bone_ik(base: np.ndarray, target: np.ndarray, l1: float, l2: float,
             np.linalg.norm(alt, axis=-1, keepdims=True), 1e-12))
     middle = base + u * a + p * h
     return middle, end
+
+
+def _compiled_chains(base: np.ndarray, target: np.ndarray, pole: np.ndarray, l1: float,
+                     l2: float, dmin: float, dmax: float
+                     ) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`two_bone_ik` by the compiled loop (the same numbers), or None where it is
+    not in use: numba off, bone lengths not double precision, points not (..., 3) and
+    finite."""
+    from ltl_human_motion.kernel.segments import compiled_module
+    if not all(isinstance(x, float) for x in (l1, l2, dmin, dmax)):
+        return None
+    nb = compiled_module("ltl_human_motion.motion._ik_numba")
+    if nb is None:
+        return None
+    try:
+        shape = np.broadcast_shapes(base.shape, target.shape, pole.shape)
+    except ValueError:
+        return None
+    if shape[-1:] != (3,):
+        return None
+    flat = []
+    for x in (base, target, pole):
+        rows = (x if x.shape == shape else np.broadcast_to(x, shape)).reshape(-1, 3)
+        # one signature of the kernel: C-contiguous and writeable
+        flat.append(rows if rows.flags.c_contiguous and rows.flags.writeable else rows.copy())
+    if not all(np.isfinite(x).all() for x in flat):
+        return None
+    middle, end = np.empty_like(flat[0]), np.empty_like(flat[0])
+    nb.two_bone(*flat, float(l1), float(l2), float(dmin), float(dmax), middle, end)
+    return middle.reshape(shape), end.reshape(shape)
 
 
 def min_jerk(tau: np.ndarray) -> np.ndarray:
