@@ -193,3 +193,45 @@ def test_compiled_pass_kernels_equal_the_numpy_paths() -> None:
         speed = footlock._slower_speed(pts[:, 4], pts[:, 5], FPS)
         assert speed.tobytes() == footlock._slower_speed_numpy(pts[:, 4], pts[:, 5],
                                                                FPS).tobytes()
+
+
+def test_compiled_stance_loop_equals_the_numpy_path() -> None:
+    """The compiled stance loop (anchor, pin, trim to the lock limits, standing shuffle,
+    release ramps) gives the Python path's displacements, weights and stances bit for
+    bit, on feet that slide, turn, flicker and shuffle."""
+    from ltl_human_motion.kernel.segments import compiled_module
+    from ltl_human_motion.planning import footlock
+    from ltl_human_motion.planning.footlock import _contact_joint, _keep_heading, _runs, _stance
+    if compiled_module("ltl_human_motion.planning._motion_numba") is None:
+        import pytest
+        pytest.skip("numba kernels not in use")
+    rng = np.random.default_rng(2)
+    rest = SK.rest_positions()
+    rest_h = np.array([rest[J["l_ankle"], 2], rest[J["l_toe"], 2]])
+    checked = 0
+    for trial in range(40):
+        p = _slide_left_foot(_standing(360), speed=[0.0, 0.1, 0.3, 0.6][trial % 4],
+                             yaw_rate=[0.0, 0.5, 2.0][trial % 3], wobble=0.004 * (trial % 2))
+        p = p + rng.normal(size=p.shape) * [0.0, 0.0005, 0.002][trial % 3]
+        p[120:150, [J["l_ankle"], J["l_toe"]], 2] += 0.05 * (trial % 5 == 0)  # a lifted step
+        joints = np.stack([p[:, J["l_ankle"]], p[:, J["l_toe"]]], 1)
+        h = joints[:, :, 2] - rest_h
+        v = np.zeros((len(p), 2))
+        v[1:] = np.linalg.norm(np.diff(joints[:, :, :2], axis=0), axis=-1) * FPS
+        v[0] = v[1]
+        contact = _contact_joint(h)
+        T = np.arange(len(p))
+        hc, vc = h[T, contact], v[T, contact]
+        stance = _stance(hc, vc)
+        held = _keep_heading(joints, h, stance, FPS)
+        n_rel = max(1, round(footlock.RELEASE * FPS))
+        ramp = footlock.min_jerk(np.arange(1, n_rel + 1) / (n_rel + 1))
+        s_np = stance.copy()
+        d_np, w_np = footlock._lock_stances_numpy(held, joints, h, hc, vc, contact, s_np, FPS,
+                                                  n_rel, ramp, _runs(stance))
+        s_nb = stance.copy()
+        d_nb, w_nb = footlock._lock_stances(held, joints, h, hc, vc, contact, s_nb, FPS, n_rel)
+        assert d_nb.tobytes() == d_np.tobytes() and w_nb.tobytes() == w_np.tobytes()
+        assert np.array_equal(s_nb, s_np)
+        checked += int(np.any(w_np > 0))
+    assert checked > 30

@@ -105,3 +105,156 @@ def slower_foot_speed(ank, toe, fps, out) -> None:
         sa = math.sqrt(ax * ax + ay * ay)
         st = math.sqrt(tx * tx + ty * ty)
         out[t] = (sa if sa <= st else st) * fps
+
+
+@_jit
+def _roll(h, t, switch) -> float:
+    """``footlock._roll_weight`` of frame t of h (T, 2)."""
+    return _clip01(0.5 + (h[t, 0] - h[t, 1]) / (2.0 * switch))
+
+
+@_jit
+def _anchor_at(held, contact, a, b, fps, still_speed, still_time) -> int:
+    """``footlock._anchor`` of the contact point held[t, contact[t], :2], t in [a, b)."""
+    n = b - a
+    speed = np.zeros(n)
+    for i in range(1, n):
+        dx = held[a + i, contact[a + i], 0] - held[a + i - 1, contact[a + i - 1], 0]
+        dy = held[a + i, contact[a + i], 1] - held[a + i - 1, contact[a + i - 1], 1]
+        speed[i] = math.sqrt(0.0 + dx * dx + dy * dy) * fps
+    speed[0] = speed[min(1, n - 1)]
+    i = 0
+    while i < n:
+        if speed[i] <= still_speed:
+            j = i
+            while j < n and speed[j] <= still_speed:
+                j += 1
+            if j - i >= still_time * fps:
+                return (i + j) // 2
+            i = j
+        else:
+            i += 1
+    med = np.empty(2)
+    col = np.empty(n)
+    for c in range(2):              # np.median: the middle one or two, as np.mean takes them
+        for i in range(n):
+            col[i] = held[a + i, contact[a + i], c]
+        col.sort()
+        if n % 2:
+            med[c] = (0.0 + col[n // 2]) / 1.0
+        else:
+            med[c] = (0.0 + col[n // 2 - 1] + col[n // 2]) / 2.0
+    best = 0
+    least = np.inf
+    for i in range(n):
+        dx = held[a + i, contact[a + i], 0] - med[0]
+        dy = held[a + i, contact[a + i], 1] - med[1]
+        d = math.sqrt(0.0 + dx * dx + dy * dy)
+        if d < least:
+            least = d
+            best = i
+    return best
+
+
+@_jit
+def lock_stances(held, joints, h, hc, vc, contact, starts, ends, stance, ramp, fps,
+                 consts, disp, weight) -> int:
+    """The stance loop of ``footlock._foot_targets`` (its Python path, step for step):
+    every stance [starts[r], ends[r]) pinned at its anchor and trimmed to its lock
+    limits, the standing shuffle after it pinned too, and the release ramps; ``stance``
+    (T,) is changed in place, ``disp`` (T, 2, 2) and ``weight`` (T,) filled. ``consts``:
+    STILL_SPEED, STILL_TIME, MAX_LOCK, MAX_LOCK_BALL, CONTACT_SWITCH, SHUFFLE_STILL_TIME,
+    CONTACT_HEIGHT, STANCE_SPEED. Returns 1 where the Python path would raise (a shuffle
+    with a still part but no frame to enter), else 0."""
+    still_speed, still_time, max_lock, max_lock_ball = consts[0], consts[1], consts[2], \
+        consts[3]
+    switch, shuffle_time, contact_height, stance_speed = consts[4], consts[5], consts[6], \
+        consts[7]
+    T = held.shape[0]
+    n_rel = ramp.shape[0]
+    r = 0
+    pending = False
+    pa = pb = 0
+    while pending or r < starts.shape[0]:
+        if pending:
+            a, b = pa, pb
+            pending = False
+        else:
+            a, b = starts[r], ends[r]
+            r += 1
+        k = a + _anchor_at(held, contact, a, b, fps, still_speed, still_time)
+        n = b - a
+        off = np.zeros((n, 2))          # travelled, then the pin offsets
+        for i in range(1, n):
+            beta = _roll(h, a + i, switch)
+            for c in range(2):
+                s0 = held[a + i, 0, c] - held[a + i - 1, 0, c]
+                s1 = held[a + i, 1, c] - held[a + i - 1, 1, c]
+                step = (1.0 - beta) * s0 + beta * s1
+                off[i, c] = step if i == 1 else off[i - 1, c] + step
+        ref0, ref1 = off[k - a, 0], off[k - a, 1]
+        for i in range(n):
+            off[i, 0] = ref0 - off[i, 0]
+            off[i, 1] = ref1 - off[i, 1]
+        end = b
+        big = False
+        ok = np.empty(n, dtype=np.bool_)
+        for i in range(n):
+            limit = max_lock_ball if _roll(h, a + i, switch) >= 1.0 else max_lock
+            ok[i] = not (math.sqrt(0.0 + off[i, 0] * off[i, 0] + off[i, 1] * off[i, 1])
+                         > limit)
+            big = big or not ok[i]
+        lo = 0
+        if big:
+            lo = k - a
+            while lo > 0 and ok[lo - 1]:
+                lo -= 1
+            hi = k - a
+            while hi < n - 1 and ok[hi + 1]:
+                hi += 1
+            stance[a:a + lo] = False
+            stance[a + hi + 1:b] = False
+            a, b = a + lo, a + hi + 1
+        # the standing shuffle after the stance (footlock._next_stance)
+        ta, tb = b + n_rel, end
+        if tb - ta >= shuffle_time * fps:
+            found = False
+            i = ta
+            while i < tb and not found:
+                if vc[i] <= still_speed:
+                    j = i
+                    while j < tb and vc[j] <= still_speed:
+                        j += 1
+                    found = j - i >= shuffle_time * fps
+                    i = j
+                else:
+                    i += 1
+            if found:
+                enter = -1
+                for i in range(ta, tb):
+                    if hc[i] <= contact_height and vc[i] <= stance_speed:
+                        enter = i
+                        break
+                if enter < 0:
+                    return 1
+                stance[enter:tb] = True
+                pending = True
+                pa, pb = enter, tb
+        for t in range(a, b):
+            for j in range(2):
+                for c in range(2):
+                    disp[t, j, c] = held[t, j, c] - joints[t, j, c] + off[t - a + lo, c]
+            weight[t] = 1.0
+        for i in range(n_rel):
+            w = ramp[n_rel - 1 - i]
+            if a - 1 - i >= 0 and weight[a - 1 - i] < w:
+                for j in range(2):
+                    for c in range(2):
+                        disp[a - 1 - i, j, c] = disp[a, j, c] * w
+                weight[a - 1 - i] = w
+            if b + i < T and weight[b + i] < w:
+                for j in range(2):
+                    for c in range(2):
+                        disp[b + i, j, c] = disp[b - 1, j, c] * w
+                weight[b + i] = w
+    return 0

@@ -328,12 +328,66 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
     if free is not None:
         stance &= ~free
     held = _keep_heading(joints, h, stance, fps)
-    # displacement of each joint (T, 2, 2): heading kept, contact point pinned
-    disp = np.zeros((T, 2, 2))
-    weight = np.zeros(T)
     n_rel = max(1, round(RELEASE * fps))
+    disp, weight = _lock_stances(held, joints, h, hc, v[np.arange(T), contact], contact,
+                                 stance, fps, n_rel)
+    # between two stances closer than two release times the correction passes from the
+    # one to the other along the minimum-jerk profile (their ramps would meet in a step)
+    _bridge_stances(disp, weight, n_rel)
+    lift = _swing_lift(h, stance, fps)
+    out = joints.copy()
+    out[:, :, :2] += disp
+    out[:, :, 2] += lift[:, None]
+    return out[:, 0], out[:, 1], contact, stance
+
+
+#: The constants :func:`_lock_stances` hands the compiled loop, in its order.
+_STANCE_CONSTANTS = np.array([STILL_SPEED, STILL_TIME, MAX_LOCK, MAX_LOCK_BALL, CONTACT_SWITCH,
+                              SHUFFLE_STILL_TIME, CONTACT_HEIGHT, STANCE_SPEED])
+
+
+def _lock_stances(held: np.ndarray, joints: np.ndarray, h: np.ndarray, hc: np.ndarray,
+                  vc: np.ndarray, contact: np.ndarray, stance: np.ndarray, fps: float,
+                  n_rel: int) -> tuple[np.ndarray, np.ndarray]:
+    """The displacement (T, 2, 2) of a foot's ankle and toe that pins every stance of
+    ``stance`` (T,) of bool (changed in place: trimmed to the lock limits, a standing
+    shuffle added) and ramps in and out over ``n_rel`` frames, and its weight (T,) (1 on
+    held frames); ``held`` (T, 2, 3) are the joints with the heading kept, ``joints`` the
+    foot's own, ``h`` (T, 2) their heights over their rest heights, ``hc``, ``vc`` (T,)
+    the contact point's height and speed, ``contact`` (T,) the contact joint. The
+    compiled loop where it is in use (the same numbers), else :func:`_lock_stances_numpy`."""
+    T = len(held)
     ramp = min_jerk(np.arange(1, n_rel + 1) / (n_rel + 1))
     runs = _runs(stance)
+    nb = _compiled()
+    if nb is not None and np.isfinite(held).all() and np.isfinite(joints).all() \
+            and np.isfinite(h).all() and np.isfinite(vc).all():
+        starts = np.array([a for a, _ in runs], dtype=np.int64)
+        ends = np.array([b for _, b in runs], dtype=np.int64)
+        out_stance = stance.copy()
+        disp, weight = np.zeros((T, 2, 2)), np.zeros(T)
+        if nb.lock_stances(np.ascontiguousarray(held), np.ascontiguousarray(joints),
+                           np.ascontiguousarray(h), np.ascontiguousarray(hc),
+                           np.ascontiguousarray(vc), np.ascontiguousarray(contact,
+                                                                          dtype=np.int64),
+                           starts, ends, out_stance, ramp, float(fps), _STANCE_CONSTANTS,
+                           disp, weight) == 0:
+            stance[:] = out_stance
+            return disp, weight
+    return _lock_stances_numpy(held, joints, h, hc, vc, contact, stance, fps, n_rel, ramp,
+                               runs)
+
+
+def _lock_stances_numpy(held: np.ndarray, joints: np.ndarray, h: np.ndarray,
+                        hc: np.ndarray, vc: np.ndarray, contact: np.ndarray,
+                        stance: np.ndarray, fps: float, n_rel: int, ramp: np.ndarray,
+                        runs: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_lock_stances` in Python and numpy (``ramp`` (n_rel,): the release
+    profile; ``runs``: the stances' [a, b))."""
+    T = len(held)
+    disp = np.zeros((T, 2, 2))
+    weight = np.zeros(T)
+    runs = list(runs)
     while runs:
         a, b = runs.pop(0)
         k = a + _anchor(held[np.arange(a, b), contact[a:b], :2], fps)
@@ -342,7 +396,7 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
         end = b
         run_off, a, b = _trim_to_anchor(run_off, stance, a, b, k,
                                         np.where(ball, MAX_LOCK_BALL, MAX_LOCK))
-        tail = _next_stance(hc, v[np.arange(T), contact], b + n_rel, end, fps)
+        tail = _next_stance(hc, vc, b + n_rel, end, fps)
         if tail is not None:
             stance[tail[0]:tail[1]] = True
             runs.insert(0, tail)
@@ -357,14 +411,7 @@ def _foot_targets(ankle: np.ndarray, toe: np.ndarray, rest_h: tuple[float, float
             if b + i < T and weight[b + i] < w:
                 disp[b + i] = disp[b - 1] * w
                 weight[b + i] = w
-    # between two stances closer than two release times the correction passes from the
-    # one to the other along the minimum-jerk profile (their ramps would meet in a step)
-    _bridge_stances(disp, weight, n_rel)
-    lift = _swing_lift(h, stance, fps)
-    out = joints.copy()
-    out[:, :, :2] += disp
-    out[:, :, 2] += lift[:, None]
-    return out[:, 0], out[:, 1], contact, stance
+    return disp, weight
 
 
 def _unit3(v: np.ndarray) -> np.ndarray:
