@@ -103,17 +103,21 @@ def _build_array(src: np.ndarray, pelvis: np.ndarray, skeleton: Skeleton,
                                         point("chest") - point("pelvis")),
               "chest": frame_from_axes(point("l_shoulder") - point("r_shoulder"),
                                        point("neck") - point("chest"))}
-    bone = np.empty((J, 3, T))                          # each joint minus its parent
     free_j, free_p = (_FREE_J, _FREE_P) if rigid_hips else (_FREE_HIPS_J, _FREE_HIPS_P)
-    for j, which in _RIGID.items():
-        if rigid_hips or which != "pelvis":
-            bone[j] = (frames[which] @ (rest[j] - rest[PARENTS[j]])).T
-    vec = s[free_j] - s[free_p]                                         # (n, 3, T)
-    norm = np.sqrt(vec[:, 0] * vec[:, 0] + vec[:, 1] * vec[:, 1]
-                   + vec[:, 2] * vec[:, 2])[:, None]                     # (n, 1, T)
+    rigid = {j: frames[which] @ (rest[j] - rest[PARENTS[j]]) for j, which in _RIGID.items()
+             if rigid_hips or which != "pelvis"}                          # (T, 3) each
     # a degenerate (zero-length) source bone keeps the canonical rest direction
     rest_vec = rest[free_j] - rest[free_p]
     rest_dir = rest_vec / np.maximum(np.linalg.norm(rest_vec, axis=-1, keepdims=True), 1e-12)
+    compiled = _compiled_chain(src, pelvis, free_j, free_p, lengths[free_j], rest_dir, rigid)
+    if compiled is not None:
+        return compiled
+    bone = np.empty((J, 3, T))                          # each joint minus its parent
+    for j, rigid_bone in rigid.items():
+        bone[j] = rigid_bone.T
+    vec = s[free_j] - s[free_p]                                         # (n, 3, T)
+    norm = np.sqrt(vec[:, 0] * vec[:, 0] + vec[:, 1] * vec[:, 1]
+                   + vec[:, 2] * vec[:, 2])[:, None]                     # (n, 1, T)
     direction = np.where(norm > 1e-9, vec / np.maximum(norm, 1e-12), rest_dir[:, :, None])
     bone[free_j] = lengths[free_j][:, None, None] * direction
     out = np.empty((J, 3, T))
@@ -121,6 +125,33 @@ def _build_array(src: np.ndarray, pelvis: np.ndarray, skeleton: Skeleton,
     for j in range(1, J):                               # parents come before children
         out[j] = out[PARENTS[j]] + bone[j]
     return np.ascontiguousarray(out.transpose(2, 0, 1))
+
+
+_PARENTS = np.asarray(PARENTS, dtype=np.int64)
+
+
+def _compiled_chain(src: np.ndarray, pelvis: np.ndarray, free_j: np.ndarray,
+                    free_p: np.ndarray, free_len: np.ndarray, rest_dir: np.ndarray,
+                    rigid: dict[int, np.ndarray]) -> np.ndarray | None:
+    """The positions (T, J, 3) of :func:`_build_array` by the compiled loop (the same
+    numbers) from its free bones (joints, parents, lengths and rest directions) and its
+    rigid bones (joint -> (T, 3)), or None where it is not in use (numba off)."""
+    from ltl_human_motion.kernel.segments import compiled_module
+    nb = compiled_module("ltl_human_motion.motion._retarget_numba")
+    if nb is None:
+        return None
+    T = len(pelvis)
+    rigid_j = np.array(sorted(rigid), dtype=np.int64)
+    out = np.empty((T, len(JOINT_NAMES), 3))
+    nb.chain_positions(np.ascontiguousarray(src, dtype=np.float64),
+                       np.ascontiguousarray(pelvis, dtype=np.float64),
+                       np.asarray(free_j, dtype=np.int64), np.asarray(free_p, dtype=np.int64),
+                       np.ascontiguousarray(free_len, dtype=np.float64),
+                       np.ascontiguousarray(rest_dir, dtype=np.float64), rigid_j,
+                       np.ascontiguousarray(np.stack([rigid[j] for j in rigid_j])
+                                            if len(rigid_j) else np.zeros((0, T, 3))),
+                       _PARENTS, out)
+    return out
 
 
 def _check_points(points: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
