@@ -147,3 +147,67 @@ def indexed(X, ends_a, ends_b, out) -> None:
                               x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2],
                               x[k, 0], x[k, 1], x[k, 2],
                               x[m, 0] - x[k, 0], x[m, 1] - x[k, 1], x[m, 2] - x[k, 2])
+
+
+#: Slack (m) of the bounds of :func:`indexed_max_excess`: far above the rounding of a
+#: pair's distance and of the joints' summed travel, far below any clearance that matters.
+_BOUND_SLACK = 1e-9
+
+
+@_jit
+def indexed_max_excess(X, seg_ends, pair_a, pair_b, reach, where) -> float:
+    """max over t, p of reach[p] minus the distance of segments seg_ends[pair_a[p]] and
+    seg_ends[pair_b[p]] of X[t] (X (T, J, 3) finite, seg_ends (S, 2) joint indices,
+    pair_a, pair_b, reach (P,)), and where it first occurs in C order (where[0] = t,
+    where[1] = p): the numbers of ``reach - indexed(...)`` and its argmax. A pair is not
+    measured where a lower bound of its distance keeps it ``_BOUND_SLACK`` below the best
+    so far: its distance when last measured less the travel of its end joints since
+    (a segment's points move no further than its ends), or the gap of the two segments'
+    bounding spheres."""
+    S, P, J = seg_ends.shape[0], pair_a.shape[0], X.shape[1]
+    mid = np.empty((S, 3))
+    half = np.empty(S)
+    travel = np.zeros(J)            # each joint's path length so far
+    last = np.full(P, -1.0)         # each pair's distance when last measured
+    at = np.zeros((P, 4))           # its end joints' travel then
+    best = -np.inf
+    found = False
+    for t in range(X.shape[0]):
+        x = X[t]
+        if t:
+            for j in range(J):
+                d0, d1, d2 = x[j, 0] - X[t - 1, j, 0], x[j, 1] - X[t - 1, j, 1], \
+                    x[j, 2] - X[t - 1, j, 2]
+                travel[j] += math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        for s in range(S):
+            i, j = seg_ends[s, 0], seg_ends[s, 1]
+            d0, d1, d2 = x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2]
+            mid[s, 0], mid[s, 1], mid[s, 2] = x[i, 0] + 0.5 * d0, x[i, 1] + 0.5 * d1, \
+                x[i, 2] + 0.5 * d2
+            half[s] = 0.5 * math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        for p in range(P):
+            a, b = pair_a[p], pair_b[p]
+            i, j = seg_ends[a, 0], seg_ends[a, 1]
+            k, m = seg_ends[b, 0], seg_ends[b, 1]
+            if found:
+                if last[p] >= 0.0:
+                    moved = max(travel[i] - at[p, 0], travel[j] - at[p, 1]) \
+                        + max(travel[k] - at[p, 2], travel[m] - at[p, 3])
+                    if reach[p] - (last[p] - moved) + _BOUND_SLACK < best:
+                        continue
+                room = reach[p] - best + _BOUND_SLACK + half[a] + half[b]
+                g0, g1, g2 = mid[a, 0] - mid[b, 0], mid[a, 1] - mid[b, 1], mid[a, 2] - mid[b, 2]
+                if room < 0.0 or g0 * g0 + g1 * g1 + g2 * g2 > room * room:
+                    continue
+            d = _pair(x[i, 0], x[i, 1], x[i, 2],
+                      x[j, 0] - x[i, 0], x[j, 1] - x[i, 1], x[j, 2] - x[i, 2],
+                      x[k, 0], x[k, 1], x[k, 2],
+                      x[m, 0] - x[k, 0], x[m, 1] - x[k, 1], x[m, 2] - x[k, 2])
+            last[p] = d
+            at[p, 0], at[p, 1], at[p, 2], at[p, 3] = travel[i], travel[j], travel[k], travel[m]
+            e = reach[p] - d
+            if not found or e > best:
+                best = e
+                where[0], where[1] = t, p
+                found = True
+    return best

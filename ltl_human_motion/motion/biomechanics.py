@@ -151,8 +151,9 @@ def _speed_limits(n: int, labels: Sequence[str], lim: BiomechanicsLimits,
                   scale: float) -> np.ndarray:
     """Per-interval, per-joint speed limit (n, J) from the activity label of each frame."""
     out = np.full((n, len(JOINT_NAMES)), lim.other_speed)
-    names, code = np.unique(np.asarray(labels[:n], dtype=object).astype(str),
-                            return_inverse=True)
+    names: dict[str, int] = {}
+    code = np.fromiter((names.setdefault(str(x), len(names)) for x in labels[:n]),
+                       dtype=np.intp, count=min(n, len(labels)))
     kinds = [_kind(x) for x in names]
     hand_goal = np.isin(kinds, HAND_TASKS)[code]
     posture = np.isin(kinds, POSTURE_TRANSITION_TASKS)[code]
@@ -276,6 +277,33 @@ _PAIRS = _penetration_pairs()
 _PAIR_CAPSULES = np.array(_PAIRS, dtype=np.intp).T
 _PAIR_ENDS = np.array([[_J[c[1]], _J[c[2]]] for c in BODY_CAPSULES],
                       dtype=np.intp)[_PAIR_CAPSULES]
+
+
+#: The segments (S, 2) (joint pairs) of the pairs, and the segment of each side of each
+#: pair (P,) each (:func:`_deepest_penetration`'s compiled call).
+_PAIR_SEGMENTS, _PAIR_SEGMENT_INDEX = np.unique(_PAIR_ENDS.reshape(-1, 2), axis=0,
+                                                return_inverse=True)
+_PAIR_SEGMENT_INDEX = _PAIR_SEGMENT_INDEX.reshape(2, -1).astype(np.intp)
+_PAIR_SEGMENTS = np.ascontiguousarray(_PAIR_SEGMENTS, dtype=np.intp)
+_PAIR_NAMES = [(BODY_CAPSULES[i][0], BODY_CAPSULES[j][0]) for i, j in _PAIRS]
+
+
+def _deepest_penetration(p: np.ndarray, stature: float) -> tuple[int, int, float] | None:
+    """The frame, pair and depth of ``self_penetration(p, stature)``'s first maximum
+    (the same numbers), by the compiled kernel that measures only pairs that may reach
+    it; None where the kernel is not in use or ``p`` (T, J, 3) is empty or not finite."""
+    nb = compiled_module("ltl_human_motion.kernel._segments_numba")
+    x = np.ascontiguousarray(p, dtype=np.float64)
+    if nb is None or not x.size or not np.isfinite(x).all():
+        return None
+    r = capsule_radii(stature)
+    a, b = _PAIR_CAPSULES
+    where = np.zeros(2, dtype=np.intp)
+    depth = nb.indexed_max_excess(x, _PAIR_SEGMENTS, _PAIR_SEGMENT_INDEX[0],
+                                  _PAIR_SEGMENT_INDEX[1],
+                                  np.ascontiguousarray(np.maximum(r[a], r[b]),
+                                                       dtype=np.float64), where)
+    return int(where[0]), int(where[1]), float(depth)
 
 
 def self_penetration(positions: np.ndarray, stature: float = DEFAULT_STATURE
@@ -570,9 +598,14 @@ def _rom_entry(p: np.ndarray, fps: float, labels: list[str],
 
 def _penetration_entry(p: np.ndarray, fps: float, labels: list[str], stature: float) -> dict:
     """The ``self_penetration`` entry of :func:`check_biomechanics`; ``p`` is (T, J, 3)."""
-    depth, names = self_penetration(p, stature)
-    f, k = np.unravel_index(int(np.argmax(depth)), depth.shape) if depth.size else (0, 0)
-    dmax = float(depth[f, k]) if depth.size else -1.0
+    deepest = _deepest_penetration(p, stature) if _PAIRS else None
+    if deepest is not None:
+        f, k, dmax = deepest
+        names = _PAIR_NAMES
+    else:
+        depth, names = self_penetration(p, stature)
+        f, k = np.unravel_index(int(np.argmax(depth)), depth.shape) if depth.size else (0, 0)
+        dmax = float(depth[f, k]) if depth.size else -1.0
     ok = dmax <= 0.0
     a, b = names[k] if names else ("", "")
     return _entry(
