@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 
 import numba
-import numpy as np
 
 _jit = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy")
 

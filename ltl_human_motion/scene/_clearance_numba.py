@@ -109,3 +109,19 @@ def segment_aabb_distance(a, b, lo, hi, out) -> None:
             stat = min(max(stat, t0), t1)
             best = min(best, _box_point(an, d, stat, lo, hi, n))
         out[n] = best
+
+
+@_jit
+def point_bounds(rows, lo, hi) -> None:
+    """lo[m], hi[m] (3,): the least and greatest coordinates of the points rows[m] (M, N, 3),
+    N >= 1, taken as ``np.minimum`` and ``np.maximum`` fold them point after point (a NaN
+    propagates; of two equal values the later one is kept)."""
+    for m in range(rows.shape[0]):
+        for c in range(3):
+            a = b = rows[m, 0, c]
+            for n in range(1, rows.shape[1]):
+                v = rows[m, n, c]
+                a = a if (a < v or a != a) else v
+                b = b if (b > v or b != b) else v
+            lo[m, c] = a
+            hi[m, c] = b

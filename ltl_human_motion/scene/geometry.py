@@ -86,6 +86,14 @@ def point_bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     lo, hi : ndarray, shape (..., 3)
     """
     p = np.asarray(points, dtype=np.float64)
+    if p.ndim >= 2 and p.shape[-2] and p.shape[-1] == 3:
+        from ltl_human_motion.kernel.segments import compiled_module
+        nb = compiled_module("ltl_human_motion.scene._clearance_numba")
+        if nb is not None:                      # one pass, no point-major copy
+            rows = np.ascontiguousarray(p.reshape(-1, p.shape[-2], 3))
+            lo, hi = np.empty((len(rows), 3)), np.empty((len(rows), 3))
+            nb.point_bounds(rows, lo, hi)
+            return lo.reshape((*p.shape[:-2], 3)), hi.reshape((*p.shape[:-2], 3))
     # Reduced over the leading axis of a point-major copy: elementwise over contiguous
     # rows, much faster than a reduction over the middle axis.
     rows = np.ascontiguousarray(np.moveaxis(p, -2, 0))                    # (N, ..., 3)
