@@ -235,3 +235,31 @@ def test_compiled_stance_loop_equals_the_numpy_path() -> None:
         assert np.array_equal(s_nb, s_np)
         checked += int(np.any(w_np > 0))
     assert checked > 30
+
+
+def test_compiled_leg_solve_equals_the_numpy_path(monkeypatch) -> None:
+    """The compiled leg re-solve (targets out of reach raise the heel, rate-limited
+    corrections, the knee's pole, two-bone IK) gives the numpy path's joints bit for bit."""
+    from ltl_human_motion.kernel.segments import compiled_module
+    from ltl_human_motion.planning import footlock
+    if compiled_module("ltl_human_motion.planning._motion_numba") is None:
+        import pytest
+        pytest.skip("numba kernels not in use")
+    rng = np.random.default_rng(6)
+    bones = SK.bone_lengths()
+    cases = []
+    for trial in range(24):
+        p = _slide_left_foot(_standing(240), speed=0.3, yaw_rate=0.5 * (trial % 3))
+        p = p + rng.normal(size=p.shape) * [0.0, 0.001, 0.01][trial % 3]
+        s = "lr"[trial % 2]
+        ank, toe = p[:, J[f"{s}_ankle"]], p[:, J[f"{s}_toe"]]
+        shift = rng.normal(size=(len(p), 3)) * [0.0, 0.01, 0.05, 0.2][trial % 4]
+        shift[rng.random(len(p)) < 0.3] = 0.0               # frames left where they are
+        if trial % 5 == 0:
+            shift[:, 2] -= 0.3                               # out of the leg's reach
+        cases.append((p, s, ank + shift, toe + shift))
+    got = [footlock._solve_leg(p, s, bones, a, t, FPS) for p, s, a, t in cases]
+    monkeypatch.setattr(footlock, "_compiled", lambda: None)
+    for (p, s, a, t), joints in zip(cases, got):
+        ref = footlock._solve_leg(p, s, bones, a, t, FPS)
+        assert all(x.tobytes() == y.tobytes() for x, y in zip(joints, ref))

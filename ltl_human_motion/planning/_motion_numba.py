@@ -9,6 +9,8 @@ import math
 import numba
 import numpy as np
 
+from ltl_human_motion.motion._ik_numba import chain
+
 _jit = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
 
@@ -258,3 +260,97 @@ def lock_stances(held, joints, h, hc, vc, contact, starts, ends, stance, ramp, f
                         disp[b + i, j, c] = disp[b - 1, j, c] * w
                 weight[b + i] = w
     return 0
+
+
+@_jit
+def _unit_to(x0, x1, x2, y0, y1, y2, length):
+    """x + length * (y - x) / max(|y - x|, 1e-12) (``footlock._unit3``), (3 floats)."""
+    v0, v1, v2 = y0 - x0, y1 - x1, y2 - x2
+    n = math.sqrt(0.0 + v0 * v0 + v1 * v1 + v2 * v2)
+    n = n if n > 1e-12 else 1e-12
+    return x0 + length * (v0 / n), x1 + length * (v1 / n), x2 + length * (v2 / n)
+
+
+@_jit
+def leg_corrections(p, hip, ank, toe, ank_all, toe_all, leg, f_len, moved, da, dt) -> None:
+    """The first half of ``footlock._solve_leg``, step for step: the frames whose ankle
+    or toe target moves (``moved`` (T,)), and the corrections da, dt (T, 3) towards the
+    targets (zero elsewhere), the heel raised where the leg cannot reach the ankle's."""
+    for t in range(p.shape[0]):
+        m = False
+        for c in range(3):
+            m = m or abs(ank_all[t, c] - p[t, ank, c]) > 1e-9 \
+                or abs(toe_all[t, c] - p[t, toe, c]) > 1e-9
+        moved[t] = m
+        if not m:
+            for c in range(3):
+                da[t, c] = 0.0
+                dt[t, c] = 0.0
+            continue
+        h0, h1, h2 = p[t, hip, 0], p[t, hip, 1], p[t, hip, 2]
+        a0, a1, a2 = ank_all[t, 0], ank_all[t, 1], ank_all[t, 2]
+        o0, o1, o2 = toe_all[t, 0], toe_all[t, 1], toe_all[t, 2]
+        r0, r1, r2 = p[t, ank, 0] - h0, p[t, ank, 1] - h1, p[t, ank, 2] - h2
+        r = math.sqrt(0.0 + r0 * r0 + r1 * r1 + r2 * r2)
+        reach = leg if leg > r else r
+        w0, w1, w2 = a0 - h0, a1 - h1, a2 - h2
+        if math.sqrt(0.0 + w0 * w0 + w1 * w1 + w2 * w2) > reach:
+            g0, g1, g2 = o0 - h0, o1 - h1, o2 - h2
+            D = math.sqrt(0.0 + g0 * g0 + g1 * g1 + g2 * g2)
+            Dm = D if D > 1e-9 else 1e-9
+            u0, u1, u2 = g0 / Dm, g1 / Dm, g2 / Dm
+            x = (D * D + reach * reach - f_len * f_len) / (2.0 * Dm)
+            x = -reach if x < -reach else x
+            x = reach if x > reach else x
+            rr = reach * reach - x * x
+            rho = math.sqrt(rr if rr > 0.0 else 0.0)
+            c0, c1, c2 = h0 + u0 * x, h1 + u1 * x, h2 + u2 * x
+            q0, q1, q2 = a0 - c0, a1 - c1, a2 - c2
+            s = 0.0 + q0 * u0 + q1 * u1 + q2 * u2
+            q0, q1, q2 = q0 - s * u0, q1 - s * u1, q2 - s * u2
+            qn = math.sqrt(0.0 + q0 * q0 + q1 * q1 + q2 * q2)
+            qn = qn if qn > 1e-9 else 1e-9
+            q0, q1, q2 = q0 / qn, q1 / qn, q2 / qn
+            n0, n1, n2 = c0 + rho * q0, c1 + rho * q1, c2 + rho * q2
+            if D <= reach + f_len and n2 >= a2:
+                a0, a1, a2 = n0, n1, n2
+                o0, o1, o2 = _unit_to(a0, a1, a2, o0, o1, o2, f_len)
+        da[t, 0], da[t, 1], da[t, 2] = a0 - p[t, ank, 0], a1 - p[t, ank, 1], a2 - p[t, ank, 2]
+        dt[t, 0], dt[t, 1], dt[t, 2] = o0 - p[t, toe, 0], o1 - p[t, toe, 1], o2 - p[t, toe, 2]
+
+
+@_jit
+def leg_solve(p, hip, knee, ank, toe, l_hip, r_hip, moved, da, dt, offset, l1, l2, dmin,
+              dmax, f_len, pole_forward, kn_out, an_out, to_out) -> None:
+    """The second half of ``footlock._solve_leg``, step for step: on the moved frames the
+    knee, ankle and toe by two-bone IK from the hip towards the rate-limited targets
+    p + da, p + dt (T, 3), the knee bent towards the smoothed ``offset`` (T, 3) and
+    forward; kn_out, an_out, to_out (T, 3) hold the other frames' joints already."""
+    for t in range(p.shape[0]):
+        if not moved[t]:
+            continue
+        f0, f1 = p[t, toe, 0] - p[t, ank, 0], p[t, toe, 1] - p[t, ank, 1]
+        fn = math.sqrt(0.0 + f0 * f0 + f1 * f1)
+        fn = fn if fn > 1e-9 else 1e-9
+        w0, w1, w2 = f0 / fn, f1 / fn, 0.0
+        e0 = (p[t, l_hip, 1] - p[t, r_hip, 1]) * 1.0
+        e1 = (p[t, l_hip, 0] - p[t, r_hip, 0]) * -1.0
+        en = math.sqrt(0.0 + e0 * e0 + e1 * e1 + 0.0 * 0.0)
+        en = en if en > 1e-9 else 1e-9
+        e0, e1, e2 = e0 / en, e1 / en, 0.0 / en
+        q0 = offset[t, 0] + 0.01 * w0
+        q1 = offset[t, 1] + 0.01 * w1
+        q2 = offset[t, 2] + 0.01 * w2
+        lean = 0.0 + q0 * e0 + q1 * e1 + q2 * e2
+        more = pole_forward - lean
+        more = more if (more > 0.0 or more != more) else 0.0
+        q0, q1, q2 = q0 + more * e0, q1 + more * e1, q2 + more * e2
+        k0, k1, k2, n0, n1, n2 = chain(
+            p[t, hip, 0], p[t, hip, 1], p[t, hip, 2],
+            p[t, ank, 0] + da[t, 0], p[t, ank, 1] + da[t, 1], p[t, ank, 2] + da[t, 2],
+            q0, q1, q2, l1, l2, dmin, dmax)
+        kn_out[t, 0], kn_out[t, 1], kn_out[t, 2] = k0, k1, k2
+        an_out[t, 0], an_out[t, 1], an_out[t, 2] = n0, n1, n2
+        to_out[t, 0], to_out[t, 1], to_out[t, 2] = _unit_to(
+            n0, n1, n2, p[t, toe, 0] + dt[t, 0], p[t, toe, 1] + dt[t, 1],
+            p[t, toe, 2] + dt[t, 2], f_len)

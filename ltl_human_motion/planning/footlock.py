@@ -611,6 +611,11 @@ def _solve_leg(p: np.ndarray, s: str, bones: np.ndarray, ank_all: np.ndarray,
     towards the ankle and toe targets (T, 3) by two-bone IK from the unchanged hip."""
     hip, knee, ank, toe = (_J[f"{s}_{n}"] for n in ("hip", "knee", "ankle", "toe"))
     kn_out, an_out, to_out = p[:, knee].copy(), p[:, ank].copy(), p[:, toe].copy()
+    nb = _compiled()
+    if nb is not None and np.isfinite(p).all() and np.isfinite(ank_all).all() \
+            and np.isfinite(toe_all).all():
+        return _solve_leg_compiled(nb, p, s, bones, ank_all, toe_all, fps,
+                                   (kn_out, an_out, to_out))
     moved = (np.any(np.abs(ank_all - p[:, ank]) > 1e-9, axis=1)
              | np.any(np.abs(toe_all - p[:, toe]) > 1e-9, axis=1))
     if not np.any(moved):
@@ -673,3 +678,35 @@ def _solve_leg(p: np.ndarray, s: str, bones: np.ndarray, ank_all: np.ndarray,
     an_out[moved] = an
     to_out[moved] = an + float(bones[toe]) * _unit3(toe_target - an)
     return kn_out, an_out, to_out
+
+
+def _solve_leg_compiled(nb: ModuleType, p: np.ndarray, s: str, bones: np.ndarray,
+                        ank_all: np.ndarray, toe_all: np.ndarray, fps: float,
+                        out: tuple[np.ndarray, np.ndarray, np.ndarray]
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_solve_leg` by the compiled loops (the same numbers): ``out`` are the knee,
+    ankle and toe (T, 3) each, copies of ``p``'s (finite), changed on the moved frames."""
+    hip, knee, ank, toe = (_J[f"{s}_{n}"] for n in ("hip", "knee", "ankle", "toe"))
+    T = len(p)
+    pc = np.ascontiguousarray(p, dtype=np.float64)
+    moved = np.empty(T, dtype=np.bool_)
+    da, dt = np.empty((T, 3)), np.empty((T, 3))
+    f_len = float(bones[toe])
+    nb.leg_corrections(pc, hip, ank, toe, np.ascontiguousarray(ank_all, dtype=np.float64),
+                       np.ascontiguousarray(toe_all, dtype=np.float64),
+                       float(0.995 * (bones[knee] + bones[ank])), f_len, moved, da, dt)
+    if not np.any(moved):
+        return out
+    # no correction changes faster than MAX_CORRECTION_RATE
+    step = MAX_CORRECTION_RATE / fps
+    da, dt = _rate_limited(da, step), _rate_limited(dt, step)
+    offset = p[:, knee] - 0.5 * (p[:, hip] + p[:, ank])
+    offset = uniform_filter1d(offset, 2 * max(1, round(POLE_SMOOTH * fps)) + 1, axis=0,
+                              mode="nearest")
+    l1, l2 = bones[knee], bones[ank]
+    nb.leg_solve(pc, hip, knee, ank, toe, _J["l_hip"], _J["r_hip"], moved,
+                 np.ascontiguousarray(da), np.ascontiguousarray(dt),
+                 np.ascontiguousarray(offset, dtype=np.float64), float(l1), float(l2),
+                 float(abs(l1 - l2) + 1e-6), float(1.0 * (l1 + l2)), f_len, POLE_FORWARD,
+                 *out)
+    return out
