@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from ltl_human_motion.planning.junction_repair import UNLOCK_HOLD, UNLOCK_RAMP, unlock_weights
 
@@ -36,3 +37,17 @@ def test_a_foot_locked_through_the_other_leg_is_unlocked_there(monkeypatch) -> N
     monkeypatch.setattr(pipeline, "JUNCTION_REPAIRS", 0)
     m = synthesize(PAPER_SPECS["S2"], cell, stature=1.65, seed=4, options=bio)[0]
     assert not m.verification["self_penetration"]["passed"]
+
+
+@pytest.mark.slow
+def test_a_junction_still_too_fast_after_one_stretch_is_stretched_again() -> None:
+    """A generated cell's carry for a 1.95 m worker: a toe at a junction of two walking
+    clips moved at 5.55 m/s against its 5.46 m/s limit after the junction's windows were
+    doubled once; doubled again on the next repair, the motion verifies."""
+    from ltl_human_motion.planning import synthesize
+    from ltl_human_motion.scenarios.generator import generate_scenarios
+    from ltl_human_motion.scene.cell_yaml import cell_from_yaml
+    scen = generate_scenarios(9, seed=0)[8]
+    cell = cell_from_yaml(scen.yaml)
+    motion = synthesize("F carry(P8, Zone20)", cell, stature=scen.stature, seed=0)[0]
+    assert motion.verification["passed"] and motion.verification["joint_speed"]["passed"]

@@ -118,6 +118,12 @@ class Goal:
         ``clearance(xy (M, 2)) -> (M,)``: the floor clearance map the walk to this goal
         keeps ``body_radius`` on, when not the caller's default (a squeeze through a
         narrow aisle keeps it on the obstacles' footprints).
+    stop_clearance : callable or None
+        Where no step into a stop keeps ``body_radius`` on ``clearance``, the floor map
+        it may keep it on instead: the footprint map where the search checks the whole
+        body, as the body stands still there with its arms at its sides (the walking
+        map, widened for swinging arms at shelves, held stops in a 0.83 m aisle to its
+        middle line, and the search spent its budget there).
     reroute : callable or None
         ``reroute((x, y)) -> Goal | None``: the same goal with a heuristic that avoids the
         floor around (x, y), where a search stalled (None: no other way).
@@ -132,6 +138,7 @@ class Goal:
     heading: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     description: str = ""
     clearance: Callable[[np.ndarray], np.ndarray] | None = None
+    stop_clearance: Callable[[np.ndarray], np.ndarray] | None = None
     reroute: Callable[[tuple[float, float]], Goal | None] | None = None
     possible: Callable[[], bool] | None = None
 
@@ -254,14 +261,18 @@ def _arrivals(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, goal: Goal,
               forbidden: frozenset[tuple[int, int, int, int]], options: SearchOptions
               ) -> tuple[np.ndarray, list[tuple[int, Pose]]]:
     """Which successors (M,) end the search: a stop primitive in the goal, or a walking
-    one in the goal that a stop primitive can finish (the first such; its end pose in
+    one in the goal that a stop primitive can finish (the first such, keeping
+    ``body_radius`` on ``clearance``, else on ``goal.stop_clearance``; its end pose in
     ``ends`` becomes the stop's, and the stop is returned as the tail to append)."""
     near = goal.reached(ends[:, 0], ends[:, 1], ends[:, 2])
     done = near & index.stops[succ]
     tail: list[tuple[int, Pose]] = []
     if not done.any() and near.any():
-        found = _first_stop(index, succ, ends, np.flatnonzero(near), goal, allowed,
-                            clearance, body_clear, forbidden, options)
+        found = None
+        for floor in (clearance, goal.stop_clearance):
+            if found is None and floor is not None:
+                found = _first_stop(index, succ, ends, np.flatnonzero(near), goal, allowed,
+                                    floor, body_clear, forbidden, options)
         if found is not None:
             m, stop, end = found
             tail = [(stop, (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2])))]

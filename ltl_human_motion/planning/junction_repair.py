@@ -28,8 +28,10 @@ from ltl_human_motion.planning.verify import colliding_frames
 
 #: Times a motion is blended again with repaired junctions.
 JUNCTION_REPAIRS = 3
-#: Factor on the windows of a junction near a joint faster than its limit.
+#: Factor on the windows of a junction near a joint faster than its limit, each repair.
 JUNCTION_STRETCH = 2.0
+#: The most a junction's windows are stretched, repair after repair.
+MAX_STRETCH = JUNCTION_STRETCH ** JUNCTION_REPAIRS
 #: Seconds around a frame that foot locking moved into an obstacle or through a body
 #: part over which it is faded out, and the length of the fades on either side.
 UNLOCK_HOLD = 0.1
@@ -94,8 +96,8 @@ def repaired(report: dict, synth, cell, held: dict[str, np.ndarray] | None, stat
     frames = np.flatnonzero(fast)
     stretch = dict(repairs.stretch)
     for i, c in enumerate(junctions):
-        if i not in stretch and frames.size and np.min(np.abs(frames - c)) <= window:
-            stretch[i] = JUNCTION_STRETCH
+        if frames.size and np.min(np.abs(frames - c)) <= window:
+            stretch[i] = min(stretch.get(i, 1.0) * JUNCTION_STRETCH, MAX_STRETCH)
     if stretch == repairs.stretch:
         return None
     return JunctionRepairs(dict(repairs.shares), stretch, repairs.unlock)

@@ -165,7 +165,7 @@ class SequencePlanner:
         self.ctx = PlanContext.build(cell, library, rng, options)
         self.state = WorkerState()
         self.executor = StepExecutor(self.ctx, self.state)
-        self.goals = WalkGoals(self.ctx, self.state)
+        self.goals = WalkGoals(self.ctx, self.state, turn_clear=self.executor.turn_clear)
         self.goal_steps = GoalSteps(self.ctx, self.state, self.executor, self.goals)
         self.steps: list[StepPlan] = []
         #: Steps that failed in an earlier order of the tasks, by :meth:`situation`: the

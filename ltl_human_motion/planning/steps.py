@@ -94,6 +94,11 @@ SWEEP_PARTS: tuple[str, ...] = ("l_upper_arm", "r_upper_arm", "l_lower_arm", "r_
                                 "l_hand", "r_hand", "l_palm", "r_palm")
 _SWEEP_INDICES = part_indices(SWEEP_PARTS)
 
+#: Headings at which :meth:`StepExecutor.turn_clear` checks the body (odd, as
+#: :meth:`StepExecutor.body_clear` reads even and odd samples): 0.4 rad apart in a
+#: half turn.
+TURN_SAMPLES = 9
+
 #: Searches run again after the path found collided on a frame the search did not
 #: sample (each forbids the colliding primitive at its pose).
 WALK_REPAIRS = 4
@@ -268,6 +273,27 @@ class StepExecutor:
             keep = out.nonzero()[0]
             out[keep] = self.held_clear(poses[keep], standing[keep])
         return out
+
+    def turn_clear(self, x: np.ndarray, y: np.ndarray, yaw: np.ndarray, to_yaw: np.ndarray
+                   ) -> np.ndarray:
+        """Whether the standing body (and the parts in hand) turned on the spot at floor
+        points (x, y) from ``yaw`` to ``to_yaw`` keeps clear (:meth:`body_clear` of the
+        stance at ``TURN_SAMPLES`` headings between; a standing primitive's rule: no
+        part gets closer than it starts). All (M,); bool (M,). The room a walk needs to
+        end turned away from its goal, asked of the body instead of a disc on the floor:
+        in an aisle 0.8 m wide the hips turn, while the walking map, widened for the arms
+        at tall parts, has no disc of that radius."""
+        lib = self.ctx.library
+        stance = self.ctx.stance(self.state.carrying)                         # (J, 3)
+        a = np.asarray(yaw, dtype=float)[:, None] + np.asarray(
+            wrap_angle(np.asarray(to_yaw) - np.asarray(yaw)), dtype=float)[:, None] \
+            * np.linspace(0.0, 1.0, TURN_SAMPLES)                              # (M, K)
+        c, s = np.cos(a)[..., None], np.sin(a)[..., None]
+        poses = np.empty(a.shape + stance.shape)
+        poses[..., 0] = c * stance[:, 0] - s * stance[:, 1] + np.asarray(x)[:, None, None]
+        poses[..., 1] = s * stance[:, 0] + c * stance[:, 1] + np.asarray(y)[:, None, None]
+        poses[..., 2] = stance[:, 2] + lib.standing_height
+        return self.body_clear(poses, np.ones(len(poses), dtype=bool))
 
     def search_options(self):
         """The search's options, with the body's exact checks (``near_radius``) begun far
@@ -447,7 +473,6 @@ class StepExecutor:
         hand or elbow into a rack's board (a tall worker's hands at the 0.91 m board,
         elbows at the 1.2 m board) and the search floods the spot until its budget runs
         out; square to the gap it may walk out. Returns whether the step was added."""
-        from ltl_human_motion.planning.turns import make_step_primitive
         x, y, yaw = self.state.pose
         axis = self.gap_axis(goal)
         if axis is None:
@@ -467,15 +492,9 @@ class StepExecutor:
         if math.hypot(dxw, dyw) < ADJUST_STILL[0] and \
                 abs(float(wrap_angle(axis - yaw))) < ADJUST_STILL[1]:
             return False                    # square already
-        lib = self.ctx.library
-        mp = make_step_primitive(self.ctx.stance(carrying), lib.standing_height,
-                                 c * dxw + s * dyw, -s * dxw + c * dyw,
-                                 float(wrap_angle(axis - yaw)), lib.skeleton, lib.fps,
-                                 "carry" if carrying else "walk")
-        if not self.placed_clear(mp, self.state.pose, samples=None):
+        if not self.take_steps([((c * dxw + s * dyw, -s * dxw + c * dyw,
+                                  float(wrap_angle(axis - yaw))),)]):
             return False
-        self.add(mp, self.state.pose, -1, self.ctx.overlap)
-        self.state.pose = self.hand_over_pose(mp, self.state.pose)
         self.state.gait_state = None
         return True
 
@@ -784,47 +803,51 @@ class StepExecutor:
         If that step would touch an obstacle, stand a little further back (up to 15 cm).
         Returns False if no adjustment is clear (the worker stays where the walk ended).
         """
-        from ltl_human_motion.planning.turns import make_step_primitive
         x, y, yaw = self.state.pose
         px, py, pyaw, _ = (float(v[0]) for v in ideal_placement(
             self.ctx, target, placement, np.array([x]), np.array([y]), back_limit,
             stand_yaw=stand_yaw))
-        carrying = self.state.carrying
         back_dir = np.array([math.cos(pyaw), math.sin(pyaw)])
         c, s = math.cos(yaw), math.sin(yaw)
-        stance = self.ctx.stance(carrying)
-        task_name = "carry" if carrying else "walk"
-        lib = self.ctx.library
-
-        def step(dx: float, dy: float, dyaw: float) -> MotionPrimitive:
-            return make_step_primitive(stance, lib.standing_height, dx, dy, dyaw, lib.skeleton,
-                                       lib.fps, task_name)
-
         for back in ADJUST_BACKS:
             qx, qy = px - back * back_dir[0], py - back * back_dir[1]
             dx, dy = c * (qx - x) + s * (qy - y), -s * (qx - x) + c * (qy - y)
             dyaw = float(wrap_angle(pyaw - yaw))
             if math.hypot(dx, dy) < ADJUST_STILL[0] and abs(dyaw) < ADJUST_STILL[1]:
                 return True
-            # Step and turn at once; or turn where the walk ended, then step in. The
-            # primitives are made when tried (the first plan is usually clear).
+            # Step and turn at once; or turn where the walk ended, then step in.
             cp, sp = math.cos(dyaw), math.sin(dyaw)
-            plans = [((dx, dy, dyaw),),
-                     ((0.0, 0.0, dyaw), (cp * dx + sp * dy, -sp * dx + cp * dy, 0.0))]
-            for moves in plans:
-                pose = self.state.pose
-                plan = []
-                for move in moves:
-                    mp = step(*move)
-                    if not self.placed_clear(mp, pose):
-                        break
-                    plan.append(mp)
-                    pose = self.hand_over_pose(mp, pose)
-                if len(plan) == len(moves):
-                    for mp in plan:
-                        self.add(mp, self.state.pose, -1, self.ctx.overlap)
-                        self.state.pose = self.hand_over_pose(mp, self.state.pose)
-                    return True
+            if self.take_steps([((dx, dy, dyaw),),
+                                ((0.0, 0.0, dyaw), (cp * dx + sp * dy, -sp * dx + cp * dy,
+                                                    0.0))]):
+                return True
+        return False
+
+    def take_steps(self, plans: list[tuple[tuple[float, float, float], ...]]) -> bool:
+        """Add the first of ``plans`` whose standing steps all keep the body and the
+        parts in hand clear on every frame (:meth:`placed_clear`); each plan is a
+        sequence of moves (dx, dy, dyaw) (m, m, rad) in the frame of the pose the move
+        starts from (:func:`.turns.make_step_primitive`). The primitives are made when
+        tried (the first plan is usually clear). Returns whether a plan was added."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        lib = self.ctx.library
+        carrying = self.state.carrying
+        stance = self.ctx.stance(carrying)
+        for moves in plans:
+            pose = self.state.pose
+            plan = []
+            for dx, dy, dyaw in moves:
+                mp = make_step_primitive(stance, lib.standing_height, dx, dy, dyaw,
+                                         lib.skeleton, lib.fps, "carry" if carrying else "walk")
+                if not self.placed_clear(mp, pose):
+                    break
+                plan.append(mp)
+                pose = self.hand_over_pose(mp, pose)
+            if len(plan) == len(moves):
+                for mp in plan:
+                    self.add(mp, self.state.pose, -1, self.ctx.overlap)
+                    self.state.pose = self.hand_over_pose(mp, self.state.pose)
+                return True
         return False
 
 

@@ -66,6 +66,11 @@ STALL_BLOCK_RADIUS = 0.3
 #: 72 directions (5 degrees, 2-3 cm apart at the 0.25-0.4 m ring).
 RING_SAMPLES = (8, 72)
 
+#: ``turn_clear(x, y, yaw, to_yaw) -> bool`` (all (M,)): whether the standing body turned
+#: on the spot at (x, y) from ``yaw`` to ``to_yaw`` keeps clear
+#: (:meth:`.steps.StepExecutor.turn_clear`).
+TurnClear = Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+
 #: Navigation fields by floor grid and goal (see :meth:`WalkGoals.field`).
 _FIELD_CACHE: BoundedCache[NavigationField] = BoundedCache(16)
 
@@ -130,20 +135,26 @@ def _stands_to_reach(ctx: PlanContext, target: np.ndarray, placement: tuple[floa
                      back: float, adjust: float,
                      side: Callable[[np.ndarray, np.ndarray], np.ndarray],
                      walk_map: Callable[[np.ndarray], np.ndarray], stand_yaw: float | None,
-                     inner: float, x: np.ndarray, y: np.ndarray, yaw: np.ndarray | None
-                     ) -> np.ndarray:
+                     inner: float, turn_clear: TurnClear | None, x: np.ndarray,
+                     y: np.ndarray, yaw: np.ndarray | None) -> np.ndarray:
     """The goal test of :meth:`WalkGoals.reach` for root poses (x, y, yaw) (M,) in its
     band: the ideal spot (:func:`.standing.ideal_placement`, up to ``back`` further back;
     room on ``walk_map``) is free, within ``adjust`` and on ``side``, and the worker
-    faces its way or has room to turn there (any heading where ``yaw`` is None); with
-    ``stand_yaw``, the root at least ``inner`` from the target. Bool (M,)."""
+    faces its way or has room to turn there: ``turn_room`` of floor, or where there is
+    less, the body turned on the spot keeps clear (``turn_clear``); any heading where
+    ``yaw`` is None. With ``stand_yaw``, the root at least ``inner`` from the target.
+    Bool (M,)."""
     px, py, pyaw, free, here = ideal_placement(ctx, target, placement, x, y, back, room=True,
                                                walk_map=walk_map, stand_yaw=stand_yaw)
     out = free & (np.hypot(px - x, py - y) <= adjust) & side(x, y)
     if yaw is not None:
         # Turning on the spot needs room for the hips; facing nearly right needs none.
-        out &= (here > ctx.turn_room) \
-            | (np.abs(wrap_angle(pyaw - yaw)) <= ctx.options.heading_tolerance)
+        turn = (here <= ctx.turn_room) \
+            & (np.abs(wrap_angle(pyaw - yaw)) > ctx.options.heading_tolerance)
+        if turn_clear is not None and (out & turn).any():
+            k = np.flatnonzero(out & turn)
+            turn[k] = ~turn_clear(x[k], y[k], yaw[k], pyaw[k])
+        out &= ~turn
     if stand_yaw is not None:
         # The spot is fixed: a walk must still end on the ring, not nearer (under the
         # board the standing step would have to back out of).
@@ -202,11 +213,16 @@ class WalkGoals:
     ctx : PlanContext
     state : WorkerState
         Read for where the worker stands now and whether it carries a part.
+    turn_clear : TurnClear, optional
+        Whether the body turns on the spot clear where the floor has less than
+        ``turn_room`` (without it, such spots end a walk only facing the goal's way).
     """
 
-    def __init__(self, ctx: PlanContext, state: WorkerState) -> None:
+    def __init__(self, ctx: PlanContext, state: WorkerState,
+                 turn_clear: TurnClear | None = None) -> None:
         self.ctx = ctx
         self.state = state
+        self.turn_clear = turn_clear
 
     def field(self, goal_cells, key: tuple | None = None, squeeze: bool = False
               ) -> NavigationField:
@@ -273,7 +289,16 @@ class WalkGoals:
             return self.from_field(around, reached, desc, task, heading)
 
         return Goal(reached, distance, field.heading if heading is None else heading(field),
-                    desc, clearance=field.grid.clearance, reroute=reroute)
+                    desc, clearance=field.grid.clearance, stop_clearance=self.stop_floor,
+                    reroute=reroute)
+
+    def stop_floor(self, xy: np.ndarray) -> np.ndarray:
+        """The floor map a walk's last step into a stop keeps ``body_radius`` on where the
+        walking map leaves it none (:attr:`.astar.Goal.stop_clearance`): the footprint
+        map less the room a standing body needs beyond that radius (``stand_room``, as
+        for a goal primitive's spot), so that the legs stop clear of the furniture.
+        ``xy`` (M, 2); (M,)."""
+        return self.ctx.stand_map(xy) - (self.ctx.stand_room - self.ctx.options.body_radius)
 
     def reach(self, target: np.ndarray, placement: tuple[float, float], desc: str,
               task: str, adjust: float | None = None,
@@ -333,7 +358,7 @@ class WalkGoals:
 
         reached_in_band = functools.partial(
             _stands_to_reach, self.ctx, target, placement, back, adjust, side,
-            field.grid.clearance, stand_yaw, dist - tol)
+            field.grid.clearance, stand_yaw, dist - tol, self.turn_clear)
 
         def reached(x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
             r = np.hypot(tx - x, ty - y)
