@@ -34,7 +34,7 @@ setup(
     },
     entry_points={
         "console_scripts": [
-            "ltl-human-motion = ltl_human_motion.cli:main",
+            "ltl-human-motion = ltl_human_motion.cli:run",
             "synthesis_node = ltl_human_motion.ros.entry_points:synthesis_node",
             "skeleton_publisher = ltl_human_motion.ros.entry_points:skeleton_publisher",
             "occupancy_node = ltl_human_motion.ros.entry_points:occupancy_node",

@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from ltl_human_motion import __version__
 from ltl_human_motion.cli import interrupts
 from ltl_human_motion.errors import LtlHumanMotionError
+from ltl_human_motion.kernel.kept_alive import end_if_kept
 
 SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tasks", "library", "synthesize", "render", "paper", "batch", "bringup", "call", "ur_sim",
@@ -60,6 +61,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 1
         code = int(args._run(args) or 0)
         interrupts.check()
+        sys.stdout.flush()           # a closed pipe fails here, not at the final flush
         return code
     except LtlHumanMotionError as exc:
         print(f"ltl-human-motion {args.command}: error: {exc}", file=sys.stderr)
@@ -74,5 +76,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 141
 
 
+def run() -> None:
+    """The console script: :func:`main`'s exit code, ended past the teardown where a
+    broken robot interface is kept alive (:func:`.kernel.kept_alive.end_if_kept`)."""
+    code = main()
+    end_if_kept(code)
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()

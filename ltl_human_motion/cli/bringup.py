@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from ltl_human_motion.cli import interrupts
+from ltl_human_motion.kernel.kept_alive import end_if_kept
 
 NAME = "bringup"
 HELP = "start the ROS 2 nodes of a bringup file in one process (optionally recording MCAP)"
@@ -149,4 +150,6 @@ def ros_entry_point(args: list[str] | None = None) -> int:
     from ltl_human_motion.cli import main
 
     argv = sys.argv[1:] if args is None else list(args)
-    return main([NAME, *rclpy.utilities.remove_ros_args(argv)])
+    code = main([NAME, *rclpy.utilities.remove_ros_args(argv)])
+    end_if_kept(code)
+    return code

@@ -37,7 +37,6 @@ still-broken one alive until the process exits rather than destroying it.
 
 from __future__ import annotations
 
-import ctypes
 import logging
 import math
 import threading
@@ -49,6 +48,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ltl_human_motion.kernel.kept_alive import keep_alive_forever
 from ltl_human_motion.kernel.segments import (
     check_capsules,
     compiled,
@@ -224,8 +224,6 @@ class _Occupancy:
     horizons: NDArray[np.float64] | None = None
 
 
-_KEEP_ALIVE: list[object] = []
-
 #: Seconds :meth:`CoexistenceController.close` waits for one RTDE interface's disconnect
 #: (about 1 ms from a live controller).
 DISCONNECT_TIMEOUT = 1.0
@@ -247,12 +245,6 @@ def _disconnect_within(obj: Any, timeout: float) -> str | None:
     thread.start()
     thread.join(timeout)
     return failure[0] if thread.is_alive() or failure else None
-
-
-def _keep_alive_forever(obj: object) -> None:
-    """Never destroy ``obj`` (a broken ur_rtde interface whose destructor would abort)."""
-    _KEEP_ALIVE.append(obj)
-    ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))
 
 
 class CoexistenceController:
@@ -656,7 +648,7 @@ class CoexistenceController:
                     continue
                 log.warning("RTDE %s: disconnect failed (%s)", attr[1:], failure)
             lost.append(attr[1:])
-            _keep_alive_forever(obj)
+            keep_alive_forever(obj)
         if lost:
             log.warning("robot connection lost before the stop (RTDE %s); not disconnected",
                         " and ".join(lost))

@@ -18,6 +18,8 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
+from ltl_human_motion.kernel.kept_alive import end_if_kept
+
 if TYPE_CHECKING:
     from rclpy.node import Node
 
@@ -40,9 +42,11 @@ def quiet_on_interrupt(entry: Callable[..., int]) -> Callable[..., int]:
     @functools.wraps(entry)
     def run(*args: object, **kwargs: object) -> int:
         try:
-            return entry(*args, **kwargs)
+            code = entry(*args, **kwargs)
         except KeyboardInterrupt:
-            return 0
+            code = 0
+        end_if_kept(code)
+        return code
     return run
 
 
