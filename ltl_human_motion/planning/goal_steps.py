@@ -507,12 +507,12 @@ class GoalSteps:
         Returns the gait primitives walked."""
         lowered = raised and not self.state.held
         if lowered:
-            self.executor.arm_transition(True, -1)
+            self.executor.arm_transition(True, -1, text)
         self.executor.step_out()            # the first try may have left the worker at a rack
         walked = self.approach(target, spot, text, sector=sector, budget=budget,
                                stand_yaw=stand_yaw)
         if lowered or (raise_back and not self.state.held):
-            self.executor.arm_transition(False, -1)
+            self.executor.arm_transition(False, -1, text)
             if not lowered:
                 self.state.start_arms = StartArms(self.ctx.stance(True), 0.0)
         return walked

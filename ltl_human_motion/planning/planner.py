@@ -394,7 +394,7 @@ class SequencePlanner:
                 settle(self.goal_steps, arms, i, text)
             carrying_before = True
         if self.state.carrying != carrying_before and self.state.seat is None:
-            self.executor.arm_transition(carrying_before, i)
+            self.executor.arm_transition(carrying_before, i, text)
         if kind in ("sit", "standUp"):
             self.state.seat = target if kind == "sit" else None
         lift = None

@@ -365,8 +365,10 @@ class StepExecutor:
         return bool(np.sum(np.abs(offset(self.ctx.stance(True)) - seated))
                     < np.sum(np.abs(offset(self.ctx.stance(False)) - seated)))
 
-    def arm_transition(self, carrying_before: bool, label: int) -> None:
-        """Bring the arms from the walk stance to the carry stance or back.
+    def arm_transition(self, carrying_before: bool, label: int, task: str | None = None
+                       ) -> None:
+        """Bring the arms from the walk stance to the carry stance or back (for ``task``,
+        named in the error where it is blocked).
 
         The palms move beside the body on a smooth curve, timed by Fitts' law with a
         bounded peak speed (:func:`~ltl_human_motion.motion.arm_transition.
@@ -380,10 +382,10 @@ class StepExecutor:
                              rel, root, self.ctx.library.fps, "planner: arm transition")
         if not self.placed_clear(mp, self.state.pose) and not self.step_back(carrying_before,
                                                                            label, mp):
-            raise PlanningError(f"bringing the arms {'down' if carrying_before else 'up'} at "
+            raise PlanningError(("" if task is None else f"task {task}: ")
+                                + f"bringing the arms {'down' if carrying_before else 'up'} at "
                                 f"({self.state.pose[0]:.2f}, {self.state.pose[1]:.2f}) hits an "
-                                "obstacle, "
-                                "also after a step back", reason="blocked")
+                                "obstacle, also after a step back", task=task, reason="blocked")
         self.add(mp, self.state.pose, label, self.ctx.overlap)
 
     def arm_poses(self, carrying_before: bool) -> np.ndarray:
