@@ -50,48 +50,45 @@ def _free_space(cell, half: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return free, origin
 
 
-def _reachable(cell, part: str) -> tuple[np.ndarray, np.ndarray]:
-    """The voxels (bool grid) the centre of ``part`` can reach from where it lies, and
-    the grid's origin; cached per cell (by identity) and part."""
+def _reachable(cell, part: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The labelled free space (:func:`_components`) of ``part``'s size, the grid's origin
+    and the labels its centre can reach from where it lies (none: every voxel, the part
+    lies where no voxel is free); cached per cell (by identity) and part."""
     return _FREE.get_or_build((part,), lambda: _fill(cell, part), owner=cell)
 
 
-def _components(cell, half: np.ndarray
-                ) -> tuple[np.ndarray, np.ndarray, BoundedCache[np.ndarray]]:
-    """The labelled components of the free space (:func:`_free_space`), the grid's origin
-    and the reachable sets by seed labels; built once per obstacle layout, workspace and
-    part size (a part moved to another place of the same cell reuses it)."""
-    def build() -> tuple[np.ndarray, np.ndarray, BoundedCache[np.ndarray]]:
+def _components(cell, half: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The labelled components of the free space (:func:`_free_space`) and the grid's
+    origin; built once per obstacle layout, workspace and part size (a part moved to
+    another place of the same cell reuses it)."""
+    def build() -> tuple[np.ndarray, np.ndarray]:
         from scipy import ndimage
         free, origin = _free_space(cell, half)
-        return ndimage.label(free)[0], origin, BoundedCache(16)
+        return ndimage.label(free)[0], origin
     lo, hi = (np.asarray(v, dtype=np.float64) for v in cell.workspace)
     key = (tuple(lo.tolist()), tuple(hi.tolist()), tuple(half.tolist()))
     return _LABELS.get_or_build(key, build, owner=cell.obstacles)
 
 
-def _fill(cell, part: str) -> tuple[np.ndarray, np.ndarray]:
+def _fill(cell, part: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`_reachable`, computed."""
     p_lo, p_hi = (np.asarray(v, dtype=np.float64) for v in cell.object(part).shape.aabb())
-    labels, origin, reached = _components(cell, (p_hi - p_lo) / 2)
+    labels, origin = _components(cell, (p_hi - p_lo) / 2)
     k = np.clip(np.round(((p_lo + p_hi) / 2 - origin) / VOXEL).astype(int), 0,
                 np.array(labels.shape) - 1)
     near = labels[max(k[0] - 1, 0):k[0] + 2, max(k[1] - 1, 0):k[1] + 2,
                   max(k[2] - 1, 0):k[2] + 2]
-    seeds = np.unique(near[near > 0])
-    return reached.get_or_build(
-        tuple(seeds.tolist()),
-        lambda: np.isin(labels, seeds) if seeds.size else np.ones(labels.shape, bool)), origin
+    return labels, origin, np.unique(near[near > 0])
 
 
 def can_pass(cell, part: str, lo: np.ndarray, hi: np.ndarray) -> bool:
     """Whether the centre of ``part`` can get from where it lies into the box
     [``lo``, ``hi``] (3,) without its box meeting an obstacle (module docstring: the
     answer errs towards True)."""
-    reach, origin = _reachable(cell, part)
+    labels, origin, seeds = _reachable(cell, part)
     a = np.floor((np.asarray(lo) - origin) / VOXEL).astype(int)
     b = np.ceil((np.asarray(hi) - origin) / VOXEL).astype(int) + 1
-    a, b = np.clip(a, 0, reach.shape), np.clip(b, 0, reach.shape)
-    if np.any(b <= a):
+    a, b = np.clip(a, 0, labels.shape), np.clip(b, 0, labels.shape)
+    if np.any(b <= a) or not seeds.size:
         return True
-    return bool(reach[a[0]:b[0], a[1]:b[1], a[2]:b[2]].any())
+    return bool(np.isin(labels[a[0]:b[0], a[1]:b[1], a[2]:b[2]], seeds).any())
