@@ -135,3 +135,14 @@ def test_output_into_a_closed_pipe_ends_quietly(tmp_path):
     os.close(write)
     assert "Traceback" not in proc.stderr
     assert proc.returncode in (0, 141)
+
+
+def test_synthesize_out_given_a_file_name_says_it_takes_a_folder(tmp_path, capsys) -> None:
+    """`--out motion.npz` made a folder named motion.npz; it is refused before any
+    synthesis, with the folder to give instead."""
+    from ltl_human_motion.cli import main
+    code = main(["synthesize", "--spec", "F grasp(O1)", "--cell", "paper_cell",
+                 "--out", str(tmp_path / "grasp.npz")])
+    err = capsys.readouterr().err
+    assert code == 2 and "give a folder" in err and str(tmp_path / "grasp") in err
+    assert not (tmp_path / "grasp.npz").exists()

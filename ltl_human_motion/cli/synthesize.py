@@ -71,6 +71,11 @@ def run(args: argparse.Namespace) -> int:
         print("ltl-human-motion synthesize: error: --variants and --cycles must be >= 1",
               file=sys.stderr)
         return 2
+    if args.out.suffix.lower() in (".npz", ".json", ".csv", ".bvh") or args.out.is_file():
+        print(f"ltl-human-motion synthesize: error: --out {args.out}: give a folder; the "
+              f"motions are written into it as motion_000.npz, motion_000.json, ... (e.g. "
+              f"--out {args.out.with_suffix('')})", file=sys.stderr)
+        return 2
     pictures = picture_options(args)
     if isinstance(pictures, str):
         print(f"ltl-human-motion synthesize: error: {pictures}", file=sys.stderr)
