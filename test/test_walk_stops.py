@@ -61,7 +61,7 @@ def test_a_tall_workers_insert_deep_in_a_chamber_stands_where_the_walk_can_stop(
     cell = _cell("chamber", 1)
     motion = synthesize("F insert(blank, vise_b)", cell, stature=1.95, seed=0)[0]
     assert not collision(motion.motion.positions, cell, stature=1.95).any()
-    insert = [g for g in motion.stats.goal_primitives if g["task"].startswith("insert")][0]
+    insert = next(g for g in motion.stats.goal_primitives if g["task"].startswith("insert"))
     assert insert["expanded"] < 2000
 
 

@@ -136,7 +136,8 @@ def load_motion(path: Path):
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``ltl-human-motion render``."""
     parser.add_argument("motion", type=Path,
-                        help="motion file written by synthesize into its --out folder (motion_000.npz or .json)")
+                        help="motion file written by synthesize into its --out folder "
+                             "(motion_000.npz or .json)")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE",
                         help="output picture: .gif (animation) or .png, .svg, .pdf (sheet of "
                              "snapshots)")

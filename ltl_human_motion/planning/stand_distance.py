@@ -51,9 +51,10 @@ def farther_placement(ctx: PlanContext, target: np.ndarray, placement: tuple[flo
                       reaches: Callable[[tuple[float, float, float]], bool]
                       ) -> tuple[float, float] | None:
     """Where no two neighbouring sides of ``target`` (3,) have a free spot for
-    ``placement`` (ahead, left, m) whose level line to the target is open (:func:`has_spot`), the nearest placement
-    further back (by ``STEP``, up to ``FURTHEST``) that has one and from which
-    ``reaches((ahead, left, height))`` (the goal model's reach test in the start frame);
+    ``placement`` (ahead, left, m) whose level line to the target is open
+    (:func:`has_spot`), the nearest placement further back (by ``STEP``, up to
+    ``FURTHEST``) that has one and from which ``reaches((ahead, left, height))`` (the
+    goal model's reach test in the start frame);
     None where ``placement`` has such a spot, or no placement further back does."""
     if has_spot(ctx, target, placement, open_line=True):
         return None
