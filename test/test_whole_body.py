@@ -116,3 +116,29 @@ def test_a_hand_path_through_a_board_is_never_returned_colliding(reach):
             or result.end_miss > END_TOLERANCE
     else:
         assert _clearance(world_positions(made), board).min() >= 0.0
+
+
+def test_a_palm_held_off_its_target_gives_up_at_the_first_frame_it_misses(reach):
+    """A wall between the palm and the part: the program cannot reach it. Told to give up
+    where the palm misses the contact frame, it stops there (the frames after are the
+    reference's) with the same miss at that frame as the full run; a tolerance it meets
+    changes nothing."""
+    mp, ref = reach
+    contact = int(mp.meta["contact_frame"])
+    hand = JOINT_INDEX["r_hand"]
+    palm = ref[contact, hand]
+    wall = PartSet([Box.from_bounds(np.array([palm[0] - 0.15, -0.8, 0.0]),
+                                    np.array([palm[0] - 0.1, 0.4, 2.0]))])
+    field_ = PartSetField(wall, (0.0, 0.0, 0.0))
+    full = track_reference(ref, STATURE, field_, tracked=("r_hand",), fps=mp.fps)
+    missed = float(np.linalg.norm(full.positions[contact, hand] - palm))
+    assert missed > CONTACT_TOLERANCE
+    early = track_reference(ref, STATURE, field_, tracked=("r_hand",), fps=mp.fps,
+                            give_up=((contact,), CONTACT_TOLERANCE))
+    assert np.array_equal(early.positions[:contact + 1], full.positions[:contact + 1])
+    solved = int(np.flatnonzero(np.any(early.positions != ref, axis=(1, 2))).max())
+    assert solved < len(ref) - 1 and np.array_equal(early.positions[solved + 1:],
+                                                    ref[solved + 1:])
+    kept = track_reference(ref, STATURE, field_, tracked=("r_hand",), fps=mp.fps,
+                           give_up=((contact,), 10.0))
+    assert np.array_equal(kept.positions, full.positions)

@@ -181,7 +181,8 @@ def constrained_primitive(mp: MotionPrimitive, parts: PartSet,
     result = track_reference(ref, stature, field_, tracked=tracked, fps=mp.fps, held=held,
                              held_from=held_from, release_from=max(hold), options=options,
                              palms=clear_palms(ref, tracked, field_, min(hold), max(hold),
-                                               PathRoom(_palm_room(stature, options))))
+                                               PathRoom(_palm_room(stature, options))),
+                             give_up=(tuple(hold), contact_tolerance(mp.task)))
     miss = max(float(np.linalg.norm(result.positions[f, JOINT_INDEX[j]]
                                      - ref[f, JOINT_INDEX[j]]))
                for f in hold for j in tracked)

@@ -118,6 +118,16 @@ class TrackingResult:
     window: tuple[int, int] = (0, 0)
 
 
+def _missed(out: np.ndarray, ref: np.ndarray, tracked: tuple[str, ...],
+            give_up: tuple[tuple[int, ...], float], after: int, upto: int) -> bool:
+    """Whether a tracked palm of ``out`` (T, J, 3) is further than ``give_up``'s
+    tolerance from ``ref``'s at one of its frames in (``after``, ``upto``]."""
+    frames, tolerance = give_up
+    idx = [JOINT_INDEX[j] for j in tracked]
+    return any(float(np.linalg.norm(out[f, idx] - ref[f, idx], axis=-1).max()) > tolerance
+               for f in frames if after < f <= upto)
+
+
 #: Frames the program starts before the first frame with an obstacle within
 #: ``influence`` (the solution equals the reference up to there).
 _LEAD_FRAMES = 2
@@ -299,7 +309,8 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
                     options: WholeBodyOptions | None = None, fps: float = 30.0,
                     held: HeldPart | None = None, held_from: int = 0,
                     release_from: int | None = None,
-                    palms: np.ndarray | None = None) -> TrackingResult:
+                    palms: np.ndarray | None = None,
+                    give_up: tuple[tuple[int, ...], float] | None = None) -> TrackingResult:
     """Positions (T, J, 3) of the worker's model tracking ``reference`` (T, J, 3) under
     the constraints of the module docstring.
 
@@ -310,6 +321,9 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
     the reference's last pose, where the next primitive starts. ``palms`` (T,
     len(tracked), 3): the tracked palms' path where it is not the reference's (made
     clear of the obstacles, :func:`.palm_path.clear_palm_path`; the wrists move along).
+    ``give_up`` (frames, tolerance m): stop once a tracked palm is further than that from
+    its reference at one of those frames (the caller refuses such a motion; the frames
+    after it are the reference's).
     """
     import pink
     import pinocchio as pin
@@ -355,6 +369,9 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
         q_prev = conf.q.copy()
         if t > last_near and np.abs(out[t] - ref[t]).max() < _CONVERGED:
             out[t:] = ref[t:]
+            break
+        if give_up is not None and _missed(out, ref, tracked, give_up, t - step, t):
+            out[t + 1:] = ref[t + 1:]
             break
     end_miss = float(np.abs(out[-1] - ref[-1]).max())
     if end_miss > 0.0:
