@@ -159,6 +159,99 @@ def _anchor_at(held, contact, a, b, fps, still_speed, still_time) -> int:
 
 
 @_jit
+def _pin_offsets(held, h, switch, a, n, k):
+    """The offsets (n, 2) that pin a stance's frames [a, a + n) at its anchor frame
+    ``k``: the ground distance the blended foot travelled from frame a, taken from its
+    value at k."""
+    off = np.zeros((n, 2))          # travelled, then the pin offsets
+    for i in range(1, n):
+        beta = _roll(h, a + i, switch)
+        for c in range(2):
+            s0 = held[a + i, 0, c] - held[a + i - 1, 0, c]
+            s1 = held[a + i, 1, c] - held[a + i - 1, 1, c]
+            step = (1.0 - beta) * s0 + beta * s1
+            off[i, c] = step if i == 1 else off[i - 1, c] + step
+    ref0, ref1 = off[k - a, 0], off[k - a, 1]
+    for i in range(n):
+        off[i, 0] = ref0 - off[i, 0]
+        off[i, 1] = ref1 - off[i, 1]
+    return off
+
+
+@_jit
+def _lock_window(off, h, switch, a, n, k, max_lock, max_lock_ball):
+    """The frames (lo, hi), relative to a, around the anchor ``k`` whose pin offsets
+    ``off`` (n, 2) stay within the lock limits (heel or ball), and whether any frame of
+    the stance exceeds them."""
+    big = False
+    ok = np.empty(n, dtype=np.bool_)
+    for i in range(n):
+        limit = max_lock_ball if _roll(h, a + i, switch) >= 1.0 else max_lock
+        ok[i] = not (math.sqrt(0.0 + off[i, 0] * off[i, 0] + off[i, 1] * off[i, 1])
+                     > limit)
+        big = big or not ok[i]
+    lo = k - a
+    while lo > 0 and ok[lo - 1]:
+        lo -= 1
+    hi = k - a
+    while hi < n - 1 and ok[hi + 1]:
+        hi += 1
+    return lo, hi, big
+
+
+@_jit
+def _shuffle_entry(hc, vc, ta, tb, fps, still_speed, shuffle_time, contact_height,
+                   stance_speed) -> int:
+    """The frame a standing shuffle in [ta, tb) is entered at (``footlock._next_stance``):
+    -2 where there is none (no still part of ``shuffle_time``), -1 where there is a
+    still part but no frame to enter (the Python path raises)."""
+    if tb - ta < shuffle_time * fps:
+        return -2
+    found = False
+    i = ta
+    while i < tb and not found:
+        if vc[i] <= still_speed:
+            j = i
+            while j < tb and vc[j] <= still_speed:
+                j += 1
+            found = j - i >= shuffle_time * fps
+            i = j
+        else:
+            i += 1
+    if not found:
+        return -2
+    for i in range(ta, tb):
+        if hc[i] <= contact_height and vc[i] <= stance_speed:
+            return i
+    return -1
+
+
+@_jit
+def _write_pins(held, joints, off, a, b, lo, ramp, disp, weight) -> None:
+    """The pin displacements of frames [a, b) (offsets ``off`` from row ``lo``) at weight
+    1, and the release ramps either side where they weigh more than what is there."""
+    T = held.shape[0]
+    n_rel = ramp.shape[0]
+    for t in range(a, b):
+        for j in range(2):
+            for c in range(2):
+                disp[t, j, c] = held[t, j, c] - joints[t, j, c] + off[t - a + lo, c]
+        weight[t] = 1.0
+    for i in range(n_rel):
+        w = ramp[n_rel - 1 - i]
+        if a - 1 - i >= 0 and weight[a - 1 - i] < w:
+            for j in range(2):
+                for c in range(2):
+                    disp[a - 1 - i, j, c] = disp[a, j, c] * w
+            weight[a - 1 - i] = w
+        if b + i < T and weight[b + i] < w:
+            for j in range(2):
+                for c in range(2):
+                    disp[b + i, j, c] = disp[b - 1, j, c] * w
+            weight[b + i] = w
+
+
+@_jit
 def lock_stances(held, joints, h, hc, vc, contact, starts, ends, stance, ramp, fps,
                  consts, disp, weight) -> int:
     """The stance loop of ``footlock._foot_targets`` (its Python path, step for step):
@@ -172,7 +265,6 @@ def lock_stances(held, joints, h, hc, vc, contact, starts, ends, stance, ramp, f
         consts[3]
     switch, shuffle_time, contact_height, stance_speed = consts[4], consts[5], consts[6], \
         consts[7]
-    T = held.shape[0]
     n_rel = ramp.shape[0]
     r = 0
     pending = False
@@ -186,79 +278,25 @@ def lock_stances(held, joints, h, hc, vc, contact, starts, ends, stance, ramp, f
             r += 1
         k = a + _anchor_at(held, contact, a, b, fps, still_speed, still_time)
         n = b - a
-        off = np.zeros((n, 2))          # travelled, then the pin offsets
-        for i in range(1, n):
-            beta = _roll(h, a + i, switch)
-            for c in range(2):
-                s0 = held[a + i, 0, c] - held[a + i - 1, 0, c]
-                s1 = held[a + i, 1, c] - held[a + i - 1, 1, c]
-                step = (1.0 - beta) * s0 + beta * s1
-                off[i, c] = step if i == 1 else off[i - 1, c] + step
-        ref0, ref1 = off[k - a, 0], off[k - a, 1]
-        for i in range(n):
-            off[i, 0] = ref0 - off[i, 0]
-            off[i, 1] = ref1 - off[i, 1]
+        off = _pin_offsets(held, h, switch, a, n, k)
         end = b
-        big = False
-        ok = np.empty(n, dtype=np.bool_)
-        for i in range(n):
-            limit = max_lock_ball if _roll(h, a + i, switch) >= 1.0 else max_lock
-            ok[i] = not (math.sqrt(0.0 + off[i, 0] * off[i, 0] + off[i, 1] * off[i, 1])
-                         > limit)
-            big = big or not ok[i]
-        lo = 0
+        lo, hi, big = _lock_window(off, h, switch, a, n, k, max_lock, max_lock_ball)
         if big:
-            lo = k - a
-            while lo > 0 and ok[lo - 1]:
-                lo -= 1
-            hi = k - a
-            while hi < n - 1 and ok[hi + 1]:
-                hi += 1
             stance[a:a + lo] = False
             stance[a + hi + 1:b] = False
             a, b = a + lo, a + hi + 1
+        else:
+            lo = 0
         # the standing shuffle after the stance (footlock._next_stance)
-        ta, tb = b + n_rel, end
-        if tb - ta >= shuffle_time * fps:
-            found = False
-            i = ta
-            while i < tb and not found:
-                if vc[i] <= still_speed:
-                    j = i
-                    while j < tb and vc[j] <= still_speed:
-                        j += 1
-                    found = j - i >= shuffle_time * fps
-                    i = j
-                else:
-                    i += 1
-            if found:
-                enter = -1
-                for i in range(ta, tb):
-                    if hc[i] <= contact_height and vc[i] <= stance_speed:
-                        enter = i
-                        break
-                if enter < 0:
-                    return 1
-                stance[enter:tb] = True
-                pending = True
-                pa, pb = enter, tb
-        for t in range(a, b):
-            for j in range(2):
-                for c in range(2):
-                    disp[t, j, c] = held[t, j, c] - joints[t, j, c] + off[t - a + lo, c]
-            weight[t] = 1.0
-        for i in range(n_rel):
-            w = ramp[n_rel - 1 - i]
-            if a - 1 - i >= 0 and weight[a - 1 - i] < w:
-                for j in range(2):
-                    for c in range(2):
-                        disp[a - 1 - i, j, c] = disp[a, j, c] * w
-                weight[a - 1 - i] = w
-            if b + i < T and weight[b + i] < w:
-                for j in range(2):
-                    for c in range(2):
-                        disp[b + i, j, c] = disp[b - 1, j, c] * w
-                weight[b + i] = w
+        enter = _shuffle_entry(hc, vc, b + n_rel, end, fps, still_speed, shuffle_time,
+                               contact_height, stance_speed)
+        if enter == -1:
+            return 1
+        if enter >= 0:
+            stance[enter:end] = True
+            pending = True
+            pa, pb = enter, end
+        _write_pins(held, joints, off, a, b, lo, ramp, disp, weight)
     return 0
 
 
