@@ -36,14 +36,16 @@ def test_a_worker_facing_away_turns_on_the_spot_before_stepping_to_the_region() 
     """move(O1, R2) at 1.95 m: after the grasp from the left rack the worker faces it,
     0.6 m from where the move reaches R2's centre; no gait turns round in the aisle with
     the part in hand (the search took 5,800 nodes), so the worker turns on the spot and
-    steps there."""
+    steps there: between the grasp and the move only standing steps and turns, one of
+    them turning by more than 90 degrees."""
     synth = synthesize("F move(O1, R2)", AISLE, stature=1.95, seed=1)[0]
     assert synth.verification["passed"]
     names = [name for name, _, _ in synth.stats.segments]
-    turn = next(i for i, n in enumerate(names) if n.startswith("carry_turn"))
+    grasp = next(i for i, n in enumerate(names) if n.startswith("grasp_"))
     move = next(i for i, n in enumerate(names) if n.startswith("move_"))
-    assert turn < move
-    assert all(n.startswith(("carry_step", "carry_turn")) for n in names[turn:move])
+    between = names[grasp + 1:move]
+    assert between and all(n.startswith(("carry_step", "carry_turn")) for n in between)
+    assert max(abs(float(n.rsplit("_", 1)[1])) for n in between) > 90.0
     assert synth.stats.nodes_expanded < 1000
 
 
