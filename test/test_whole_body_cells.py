@@ -108,3 +108,16 @@ def test_a_tall_workers_extract_takes_the_part_off_the_chamber_floor():
     track = np.asarray(motion.objects["done"])
     carried = track[np.isfinite(track).all(axis=1)]
     assert object_clearance(cell, "done", carried).min() >= 0.0
+
+
+def test_a_short_workers_reach_over_a_bench_takes_the_time_to_stand_back_up():
+    """A 1.55 m worker's part on a wall shelf behind a bench (a cell of generator seed 1):
+    the whole-body program reaches it, but coming back up clear of the bench its body
+    lags behind the reference and ended centimetres from the standing pose the next
+    motion starts in; given up to END_HOLD_SECONDS more it ends there, and the grasp is
+    verified."""
+    built = build_cell("boards", 1, 0)
+    cell = cell_from_yaml(built.yaml, source=built.name)
+    motion = _verified("F grasp(P_b1)", cell, 1.55)
+    grasp = next(s for s in motion.stats.segments if s[0].startswith("grasp_"))
+    assert grasp[0].endswith("_wb")                     # the program's motion

@@ -11,12 +11,13 @@ motion where it still reaches the task's target at contact.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ltl_human_motion.motion.goals.kinematics import HeldPart
 from ltl_human_motion.motion.goals.optimizer import (
+    RETURN_SECONDS,
     TrackingResult,
     WholeBodyOptions,
     track_reference,
@@ -47,6 +48,11 @@ def contact_tolerance(task: str) -> float:
 #: it is faded out (:func:`~ltl_human_motion.motion.goals.optimizer.track_reference`; the
 #: bones stretch by as much, as in the goal models' own end blends).
 END_TOLERANCE = 0.01
+#: Seconds the program may take beyond the reference's end to come back to its last pose
+#: (the reference holding it): kept clear of a low board on the way up, a tall worker's
+#: thigh lags behind the reference's return and ended 14 cm from the standing pose the
+#: next primitive starts in.
+END_HOLD_SECONDS = 1.0
 
 
 @dataclass(frozen=True)
@@ -178,15 +184,44 @@ def constrained_primitive(mp: MotionPrimitive, parts: PartSet,
         + [int(mp.meta.get("contact_frame", len(ref) - 1))]
     field_ = PartSetField(parts, tuple(map(float, pose)))
     options = program_options(mp.task, stature)
-    result = track_reference(ref, stature, field_, tracked=tracked, fps=mp.fps, held=held,
-                             held_from=held_from, release_from=max(hold), options=options,
-                             palms=clear_palms(ref, tracked, field_, min(hold), max(hold),
-                                               PathRoom(_palm_room(stature, options))),
-                             give_up=(tuple(hold), contact_tolerance(mp.task)))
+    palms = clear_palms(ref, tracked, field_, min(hold), max(hold),
+                        PathRoom(_palm_room(stature, options)))
+
+    def track(reference: np.ndarray, palms: np.ndarray | None) -> TrackingResult:
+        return track_reference(reference, stature, field_, tracked=tracked, fps=mp.fps,
+                               held=held, held_from=held_from, release_from=max(hold),
+                               options=options, palms=palms,
+                               give_up=(tuple(hold), contact_tolerance(mp.task)))
+
+    result = track(ref, palms)
     miss = max(float(np.linalg.norm(result.positions[f, JOINT_INDEX[j]]
                                      - ref[f, JOINT_INDEX[j]]))
                for f in hold for j in tracked)
-    if miss > contact_tolerance(mp.task) or result.least_clearance < 0.0 \
-            or result.end_miss > END_TOLERANCE:
+    if miss > contact_tolerance(mp.task) or result.least_clearance < 0.0:
         return None, miss, result
+    if result.end_miss > END_TOLERANCE:
+        result = _with_more_time(track, ref, palms, round(END_HOLD_SECONDS * mp.fps), mp.fps)
+        if result.end_miss > END_TOLERANCE or result.least_clearance < 0.0:
+            return None, miss, result
     return _primitive(mp, result.positions), miss, result
+
+
+def _with_more_time(track, ref: np.ndarray, palms: np.ndarray | None, frames: int,
+                    fps: float) -> TrackingResult:
+    """``track`` (the program) of ``ref`` (T, J, 3) followed by ``frames`` frames holding
+    its last pose (``palms`` (T, K, 3) likewise), cut at the first frame from T - 1 on
+    within ``END_TOLERANCE`` of that pose: the motion takes the time it needs to end
+    where the next primitive starts (``fps``: its frame rate). Its ``end_miss`` is the
+    cut frame's distance."""
+    def held(a: np.ndarray) -> np.ndarray:
+        return np.concatenate([a, np.repeat(a[-1:], frames, axis=0)])
+
+    longer = track(held(ref), None if palms is None else held(palms))
+    # (the last RETURN_SECONDS are faded onto the pose: only the frames before count)
+    solved = longer.positions[len(ref) - 1:len(ref) + frames - int(RETURN_SECONDS * fps)]
+    off = np.abs(solved - ref[-1]).max(axis=(1, 2))
+    within = np.flatnonzero(off <= END_TOLERANCE)
+    if not within.size:
+        return longer
+    end = len(ref) - 1 + int(within[0])
+    return replace(longer, positions=longer.positions[:end + 1], end_miss=float(off[within[0]]))
