@@ -268,11 +268,12 @@ def _arrivals(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, goal: Goal,
     done = near & index.stops[succ]
     tail: list[tuple[int, Pose]] = []
     if not done.any() and near.any():
-        found = None
-        for floor in (clearance, goal.stop_clearance):
-            if found is None and floor is not None:
-                found = _first_stop(index, succ, ends, np.flatnonzero(near), goal, allowed,
-                                    floor, body_clear, forbidden, options)
+        at = np.flatnonzero(near)
+        found = _first_stop(index, succ, ends, at, goal, allowed, clearance, body_clear,
+                            forbidden, options)
+        if found is None and goal.stop_clearance is not None:
+            found = _first_stop(index, succ, ends, at, goal, allowed, goal.stop_clearance,
+                                body_clear, forbidden, options)
         if found is not None:
             m, stop, end = found
             tail = [(stop, (float(ends[m, 0]), float(ends[m, 1]), float(ends[m, 2])))]

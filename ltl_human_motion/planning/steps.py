@@ -285,13 +285,12 @@ class StepExecutor:
         at tall parts, has no disc of that radius."""
         lib = self.ctx.library
         stance = self.ctx.stance(self.state.carrying)                         # (J, 3)
-        a = np.asarray(yaw, dtype=float)[:, None] + np.asarray(
-            wrap_angle(np.asarray(to_yaw) - np.asarray(yaw)), dtype=float)[:, None] \
+        a = yaw[:, None] + wrap_angle(to_yaw - yaw)[:, None] \
             * np.linspace(0.0, 1.0, TURN_SAMPLES)                              # (M, K)
         c, s = np.cos(a)[..., None], np.sin(a)[..., None]
         poses = np.empty(a.shape + stance.shape)
-        poses[..., 0] = c * stance[:, 0] - s * stance[:, 1] + np.asarray(x)[:, None, None]
-        poses[..., 1] = s * stance[:, 0] + c * stance[:, 1] + np.asarray(y)[:, None, None]
+        poses[..., 0] = c * stance[:, 0] - s * stance[:, 1] + x[:, None, None]
+        poses[..., 1] = s * stance[:, 0] + c * stance[:, 1] + y[:, None, None]
         poses[..., 2] = stance[:, 2] + lib.standing_height
         return self.body_clear(poses, np.ones(len(poses), dtype=bool))
 
