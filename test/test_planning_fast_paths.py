@@ -292,20 +292,35 @@ def test_fields_with_a_key_are_reused_between_planners(paper) -> None:
 
 
 def test_compiled_field_distances_equal_the_numpy_path(paper, monkeypatch) -> None:
-    """The obstacle field's compiled distances (points near and off its grid) and the least
-    distance over offsets (a part in hand read at points on its box) equal the numpy
-    path's, bit for bit."""
+    """The obstacle field's compiled distances (points near and off its grid) equal the
+    numpy path's, bit for bit; its compiled test of a part in hand read at points on its
+    box (which skips the points far from every obstacle and stops at the first that
+    fails) answers as the numpy path, which reads every point."""
     from ltl_human_motion.planning import navigation
     if navigation._compiled_loops() is None:
         pytest.skip("numba is not in use")
     field = ObstacleField(paper)
     rng = np.random.default_rng(5)
     centres = rng.uniform(field.lo - 0.3, field.lo + field.res * field.shape + 0.3, (40, 7, 3))
-    offsets = rng.normal(scale=0.05, size=(9, 3))
-    compiled = (field.distance(centres), field.least_distance(centres, offsets))
+    side = np.linspace(-0.3, 0.3, 13)
+    box = np.stack(np.meshgrid(side, side, side, indexing="ij"), axis=-1).reshape(-1, 3)
+    offsets = box[np.any(np.abs(box) > 0.29, axis=1)]
+    near = field.part_lo[rng.integers(len(field.part_lo), size=400)]
+    held = near[:, None] + rng.normal(scale=0.3, size=(400, 5, 3))
+    standing = rng.random(400) < 0.5
+    thresholds = (0.02, 0.1)
+
+    def answers() -> tuple[np.ndarray, ...]:
+        return (field.distance(centres),
+                *(field.points_clear(held, offsets, t, standing) for t in thresholds))
+
+    compiled = answers()
     monkeypatch.setattr(navigation, "_compiled_loops", lambda: None)
-    numpy = (field.distance(centres), field.distance(centres[..., None, :] + offsets).min(-1))
+    numpy = answers()
+    assert compiled[0].shape == (40, 7)
     for got, want in zip(compiled, numpy):
-        assert got.shape == want.shape == (40, 7)
         np.testing.assert_array_equal(got, want)
     assert (compiled[0] < 0.05).any() and (compiled[0] >= field.far).any()
+    for ok in compiled[1:]:
+        assert ok.any() and not ok.all()
+        assert (ok & standing).any() and (~ok & standing).any()

@@ -107,17 +107,98 @@ def field_distances(grid, lo, res, far, pts, out) -> None:
 
 
 @_jit
-def least_field_distances(grid, lo, res, far, centres, offsets, out) -> None:
-    """out[n] = the least field distance (:func:`_field_distance`) over the points
-    centres[n] + offsets[k], centres (N, 3) and offsets (K, 3) finite, K >= 1."""
-    for n in range(centres.shape[0]):
-        least = np.inf
-        for k in range(offsets.shape[0]):
-            d = _field_distance(grid, lo, res, far, centres[n, 0] + offsets[k, 0],
-                                centres[n, 1] + offsets[k, 1], centres[n, 2] + offsets[k, 2])
-            if d < least or k == 0:
-                least = d
-        out[n] = least
+def _box_near(lo0, lo1, lo2, hi0, hi1, hi2, part_lo, part_hi, parts, n_parts, limit2):
+    """Whether the box lo, hi comes nearer than ``sqrt(limit2)`` to the box of any of
+    the parts ``parts[:n_parts]`` (part_lo, part_hi (P, 3))."""
+    for q in range(n_parts):
+        p = parts[q]
+        g0 = max(max(part_lo[p, 0] - hi0, lo0 - part_hi[p, 0]), 0.0)
+        g1 = max(max(part_lo[p, 1] - hi1, lo1 - part_hi[p, 1]), 0.0)
+        g2 = max(max(part_lo[p, 2] - hi2, lo2 - part_hi[p, 2]), 0.0)
+        if g0 * g0 + g1 * g1 + g2 * g2 < limit2:
+            return True
+    return False
+
+
+@_jit
+def _group_least(grid, lo, res, far, c0, c1, c2, offsets, start, stop, thr, allowed):
+    """The least field distance (:func:`_field_distance`) over the points c + offsets[k],
+    ``start <= k < stop``, read until one has ``distance - thr < allowed`` (that one's
+    distance); ``inf`` for no points."""
+    least = np.inf
+    for k in range(start, stop):
+        d = _field_distance(grid, lo, res, far, c0 + offsets[k, 0], c1 + offsets[k, 1],
+                            c2 + offsets[k, 2])
+        if d < least:
+            least = d
+            if not d - thr >= allowed:
+                break
+    return least
+
+
+@_jit
+def held_points_clear(grid, lo, res, far, centres, offsets, starts, group_lo, group_hi,
+                      part_lo, part_hi, limit, thr, standing, out) -> None:
+    """out[m] = whether every point centres[m, s] + offsets[k] (centres (M, S, 3), offsets
+    (K, 3), finite) has field distance (:func:`_field_distance`) ``d`` with ``d - thr >=
+    allowed``: 0, or for ``standing[m]`` min(least ``d - thr`` at s = 0, 0) - 0.005.
+
+    offsets[starts[g]:starts[g + 1]] lie in the box group_lo[g], group_hi[g] (G, 3);
+    a group whose box at a sample keeps ``limit`` from every obstacle part's box
+    (part_lo, part_hi (P, 3)) is not read (``limit``: ``thr`` and the interpolation
+    error, so its points pass; ``inf`` reads every point). Stops at the first point
+    that fails."""
+    M, S, P, G = centres.shape[0], centres.shape[1], part_lo.shape[0], starts.shape[0] - 1
+    limit2 = limit * limit
+    olo0, olo1, olo2 = group_lo[:, 0].min(), group_lo[:, 1].min(), group_lo[:, 2].min()
+    ohi0, ohi1, ohi2 = group_hi[:, 0].max(), group_hi[:, 1].max(), group_hi[:, 2].max()
+    every = np.arange(P)
+    near = np.empty(P, dtype=np.int64)
+    for m in range(M):
+        lo0 = lo1 = lo2 = np.inf
+        hi0 = hi1 = hi2 = -np.inf
+        for s in range(S):
+            lo0, hi0 = min(lo0, centres[m, s, 0]), max(hi0, centres[m, s, 0])
+            lo1, hi1 = min(lo1, centres[m, s, 1]), max(hi1, centres[m, s, 1])
+            lo2, hi2 = min(lo2, centres[m, s, 2]), max(hi2, centres[m, s, 2])
+        n_near = 0
+        for p in range(P):
+            if _box_near(lo0 + olo0, lo1 + olo1, lo2 + olo2, hi0 + ohi0, hi1 + ohi1,
+                         hi2 + ohi2, part_lo, part_hi, every[p:p + 1], 1, limit2):
+                near[n_near] = p
+                n_near += 1
+        ok = True
+        allowed = 0.0
+        first = 0
+        if n_near and standing[m]:
+            # the least at the first sample over every group near (the others keep thr)
+            c0, c1, c2 = centres[m, 0, 0], centres[m, 0, 1], centres[m, 0, 2]
+            least = np.inf
+            for g in range(G):
+                if _box_near(c0 + group_lo[g, 0], c1 + group_lo[g, 1], c2 + group_lo[g, 2],
+                             c0 + group_hi[g, 0], c1 + group_hi[g, 1], c2 + group_hi[g, 2],
+                             part_lo, part_hi, near, n_near, limit2):
+                    least = min(least, _group_least(grid, lo, res, far, c0, c1, c2, offsets,
+                                                    starts[g], starts[g + 1], thr, -np.inf))
+            allowed = min(least - thr, 0.0) - 0.005
+            first = 1
+        for s in range(first, S if n_near else 0):
+            c0, c1, c2 = centres[m, s, 0], centres[m, s, 1], centres[m, s, 2]
+            if not _box_near(c0 + olo0, c1 + olo1, c2 + olo2, c0 + ohi0, c1 + ohi1, c2 + ohi2,
+                             part_lo, part_hi, near, n_near, limit2):
+                continue
+            for g in range(G):
+                if _box_near(c0 + group_lo[g, 0], c1 + group_lo[g, 1], c2 + group_lo[g, 2],
+                             c0 + group_hi[g, 0], c1 + group_hi[g, 1], c2 + group_hi[g, 2],
+                             part_lo, part_hi, near, n_near, limit2):
+                    d = _group_least(grid, lo, res, far, c0, c1, c2, offsets, starts[g],
+                                     starts[g + 1], thr, allowed)
+                    if not d - thr >= allowed:
+                        ok = False
+                        break
+            if not ok:
+                break
+        out[m] = ok
 
 
 @_jit

@@ -10,6 +10,7 @@ unreachable goal is known before any primitive is expanded.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
@@ -393,19 +394,48 @@ class ObstacleField:
         out = np.where(outside, np.maximum(out, self.far), out)
         return out.reshape(pts.shape[:-1])
 
-    def least_distance(self, centres: np.ndarray, offsets: np.ndarray) -> np.ndarray:
-        """The least :meth:`distance` over the points ``centres[..., None, :] + offsets``:
-        centres (..., 3), offsets (K, 3) with K >= 1; shape (...). One compiled call where
-        the compiled kernel is in use (a part in hand read at points on its box)."""
+    def points_clear(self, centres: np.ndarray, offsets: np.ndarray, threshold: float,
+                     standing: np.ndarray) -> np.ndarray:
+        """Whether the points ``centres[m, s] + offsets`` (a part in hand read at points on
+        its box) keep a field gap (:meth:`distance` less ``threshold``) of at least 0 at
+        every sample, or, for ``standing[m]``, of at least the least gap at the first
+        sample (if below 0) less 5 mm.
+
+        The compiled kernel, where in use, reads only the points near an obstacle part's
+        bounding box (the others keep ``threshold`` whatever the grid says) and stops at
+        the first point that fails: the same answers as reading every point.
+
+        Parameters
+        ----------
+        centres : ndarray, shape (M, S, 3)
+        offsets : ndarray, shape (K, 3), K >= 1
+        threshold : float
+        standing : ndarray of bool, shape (M,)
+
+        Returns
+        -------
+        ok : ndarray of bool, shape (M,)
+        """
         c = np.asarray(centres, dtype=np.float64)
-        o = np.ascontiguousarray(offsets, dtype=np.float64)
+        o = np.asarray(offsets, dtype=np.float64)
+        if self.empty:
+            return np.ones(len(c), dtype=bool)
         nb = _compiled_loops()
-        if self.empty or nb is None or not (np.isfinite(c).all() and np.isfinite(o).all()):
-            return self.distance(c[..., None, :] + o).min(axis=-1)
-        out = np.empty(c.shape[:-1])
-        nb.least_field_distances(np.ascontiguousarray(self.dist, dtype=np.float64), self.lo,
-                                 self.res, float(self.far),
-                                 np.ascontiguousarray(c.reshape(-1, 3)), o, out.reshape(-1))
+        if nb is None or not (np.isfinite(c).all() and np.isfinite(o).all()):
+            gap = self.distance(c[..., None, :] + o).min(axis=-1) - threshold   # (M, S)
+            allowed = np.where(standing, np.minimum(gap[:, 0], 0.0) - 0.005, 0.0)
+            return gap.min(axis=1) >= allowed
+        groups = _point_groups(o.tobytes(), o.shape[0])
+        # Points this far from every part's box read at least ``threshold``: the grid's
+        # corners around them are within sqrt(3) res (a micrometre spare for rounding).
+        limit = threshold + self.res * np.sqrt(3.0) + 1e-6
+        out = np.empty(len(c), dtype=np.bool_)
+        nb.held_points_clear(np.ascontiguousarray(self.dist, dtype=np.float64),
+                             np.asarray(self.lo, dtype=np.float64), float(self.res),
+                             float(self.far), np.ascontiguousarray(c), groups.offsets,
+                             groups.starts, groups.lo, groups.hi, self.part_lo, self.part_hi,
+                             float(limit) if limit < self.far else np.inf, float(threshold),
+                             np.ascontiguousarray(standing, dtype=np.bool_), out)
         return out
 
     def clear(self, poses: np.ndarray, stature: float, margin: float = 0.01,
@@ -511,6 +541,46 @@ class ObstacleField:
             radii + margin + self.res * 0.4, bool(relative), self.part_lo, self.part_hi,
             limit, out)
         return out
+
+
+#: Side (m) of the cubes the points of a part in hand are grouped in for
+#: :meth:`ObstacleField.points_clear` (a group near no obstacle is not read).
+POINT_GROUP_SIZE = 0.15
+
+
+@dataclass(frozen=True)
+class PointGroups:
+    """Points grouped by the cube of side ``POINT_GROUP_SIZE`` they lie in.
+
+    Attributes
+    ----------
+    offsets : ndarray, shape (K, 3)
+        The points, group after group.
+    starts : ndarray of int, shape (G + 1,)
+        Group g is ``offsets[starts[g]:starts[g + 1]]``.
+    lo, hi : ndarray, shape (G, 3)
+        Each group's bounding box.
+    """
+
+    offsets: np.ndarray
+    starts: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+
+
+@lru_cache(maxsize=32)
+def _point_groups(data: bytes, n: int) -> PointGroups:
+    """:class:`PointGroups` of the points (n, 3) stored in ``data`` (float64, C order).
+    Shared: callers must not write to them."""
+    pts = np.frombuffer(data, dtype=np.float64).reshape(n, 3)
+    cube = np.floor((pts - pts.min(axis=0)) / POINT_GROUP_SIZE).astype(np.int64)
+    keys, group = np.unique(cube, axis=0, return_inverse=True)
+    group = group.reshape(-1)
+    order = np.argsort(group, kind="stable")
+    starts = np.r_[0, np.cumsum(np.bincount(group, minlength=len(keys)))].astype(np.int64)
+    lo = np.array([pts[order[a:b]].min(axis=0) for a, b in zip(starts[:-1], starts[1:])])
+    hi = np.array([pts[order[a:b]].max(axis=0) for a, b in zip(starts[:-1], starts[1:])])
+    return PointGroups(np.ascontiguousarray(pts[order]), starts, lo, hi)
 
 
 def _parts_key(parts: np.ndarray | None) -> tuple[int, ...] | None:

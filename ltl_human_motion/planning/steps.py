@@ -322,10 +322,8 @@ class StepExecutor:
         for name, joint in self.state.held.items():
             pts, _ = held_surface(self.ctx.cell, name)
             centre = poses[:, :, JOINT_INDEX[joint]] + self.state.held_offset(name)
-            d = field.least_distance(centre, pts)                             # (M, S)
-            gap = d - (HELD_SEARCH_MARGIN + field.res * 0.4)
-            allowed = np.where(standing, np.minimum(gap[:, 0], 0.0) - 0.005, 0.0)
-            out &= gap.min(axis=1) >= allowed
+            out &= field.points_clear(centre, pts, HELD_SEARCH_MARGIN + field.res * 0.4,
+                                      standing)
         return out
 
     def sit_still(self, seconds: float) -> MotionPrimitive:
