@@ -150,7 +150,8 @@ def test_body_clearance_compiled_bounds_equal_the_numpy_ones(exact_below, monkey
 
 def test_compiled_segment_box_distance_equals_the_closed_form() -> None:
     """The compiled exact distance gives the numpy closed form's numbers bit for bit,
-    also for segments parallel to a face and for points (zero length)."""
+    also for segments parallel to a face, for points (zero length) and for segments that
+    start on a face plane."""
     from ltl_human_motion.scene import clearance
 
     nb = clearance._compiled_bounds()
@@ -164,8 +165,28 @@ def test_compiled_segment_box_distance_equals_the_closed_form() -> None:
     b[500:1000, 1:] = a[500:1000, 1:]
     b[1000:1500] = a[1000:1500]
     half = np.abs(rng.normal(scale=0.3, size=(n, 3))) + 0.01
+    # Ends on a face plane, going either way (crossings at +0 and -0, tied with t = 0).
+    a[1500:2000, 0] = half[1500:2000, 0]
+    a[2000:2500, 2] = -half[2000:2500, 2]
+    b[2000:2500, 2] = a[2000:2500, 2] + rng.choice([-0.2, 0.2], 500)
     got = np.empty(n)
     nb.segment_aabb_distance(a, b, -half, half, got)
     want = segment_aabb_distance(a, b, -half, half)
     assert got.tobytes() == want.tobytes()
     assert np.any(want == 0.0) and np.any(want > 0.1)
+
+
+def test_box_segment_distance_compiled_equals_the_closed_form() -> None:
+    """A box's segment distance (the verifier's region checks) takes the compiled closed
+    form where it is in use: the numpy closed form's numbers, bit for bit, in the shape
+    of the segments given."""
+    box = Box([0.4, -0.2, 0.9], [0.5, 0.3, 0.2], yaw=0.7)
+    rng = np.random.default_rng(8)
+    a = rng.normal(scale=0.6, size=(40, 7, 3)) + box.center
+    b = a + rng.normal(scale=0.2, size=a.shape)
+    got = box.segment_distance(a, b)
+    want = segment_aabb_distance(box.to_local(a), box.to_local(b), -box.half, box.half)
+    assert got.shape == (40, 7)
+    assert got.tobytes() == want.tobytes()
+    assert np.any(want == 0.0) and np.any(want > 0.1)
+    assert box.segment_distance(a[0, 0], b[0, 0]).shape == ()

@@ -60,55 +60,101 @@ def body_bounds(seg, rad, lo, hi, plo, phi, exact_below):
 
 
 @_jit
-def _box_point(a, d, t, lo, hi, n):
-    """``point_box_distance`` of the point a + t d (3,) to box n of lo, hi (N, 3)."""
-    e0 = max(max(lo[n, 0] - (a[0] + t * d[0]), (a[0] + t * d[0]) - hi[n, 0]), 0.0)
-    e1 = max(max(lo[n, 1] - (a[1] + t * d[1]), (a[1] + t * d[1]) - hi[n, 1]), 0.0)
-    e2 = max(max(lo[n, 2] - (a[2] + t * d[2]), (a[2] + t * d[2]) - hi[n, 2]), 0.0)
-    return math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+def _box_point2(a0, a1, a2, d0, d1, d2, t, lo0, lo1, lo2, hi0, hi1, hi2):
+    """The square of ``point_box_distance`` of the point a + t d to the box lo, hi (the
+    sum its square root is taken of)."""
+    e0 = max(max(lo0 - (a0 + t * d0), (a0 + t * d0) - hi0), 0.0)
+    e1 = max(max(lo1 - (a1 + t * d1), (a1 + t * d1) - hi1), 0.0)
+    e2 = max(max(lo2 - (a2 + t * d2), (a2 + t * d2) - hi2), 0.0)
+    return e0 * e0 + e1 * e1 + e2 * e2
+
+
+@_jit
+def _segment_aabb(a0, a1, a2, b0, b1, b2, lo0, lo1, lo2, hi0, hi1, hi2, knots):
+    """``geometry.segment_aabb_distance`` of segment [a, b] and box lo, hi: the 15
+    candidates of the closed form (ends, face crossings, clipped stationary points of
+    the pieces), operation for operation; the least of their squared distances has the
+    least root, so one square root is taken (knots: scratch (8,))."""
+    d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2
+    knots[0], knots[1] = 0.0, 1.0
+    for j, face, a, d in ((2, lo0, a0, d0), (3, lo1, a1, d1), (4, lo2, a2, d2),
+                          (5, hi0, a0, d0), (6, hi1, a1, d1), (7, hi2, a2, d2)):
+        c = (face - a) / d
+        knots[j] = min(max(c, 0.0), 1.0) if math.isfinite(c) else 0.0
+    for i in range(1, 8):            # insertion sort: np.sort's values, faster on 8
+        v = knots[i]
+        j = i - 1
+        while j >= 0 and knots[j] > v:
+            knots[j + 1] = knots[j]
+            j -= 1
+        knots[j + 1] = v
+    best = np.inf
+    for i in range(8):
+        best = min(best, _box_point2(a0, a1, a2, d0, d1, d2, knots[i], lo0, lo1, lo2,
+                                     hi0, hi1, hi2))
+    for i in range(7):
+        t0, t1 = knots[i], knots[i + 1]
+        half = 0.5 * (t0 + t1)
+        num = 0.0
+        den = 0.0
+        for k, a, d, lo, hi in ((0, a0, d0, lo0, hi0), (1, a1, d1, lo1, hi1),
+                                (2, a2, d2, lo2, hi2)):
+            mid = a + half * d
+            if mid < lo:
+                off, slope = a - lo, d
+            elif mid > hi:
+                off, slope = a - hi, d
+            else:
+                off, slope = 0.0, 0.0
+            num = num + off * slope if k else off * slope
+            den = den + slope * slope if k else slope * slope
+        num = -num
+        stat = num / den if den > 0 else t0
+        stat = min(max(stat, t0), t1)
+        best = min(best, _box_point2(a0, a1, a2, d0, d1, d2, stat, lo0, lo1, lo2, hi0, hi1,
+                                     hi2))
+    return math.sqrt(best)
 
 
 @_jit
 def segment_aabb_distance(a, b, lo, hi, out) -> None:
     """out[n] = ``geometry.segment_aabb_distance`` of segment [a[n], b[n]] and box
-    lo[n], hi[n] (all (N, 3)): the 15 candidates of the closed form (ends, face
-    crossings, clipped stationary points of the pieces), operation for operation."""
+    lo[n], hi[n] (all (N, 3)) (:func:`_segment_aabb`)."""
     knots = np.empty(8)
-    d = np.empty(3)
-    an = np.empty(3)
     for n in range(a.shape[0]):
-        for k in range(3):
-            an[k] = a[n, k]
-            d[k] = b[n, k] - a[n, k]
-        knots[0], knots[1] = 0.0, 1.0
-        for k in range(3):
-            for j, face in ((2 + k, lo[n, k]), (5 + k, hi[n, k])):
-                c = (face - an[k]) / d[k]
-                knots[j] = min(max(c, 0.0), 1.0) if math.isfinite(c) else 0.0
-        knots.sort()
-        best = np.inf
-        for i in range(8):
-            best = min(best, _box_point(an, d, knots[i], lo, hi, n))
-        for i in range(7):
-            t0, t1 = knots[i], knots[i + 1]
-            half = 0.5 * (t0 + t1)
-            num = 0.0
-            den = 0.0
-            for k in range(3):
-                mid = an[k] + half * d[k]
-                if mid < lo[n, k]:
-                    off, slope = an[k] - lo[n, k], d[k]
-                elif mid > hi[n, k]:
-                    off, slope = an[k] - hi[n, k], d[k]
-                else:
-                    off, slope = 0.0, 0.0
-                num = num + off * slope if k else off * slope
-                den = den + slope * slope if k else slope * slope
-            num = -num
-            stat = num / den if den > 0 else t0
-            stat = min(max(stat, t0), t1)
-            best = min(best, _box_point(an, d, stat, lo, hi, n))
-        out[n] = best
+        out[n] = _segment_aabb(a[n, 0], a[n, 1], a[n, 2], b[n, 0], b[n, 1], b[n, 2],
+                               lo[n, 0], lo[n, 1], lo[n, 2], hi[n, 0], hi[n, 1], hi[n, 2],
+                               knots)
+
+
+@_jit
+def exact_box_caps(seg, rad, f_idx, p_idx, caps, exact_below, is_box, center, half,
+                   others) -> int:
+    """The exact values of :func:`body_bounds`' capsule bounds below ``exact_below``
+    against axis-aligned boxes, in place: caps[m, k] = the segment-box distance
+    (:func:`_segment_aabb`) of capsule k of frame f_idx[m] (seg (F, K, 2, 3)) and box
+    p_idx[m] (``is_box`` (P,), ``center``, ``half`` (P, 3)), both moved by the box's
+    centre, less rad[k]. The flat indices m * K + k of the pairs below ``exact_below``
+    with another part are written to ``others``; returns their count."""
+    K = seg.shape[1]
+    knots = np.empty(8)
+    n_others = 0
+    for m in range(f_idx.shape[0]):
+        f, p = f_idx[m], p_idx[m]
+        c0, c1, c2 = center[p, 0], center[p, 1], center[p, 2]
+        h0, h1, h2 = half[p, 0], half[p, 1], half[p, 2]
+        for k in range(K):
+            if not caps[m, k] < exact_below:
+                continue
+            if not is_box[p]:
+                others[n_others] = m * K + k
+                n_others += 1
+                continue
+            caps[m, k] = _segment_aabb(seg[f, k, 0, 0] - c0, seg[f, k, 0, 1] - c1,
+                                       seg[f, k, 0, 2] - c2, seg[f, k, 1, 0] - c0,
+                                       seg[f, k, 1, 1] - c1, seg[f, k, 1, 2] - c2,
+                                       -h0, -h1, -h2, h0, h1, h2, knots) - rad[k]
+    return n_others
 
 
 @_jit

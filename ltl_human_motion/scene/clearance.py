@@ -209,11 +209,14 @@ class PartSet:
             np.ascontiguousarray(hi), self.lo, self.hi, float(exact_below))
         if f_idx.size:
             K = seg.shape[1]
-            near = np.flatnonzero(caps.ravel() < exact_below)
-            if near.size:
-                m, k = np.divmod(near, K)
+            others = np.empty(caps.size, dtype=np.intp)
+            n_others = nb.exact_box_caps(seg, rad, f_idx, p_idx, caps, float(exact_below),
+                                         self.is_box, self.center, self.half, others)
+            if n_others:
+                m, k = np.divmod(others[:n_others], K)
                 ends = seg[f_idx[m], k]                                          # (N, 2, 3)
-                caps.ravel()[near] = self._exact(ends[:, 0], ends[:, 1], rad[k], p_idx[m])
+                caps.ravel()[others[:n_others]] = self._exact(ends[:, 0], ends[:, 1],
+                                                              rad[k], p_idx[m])
             body[f_idx, p_idx] = caps.min(axis=1)
         return body.min(axis=1)
 

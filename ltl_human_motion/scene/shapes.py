@@ -296,7 +296,18 @@ class Box(Shape):
         return point_box_signed_distance(self.to_local(points), -self.half, self.half)
 
     def segment_distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return segment_aabb_distance(self.to_local(a), self.to_local(b), -self.half, self.half)
+        from ltl_human_motion.kernel.segments import compiled_module
+        la, lb = np.broadcast_arrays(self.to_local(a), self.to_local(b))
+        nb = compiled_module("ltl_human_motion.scene._clearance_numba")
+        if nb is None or not (np.isfinite(la).all() and np.isfinite(lb).all()):
+            return segment_aabb_distance(la, lb, -self.half, self.half)
+        # the closed form's numbers, compiled (a box's verification reads every frame)
+        flat_a = np.ascontiguousarray(la.reshape(-1, 3))
+        flat_b = np.ascontiguousarray(lb.reshape(-1, 3))
+        out = np.empty(len(flat_a))
+        nb.segment_aabb_distance(flat_a, flat_b, np.repeat(-self.half[None], len(out), 0),
+                                 np.repeat(self.half[None], len(out), 0), out)
+        return out.reshape(la.shape[:-1])
 
     def aabb(self) -> tuple[np.ndarray, np.ndarray]:
         if self.axis_aligned:
