@@ -73,3 +73,19 @@ def test_one_open_side_is_not_a_place_to_stand():
     vise = np.array([0.581, -2.35, 1.04])
     assert not has_spot(ctx, vise, (0.234, -0.1365), open_line=True)
     assert has_spot(ctx, vise, (0.234 + 0.16, -0.1365), open_line=True)
+
+
+def test_a_worker_wedged_between_a_conveyor_and_a_pallet_steps_away_before_turning():
+    """A 1.55 m worker takes a part off a conveyor next to a floor pallet (generator seed
+    1) and faces the belt 0.24 m from it: every turn on the spot swings a thigh 1-1.5 cm
+    into the conveyor on a frame the search does not sample. Before, each repair forbade
+    one turn and the next search took another, until the walk was refused after 19 s of
+    CPU; now the turns are forbidden together and the worker first steps away from the
+    belt, and the move is verified."""
+    built = build_cell("conveyor", 1, 0)
+    cell = cell_from_yaml(built.yaml, source=built.name)
+    motion = synthesize("F move(P_c1, R_tab)", cell, stature=1.55, seed=0)[0]
+    assert not collision(motion.motion.positions, cell, stature=1.55).any()
+    names = [s[0] for s in motion.stats.segments]
+    grasped = next(i for i, n in enumerate(names) if n.startswith("grasp_"))
+    assert any(n.startswith("carry_step_") for n in names[grasped + 1:grasped + 4])

@@ -142,3 +142,58 @@ def test_a_palm_held_off_its_target_gives_up_at_the_first_frame_it_misses(reach)
     kept = track_reference(ref, STATURE, field_, tracked=("r_hand",), fps=mp.fps,
                            give_up=((contact,), 10.0))
     assert np.array_equal(kept.positions, full.positions)
+
+
+def test_balance_rows_are_the_centre_of_mass_distance_to_the_support_edges(reach):
+    """The balance rows are the first-order change of the centre of mass's distance
+    inside each edge of the feet's support polygon (the verifier's outline): the
+    standing pose is inside every edge, and a small step of the configuration changes
+    each distance by ``-G dq`` to within second order."""
+    from ltl_human_motion.motion.goals.constraints import balance_rows, support_edges
+    from ltl_human_motion.motion.ik import center_of_mass
+    _, ref = reach
+    kin = body_kinematics(STATURE)
+    q = kin.configurations(ref[:1])[0]
+    pos = kin.positions(q)
+    edges = support_edges(pos, STATURE)
+    inside = -(edges[:, :2] @ center_of_mass(pos)[:2] + edges[:, 2])
+    assert inside.min() > 0.0
+    G, h = balance_rows(kin, pos, edges, influence=1.0, damper=0.3)
+    assert np.allclose(h, 0.3 * inside)
+    import pinocchio as pin
+    dq = np.random.default_rng(0).normal(0.0, 1e-3, kin.model.nv)
+    moved = kin.positions(pin.integrate(kin.model, q, dq))
+    after = -(edges[:, :2] @ center_of_mass(moved)[:2] + edges[:, 2])
+    assert np.allclose(inside - after, G @ dq, atol=1e-5)
+
+
+def test_range_rows_are_the_anatomical_angles_first_order_change(reach):
+    """A range-of-motion row is the first-order change of the verifier's anatomical
+    angle (degrees) it bounds: at the reach's contact pose, with every range narrowed
+    to within a degree of the angles there, each row's ``G dq`` is the angle's change
+    (lower limits: its decrease) over a small step, to within second order."""
+    import pinocchio as pin
+
+    from ltl_human_motion.motion.biomechanics import joint_angles
+    from ltl_human_motion.motion.goals.constraints import rom_rows
+    mp, ref = reach
+    kin = body_kinematics(STATURE)
+    q = kin.configurations(ref[int(mp.meta["contact_frame"])][None])[0]
+    pos = kin.positions(q)
+    before = {k: float(v[0]) for k, v in joint_angles(pos[None]).items()}
+    ranges = {"knee_flexion": (before["r_knee_flexion"] - 1.0, 150.0),
+              "elbow_flexion": (0.0, before["r_elbow_flexion"] + 1.0)}
+    others = {k[2:] if k[:2] in ("l_", "r_") else k for k in before} - set(ranges)
+    ranges.update({k: (-1e3, 1e3) for k in others})
+    G, h = rom_rows(kin, pos, ranges, influence=2.0, margin=0.0, damper=1.0)
+    dq = np.random.default_rng(1).normal(0.0, 1e-4, kin.model.nv)
+    after = {k: float(v[0]) for k, v in joint_angles(
+        kin.positions(pin.integrate(kin.model, q, dq))[None]).items()}
+    change = {k: after[k] - before[k] for k in before}
+    # rows in order: r/l knee lower limits, r/l elbow upper limits, as near as each is
+    expected = [-change[n] for n in ("l_knee_flexion", "r_knee_flexion")
+                if before[n] - ranges["knee_flexion"][0] < 2.0] + [
+        change[n] for n in ("l_elbow_flexion", "r_elbow_flexion")
+        if ranges["elbow_flexion"][1] - before[n] < 2.0]
+    assert len(expected) == len(h) >= 2
+    assert np.allclose(sorted(G @ dq), sorted(expected), atol=2e-3)

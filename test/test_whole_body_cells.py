@@ -121,3 +121,45 @@ def test_a_short_workers_reach_over_a_bench_takes_the_time_to_stand_back_up():
     motion = _verified("F grasp(P_b1)", cell, 1.55)
     grasp = next(s for s in motion.stats.segments if s[0].startswith("grasp_"))
     assert grasp[0].endswith("_wb")                     # the program's motion
+
+
+def test_a_tall_worker_takes_a_part_out_past_an_open_machine_door():
+    """A 1.95 m worker at a chamber (generator seed 1) whose open door stands beside him:
+    he stands a few millimetres from the machine's base, which the program's planted
+    feet may keep (every step of it was infeasible while they were asked to keep the
+    body's 2 cm margin: refused, the palm 58 cm short); then the carry stance's elbow
+    would meet the door, and the worker steps back and aside at once before raising his
+    arms (a step back or aside alone leaves it in the door)."""
+    built = build_cell("chamber", 1, 0)
+    cell = cell_from_yaml(built.yaml, source=built.name)
+    motion = _verified("F(extract(done, vise_a) & F(move(done, R_tab)))", cell, 1.95)
+    names = [s[0] for s in motion.stats.segments]
+    assert any(n.startswith("extract_") and n.endswith("_wb") for n in names)
+    track = np.asarray(motion.objects["done"])
+    carried = track[np.isfinite(track).all(axis=1)]
+    assert object_clearance(cell, "done", carried).min() >= 0.0
+
+
+def test_a_short_workers_reach_over_a_bench_keeps_its_balance():
+    """A 1.55 m worker's part on a wall shelf 0.4 m behind a bench's edge (generator
+    seed 0): the whole-body program leans over the bench to reach it; with the centre of
+    mass held over the feet as a constraint of every step (before: a task term only)
+    the motion passes the balance check and is verified."""
+    built = build_cell("boards", 0, 1)
+    cell = cell_from_yaml(built.yaml, source=built.name)
+    motion = _verified("F grasp(P_b2)", cell, 1.55)
+    grasp = next(s for s in motion.stats.segments if s[0].startswith("grasp_"))
+    assert grasp[0].endswith("_wb")
+
+
+def test_hands_that_let_go_over_a_desk_come_down_over_its_edge():
+    """A 1.75 m worker inserts a part into a jig on a desk (generator seed 1): the insert
+    ends with the hands in front over the desk, where bringing them down on the
+    transition's fixed curve passes through the desk's edge and every step back or aside
+    first dips a hand into it. The whole-body program remakes the transition, the palms'
+    way made clear and the knees kept within their range of motion (the verifier's
+    angles are a constraint of every step: before, a knee hyperextended 5.6 degrees)."""
+    built = build_cell("desk", 1, 1)
+    cell = cell_from_yaml(built.yaml, source=built.name)
+    motion = _verified("F(extract(P_bin, bin_a) & F(insert(P_bin, jig)))", cell, 1.75)
+    assert any(s[0] == "arms_to_walk_wb" for s in motion.stats.segments)

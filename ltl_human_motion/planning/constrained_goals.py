@@ -28,7 +28,7 @@ from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.scene.clearance import PartSet
 
 __all__ = ["CONTACT_TOLERANCE", "TAKE_TOLERANCE", "PartSetField", "constrained_primitive",
-           "contact_tolerance"]
+           "constrained_transition", "contact_tolerance"]
 
 #: How far (m) the tracked palm may be from the reference's at the contact and hold
 #: frames for the motion to still do the task: where the part goes (insert, move, an
@@ -106,8 +106,8 @@ class BodyPairs:
 
 def program_options(kind: str, stature: float) -> WholeBodyOptions:
     """The whole-body program's options for goal task ``kind``: the verifier's joint speed
-    limits (with :data:`SPEED_ROOM`) and self-penetration pairs (with
-    :data:`SELF_MARGIN`) for a worker of ``stature``."""
+    limits (with :data:`SPEED_ROOM`), self-penetration pairs (with :data:`SELF_MARGIN`)
+    and ranges of motion for a worker of ``stature``."""
     from ltl_human_motion.motion.biomechanics import (
         _PAIR_CAPSULES,
         _PAIR_ENDS,
@@ -121,7 +121,9 @@ def program_options(kind: str, stature: float) -> WholeBodyOptions:
     a, b = _PAIR_CAPSULES
     pairs = BodyPairs(_PAIR_ENDS[0], _PAIR_ENDS[1], np.maximum(r[a], r[b]) + SELF_MARGIN)
     return WholeBodyOptions(speed_limits=tuple(float(v) * SPEED_ROOM for v in speeds),
-                            self_pairs=pairs)
+                            self_pairs=pairs,
+                            ranges=tuple((k, float(lo), float(hi))
+                                         for k, (lo, hi) in sorted(limits.rom.items())))
 
 
 def _primitive(mp: MotionPrimitive, world: np.ndarray) -> MotionPrimitive:
@@ -204,6 +206,22 @@ def constrained_primitive(mp: MotionPrimitive, parts: PartSet,
         if result.end_miss > END_TOLERANCE or result.least_clearance < 0.0:
             return None, miss, result
     return _primitive(mp, result.positions), miss, result
+
+
+def constrained_transition(mp: MotionPrimitive, parts: PartSet,
+                           pose: tuple[float, float, float], stature: float
+                           ) -> MotionPrimitive | None:
+    """The empty-handed arm transition ``mp`` (both palms from one stance to the other,
+    started at floor pose ``pose``) remade by the whole-body program among the obstacle
+    ``parts``: the palms' way made clear of them (:func:`clear_palms`), the body kept
+    clear, and the motion ending in the reference's last pose (where the next primitive
+    starts); None where the program does not make it so. A worker who let go of a part
+    over a desk brings the hands back over its edge, not through it."""
+    meta = dict(mp.meta, hand="both", contact_frame=mp.n_frames - 1, hold_frames=[])
+    made, _, _ = constrained_primitive(replace(mp, meta=meta), parts, pose, stature)
+    if made is None:
+        return None
+    return replace(made, meta=dict(mp.meta, whole_body=True))
 
 
 def _with_more_time(track, ref: np.ndarray, palms: np.ndarray | None, frames: int,

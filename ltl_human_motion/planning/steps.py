@@ -370,7 +370,8 @@ class StepExecutor:
         The palms move beside the body on a smooth curve, timed by Fitts' law with a
         bounded peak speed (:func:`~ltl_human_motion.motion.arm_transition.
         arm_transition_poses`). Where the transition would hit an obstacle, the worker
-        steps back first.
+        steps back first, or where no step clears it the whole-body program remakes it
+        (:meth:`transition_clear`).
         """
         rel = self.arm_poses(carrying_before)
         root = np.zeros((len(rel), 4))
@@ -379,11 +380,30 @@ class StepExecutor:
                              rel, root, self.ctx.library.fps, "planner: arm transition")
         if not self.placed_clear(mp, self.state.pose) and not self.step_back(carrying_before,
                                                                            label, mp):
+            mp = self.transition_clear(mp)
+        if mp is None:
             raise PlanningError(("" if task is None else f"task {task}: ")
                                 + f"bringing the arms {'down' if carrying_before else 'up'} at "
                                 f"({self.state.pose[0]:.2f}, {self.state.pose[1]:.2f}) hits an "
                                 "obstacle, also after a step back", task=task, reason="blocked")
         self.add(mp, self.state.pose, label, self.ctx.overlap)
+
+    def transition_clear(self, mp: MotionPrimitive) -> MotionPrimitive | None:
+        """Arm transition ``mp`` at the current pose remade by the whole-body program
+        (:func:`.constrained_goals.constrained_transition`) where the hands are empty and
+        the program is on, if it keeps the body clear on every frame and passes the
+        verifier's biomechanical checks; else None."""
+        from ltl_human_motion.motion.biomechanics import check_biomechanics
+        from ltl_human_motion.planning.constrained_goals import constrained_transition
+        if self.state.held or not self.ctx.options.whole_body:
+            return None
+        made = constrained_transition(mp, self.ctx.cell.part_set, self.state.pose,
+                                      self.ctx.stature)
+        if made is None or not self.placed_clear(made, self.state.pose):
+            return None
+        checks = check_biomechanics(world_positions(made), made.fps, stature=self.ctx.stature,
+                                    labels=[made.task] * made.n_frames)
+        return made if all(entry["passed"] for entry in checks.values()) else None
 
     def arm_poses(self, carrying_before: bool) -> np.ndarray:
         """Root-relative poses (T, J, 3) of the arm transition (made once per library and
@@ -462,6 +482,31 @@ class StepExecutor:
                 self.add(mp, self.state.pose, -1, self.ctx.overlap)
                 self.state.pose = self.hand_over_pose(mp, self.state.pose)
                 return
+
+    def step_away(self, carrying: bool) -> bool:
+        """A model-made standing step back, aside or both (``STEP_OUT_DISTANCES`` by
+        ``SIDE_STEPS``) onto floor with more clearance than where the worker stands,
+        clear on every frame: where the first move of every walk from here, a turn on
+        the spot, swings a leg into the furniture in front. Returns whether it stepped."""
+        from ltl_human_motion.planning.turns import make_step_primitive
+        lib = self.ctx.library
+        x, y, yaw = self.state.pose
+        c, s = math.cos(yaw), math.sin(yaw)
+        here = float(self.ctx.clearance(np.array([[x, y]]))[0])
+        moves = [(-back, 0.0) for back in STEP_OUT_DISTANCES] \
+            + [(0.0, side) for side in SIDE_STEPS] \
+            + [(-back, side) for back in STEP_OUT_DISTANCES for side in SIDE_STEPS]
+        for dx, dy in moves:
+            to = np.array([[x + c * dx - s * dy, y + s * dx + c * dy]])
+            if float(self.ctx.clearance(to)[0]) <= here:
+                continue
+            mp = make_step_primitive(self.ctx.stance(carrying), lib.standing_height, dx, dy,
+                                     0.0, lib.skeleton, lib.fps, "carry" if carrying else "walk")
+            if self.placed_clear(mp, self.state.pose, samples=None):
+                self.add(mp, self.state.pose, -1, self.ctx.overlap)
+                self.state.pose = self.hand_over_pose(mp, self.state.pose)
+                return True
+        return False
 
     def square_up(self, goal: Goal, carrying: bool) -> bool:
         """In a narrow gap (its middle has less floor clearance on the footprint map than
@@ -565,8 +610,9 @@ class StepExecutor:
         """Step back from an obstacle in front so that ``then`` is clear afterwards: the
         gait index's 0.3 m step back, else a model-made step of ``STEP_OUT_DISTANCES``,
         else a step aside of ``SIDE_STEPS`` (a board at elbow height beside the worker,
-        in an aisle). Returns False (nothing added) when no step and ``then`` are both
-        clear."""
+        in an aisle), else both at once (an open machine door beside the worker at a
+        chamber, reaching back further than a step). Returns False (nothing added) when
+        no step and ``then`` are both clear."""
         from ltl_human_motion.planning.turns import make_step_primitive
         task = "carry" if carrying else "walk"
         lib = self.ctx.library
@@ -575,8 +621,9 @@ class StepExecutor:
             yield from [mp for mp in self.ctx.index.primitives
                         if mp.task == task and mp.meta.get("step") == GAIT_STEP_BACK
                         and not mp.meta.get("turn")][:1]
-            moves = [(-back, 0.0) for back in STEP_OUT_DISTANCES] + [(0.0, side)
-                                                                     for side in SIDE_STEPS]
+            moves = [(-back, 0.0) for back in STEP_OUT_DISTANCES] \
+                + [(0.0, side) for side in SIDE_STEPS] \
+                + [(-back, side) for back in STEP_OUT_DISTANCES for side in SIDE_STEPS]
             for dx, dy in moves:                       # made when tried
                 yield make_step_primitive(self.ctx.stance(carrying), lib.standing_height, dx, dy,
                                           0.0, lib.skeleton, lib.fps, task)
@@ -609,7 +656,7 @@ class StepExecutor:
             else budget.within(self.ctx.options.budget)
         if goal.clearance is self.ctx.stand_map:
             budget = replace(budget, idle_nodes=SQUEEZE_NODES)
-        used, repairs, reroutes = 0, 0, 0
+        used, repairs, reroutes, stepped = 0, 0, 0, False
         while True:
             self.ctx.rng.bit_generator.state = noise_state      # the same costs every time
             stall = STALL_NODES if goal.reroute is not None and reroutes < MAX_REROUTES \
@@ -633,6 +680,11 @@ class StepExecutor:
             bad = self.first_collision(res.primitives, res.poses)
             if bad is None:
                 break
+            if bad == 0 and not stepped and self.ctx.index.standing[res.primitives[0]] \
+                    and self.step_away(carry):
+                # Too tight a place to turn (a thigh into a conveyor): step away first.
+                stepped, forbidden = True, set()
+                continue
             forbidden |= self.forbid(res.primitives, res.poses, bad)
             repairs += 1
             if repairs > WALK_REPAIRS:
@@ -665,15 +717,24 @@ class StepExecutor:
     def forbid(self, primitives: list[int], poses: list[Pose], bad: int
                ) -> set[tuple[int, int, int, int]]:
         """What a search must not take again after primitive ``bad`` of its path collided:
-        that primitive from its pose, and where it is a stop (the arms swing forward as
-        the worker stops at furniture) that ends a walk, every gait stop from there and
-        from the neighbouring closed-set cells: the stops from one spot sweep nearly the
-        same space, and forbidding them one at a time, one cell at a time, used up the
-        ``WALK_REPAIRS``."""
+        that primitive from its pose; where it is a turn on the spot, every such turn
+        from there; and where it is a stop (the arms swing forward as the worker stops
+        at furniture) that ends a walk, every gait stop from there and from the
+        neighbouring closed-set cells: the stops from one spot sweep nearly the same
+        space, and forbidding them one at a time, one cell at a time, used up the
+        ``WALK_REPAIRS`` (so did the turns of a worker facing a conveyor, his thigh
+        swinging into it, each turn tried in turn)."""
         i, j, k = placement_key(*poses[bad])
         prim = primitives[bad]
-        if bad == 0 or not self.ctx.index.stops[prim] or self.ctx.index.standing[prim]:
-            return {(prim, i, j, k)}               # the first move, a turn on the spot
+        index = self.ctx.index
+        if index.standing[prim] and index.primitives[prim].meta.get("turn"):
+            # A turn on the spot (the first move from a tight place): every turn from
+            # there sweeps the legs through nearly the same space.
+            turns = [p for p in np.flatnonzero(index.standing).tolist()
+                     if index.primitives[p].meta.get("turn")]
+            return {(int(p), i, j, k) for p in turns}
+        if bad == 0 or not index.stops[prim] or index.standing[prim]:
+            return {(prim, i, j, k)}               # the first move, a step on the spot
         stops = np.flatnonzero(self.ctx.index.stops & ~self.ctx.index.standing).tolist()
         return {(int(p), i + di, j + dj, k) for p in stops
                 for di in (-1, 0, 1) for dj in (-1, 0, 1)}

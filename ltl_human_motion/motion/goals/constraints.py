@@ -19,8 +19,8 @@ from ltl_human_motion.motion.goals.kinematics import (
     point_jacobians,
 )
 
-__all__ = ["ObstacleField", "SelfPairs", "clearance_rows", "reference_clearance",
-           "self_rows", "speed_rows"]
+__all__ = ["ObstacleField", "SelfPairs", "balance_rows", "clearance_rows",
+           "reference_clearance", "rom_rows", "self_rows", "speed_rows"]
 
 _FD_STEP = 1e-4
 
@@ -55,6 +55,11 @@ class SelfPairs(Protocol):
 #: Capsules that take ``hand_margin``: the hands and forearms.
 _HAND_CAPSULES = np.array([i for i, c in enumerate(BODY_CAPSULES)
                            if c[0][2:] in ("hand", "palm", "lower_arm")])
+#: Capsules of the planted feet, which the program holds where the stance put them
+#: (stepping is the gait's job): they keep the verifier's clearance of 0, not a margin
+#: they could only gain by moving. A stance a few millimetres from a machine's base
+#: otherwise asks the fixed foot to back off, and no step of the program is feasible.
+_FOOT_CAPSULES = np.array([i for i, c in enumerate(BODY_CAPSULES) if c[0][2:] == "foot"])
 
 
 def _margins(margins: tuple[float, float, float], n: int) -> np.ndarray:
@@ -64,6 +69,7 @@ def _margins(margins: tuple[float, float, float], n: int) -> np.ndarray:
     out = np.full(n, part)
     out[:len(BODY_CAPSULES)] = body
     out[_HAND_CAPSULES] = hand
+    out[_FOOT_CAPSULES] = 0.0
     return out
 
 
@@ -162,3 +168,91 @@ def speed_rows(kin: BodyKinematics, limits: np.ndarray, seconds: float
     J = point_jacobians(kin, np.arange(len(limits))).reshape(-1, kin.model.nv)   # (3J, nv)
     bound = np.repeat(np.asarray(limits) * seconds / np.sqrt(2.0), 3)
     return np.vstack([J, -J]), np.concatenate([bound, bound])
+
+
+def _com_weights(joints: int) -> np.ndarray:
+    """Weights (J,) of the joint positions in the verifier's centre of mass (Winter's
+    segment masses, :func:`~ltl_human_motion.motion.ik.center_of_mass`, which is linear
+    in them)."""
+    from ltl_human_motion.motion.ik import SEGMENT_MASS
+    from ltl_human_motion.motion.skeleton import JOINT_INDEX
+    w = np.zeros(joints)
+    for a, b, mass, frac in SEGMENT_MASS:
+        w[JOINT_INDEX[a]] += mass * (1.0 - frac)
+        w[JOINT_INDEX[b]] += mass * frac
+    return w / w.sum()
+
+
+def support_edges(pos: np.ndarray, stature: float) -> np.ndarray:
+    """The support polygon of both feet at joint positions ``pos`` (J, 3), as the
+    verifier's balance check outlines them: its edges' lines (E, 3), ``n . x + c <= 0``
+    inside, with unit outward normals ``n``."""
+    from scipy.spatial import ConvexHull
+
+    from ltl_human_motion.motion.biomechanics import _foot_outline
+    from ltl_human_motion.motion.skeleton import JOINT_INDEX
+    corners = np.concatenate([
+        _foot_outline(pos[None, JOINT_INDEX[f"{s}_ankle"]], pos[None, JOINT_INDEX[f"{s}_toe"]],
+                      stature)[0] for s in ("l", "r")])
+    return ConvexHull(corners).equations
+
+
+def balance_rows(kin: BodyKinematics, pos: np.ndarray, edges: np.ndarray,
+                 influence: float, damper: float) -> tuple[np.ndarray, np.ndarray]:
+    """Velocity-damper rows ``G dq <= h`` keeping the centre of mass of joint positions
+    ``pos`` (J, 3) over the support polygon ``edges`` (E, 3) (:func:`support_edges`): for
+    each edge the centre of mass is nearer than ``influence`` to, one step may use the
+    fraction ``damper`` of its distance inside."""
+    w = _com_weights(len(pos))
+    com = w @ pos
+    inside = -(edges[:, :2] @ com[:2] + edges[:, 2])                      # (E,)
+    near = np.flatnonzero(inside < influence)
+    if near.size == 0:
+        return np.zeros((0, kin.model.nv)), np.zeros(0)
+    joints = np.flatnonzero(w)
+    J = np.einsum("k,kin->in", w[joints], point_jacobians(kin, joints))      # (3, nv)
+    return edges[near, :2] @ J[:2], damper * inside[near]
+
+
+#: Finite-difference step of the range-of-motion rows, m.
+_ROM_FD_STEP = 1e-5
+
+
+def rom_rows(kin: BodyKinematics, pos: np.ndarray, ranges: dict[str, tuple[float, float]],
+             influence: float, margin: float, damper: float
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Velocity-damper rows ``G dq <= h`` keeping the verifier's anatomical joint angles
+    (:func:`~ltl_human_motion.motion.biomechanics.joint_angles`, degrees, of joint
+    positions ``pos`` (J, 3)) within ``ranges`` (by key without side: ``knee_flexion``
+    -> (lo, hi)) less ``margin`` degrees: a row for each angle within ``influence``
+    degrees of a limit, one step using the fraction ``damper`` of what is left (an
+    angle already past the margin, as a reference may hold it, only goes no further). The
+    angles' gradients are central differences of the joint positions pushed through the
+    joints' Jacobians."""
+    from ltl_human_motion.motion.biomechanics import joint_angles
+    angles = joint_angles(pos[None])
+    near = []
+    for name, a in angles.items():
+        key = name[2:] if name[:2] in ("l_", "r_") else name
+        lo, hi = ranges[key]
+        value = float(a[0])
+        if value - lo < influence:
+            near.append((name, 1.0, value - lo - margin))
+        if hi - value < influence:
+            near.append((name, -1.0, hi - value - margin))
+    if not near:
+        return np.zeros((0, kin.model.nv)), np.zeros(0)
+    n = len(pos)
+    steps = np.concatenate([np.eye(3), -np.eye(3)]) * _ROM_FD_STEP                    # (6, 3)
+    moved = np.broadcast_to(pos, (6, n, n, 3)).copy()                                # step, joint
+    moved[:, np.arange(n), np.arange(n)] += steps[:, None, :]
+    names = sorted({name for name, _, _ in near})
+    perturbed = joint_angles(moved.reshape(-1, n, 3), names)
+    J = point_jacobians(kin, np.arange(n))                                           # (n, 3, nv)
+    G, h = [], []
+    for name, sign, room in near:
+        v = perturbed[name].reshape(6, n)
+        grad = (v[:3] - v[3:]).T / (2 * _ROM_FD_STEP)                                # (n, 3)
+        G.append(-sign * np.einsum("jc,jcn->n", grad, J))
+        h.append(damper * max(room, 0.0))
+    return np.array(G), np.array(h)

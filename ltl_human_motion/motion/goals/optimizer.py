@@ -11,7 +11,11 @@ that the worker's kinematic model tracks frame by frame as a quadratic program
   positions, the pelvis and the centre of mass near the reference's, a posture term
   pulling every joint towards the reference's angles.
 * **Constraints** (every step): the feet stay planted (equality: the toe links' poses,
-  which fix each foot, where the reference has them); the URDF's joint ranges of motion
+  which fix each foot, where the reference has them); the centre of mass over the feet's
+  support polygon as the verifier's balance check outlines it (a velocity damper on its
+  distance inside each edge); the verifier's ranges of motion of the anatomical angles
+  (dampers on the angles, differentiated through the joint positions) and the URDF's
+  joint ranges
   (widened only where the reference itself goes beyond them), joint and root speed
   bounds; and
   clearance, a velocity damper (Faverjon & Tournassoud 1987; Kanoun et al. 2011) on the
@@ -42,10 +46,13 @@ import numpy as np
 from ltl_human_motion.motion.goals.constraints import (
     ObstacleField,
     SelfPairs,
+    balance_rows,
     clearance_rows,
     reference_clearance,
+    rom_rows,
     self_rows,
     speed_rows,
+    support_edges,
 )
 from ltl_human_motion.motion.goals.kinematics import (
     BODY_ID,
@@ -64,7 +71,8 @@ __all__ = ["POSTURE_GAINS", "RETURN_SECONDS", "TrackingResult", "WholeBodyOption
 class WholeBodyOptions:
     """Weights and constraint settings of :func:`track_reference`.
 
-    margin: clearance kept from every obstacle part, m (over the verifier's 0 by what the
+    margin: clearance kept from every obstacle part but by the planted feet (which keep
+    0), m (over the verifier's 0 by what the
     junction blends and foot locking move a goal motion's first and last frames);
     hand_margin that of the hands and forearms, which reach into tight places (a chamber,
     a bin), and part_margin that of a part in hand (it rests on the furniture it is taken
@@ -76,7 +84,11 @@ class WholeBodyOptions:
     joint_speed (rad/s) and root_speed (m/s, rad/s) bound each step; speed_limits (J,)
     m/s bound every joint's speed (the verifier's, with room); self_pairs are the body's
     own capsule pairs kept apart (constrained within ``self_influence`` m of their least
-    distance).
+    distance); the centre of mass is kept over the feet's support polygon, constrained
+    within ``balance_influence`` m of its edges (None: not constrained); ``ranges``
+    ((angle, lo, hi) degrees, the verifier's ranges of motion by anatomical angle) keep
+    each angle ``range_margin`` inside them, constrained within ``range_influence``
+    degrees of a limit (None: only the URDF's joint limits).
     """
 
     margin: float = 0.02
@@ -97,6 +109,10 @@ class WholeBodyOptions:
     speed_limits: tuple[float, ...] | None = None
     self_pairs: SelfPairs | None = None
     self_influence: float = 0.05
+    balance_influence: float | None = 0.05
+    ranges: tuple[tuple[str, float, float], ...] | None = None
+    range_influence: float = 5.0
+    range_margin: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -184,11 +200,12 @@ class _Tracker:
     """The per-frame program of :func:`track_reference`."""
 
     def __init__(self, kin: BodyKinematics, ref: np.ndarray, tracked: tuple[str, ...],
-                 opts: WholeBodyOptions, fps: float, palms: np.ndarray | None = None
-                 ) -> None:
+                 opts: WholeBodyOptions, fps: float, palms: np.ndarray | None = None,
+                 stature: float | None = None) -> None:
         import pinocchio as pin
         from pink.tasks import ComTask, FrameTask, PostureTask
         self.kin, self.ref, self.opts, self.dt = kin, ref, opts, 1.0 / fps
+        self.stature = stature
         self.q_ref = kin.configurations(ref)
         self.q_ref[:, 7:] = np.unwrap(self.q_ref[:, 7:], axis=0)
         self.roots = root_poses(ref)
@@ -254,8 +271,10 @@ class _Tracker:
     def rows(self, q: np.ndarray, field_: ObstacleField, held: HeldPart | None,
              frames: int) -> tuple[np.ndarray, np.ndarray, bool]:
         """The inequality rows ``G dq <= h`` of a step over ``frames`` frames from ``q``:
-        clearance to the obstacles and within the body, joint speeds; and whether an
-        obstacle or a body pair is near enough to constrain it."""
+        clearance to the obstacles and within the body, ranges of motion, balance, joint
+        speeds; and
+        whether an obstacle, a body pair, a range's limit or an edge of the support
+        polygon is near enough to constrain it."""
         opts, kin = self.opts, self.kin
         pos = kin.positions(q)
         G, h, _ = clearance_rows(kin, pos, field_, held, opts.influence, opts.damper,
@@ -264,6 +283,12 @@ class _Tracker:
         if opts.self_pairs is not None:
             parts.append(self_rows(kin, pos, opts.self_pairs, opts.self_influence,
                                    opts.damper))
+        if opts.ranges is not None:
+            parts.append(rom_rows(kin, pos, {k: (lo, hi) for k, lo, hi in opts.ranges},
+                                  opts.range_influence, opts.range_margin, opts.damper))
+        if opts.balance_influence is not None and self.stature is not None:
+            parts.append(balance_rows(kin, pos, support_edges(pos, self.stature),
+                                      opts.balance_influence, opts.damper))
         active = sum(len(x[1]) for x in parts) > 0
         if opts.speed_limits is not None:
             parts.append(speed_rows(kin, np.asarray(opts.speed_limits), self.dt * frames))
@@ -343,7 +368,7 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
     last_near = len(ref) - 1 - int(np.argmax(np.isfinite(near[::-1])))
     if palms is not None and moved.any():
         last_near = max(last_near, len(ref) - 1 - int(np.argmax(moved[::-1])))
-    tracker = _Tracker(kin, ref, tracked, opts, fps, palms)
+    tracker = _Tracker(kin, ref, tracked, opts, fps, palms, stature)
     release = int(0.75 * len(ref)) if release_from is None else int(release_from)
     conf = pink.Configuration(kin.model, kin.data, tracker.q_ref[first].copy())
     out = ref.copy()
