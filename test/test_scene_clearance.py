@@ -125,8 +125,12 @@ def test_helpers_match_their_references() -> None:
     np.testing.assert_array_equal(per, one)
 
 
+@pytest.mark.parametrize("boxes_only", [False, True])
 @pytest.mark.parametrize("exact_below", [float(np.nextafter(0.0, 1.0)), 0.05, 0.4, np.inf])
-def test_body_clearance_compiled_bounds_equal_the_numpy_ones(exact_below, monkeypatch) -> None:
+def test_body_clearance_compiled_bounds_equal_the_numpy_ones(exact_below, boxes_only,
+                                                            monkeypatch) -> None:
+    """Bit for bit, also where every part is an axis-aligned box (one compiled pass); the
+    capsule-by-part clearances too."""
     from ltl_human_motion.scene import clearance
 
     if clearance._compiled_bounds() is None:
@@ -136,13 +140,19 @@ def test_body_clearance_compiled_bounds_equal_the_numpy_ones(exact_below, monkey
     where = rng.uniform([-0.5, -2.0, 0.0], [2.0, 2.0, 0.0], (300, 1, 3))
     poses = rest[None] + where + rng.normal(scale=0.05, size=(300, *rest.shape))
     seg, rad = capsules_from_positions(poses, 1.75)
-    ps = PartSet(PARTS)
+    ps = PartSet(PARTS[:2] if boxes_only else PARTS)
+    assert ps.is_box.all() == boxes_only
     fast = ps.body_clearance(seg, rad, exact_below)
     fast_bounded = ps.body_clearance(seg, rad, exact_below, bounds=point_bounds(poses))
+    fast_pairs = ps.pair_clearance(seg.reshape(-1, 2, 3), np.tile(rad, len(poses)),
+                                   exact_below)
     monkeypatch.setattr(clearance, "_compiled_bounds", lambda: None)
     slow = ps.body_clearance(seg, rad, exact_below)
     # Bit for bit: the same bounds, the same exact values of the same pairs.
     assert fast.tobytes() == slow.tobytes()
+    assert fast_pairs.tobytes() == ps.pair_clearance(seg.reshape(-1, 2, 3),
+                                                     np.tile(rad, len(poses)),
+                                                     exact_below).tobytes()
     assert fast_bounded.tobytes() == ps.body_clearance(seg, rad, exact_below,
                                                       bounds=point_bounds(poses)).tobytes()
     assert np.any(slow < min(exact_below, 0.4)) and np.any(slow >= 0.05)

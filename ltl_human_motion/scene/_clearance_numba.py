@@ -141,8 +141,6 @@ def exact_box_caps(seg, rad, f_idx, p_idx, caps, exact_below, is_box, center, ha
     n_others = 0
     for m in range(f_idx.shape[0]):
         f, p = f_idx[m], p_idx[m]
-        c0, c1, c2 = center[p, 0], center[p, 1], center[p, 2]
-        h0, h1, h2 = half[p, 0], half[p, 1], half[p, 2]
         for k in range(K):
             if not caps[m, k] < exact_below:
                 continue
@@ -150,10 +148,81 @@ def exact_box_caps(seg, rad, f_idx, p_idx, caps, exact_below, is_box, center, ha
                 others[n_others] = m * K + k
                 n_others += 1
                 continue
-            caps[m, k] = _segment_aabb(seg[f, k, 0, 0] - c0, seg[f, k, 0, 1] - c1,
-                                       seg[f, k, 0, 2] - c2, seg[f, k, 1, 0] - c0,
-                                       seg[f, k, 1, 1] - c1, seg[f, k, 1, 2] - c2,
-                                       -h0, -h1, -h2, h0, h1, h2, knots) - rad[k]
+            caps[m, k] = _cap_box(seg, f, k, p, center, half, knots) - rad[k]
+    return n_others
+
+
+@_jit
+def _least(best, v):
+    """``np.min``'s fold of v into best: a NaN stays."""
+    return v if (v < best or v != v) else best
+
+
+@_jit
+def _cap_box(seg, f, k, p, center, half, knots):
+    """The segment-box distance (:func:`_segment_aabb`) of capsule k of frame f of seg
+    (F, K, 2, 3) and the axis-aligned box p (``center``, ``half`` (P, 3)), both moved by
+    the box's centre."""
+    c0, c1, c2 = center[p, 0], center[p, 1], center[p, 2]
+    h0, h1, h2 = half[p, 0], half[p, 1], half[p, 2]
+    return _segment_aabb(seg[f, k, 0, 0] - c0, seg[f, k, 0, 1] - c1, seg[f, k, 0, 2] - c2,
+                         seg[f, k, 1, 0] - c0, seg[f, k, 1, 1] - c1, seg[f, k, 1, 2] - c2,
+                         -h0, -h1, -h2, h0, h1, h2, knots)
+
+
+@_jit
+def body_clearance_boxes(seg, rad, lo, hi, plo, phi, exact_below, center, half, out) -> None:
+    """out[f] = ``PartSet.body_clearance`` of body f (seg (F, K, 2, 3), its box lo, hi
+    (F, 3)) against parts that are all axis-aligned boxes (plo, phi, ``center``, ``half``
+    (P, 3)): :func:`body_bounds` and :func:`exact_box_caps` in one pass, each value
+    folded into the least as it is made."""
+    F, K, P = seg.shape[0], seg.shape[1], plo.shape[0]
+    rmax = rad.max()
+    knots = np.empty(8)
+    for f in range(F):
+        best = np.inf
+        for p in range(P):
+            v = _gap(lo[f, 0], lo[f, 1], lo[f, 2], hi[f, 0], hi[f, 1], hi[f, 2],
+                     plo[p], phi[p]) - rmax
+            if v < exact_below:
+                v = np.inf
+                for k in range(K):
+                    a, b = seg[f, k, 0], seg[f, k, 1]
+                    cap = _gap(np.minimum(a[0], b[0]), np.minimum(a[1], b[1]),
+                               np.minimum(a[2], b[2]), np.maximum(a[0], b[0]),
+                               np.maximum(a[1], b[1]), np.maximum(a[2], b[2]),
+                               plo[p], phi[p]) - rad[k]
+                    if cap < exact_below:
+                        cap = _cap_box(seg, f, k, p, center, half, knots) - rad[k]
+                    v = _least(v, cap)
+            best = _least(best, v)
+        out[f] = best
+
+
+@_jit
+def pair_bounds(seg, rad, plo, phi, exact_below, is_box, center, half, out, others) -> int:
+    """``PartSet.pair_clearance`` of capsules seg (N, 2, 3) with radii (N,) against every
+    part (plo, phi (P, 3)) into out (N, P): the box gap less the radius, exact below
+    ``exact_below`` for axis-aligned boxes (``is_box`` (P,), ``center``, ``half``
+    (P, 3); :func:`_cap_box`). The flat indices n * P + p of the pairs below
+    ``exact_below`` with another part are written to ``others``; returns their count."""
+    N, P = seg.shape[0], plo.shape[0]
+    knots = np.empty(8)
+    n_others = 0
+    one = seg.reshape(N, 1, 2, 3)
+    for n in range(N):
+        a, b = seg[n, 0], seg[n, 1]
+        lo0, lo1, lo2 = np.minimum(a[0], b[0]), np.minimum(a[1], b[1]), np.minimum(a[2], b[2])
+        hi0, hi1, hi2 = np.maximum(a[0], b[0]), np.maximum(a[1], b[1]), np.maximum(a[2], b[2])
+        for p in range(P):
+            v = _gap(lo0, lo1, lo2, hi0, hi1, hi2, plo[p], phi[p]) - rad[n]
+            if v < exact_below:
+                if is_box[p]:
+                    v = _cap_box(one, n, 0, p, center, half, knots) - rad[n]
+                else:
+                    others[n_others] = n * P + p
+                    n_others += 1
+            out[n, p] = v
     return n_others
 
 

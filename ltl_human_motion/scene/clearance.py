@@ -121,12 +121,33 @@ class PartSet:
         clearance : ndarray, shape (N, P)
             As :meth:`Shape.capsule_clearance` of each part.
         """
+        nb = _compiled_bounds()
+        if nb is not None and np.isfinite(segments).all():
+            return self._pair_clearance_compiled(nb, segments, radii, exact_below)
         a, b = segments[:, 0], segments[:, 1]
         out = box_gap(np.minimum(a, b)[:, None], np.maximum(a, b)[:, None],
                        self.lo, self.hi) - radii[:, None]
         n_idx, p_idx = np.nonzero(out < exact_below)
         if n_idx.size:
             out[n_idx, p_idx] = self._exact(a[n_idx], b[n_idx], radii[n_idx], p_idx)
+        return out
+
+    def _pair_clearance_compiled(self, nb: ModuleType, segments: np.ndarray,
+                                 radii: np.ndarray, exact_below: float) -> np.ndarray:
+        """:meth:`pair_clearance` of finite capsules (N, 2, 3) with radii (N,), the bounds
+        and the boxes' exact values compiled (:func:`._clearance_numba.pair_bounds`), the
+        other parts' exact values as in numpy; (N, P)."""
+        seg = np.ascontiguousarray(segments, dtype=np.float64)
+        rad = np.ascontiguousarray(radii, dtype=np.float64)
+        P = len(self.parts)
+        out = np.empty((len(seg), P))
+        others = np.empty(out.size, dtype=np.intp)
+        n_others = nb.pair_bounds(seg, rad, self.lo, self.hi, float(exact_below), self.is_box,
+                                  self.center, self.half, out, others)
+        if n_others:
+            n_idx, p_idx = np.divmod(others[:n_others], P)
+            out.ravel()[others[:n_others]] = self._exact(seg[n_idx, 0], seg[n_idx, 1],
+                                                         rad[n_idx], p_idx)
         return out
 
     def capsule_clearance(self, segments: np.ndarray, radii: np.ndarray,
@@ -202,8 +223,16 @@ class PartSet:
                                  lo: np.ndarray, hi: np.ndarray, exact_below: float
                                  ) -> np.ndarray:
         """:meth:`body_clearance` of bodies (F, K, 2, 3) with their boxes lo, hi (F, 3),
-        the bounds compiled (:mod:`._clearance_numba`), the exact values as in numpy."""
+        the bounds and the boxes' exact values compiled (:mod:`._clearance_numba`; in one
+        pass where every part is an axis-aligned box), the other parts' as in numpy."""
         seg = np.ascontiguousarray(seg, dtype=np.float64)
+        if not self._others and np.isfinite(seg).all():
+            out = np.empty(len(seg))
+            nb.body_clearance_boxes(seg, np.ascontiguousarray(rad, dtype=np.float64),
+                                    np.ascontiguousarray(lo), np.ascontiguousarray(hi),
+                                    self.lo, self.hi, float(exact_below), self.center,
+                                    self.half, out)
+            return out
         body, f_idx, p_idx, caps = nb.body_bounds(
             seg, np.ascontiguousarray(rad, dtype=np.float64), np.ascontiguousarray(lo),
             np.ascontiguousarray(hi), self.lo, self.hi, float(exact_below))
