@@ -112,8 +112,9 @@ def test_obstacle_field_clear_matches_reading_every_capsule(paper, compiled, mon
 @pytest.mark.parametrize("compiled", [False, True])
 def test_clear_samples_equals_clear_of_the_selection(paper, compiled, monkeypatch) -> None:
     """The search's one-call test of some candidates at some samples (with the bounding
-    box pre-test in the compiled loop) answers as :meth:`ObstacleField.clear` of the
-    selected poses, for the whole body and for the arms with the sweep margin."""
+    box pre-tests in the compiled loop, of the candidate and of each capsule) answers as
+    :meth:`ObstacleField.clear` of the selected poses, for the whole body and for the
+    arms with the sweep margin."""
     from ltl_human_motion.motion.capsules import part_indices
     from ltl_human_motion.planning.steps import SWEEP_MARGIN, SWEEP_PARTS
     field = _field_on_path(paper, compiled, monkeypatch)

@@ -202,23 +202,14 @@ def held_points_clear(grid, lo, res, far, centres, offsets, starts, group_lo, gr
 
 
 @_jit
-def _sample_gaps(grid, lo, res, far, pos, m, s, ia, ib, long, need, used, dj, gaps) -> None:
-    """gaps[k] = the field gap of capsule k (joints ia[k], ib[k]) at sample s of candidate
-    m: the nearer of its ends' distances (and of its middle's, for a long capsule) less
-    need[k]; each joint (``used`` (J,) bool) read once into dj (J,)."""
-    for j in range(used.shape[0]):
-        if used[j]:
-            dj[j] = _field_distance(grid, lo, res, far, pos[m, s, j, 0], pos[m, s, j, 1],
-                                    pos[m, s, j, 2])
-    for k in range(ia.shape[0]):
-        a, b = ia[k], ib[k]
-        d = min(dj[a], dj[b])
-        if long[k]:
-            mid = _field_distance(grid, lo, res, far, (pos[m, s, a, 0] + pos[m, s, b, 0]) / 2.0,
-                                  (pos[m, s, a, 1] + pos[m, s, b, 1]) / 2.0,
-                                  (pos[m, s, a, 2] + pos[m, s, b, 2]) / 2.0)
-            d = min(d, mid)
-        gaps[k] = d - need[k]
+def _joint_distance(grid, lo, res, far, pos, m, s, j, dj, read, stamp):
+    """The field distance at joint j of sample s of candidate m (pos (M, S, J, 3)), read
+    once per ``stamp`` into dj (J,) (``read`` (J,): the stamp it was read at)."""
+    if read[j] != stamp:
+        dj[j] = _field_distance(grid, lo, res, far, pos[m, s, j, 0], pos[m, s, j, 1],
+                                pos[m, s, j, 2])
+        read[j] = stamp
+    return dj[j]
 
 
 @_jit
@@ -229,18 +220,28 @@ def body_samples_clear(grid, lo, res, far, pos, cand, samples, ia, ib, long, nee
     whose sampled joints' bounding box keeps ``limit`` from every obstacle part's box
     (part_lo, part_hi (P, 3)) passes unread, as the numpy pre-test (``box_gap`` of
     ``point_bounds``, the same arithmetic); for the others, whether every capsule
-    keeps its field gap (:func:`_sample_gaps`) >= 0 at every sample, or with
-    ``relative`` >= min(its gap at the first sample, 0) - 0.005 (``need`` (K,): radius,
-    margin and interpolation allowance). Stops at the first failing sample."""
+    keeps its field gap >= 0 at every sample, or with ``relative`` >= min(its gap at
+    the first sample, 0) - 0.005 (the gap: the nearer of its ends' distances, and of its
+    middle's for a long capsule, less ``need`` (K,): radius, margin and interpolation
+    allowance), each joint read once per sample. Stops at the first failing capsule. With a finite
+    ``limit``, a capsule whose ends' box keeps its need and the interpolation error (a
+    micrometre spare) from every part's box is not read: its gap is > 0."""
     K = ia.shape[0]
     J = pos.shape[2]
-    used = np.zeros(J, dtype=np.bool_)
-    for k in range(K):
-        used[ia[k]] = True
-        used[ib[k]] = True
+    P = part_lo.shape[0]
     dj = np.empty(J)
-    gaps = np.empty(K)
+    read = np.zeros(J, dtype=np.int64)
+    stamp = 0
     first = np.zeros(K)
+    prune = limit < np.inf
+    reach2 = np.empty(K)
+    widest = 0.0
+    for k in range(K):
+        r = need[k] + res * math.sqrt(3.0) + 1e-6
+        reach2[k] = r * r
+        widest = max(widest, r * r)
+    every = np.arange(P)
+    near = np.empty(P, dtype=np.int64)
     for n in range(cand.shape[0]):
         m = cand[n]
         blo0 = blo1 = blo2 = np.inf
@@ -253,7 +254,7 @@ def body_samples_clear(grid, lo, res, far, pos, cand, samples, ia, ib, long, nee
                 blo1, bhi1 = min(blo1, y), max(bhi1, y)
                 blo2, bhi2 = min(blo2, z), max(bhi2, z)
         box = np.inf
-        for p in range(part_lo.shape[0]):
+        for p in range(P):
             g0 = max(max(part_lo[p, 0] - bhi0, blo0 - part_hi[p, 0]), 0.0)
             g1 = max(max(part_lo[p, 1] - bhi1, blo1 - part_hi[p, 1]), 0.0)
             g2 = max(max(part_lo[p, 2] - bhi2, blo2 - part_hi[p, 2]), 0.0)
@@ -261,17 +262,44 @@ def body_samples_clear(grid, lo, res, far, pos, cand, samples, ia, ib, long, nee
         if not box < limit:
             out[n] = True
             continue
+        n_near = P
+        if prune:
+            n_near = 0
+            for p in range(P):
+                if _box_near(blo0, blo1, blo2, bhi0, bhi1, bhi2, part_lo, part_hi,
+                             every[p:p + 1], 1, widest):
+                    near[n_near] = p
+                    n_near += 1
+        else:
+            near[:] = every
         ok = True
-        if relative:
-            _sample_gaps(grid, lo, res, far, pos, m, samples[0], ia, ib, long, need, used,
-                         dj, gaps)
+        for t in range(-1 if relative else 0, samples.shape[0]):
+            s = samples[max(t, 0)]
+            stamp += 1
             for k in range(K):
-                first[k] = min(gaps[k], 0.0) - 0.005
-        for t in range(samples.shape[0]):
-            _sample_gaps(grid, lo, res, far, pos, m, samples[t], ia, ib, long, need, used,
-                         dj, gaps)
-            for k in range(K):
-                if not gaps[k] >= first[k]:
+                a, b = ia[k], ib[k]
+                if prune and not _box_near(
+                        min(pos[m, s, a, 0], pos[m, s, b, 0]),
+                        min(pos[m, s, a, 1], pos[m, s, b, 1]),
+                        min(pos[m, s, a, 2], pos[m, s, b, 2]),
+                        max(pos[m, s, a, 0], pos[m, s, b, 0]),
+                        max(pos[m, s, a, 1], pos[m, s, b, 1]),
+                        max(pos[m, s, a, 2], pos[m, s, b, 2]),
+                        part_lo, part_hi, near, n_near, reach2[k]):
+                    gap = np.inf
+                else:
+                    d = min(_joint_distance(grid, lo, res, far, pos, m, s, a, dj, read, stamp),
+                            _joint_distance(grid, lo, res, far, pos, m, s, b, dj, read, stamp))
+                    if long[k]:
+                        mid = _field_distance(grid, lo, res, far,
+                                              (pos[m, s, a, 0] + pos[m, s, b, 0]) / 2.0,
+                                              (pos[m, s, a, 1] + pos[m, s, b, 1]) / 2.0,
+                                              (pos[m, s, a, 2] + pos[m, s, b, 2]) / 2.0)
+                        d = min(d, mid)
+                    gap = d - need[k]
+                if t < 0:
+                    first[k] = min(gap, 0.0) - 0.005
+                elif not gap >= first[k]:
                     ok = False
                     break
             if not ok:
