@@ -89,3 +89,15 @@ def test_a_worker_wedged_between_a_conveyor_and_a_pallet_steps_away_before_turni
     names = [s[0] for s in motion.stats.segments]
     grasped = next(i for i, n in enumerate(names) if n.startswith("grasp_"))
     assert any(n.startswith("carry_step_") for n in names[grasped + 1:grasped + 4])
+
+
+def test_a_worker_facing_a_rack_with_a_part_in_hand_steps_away_before_walking_out(aisle):
+    """A 1.55 m worker takes P_l09 off the left rack's 0.9 m board and stands facing
+    the rack 0.28 m from it, the part in front of him: no search gets away from there
+    (the squeeze search gave up after 1,001 nodes and the carry was refused). He first
+    steps back towards the aisle's middle, then walks out."""
+    motion = synthesize("F carry(P_l09, Zone)", aisle, stature=1.55, seed=0)[0]
+    assert not collision(motion.motion.positions, aisle, stature=1.55).any()
+    names = [s[0] for s in motion.stats.segments]
+    grasped = next(i for i, n in enumerate(names) if n.startswith("grasp_"))
+    assert any(n.startswith("carry_step_") for n in names[grasped + 1:grasped + 4])

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -483,28 +484,31 @@ class StepExecutor:
                 self.state.pose = self.hand_over_pose(mp, self.state.pose)
                 return
 
-    def step_away(self, carrying: bool) -> bool:
+    def step_away(self, carrying: bool, clearance: Callable[[np.ndarray], np.ndarray]
+                  ) -> bool:
         """A model-made standing step back, aside or both (``STEP_OUT_DISTANCES`` by
-        ``SIDE_STEPS``) onto floor with more clearance than where the worker stands,
-        clear on every frame: where the first move of every walk from here, a turn on
-        the spot, swings a leg into the furniture in front. Returns whether it stepped."""
+        ``SIDE_STEPS``) onto floor with more ``clearance`` (the search's map, of (M, 2)
+        points) than where the worker stands, clear on every frame: where the first move
+        of every walk from here, a turn on the spot, swings a leg into the furniture in
+        front, or no search gets away from here. Returns whether it stepped."""
         from ltl_human_motion.planning.turns import make_step_primitive
         lib = self.ctx.library
         x, y, yaw = self.state.pose
         c, s = math.cos(yaw), math.sin(yaw)
-        here = float(self.ctx.clearance(np.array([[x, y]]))[0])
+        here = float(clearance(np.array([[x, y]]))[0])
         moves = [(-back, 0.0) for back in STEP_OUT_DISTANCES] \
             + [(0.0, side) for side in SIDE_STEPS] \
             + [(-back, side) for back in STEP_OUT_DISTANCES for side in SIDE_STEPS]
         for dx, dy in moves:
             to = np.array([[x + c * dx - s * dy, y + s * dx + c * dy]])
-            if float(self.ctx.clearance(to)[0]) <= here:
+            if float(clearance(to)[0]) <= here:
                 continue
             mp = make_step_primitive(self.ctx.stance(carrying), lib.standing_height, dx, dy,
                                      0.0, lib.skeleton, lib.fps, "carry" if carrying else "walk")
             if self.placed_clear(mp, self.state.pose, samples=None):
                 self.add(mp, self.state.pose, -1, self.ctx.overlap)
                 self.state.pose = self.hand_over_pose(mp, self.state.pose)
+                self.state.gait_state = None
                 return True
         return False
 
@@ -676,12 +680,19 @@ class StepExecutor:
                 goal = goal.reroute(res.closest_at) or replace(goal, reroute=None)
                 continue
             if isinstance(res, SearchFailure):
+                if not stepped and res.reason in ("budget", "blocked") \
+                        and used < budget.max_nodes \
+                        and self.step_away(carry, goal.clearance or self.ctx.clearance):
+                    # No way on from where it stands (facing a rack in an aisle with a
+                    # part in hand, too close to turn): step away first.
+                    stepped, forbidden = True, set()
+                    continue
                 break
             bad = self.first_collision(res.primitives, res.poses)
             if bad is None:
                 break
             if bad == 0 and not stepped and self.ctx.index.standing[res.primitives[0]] \
-                    and self.step_away(carry):
+                    and self.step_away(carry, goal.clearance or self.ctx.clearance):
                 # Too tight a place to turn (a thigh into a conveyor): step away first.
                 stepped, forbidden = True, set()
                 continue
