@@ -227,6 +227,27 @@ def pair_bounds(seg, rad, plo, phi, exact_below, is_box, center, half, out, othe
 
 
 @_jit
+def polygon_signed_distance(p, a, ab, normal, eps, out) -> None:
+    """out[n] = ``geometry.point_polygon_signed_distance`` of p[n] (N, 2) to the convex
+    polygon with edges a[v] + t ab[v] (V, 2) and unit outward normals (V, 2) (``eps``:
+    its least squared edge length), operation for operation."""
+    for n in range(p.shape[0]):
+        px, py = p[n, 0], p[n, 1]
+        inside = True
+        best = np.inf
+        for v in range(a.shape[0]):
+            ox, oy = px - a[v, 0], py - a[v, 1]
+            if not ox * normal[v, 0] + oy * normal[v, 1] <= 0.0:
+                inside = False
+            t = (ox * ab[v, 0] + oy * ab[v, 1]) / max(ab[v, 0] * ab[v, 0] + ab[v, 1] * ab[v, 1],
+                                                       eps)
+            t = min(max(t, 0.0), 1.0)
+            dx, dy = px - (a[v, 0] + t * ab[v, 0]), py - (a[v, 1] + t * ab[v, 1])
+            best = min(best, math.sqrt(dx * dx + dy * dy))
+        out[n] = -best if inside else best
+
+
+@_jit
 def point_bounds(rows, lo, hi) -> None:
     """lo[m], hi[m] (3,): the least and greatest coordinates of the points rows[m] (M, N, 3),
     N >= 1, taken as ``np.minimum`` and ``np.maximum`` fold them point after point (a NaN

@@ -301,16 +301,36 @@ def point_polygon_signed_distance(p: np.ndarray, vertices: np.ndarray) -> np.nda
     d : ndarray, shape (...)
     """
     p = np.asarray(p, dtype=np.float64)
-    v = np.asarray(vertices, dtype=np.float64)
-    a = v
-    b = np.roll(v, -1, axis=0)
-    edge = b - a                                                     # (V, 2)
+    a, edge, normal = _polygon_edges(vertices)
+    from ltl_human_motion.kernel.segments import compiled_module
+    nb = compiled_module("ltl_human_motion.scene._clearance_numba")
+    if nb is None or p.ndim == 0 or p.shape[-1] != 2 or not np.isfinite(p).all():
+        return _polygon_signed_distance(p, a, edge, normal)
+    # the same numbers, compiled: a floor map reads every grid cell against every part
+    flat = np.ascontiguousarray(p.reshape(-1, 2))
+    out = np.empty(len(flat))
+    nb.polygon_signed_distance(flat, a, edge, normal, _EPS, out)
+    return out.reshape(p.shape[:-1])
+
+
+def _polygon_edges(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A counter-clockwise convex polygon's (V, 2) edges: start points, vectors to the
+    next vertex and unit outward normals, each (V, 2)."""
+    a = np.ascontiguousarray(vertices, dtype=np.float64)
+    edge = np.roll(a, -1, axis=0) - a                                # (V, 2)
     normal = np.stack([edge[:, 1], -edge[:, 0]], axis=-1)            # outward for CCW
     normal /= np.maximum(np.linalg.norm(normal, axis=-1, keepdims=True), _EPS)
+    return a, edge, normal
+
+
+def _polygon_signed_distance(p: np.ndarray, a: np.ndarray, edge: np.ndarray,
+                             normal: np.ndarray) -> np.ndarray:
+    """:func:`point_polygon_signed_distance` of points p (..., 2) in numpy, for the
+    polygon's :func:`_polygon_edges`."""
     pe = p[..., None, :]                                             # (..., 1, 2)
     side = np.sum((pe - a) * normal, axis=-1)                        # (..., V)
     inside = np.all(side <= 0.0, axis=-1)
-    dist = np.min(point_segment_distance(pe, a, b), axis=-1)
+    dist = np.min(point_segment_distance(pe, a, np.roll(a, -1, axis=0)), axis=-1)
     return np.where(inside, -dist, dist)
 
 
