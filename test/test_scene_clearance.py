@@ -140,7 +140,10 @@ def test_body_clearance_compiled_bounds_equal_the_numpy_ones(exact_below, boxes_
     where = rng.uniform([-0.5, -2.0, 0.0], [2.0, 2.0, 0.0], (300, 1, 3))
     poses = rest[None] + where + rng.normal(scale=0.05, size=(300, *rest.shape))
     seg, rad = capsules_from_positions(poses, 1.75)
-    ps = PartSet(PARTS[:2] if boxes_only else PARTS)
+    boxes = PARTS[:2] + (Box([0.0, 0.0, 1.0], [0.2, 0.2, 0.2]),
+                         Box([1.0, 1.0, 0.3], [0.5, 0.3, 0.6]),
+                         Box([-0.3, -1.0, 1.2], [0.4, 0.4, 0.1]))
+    ps = PartSet(boxes if boxes_only else PARTS)
     assert ps.is_box.all() == boxes_only
     fast = ps.body_clearance(seg, rad, exact_below)
     fast_bounded = ps.body_clearance(seg, rad, exact_below, bounds=point_bounds(poses))

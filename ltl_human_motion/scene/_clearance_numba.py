@@ -153,12 +153,6 @@ def exact_box_caps(seg, rad, f_idx, p_idx, caps, exact_below, is_box, center, ha
 
 
 @_jit
-def _least(best, v):
-    """``np.min``'s fold of v into best: a NaN stays."""
-    return v if (v < best or v != v) else best
-
-
-@_jit
 def _cap_box(seg, f, k, p, center, half, knots):
     """The segment-box distance (:func:`_segment_aabb`) of capsule k of frame f of seg
     (F, K, 2, 3) and the axis-aligned box p (``center``, ``half`` (P, 3)), both moved by
@@ -170,32 +164,56 @@ def _cap_box(seg, f, k, p, center, half, knots):
                          -h0, -h1, -h2, h0, h1, h2, knots)
 
 
+#: How far (m) above the least clearance found a bound must be for the values it bounds
+#: to be passed over unread: far more than their rounding errors (about 1e-14 m).
+PASS_OVER = 1e-9
+
+
 @_jit
 def body_clearance_boxes(seg, rad, lo, hi, plo, phi, exact_below, center, half, out) -> None:
     """out[f] = ``PartSet.body_clearance`` of body f (seg (F, K, 2, 3), its box lo, hi
-    (F, 3)) against parts that are all axis-aligned boxes (plo, phi, ``center``, ``half``
-    (P, 3)): :func:`body_bounds` and :func:`exact_box_caps` in one pass, each value
-    folded into the least as it is made."""
+    (F, 3), all finite) against parts that are all axis-aligned boxes (plo, phi,
+    ``center``, ``half`` (P, 3)): the least of the values of :func:`body_bounds` and
+    :func:`exact_box_caps`, as they compute them. The parts near the body are read in
+    order of their body bound; a part or capsule whose bound (each value it bounds is
+    at least that, to rounding) is ``PASS_OVER`` above the least found is passed over:
+    it cannot be the least."""
     F, K, P = seg.shape[0], seg.shape[1], plo.shape[0]
     rmax = rad.max()
     knots = np.empty(8)
+    bound = np.empty(P)
+    order = np.empty(P, dtype=np.int64)
     for f in range(F):
         best = np.inf
+        n_near = 0
         for p in range(P):
             v = _gap(lo[f, 0], lo[f, 1], lo[f, 2], hi[f, 0], hi[f, 1], hi[f, 2],
                      plo[p], phi[p]) - rmax
             if v < exact_below:
-                v = np.inf
-                for k in range(K):
-                    a, b = seg[f, k, 0], seg[f, k, 1]
-                    cap = _gap(np.minimum(a[0], b[0]), np.minimum(a[1], b[1]),
-                               np.minimum(a[2], b[2]), np.maximum(a[0], b[0]),
-                               np.maximum(a[1], b[1]), np.maximum(a[2], b[2]),
-                               plo[p], phi[p]) - rad[k]
-                    if cap < exact_below:
-                        cap = _cap_box(seg, f, k, p, center, half, knots) - rad[k]
-                    v = _least(v, cap)
-            best = _least(best, v)
+                bound[p] = v
+                i = n_near
+                while i > 0 and bound[order[i - 1]] > v:
+                    order[i] = order[i - 1]
+                    i -= 1
+                order[i] = p
+                n_near += 1
+            else:
+                best = min(best, v)
+        for i in range(n_near):
+            p = order[i]
+            if bound[p] >= best + PASS_OVER:
+                break
+            for k in range(K):
+                a, b = seg[f, k, 0], seg[f, k, 1]
+                cap = _gap(np.minimum(a[0], b[0]), np.minimum(a[1], b[1]),
+                           np.minimum(a[2], b[2]), np.maximum(a[0], b[0]),
+                           np.maximum(a[1], b[1]), np.maximum(a[2], b[2]),
+                           plo[p], phi[p]) - rad[k]
+                if cap >= best + PASS_OVER:
+                    continue
+                if cap < exact_below:
+                    cap = _cap_box(seg, f, k, p, center, half, knots) - rad[k]
+                best = min(best, cap)
         out[f] = best
 
 

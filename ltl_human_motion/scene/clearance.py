@@ -226,7 +226,8 @@ class PartSet:
         the bounds and the boxes' exact values compiled (:mod:`._clearance_numba`; in one
         pass where every part is an axis-aligned box), the other parts' as in numpy."""
         seg = np.ascontiguousarray(seg, dtype=np.float64)
-        if not self._others and np.isfinite(seg).all():
+        if not self._others and np.isfinite(seg).all() and np.isfinite(lo).all() \
+                and np.isfinite(hi).all():
             out = np.empty(len(seg))
             nb.body_clearance_boxes(seg, np.ascontiguousarray(rad, dtype=np.float64),
                                     np.ascontiguousarray(lo), np.ascontiguousarray(hi),
