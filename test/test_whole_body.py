@@ -197,3 +197,22 @@ def test_range_rows_are_the_anatomical_angles_first_order_change(reach):
         if ranges["elbow_flexion"][1] - before[n] < 2.0]
     assert len(expected) == len(h) >= 2
     assert np.allclose(sorted(G @ dq), sorted(expected), atol=2e-3)
+
+
+def test_the_support_polygons_hull_is_qhulls():
+    """The hand-written hull of the feet's eight corners has Qhull's edges (scipy's
+    ``ConvexHull`` equations), in any order, on random point sets."""
+    from scipy.spatial import ConvexHull
+
+    from ltl_human_motion.motion.goals.constraints import _convex_hull
+    rng = np.random.default_rng(0)
+    for _ in range(100):
+        points = rng.normal(size=(8, 2))
+        hull = _convex_hull(points)
+        d = np.roll(hull, -1, axis=0) - hull
+        n = np.stack([d[:, 1], -d[:, 0]], axis=1)
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        ours = np.column_stack([n, -np.einsum("ij,ij->i", n, hull)])
+        theirs = ConvexHull(points).equations
+        assert len(ours) == len(theirs)
+        assert all(np.abs(ours - e).sum(axis=1).min() < 1e-9 for e in theirs)

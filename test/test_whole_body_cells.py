@@ -163,3 +163,14 @@ def test_hands_that_let_go_over_a_desk_come_down_over_its_edge():
     cell = cell_from_yaml(built.yaml, source=built.name)
     motion = _verified("F(extract(P_bin, bin_a) & F(insert(P_bin, jig)))", cell, 1.75)
     assert any(s[0] == "arms_to_walk_wb" for s in motion.stats.segments)
+
+
+def test_a_move_into_a_bay_leans_as_far_as_the_balance_check_allows():
+    """A 1.75 m worker puts a blank into a machine's bay (generator seed 1): kept clear of
+    the machine, the program's body leans forward and to the side, its centre of mass
+    within a centimetre of the feet's outline. Held strictly inside the outline, it could
+    not come back to the standing pose (18.8 cm from it at the end: refused); allowed
+    1.5 cm out, 5 mm short of the verifier's 2 cm, it does, and the move is verified."""
+    built = build_cell("chamber", 1, 1)
+    cell = cell_from_yaml(built.yaml, source=built.name)
+    _verified("F move(blank, R_bay)", cell, 1.75)

@@ -186,32 +186,60 @@ def _com_weights(joints: int) -> np.ndarray:
 def support_edges(pos: np.ndarray, stature: float) -> np.ndarray:
     """The support polygon of both feet at joint positions ``pos`` (J, 3), as the
     verifier's balance check outlines them: its edges' lines (E, 3), ``n . x + c <= 0``
-    inside, with unit outward normals ``n``."""
-    from scipy.spatial import ConvexHull
-
+    inside, with unit outward normals ``n``. (Eight corners: a monotone-chain hull here
+    is microseconds, where importing scipy's Qhull would cost a new process 0.6 s.)"""
     from ltl_human_motion.motion.biomechanics import _foot_outline
     from ltl_human_motion.motion.skeleton import JOINT_INDEX
     corners = np.concatenate([
         _foot_outline(pos[None, JOINT_INDEX[f"{s}_ankle"]], pos[None, JOINT_INDEX[f"{s}_toe"]],
                       stature)[0] for s in ("l", "r")])
-    return ConvexHull(corners).equations
+    hull = _convex_hull(corners)
+    a, b = hull, np.roll(hull, -1, axis=0)
+    d = b - a
+    n = np.stack([d[:, 1], -d[:, 0]], axis=1)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    return np.column_stack([n, -np.einsum("ij,ij->i", n, a)])
+
+
+def _convex_hull(points: np.ndarray) -> np.ndarray:
+    """Vertices (V, 2) of the convex hull of ``points`` (N, 2), counter-clockwise
+    (Andrew's monotone chain)."""
+    pts = sorted(map(tuple, np.asarray(points, dtype=np.float64)))
+
+    def half(seq: list) -> list:
+        out: list = []
+        for p in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0:
+                out.pop()
+            out.append(p)
+        return out
+
+    lower, upper = half(pts), half(pts[::-1])
+    return np.array(lower[:-1] + upper[:-1])
 
 
 def balance_rows(kin: BodyKinematics, pos: np.ndarray, edges: np.ndarray,
-                 influence: float, damper: float) -> tuple[np.ndarray, np.ndarray]:
+                 influence: float, damper: float, reference: np.ndarray | None = None,
+                 slack: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Velocity-damper rows ``G dq <= h`` keeping the centre of mass of joint positions
     ``pos`` (J, 3) over the support polygon ``edges`` (E, 3) (:func:`support_edges`): for
     each edge the centre of mass is nearer than ``influence`` to, one step may use the
-    fraction ``damper`` of its distance inside."""
+    fraction ``damper`` of its distance inside, down to ``slack`` m outside (the
+    verifier's outline is grown by its ``balance_margin``). Where the ``reference`` pose
+    (J, 3) of the same frame has its centre of mass further out, the program's may go as
+    far out as that, no further."""
     w = _com_weights(len(pos))
-    com = w @ pos
-    inside = -(edges[:, :2] @ com[:2] + edges[:, 2])                      # (E,)
-    near = np.flatnonzero(inside < influence)
+    inside = -(edges[:, :2] @ (w @ pos)[:2] + edges[:, 2])                      # (E,)
+    floor = np.full(len(edges), -slack)
+    if reference is not None:
+        floor = np.minimum(-(edges[:, :2] @ (w @ reference)[:2] + edges[:, 2]), floor)
+    near = np.flatnonzero(inside - floor < influence)
     if near.size == 0:
         return np.zeros((0, kin.model.nv)), np.zeros(0)
     joints = np.flatnonzero(w)
     J = np.einsum("k,kin->in", w[joints], point_jacobians(kin, joints))      # (3, nv)
-    return edges[near, :2] @ J[:2], damper * inside[near]
+    return edges[near, :2] @ J[:2], damper * np.maximum(inside[near] - floor[near], 0.0)
 
 
 #: Finite-difference step of the range-of-motion rows, m.

@@ -84,8 +84,9 @@ class WholeBodyOptions:
     joint_speed (rad/s) and root_speed (m/s, rad/s) bound each step; speed_limits (J,)
     m/s bound every joint's speed (the verifier's, with room); self_pairs are the body's
     own capsule pairs kept apart (constrained within ``self_influence`` m of their least
-    distance); the centre of mass is kept over the feet's support polygon, constrained
-    within ``balance_influence`` m of its edges (None: not constrained); ``ranges``
+    distance); the centre of mass is kept over the feet's support polygon, at most
+    ``balance_slack`` m outside it (5 mm inside the verifier's margin), constrained within
+    ``balance_influence`` m of its edges (None: not constrained); ``ranges``
     ((angle, lo, hi) degrees, the verifier's ranges of motion by anatomical angle) keep
     each angle ``range_margin`` inside them, constrained within ``range_influence``
     degrees of a limit (None: only the URDF's joint limits).
@@ -110,6 +111,7 @@ class WholeBodyOptions:
     self_pairs: SelfPairs | None = None
     self_influence: float = 0.05
     balance_influence: float | None = 0.05
+    balance_slack: float = 0.015
     ranges: tuple[tuple[str, float, float], ...] | None = None
     range_influence: float = 5.0
     range_margin: float = 0.5
@@ -206,6 +208,12 @@ class _Tracker:
         from pink.tasks import ComTask, FrameTask, PostureTask
         self.kin, self.ref, self.opts, self.dt = kin, ref, opts, 1.0 / fps
         self.stature = stature
+        # The frames the verifier's balance check reads (both feet planted, the pelvis
+        # still): the balance rows hold there only.
+        self.static = np.zeros(len(ref), dtype=bool)
+        if stature is not None and opts.balance_influence is not None:
+            from ltl_human_motion.motion.biomechanics import balance_margins
+            self.static[balance_margins(ref, fps, stature)[0]] = True
         self.q_ref = kin.configurations(ref)
         self.q_ref[:, 7:] = np.unwrap(self.q_ref[:, 7:], axis=0)
         self.roots = root_poses(ref)
@@ -269,12 +277,13 @@ class _Tracker:
         return [*self.points, self.pelvis, self.posture, self.com]
 
     def rows(self, q: np.ndarray, field_: ObstacleField, held: HeldPart | None,
-             frames: int) -> tuple[np.ndarray, np.ndarray, bool]:
-        """The inequality rows ``G dq <= h`` of a step over ``frames`` frames from ``q``:
-        clearance to the obstacles and within the body, ranges of motion, balance, joint
-        speeds; and
-        whether an obstacle, a body pair, a range's limit or an edge of the support
-        polygon is near enough to constrain it."""
+             frames: int, t: int) -> tuple[np.ndarray, np.ndarray, bool]:
+        """The inequality rows ``G dq <= h`` of a step over ``frames`` frames from ``q``
+        to frame ``t``: clearance to the obstacles and within the body, ranges of motion,
+        balance (where the reference stands still at ``t``, no worse than its), joint
+        speeds; and whether an
+        obstacle, a body pair, a range's limit or an edge of the support polygon is near
+        enough to constrain it."""
         opts, kin = self.opts, self.kin
         pos = kin.positions(q)
         G, h, _ = clearance_rows(kin, pos, field_, held, opts.influence, opts.damper,
@@ -286,9 +295,10 @@ class _Tracker:
         if opts.ranges is not None:
             parts.append(rom_rows(kin, pos, {k: (lo, hi) for k, lo, hi in opts.ranges},
                                   opts.range_influence, opts.range_margin, opts.damper))
-        if opts.balance_influence is not None and self.stature is not None:
+        if self.static[t]:
             parts.append(balance_rows(kin, pos, support_edges(pos, self.stature),
-                                      opts.balance_influence, opts.damper))
+                                      opts.balance_influence, opts.damper, self.ref[t],
+                                      opts.balance_slack))
         active = sum(len(x[1]) for x in parts) > 0
         if opts.speed_limits is not None:
             parts.append(speed_rows(kin, np.asarray(opts.speed_limits), self.dt * frames))
@@ -384,7 +394,7 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
         tasks = tracker.set_frame(t)
         for _ in range(opts.iterations):
             G, h, active = tracker.rows(conf.q, field_, held if t >= held_from else None,
-                                        step)
+                                        step, t)
             constrained |= active
             failed += not tracker.step(conf, tasks, (G, h), t, step)
         for k in range(1, step):
