@@ -100,6 +100,10 @@ _SWEEP_INDICES = part_indices(SWEEP_PARTS)
 #: half turn.
 TURN_SAMPLES = 9
 
+#: A failed search that came no further than this from its start (m) got nowhere from
+#: there: the worker steps away first and it searches again (:meth:`StepExecutor.walk`).
+STUCK_RADIUS = 0.4
+
 #: Searches run again after the path found collided on a frame the search did not
 #: sample (each forbids the colliding primitive at its pose).
 WALK_REPAIRS = 4
@@ -681,7 +685,8 @@ class StepExecutor:
                 continue
             if isinstance(res, SearchFailure):
                 if not stepped and res.reason in ("budget", "blocked") \
-                        and used < budget.max_nodes \
+                        and used < budget.max_nodes and res.closest_at is not None \
+                        and math.dist(res.closest_at, self.state.pose[:2]) < STUCK_RADIUS \
                         and self.step_away(carry, goal.clearance or self.ctx.clearance):
                     # No way on from where it stands (facing a rack in an aisle with a
                     # part in hand, too close to turn): step away first.
