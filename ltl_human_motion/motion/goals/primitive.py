@@ -16,7 +16,7 @@ from ltl_human_motion.motion.goals.hand_tasks import _hand_task
 from ltl_human_motion.motion.goals.posture_checks import ObstacleClearance
 from ltl_human_motion.motion.goals.tasks import _MAX_TRAVEL, _check_furniture, _check_options
 from ltl_human_motion.motion.skeleton import Skeleton
-from ltl_human_motion.motion.types import MotionPrimitive
+from ltl_human_motion.motion.types import MotionPrimitive, world_positions
 from ltl_human_motion.vocabulary import HAND_TASKS
 
 
@@ -91,12 +91,56 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         if travel is not None and not 0.0 < float(travel) <= _MAX_TRAVEL:
             raise ValueError(f"travel must be in (0, {_MAX_TRAVEL}] m, got {travel!r}")
         board, furniture = _check_furniture(board, support, ceiling)
-        return _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel,
-                          board, obstacles, furniture)
-    if task in ("bend", "stoop", "kneel"):
-        return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
-    if task == "wait":
-        return _wait(skeleton, st, rng, duration, fps)
-    if task == "sit":
-        return _sit_primitive(skeleton, st, rng, duration, fps, target)
-    return _stand_up(skeleton, st, rng, duration, fps, target)
+        mp = _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel,
+                        board, obstacles, furniture)
+    elif task in ("bend", "stoop", "kneel"):
+        mp = _down_up(task, skeleton, st, rng, duration, fps, target, hand)
+    elif task == "wait":
+        mp = _wait(skeleton, st, rng, duration, fps)
+    elif task == "sit":
+        mp = _sit_primitive(skeleton, st, rng, duration, fps, target)
+    else:
+        mp = _stand_up(skeleton, st, rng, duration, fps, target)
+    return within_speed_limits(mp, skeleton.stature)
+
+
+#: How fast a goal primitive slowed down for the verifier's joint speed limits may move
+#: its fastest joint, as a fraction of its limit (the junction blends and foot locking
+#: add a little at its ends).
+GOAL_SPEED_ROOM = 0.97
+
+
+def within_speed_limits(mp: MotionPrimitive, stature: float) -> MotionPrimitive:
+    """``mp`` unchanged where every joint keeps within the verifier's speed limits for
+    its task (:func:`~ltl_human_motion.motion.biomechanics.check_biomechanics`); else
+    the same motion slowed down, uniformly in time, until its fastest joint moves at
+    :data:`GOAL_SPEED_ROOM` of its limit (a 1.55 m worker's crouch to the floor took its
+    knee to 2.23 m/s against 2.21). The timing models (Fitts, MTM) know no joint limits;
+    the verifier's are a constraint of the motion, not a check that refuses it."""
+    from ltl_human_motion.motion.biomechanics import BiomechanicsLimits, _speeds_and_limits
+    limits = BiomechanicsLimits()
+    speed, limit = _speeds_and_limits(world_positions(mp), mp.fps, [mp.task] * mp.n_frames,
+                                      limits, float(stature) / limits.reference_stature)
+    ratio = float(np.max(speed / limit)) if speed.size else 0.0
+    if ratio <= 1.0:
+        return mp
+    factor = ratio / GOAL_SPEED_ROOM
+    T = mp.n_frames
+    n = int(np.ceil((T - 1) * factor)) + 1
+    at = np.linspace(0.0, T - 1, n)
+    lo = np.minimum(np.floor(at).astype(int), T - 2)
+    w = (at - lo)[:, None]
+    poses = mp.poses[lo] * (1.0 - w[..., None]) + mp.poses[lo + 1] * w[..., None]
+    root = mp.root[lo] * (1.0 - w) + mp.root[lo + 1] * w
+
+    def frame(f: int) -> int:
+        return min(round(int(f) * (n - 1) / (T - 1)), n - 1)
+
+    meta = dict(mp.meta)
+    if "contact_frame" in meta:
+        meta["contact_frame"] = frame(meta["contact_frame"])
+    if "hold_frames" in meta:
+        meta["hold_frames"] = [frame(f) for f in meta["hold_frames"]]
+    return MotionPrimitive(name=mp.name, task=mp.task, poses=poses, root=root, fps=mp.fps,
+                           source=mp.source + f" (slowed {factor:.3f}x for joint speed limits)",
+                           meta=meta)
