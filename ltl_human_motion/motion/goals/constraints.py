@@ -7,6 +7,7 @@ Every row is linear in the step ``dq`` (nv,) and returned as ``G dq <= h``.
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import Protocol
 
 import numpy as np
@@ -16,6 +17,7 @@ from ltl_human_motion.motion.goals.kinematics import (
     BodyKinematics,
     HeldPart,
     body_capsules,
+    frames_capsules,
     point_jacobians,
 )
 
@@ -125,11 +127,10 @@ def reference_clearance(kin: BodyKinematics, positions: np.ndarray, field_: Obst
     for lo, hi, part in ((0, held_from, None), (held_from, len(pos), held)):
         if hi <= lo:
             continue
-        caps = [body_capsules(kin, p, part) for p in pos[lo:hi]]
-        K = len(caps[0][2])
-        a = np.concatenate([c[0] for c in caps])
-        b = np.concatenate([c[1] for c in caps])
-        cap, _, clear = field_.near(a, b, np.tile(caps[0][2], hi - lo), within)
+        a, b, rad = frames_capsules(kin, pos[lo:hi], part)
+        K = len(rad)
+        cap, _, clear = field_.near(a.reshape(-1, 3), b.reshape(-1, 3),
+                                    np.tile(rad, hi - lo), within)
         np.minimum.at(out, lo + cap // K, clear)
     return out
 
@@ -246,6 +247,21 @@ def balance_rows(kin: BodyKinematics, pos: np.ndarray, edges: np.ndarray,
 _ROM_FD_STEP = 1e-5
 
 
+@lru_cache(maxsize=4)
+def _angle_joints(joints: int) -> dict[str, np.ndarray]:
+    """The joints (indices) each anatomical angle of
+    :func:`~ltl_human_motion.motion.biomechanics.joint_angles` reads, for poses of
+    ``joints`` joints: those whose position made NaN makes the angle NaN. Moving any other
+    joint leaves the angle as it is to the bit, so its central difference is exactly 0."""
+    from ltl_human_motion.motion.biomechanics import joint_angles
+    rng = np.random.default_rng(0)
+    poses = np.broadcast_to(rng.normal(size=(joints, 3)), (joints, joints, 3)).copy()
+    poses[np.arange(joints), np.arange(joints)] = np.nan
+    with np.errstate(invalid="ignore"):
+        angles = joint_angles(poses)
+    return {name: np.flatnonzero(np.isnan(a)) for name, a in angles.items()}
+
+
 def rom_rows(kin: BodyKinematics, pos: np.ndarray, ranges: dict[str, tuple[float, float]],
              influence: float, margin: float, damper: float
              ) -> tuple[np.ndarray, np.ndarray]:
@@ -271,16 +287,21 @@ def rom_rows(kin: BodyKinematics, pos: np.ndarray, ranges: dict[str, tuple[float
     if not near:
         return np.zeros((0, kin.model.nv)), np.zeros(0)
     n = len(pos)
-    steps = np.concatenate([np.eye(3), -np.eye(3)]) * _ROM_FD_STEP                    # (6, 3)
-    moved = np.broadcast_to(pos, (6, n, n, 3)).copy()                                # step, joint
-    moved[:, np.arange(n), np.arange(n)] += steps[:, None, :]
     names = sorted({name for name, _, _ in near})
+    read = _angle_joints(n)
+    joints = np.unique(np.concatenate([read[name] for name in names]))
+    k = len(joints)
+    steps = np.concatenate([np.eye(3), -np.eye(3)]) * _ROM_FD_STEP                    # (6, 3)
+    moved = np.broadcast_to(pos, (6, k, n, 3)).copy()                                # step, joint
+    moved[:, np.arange(k), joints] += steps[:, None, :]
     perturbed = joint_angles(moved.reshape(-1, n, 3), names)
     J = point_jacobians(kin, np.arange(n))                                           # (n, 3, nv)
     G, h = [], []
     for name, sign, room in near:
-        v = perturbed[name].reshape(6, n)
-        grad = (v[:3] - v[3:]).T / (2 * _ROM_FD_STEP)                                # (n, 3)
+        v = perturbed[name].reshape(6, k)
+        diff = np.zeros((3, n))
+        diff[:, joints] = v[:3] - v[3:]
+        grad = diff.T / (2 * _ROM_FD_STEP)                 # (n, 3), laid out as einsum read it
         G.append(-sign * np.einsum("jc,jcn->n", grad, J))
         h.append(damper * max(room, 0.0))
     return np.array(G), np.array(h)

@@ -15,7 +15,7 @@ from ltl_human_motion.motion.skeleton import JOINT_INDEX, JOINT_NAMES
 from ltl_human_motion.motion.urdf import joint_angles, joint_names, link_name, root_poses
 
 __all__ = ["BODY_ID", "BodyKinematics", "HeldPart", "body_capsules", "body_kinematics",
-           "point_jacobians"]
+           "frames_capsules", "point_jacobians"]
 
 #: The body id of the model's link names.
 BODY_ID = "wbik"
@@ -46,11 +46,13 @@ class BodyKinematics:
                                 for j in JOINT_NAMES])
         self.radii = capsule_radii(stature)
 
-    def configurations(self, positions: np.ndarray) -> np.ndarray:
-        """Configurations (T, nq) whose forward kinematics are ``positions`` (T, J, 3)."""
+    def configurations(self, positions: np.ndarray, roots: np.ndarray | None = None
+                       ) -> np.ndarray:
+        """Configurations (T, nq) whose forward kinematics are ``positions`` (T, J, 3);
+        ``roots`` (T, 4, 4): their :func:`.urdf.root_poses` where the caller has them."""
         from scipy.spatial.transform import Rotation
         pos = np.asarray(positions, dtype=np.float64)
-        roots = root_poses(pos)
+        roots = root_poses(pos) if roots is None else roots
         q = np.zeros((len(pos), self.model.nq))
         q[:, :3] = roots[:, :3, 3]
         q[:, 3:7] = Rotation.from_matrix(roots[:, :3, :3]).as_quat()
@@ -119,3 +121,16 @@ def body_capsules(kin: BodyKinematics, pos: np.ndarray, held: HeldPart | None
         ja = np.concatenate([ja, np.full(len(e), held.joint)])
         jb = np.concatenate([jb, np.full(len(e), held.joint)])
     return a, b, rad, ja, jb
+
+
+def frames_capsules(kin: BodyKinematics, pos: np.ndarray, held: HeldPart | None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`body_capsules` of every frame of ``pos`` (T, J, 3) at once: end points a, b
+    (T, K, 3) and radii (K,) (the same numbers)."""
+    a, b, rad = pos[:, CAPSULE_A], pos[:, CAPSULE_B], kin.radii
+    if held is not None:
+        e = held.edges[None] + pos[:, held.joint][:, None, None]
+        a = np.concatenate([a, e[:, :, 0]], axis=1)
+        b = np.concatenate([b, e[:, :, 1]], axis=1)
+        rad = np.concatenate([rad, np.zeros(len(held.edges))])
+    return a, b, rad

@@ -214,9 +214,9 @@ class _Tracker:
         if stature is not None and opts.balance_influence is not None:
             from ltl_human_motion.motion.biomechanics import balance_margins
             self.static[balance_margins(ref, fps, stature)[0]] = True
-        self.q_ref = kin.configurations(ref)
-        self.q_ref[:, 7:] = np.unwrap(self.q_ref[:, 7:], axis=0)
         self.roots = root_poses(ref)
+        self.q_ref = kin.configurations(ref, self.roots)
+        self.q_ref[:, 7:] = np.unwrap(self.q_ref[:, 7:], axis=0)
         self.ref_data = kin.model.createData()
         self.tracked = tuple(tracked) + tuple(j.replace("hand", "wrist") for j in tracked)
         # Where the task points are (T, 2 * len(tracked), 3): the reference's, or the
@@ -276,16 +276,17 @@ class _Tracker:
         self.posture.set_target(self.q_ref[t])
         return [*self.points, self.pelvis, self.posture, self.com]
 
-    def rows(self, q: np.ndarray, field_: ObstacleField, held: HeldPart | None,
+    def rows(self, pos: np.ndarray, field_: ObstacleField, held: HeldPart | None,
              frames: int, t: int) -> tuple[np.ndarray, np.ndarray, bool]:
-        """The inequality rows ``G dq <= h`` of a step over ``frames`` frames from ``q``
-        to frame ``t``: clearance to the obstacles and within the body, ranges of motion,
+        """The inequality rows ``G dq <= h`` of a step over ``frames`` frames from the
+        configuration whose joint positions (J, 3) are ``pos`` and whose kinematics
+        ``kin.data`` holds (:meth:`.BodyKinematics.positions` made both) to frame ``t``:
+        clearance to the obstacles and within the body, ranges of motion,
         balance (where the reference stands still at ``t``, no worse than its), joint
         speeds; and whether an
         obstacle, a body pair, a range's limit or an edge of the support polygon is near
         enough to constrain it."""
         opts, kin = self.opts, self.kin
-        pos = kin.positions(q)
         G, h, _ = clearance_rows(kin, pos, field_, held, opts.influence, opts.damper,
                                  (opts.margin, opts.hand_margin, opts.part_margin))
         parts = [(G, h)]
@@ -385,6 +386,7 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
     constrained, failed = False, 0
     stride = max(round(fps / opts.rate), 1)
     t, q_prev = first, conf.q.copy()
+    pos = kin.positions(conf.q)
     while t < len(ref) - 1:
         step = min(stride, len(ref) - 1 - t)
         t += step
@@ -392,15 +394,17 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
         tracker.posture.cost = tracker.posture_weights \
             + ramp * (RETURN_WEIGHT - tracker.posture_weights)
         tasks = tracker.set_frame(t)
-        for _ in range(opts.iterations):
-            G, h, active = tracker.rows(conf.q, field_, held if t >= held_from else None,
+        for i in range(opts.iterations):
+            if i:
+                pos = kin.positions(conf.q)
+            G, h, active = tracker.rows(pos, field_, held if t >= held_from else None,
                                         step, t)
             constrained |= active
             failed += not tracker.step(conf, tasks, (G, h), t, step)
         for k in range(1, step):
             out[t - step + k] = kin.positions(pin.interpolate(kin.model, q_prev, conf.q,
                                                               k / step))
-        out[t] = kin.positions(conf.q)
+        out[t] = pos = kin.positions(conf.q)
         q_prev = conf.q.copy()
         if t > last_near and np.abs(out[t] - ref[t]).max() < _CONVERGED:
             out[t:] = ref[t:]
