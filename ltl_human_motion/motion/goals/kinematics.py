@@ -44,6 +44,8 @@ class BodyKinematics:
                                   for n in names])
         self.frames = np.array([self.model.getFrameId(link_name(j, BODY_ID))
                                 for j in JOINT_NAMES])
+        self._frame_ids = [int(f) for f in self.frames]
+        self._jacobians: np.ndarray | None = None
         self.radii = capsule_radii(stature)
 
     def configurations(self, positions: np.ndarray, roots: np.ndarray | None = None
@@ -65,7 +67,21 @@ class BodyKinematics:
         import pinocchio as pin
         pin.computeJointJacobians(self.model, self.data, q)
         pin.updateFramePlacements(self.model, self.data)
-        return np.array([self.data.oMf[int(f)].translation for f in self.frames])
+        self._jacobians = None
+        placements = self.data.oMf
+        return np.array([placements[f].translation for f in self._frame_ids])
+
+    def jacobians(self) -> np.ndarray:
+        """Translational Jacobians (J, 3, nv) of every joint link at the configuration
+        :meth:`positions` last computed (world frame), computed once per configuration."""
+        import pinocchio as pin
+        if self._jacobians is None:
+            out = np.empty((len(self._frame_ids), 3, self.model.nv))
+            for k, f in enumerate(self._frame_ids):
+                out[k] = pin.getFrameJacobian(self.model, self.data, f,
+                                              pin.LOCAL_WORLD_ALIGNED)[:3]
+            self._jacobians = out
+        return self._jacobians
 
 
 @lru_cache(maxsize=8)
@@ -76,13 +92,8 @@ def body_kinematics(stature: float) -> BodyKinematics:
 
 def point_jacobians(kin: BodyKinematics, joints: np.ndarray) -> np.ndarray:
     """Translational Jacobians (K, 3, nv) of the joint links ``joints`` (K,) at the
-    current kinematics (world frame)."""
-    import pinocchio as pin
-    out = np.empty((len(joints), 3, kin.model.nv))
-    for k, j in enumerate(joints):
-        out[k] = pin.getFrameJacobian(kin.model, kin.data, int(kin.frames[j]),
-                                      pin.LOCAL_WORLD_ALIGNED)[:3]
-    return out
+    current kinematics (world frame; :meth:`BodyKinematics.jacobians`)."""
+    return kin.jacobians()[np.asarray(joints, dtype=np.intp)]
 
 
 @dataclass(frozen=True)
