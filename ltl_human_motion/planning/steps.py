@@ -101,8 +101,14 @@ _SWEEP_INDICES = part_indices(SWEEP_PARTS)
 TURN_SAMPLES = 9
 
 #: A failed search that came no further than this from its start (m) got nowhere from
-#: there: the worker steps away first and it searches again (:meth:`StepExecutor.walk`).
+#: there: the worker steps away first and it searches again, once per start in a plan
+#: (:meth:`StepExecutor.walk`: the corpus aisle's 1.95 m worker, whom no step gets
+#: in, stepped back and forth at its entrance for every placement tried).
 STUCK_RADIUS = 0.4
+
+#: Whole-body programs of arm transitions that may fail in one plan before no more are
+#: run (:meth:`StepExecutor.transition_clear`).
+TRANSITION_PROGRAMS = 3
 
 #: Searches run again after the path found collided on a frame the search did not
 #: sample (each forbids the colliding primitive at its pose).
@@ -225,6 +231,13 @@ class StepExecutor:
     def __init__(self, ctx: PlanContext, state: WorkerState) -> None:
         self.ctx = ctx
         self.state = state
+        # Arm transitions the whole-body program remade, or failed to, by pose and name
+        # (:meth:`transition_clear`; placements tried one after another come back to the
+        # same spot), and how many programs failed.
+        self._transitions: dict[tuple, MotionPrimitive | None] = {}
+        self._transition_failures = 0
+        # Walk starts where stepping away did not get a search any further.
+        self._stuck: set[tuple] = set()
 
     def add(self, mp: MotionPrimitive, pose: Pose, label: int, blend: int) -> int:
         """Place ``mp`` at ``pose`` as the next segment (task label ``label``, blended over
@@ -397,18 +410,30 @@ class StepExecutor:
         """Arm transition ``mp`` at the current pose remade by the whole-body program
         (:func:`.constrained_goals.constrained_transition`) where the hands are empty and
         the program is on, if it keeps the body clear on every frame and passes the
-        verifier's biomechanical checks; else None."""
+        verifier's biomechanical checks; else None. Asked once per pose; after
+        ``TRANSITION_PROGRAMS`` programs that failed, no more are run (about 0.3 s each:
+        a tall worker's arms in an aisle, tried at every placement)."""
         from ltl_human_motion.motion.biomechanics import check_biomechanics
         from ltl_human_motion.planning.constrained_goals import constrained_transition
         if self.state.held or not self.ctx.options.whole_body:
             return None
+        key = (*map(float, self.state.pose), mp.name)
+        if key in self._transitions:
+            return self._transitions[key]
+        if self._transition_failures >= TRANSITION_PROGRAMS:
+            return None
         made = constrained_transition(mp, self.ctx.cell.part_set, self.state.pose,
                                       self.ctx.stature)
-        if made is None or not self.placed_clear(made, self.state.pose):
-            return None
-        checks = check_biomechanics(world_positions(made), made.fps, stature=self.ctx.stature,
-                                    labels=[made.task] * made.n_frames)
-        return made if all(entry["passed"] for entry in checks.values()) else None
+        if made is not None and self.placed_clear(made, self.state.pose):
+            checks = check_biomechanics(world_positions(made), made.fps,
+                                        stature=self.ctx.stature,
+                                        labels=[made.task] * made.n_frames)
+            made = made if all(entry["passed"] for entry in checks.values()) else None
+        else:
+            made = None
+        self._transitions[key] = made
+        self._transition_failures += made is None
+        return made
 
     def arm_poses(self, carrying_before: bool) -> np.ndarray:
         """Root-relative poses (T, J, 3) of the arm transition (made once per library and
@@ -665,6 +690,7 @@ class StepExecutor:
         if goal.clearance is self.ctx.stand_map:
             budget = replace(budget, idle_nodes=SQUEEZE_NODES)
         used, repairs, reroutes, stepped = 0, 0, 0, False
+        start = (*map(float, self.state.pose), carry)
         while True:
             self.ctx.rng.bit_generator.state = noise_state      # the same costs every time
             stall = STALL_NODES if goal.reroute is not None and reroutes < MAX_REROUTES \
@@ -687,11 +713,14 @@ class StepExecutor:
                 if not stepped and res.reason in ("budget", "blocked") \
                         and used < budget.max_nodes and res.closest_at is not None \
                         and math.dist(res.closest_at, self.state.pose[:2]) < STUCK_RADIUS \
+                        and start not in self._stuck \
                         and self.step_away(carry, goal.clearance or self.ctx.clearance):
                     # No way on from where it stands (facing a rack in an aisle with a
                     # part in hand, too close to turn): step away first.
                     stepped, forbidden = True, set()
                     continue
+                if stepped:
+                    self._stuck.add(start)
                 break
             bad = self.first_collision(res.primitives, res.poses)
             if bad is None:
