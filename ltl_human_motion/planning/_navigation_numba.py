@@ -213,6 +213,28 @@ def _joint_distance(grid, lo, res, far, pos, m, s, j, dj, read, stamp):
 
 
 @_jit
+def _samples_box(pos, m, samples, part_lo, part_hi):
+    """The bounding box (lo x, y, z, hi x, y, z) of candidate ``m``'s joints over
+    ``samples`` in ``pos`` (M, S, J, 3), and its least box gap to the parts' boxes
+    (part_lo, part_hi (P, 3))."""
+    blo0 = blo1 = blo2 = np.inf
+    bhi0 = bhi1 = bhi2 = -np.inf
+    for t in range(samples.shape[0]):
+        s = samples[t]
+        for j in range(pos.shape[2]):
+            x, y, z = pos[m, s, j, 0], pos[m, s, j, 1], pos[m, s, j, 2]
+            blo0, bhi0 = min(blo0, x), max(bhi0, x)
+            blo1, bhi1 = min(blo1, y), max(bhi1, y)
+            blo2, bhi2 = min(blo2, z), max(bhi2, z)
+    box = np.inf
+    for p in range(part_lo.shape[0]):
+        g0 = max(max(part_lo[p, 0] - bhi0, blo0 - part_hi[p, 0]), 0.0)
+        g1 = max(max(part_lo[p, 1] - bhi1, blo1 - part_hi[p, 1]), 0.0)
+        g2 = max(max(part_lo[p, 2] - bhi2, blo2 - part_hi[p, 2]), 0.0)
+        box = min(box, math.sqrt(g0 * g0 + g1 * g1 + g2 * g2))
+    return blo0, blo1, blo2, bhi0, bhi1, bhi2, box
+
+@_jit
 def body_samples_clear(grid, lo, res, far, pos, cand, samples, ia, ib, long, need,
                        relative, part_lo, part_hi, limit, out) -> None:
     """``ObstacleField.clear`` of ``pos[cand][:, samples]`` in one call: out[n] for
@@ -244,21 +266,8 @@ def body_samples_clear(grid, lo, res, far, pos, cand, samples, ia, ib, long, nee
     near = np.empty(P, dtype=np.int64)
     for n in range(cand.shape[0]):
         m = cand[n]
-        blo0 = blo1 = blo2 = np.inf
-        bhi0 = bhi1 = bhi2 = -np.inf
-        for t in range(samples.shape[0]):
-            s = samples[t]
-            for j in range(J):
-                x, y, z = pos[m, s, j, 0], pos[m, s, j, 1], pos[m, s, j, 2]
-                blo0, bhi0 = min(blo0, x), max(bhi0, x)
-                blo1, bhi1 = min(blo1, y), max(bhi1, y)
-                blo2, bhi2 = min(blo2, z), max(bhi2, z)
-        box = np.inf
-        for p in range(P):
-            g0 = max(max(part_lo[p, 0] - bhi0, blo0 - part_hi[p, 0]), 0.0)
-            g1 = max(max(part_lo[p, 1] - bhi1, blo1 - part_hi[p, 1]), 0.0)
-            g2 = max(max(part_lo[p, 2] - bhi2, blo2 - part_hi[p, 2]), 0.0)
-            box = min(box, math.sqrt(g0 * g0 + g1 * g1 + g2 * g2))
+        blo0, blo1, blo2, bhi0, bhi1, bhi2, box = _samples_box(pos, m, samples, part_lo,
+                                                               part_hi)
         if not box < limit:
             out[n] = True
             continue

@@ -710,10 +710,7 @@ class StepExecutor:
                 goal = goal.reroute(res.closest_at) or replace(goal, reroute=None)
                 continue
             if isinstance(res, SearchFailure):
-                if not stepped and res.reason in ("budget", "blocked") \
-                        and used < budget.max_nodes and res.closest_at is not None \
-                        and math.dist(res.closest_at, self.state.pose[:2]) < STUCK_RADIUS \
-                        and start not in self._stuck \
+                if not stepped and used < budget.max_nodes and self._got_nowhere(res, start) \
                         and self.step_away(carry, goal.clearance or self.ctx.clearance):
                     # No way on from where it stands (facing a rack in an aisle with a
                     # part in hand, too close to turn): step away first.
@@ -740,24 +737,21 @@ class StepExecutor:
                 goal.clearance is self.ctx.stand_map and self.square_up(goal, carry):
             return self.walk(goal, task, label, carry, budget)    # square to the gap
         if isinstance(res, SearchFailure):
-            if res.reason == "budget":
-                why = f"the search budget ran out ({used} nodes; {_approach(res.closest)})"
-            elif res.reason == "no_stop":
-                why = (f"the search reached the goal's neighbourhood but no place to stop "
-                       f"there keeps the body clear and passes the goal test ({used} nodes)")
-            else:
-                why = (f"obstacles block every way to the target (searched {res.expanded} "
-                       f"placements; {_approach(res.closest)})")
-            # No stop at the goal is a blocked goal (the caller may try other placements).
-            raise PlanningError(f"task {task}: {goal.description}: {why}", task=task,
-                                reason="blocked" if res.reason == "no_stop" else res.reason,
-                                search=res.reason)
+            raise _search_refusal(task, goal, res, used)
         for prim_id, pose in zip(res.primitives, res.poses):
             self.add(self.ctx.index.primitives[prim_id], pose, label, self.ctx.overlap)
         if res.primitives:
             self.state.pose = res.end_pose
             self.state.gait_state = None  # every walk ends with a stop primitive
         return len(res.primitives)
+
+    def _got_nowhere(self, res: SearchFailure, start: tuple) -> bool:
+        """Whether failed search ``res`` from ``start`` (floor pose and carry) came no
+        further than ``STUCK_RADIUS`` from it, and stepping away from there has not been
+        tried in vain in this plan."""
+        return res.reason in ("budget", "blocked") and res.closest_at is not None \
+            and math.dist(res.closest_at, start[:2]) < STUCK_RADIUS \
+            and start not in self._stuck
 
     def forbid(self, primitives: list[int], poses: list[Pose], bad: int
                ) -> set[tuple[int, int, int, int]]:
@@ -963,3 +957,20 @@ def _approach(closest: float) -> str:
         return ("it reached the goal's floor area but found no place there to stop at "
                 "that the goal test and the body's clearance accept")
     return f"it came no nearer than {closest:.2f} m to the goal's floor area"
+
+
+def _search_refusal(task: str, goal: Goal, res: SearchFailure, used: int) -> PlanningError:
+    """The error of a walk for ``task`` whose search for ``goal`` failed with ``res`` after
+    ``used`` nodes in all: out of budget, no stop at the goal (a blocked goal: the caller
+    may try other placements) or no way at all."""
+    if res.reason == "budget":
+        why = f"the search budget ran out ({used} nodes; {_approach(res.closest)})"
+    elif res.reason == "no_stop":
+        why = (f"the search reached the goal's neighbourhood but no place to stop "
+               f"there keeps the body clear and passes the goal test ({used} nodes)")
+    else:
+        why = (f"obstacles block every way to the target (searched {res.expanded} "
+               f"placements; {_approach(res.closest)})")
+    return PlanningError(f"task {task}: {goal.description}: {why}", task=task,
+                         reason="blocked" if res.reason == "no_stop" else res.reason,
+                         search=res.reason)

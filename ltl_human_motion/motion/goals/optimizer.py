@@ -340,6 +340,22 @@ def _blend_end(out: np.ndarray, ref: np.ndarray, frames: int) -> np.ndarray:
     return blended
 
 
+def _window(ref: np.ndarray, near: np.ndarray, palms: np.ndarray | None,
+            tracked: tuple[str, ...]) -> tuple[int, int]:
+    """The frames of ``ref`` (T, J, 3) the program solves: from ``_LEAD_FRAMES`` before
+    the first frame an obstacle is near (``near`` (T,), finite there) or the ``palms``
+    (T, K, 3) leave the reference's ``tracked`` palms, to the last such frame."""
+    first = int(np.argmax(np.isfinite(near)))
+    last_near = len(ref) - 1 - int(np.argmax(np.isfinite(near[::-1])))
+    if palms is not None:
+        moved = np.any(np.abs(np.asarray(palms) - ref[:, [JOINT_INDEX[j] for j in tracked]])
+                       > 0.0, axis=(1, 2))
+        if moved.any():
+            first = min(first, int(np.argmax(moved)))
+            last_near = max(last_near, len(ref) - 1 - int(np.argmax(moved[::-1])))
+    return max(first - _LEAD_FRAMES, 0), last_near
+
+
 def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField, *,
                     tracked: tuple[str, ...] = ("l_hand", "r_hand"),
                     options: WholeBodyOptions | None = None, fps: float = 30.0,
@@ -370,15 +386,7 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
     near = reference_clearance(kin, ref, field_, opts.influence, held, held_from)
     if not np.isfinite(near).any():
         return TrackingResult(ref, False, np.inf)
-    first = int(np.argmax(np.isfinite(near)))
-    if palms is not None:
-        moved = np.any(np.abs(np.asarray(palms) - ref[:, [JOINT_INDEX[j] for j in tracked]])
-                       > 0.0, axis=(1, 2))
-        first = min(first, int(np.argmax(moved)) if moved.any() else first)
-    first = max(first - _LEAD_FRAMES, 0)
-    last_near = len(ref) - 1 - int(np.argmax(np.isfinite(near[::-1])))
-    if palms is not None and moved.any():
-        last_near = max(last_near, len(ref) - 1 - int(np.argmax(moved[::-1])))
+    first, last_near = _window(ref, near, palms, tracked)
     tracker = _Tracker(kin, ref, tracked, opts, fps, palms, stature)
     release = int(0.75 * len(ref)) if release_from is None else int(release_from)
     conf = pink.Configuration(kin.model, kin.data, tracker.q_ref[first].copy())

@@ -93,15 +93,22 @@ def make_goal_primitive(task: str, target: np.ndarray | None, skeleton: Skeleton
         board, furniture = _check_furniture(board, support, ceiling)
         mp = _hand_task(task, target, skeleton, st, rng, duration, hand, fps, path, travel,
                         board, obstacles, furniture)
-    elif task in ("bend", "stoop", "kneel"):
-        mp = _down_up(task, skeleton, st, rng, duration, fps, target, hand)
-    elif task == "wait":
-        mp = _wait(skeleton, st, rng, duration, fps)
-    elif task == "sit":
-        mp = _sit_primitive(skeleton, st, rng, duration, fps, target)
     else:
-        mp = _stand_up(skeleton, st, rng, duration, fps, target)
+        mp = _body_task(task, target, skeleton, st, rng, duration, fps, hand)
     return within_speed_limits(mp, skeleton.stature)
+
+
+def _body_task(task: str, target: np.ndarray | None, skeleton: Skeleton, st: _Start,
+               rng: np.random.Generator, duration: float | None, fps: float,
+               hand: str) -> MotionPrimitive:
+    """The model of a task without a hand target: bend, stoop, kneel, wait, sit, standUp."""
+    if task in ("bend", "stoop", "kneel"):
+        return _down_up(task, skeleton, st, rng, duration, fps, target, hand)
+    if task == "wait":
+        return _wait(skeleton, st, rng, duration, fps)
+    if task == "sit":
+        return _sit_primitive(skeleton, st, rng, duration, fps, target)
+    return _stand_up(skeleton, st, rng, duration, fps, target)
 
 
 #: How fast a goal primitive slowed down for the verifier's joint speed limits may move
