@@ -123,6 +123,13 @@ STEP_OUT_MARGIN = 0.02
 #: Steps aside (m, left positive) tried when no backward step clears what follows.
 SIDE_STEPS: tuple[float, ...] = (0.1, -0.1, 0.2, -0.2)
 
+#: Model-made standing steps (ahead, left), m, tried in order to get room: back, aside,
+#: then both at once (an open machine door beside the worker reaches further back than
+#: a step).
+STEP_MOVES: tuple[tuple[float, float], ...] = tuple(
+    [(-back, 0.0) for back in STEP_OUT_DISTANCES] + [(0.0, side) for side in SIDE_STEPS]
+    + [(-back, side) for back in STEP_OUT_DISTANCES for side in SIDE_STEPS])
+
 #: A squeezing walk whose search ran out of budget in a gap whose middle has less floor
 #: clearance (footprint map) than this, metres, squares up to the gap's axis, steps to
 #: that middle and searches again: half the corpus aisle's 0.8 m width and 5 cm, the
@@ -513,33 +520,22 @@ class StepExecutor:
                 self.state.pose = self.hand_over_pose(mp, self.state.pose)
                 return
 
-    def step_away(self, carrying: bool, clearance: Callable[[np.ndarray], np.ndarray]
-                  ) -> bool:
-        """A model-made standing step back, aside or both (``STEP_OUT_DISTANCES`` by
-        ``SIDE_STEPS``) onto floor with more ``clearance`` (the search's map, of (M, 2)
-        points) than where the worker stands, clear on every frame: where the first move
-        of every walk from here, a turn on the spot, swings a leg into the furniture in
-        front, or no search gets away from here. Returns whether it stepped."""
-        from ltl_human_motion.planning.turns import make_step_primitive
-        lib = self.ctx.library
+    def step_away(self, clearance: Callable[[np.ndarray], np.ndarray]) -> bool:
+        """A model-made standing step of ``STEP_MOVES`` onto floor with more ``clearance``
+        (the search's map, of (M, 2) points) than where the worker stands, clear on every
+        frame (:meth:`take_steps`): where the first move of every walk from here, a turn
+        on the spot, swings a leg into the furniture in front, or no search gets away
+        from here. Returns whether it stepped."""
         x, y, yaw = self.state.pose
         c, s = math.cos(yaw), math.sin(yaw)
         here = float(clearance(np.array([[x, y]]))[0])
-        moves = [(-back, 0.0) for back in STEP_OUT_DISTANCES] \
-            + [(0.0, side) for side in SIDE_STEPS] \
-            + [(-back, side) for back in STEP_OUT_DISTANCES for side in SIDE_STEPS]
-        for dx, dy in moves:
-            to = np.array([[x + c * dx - s * dy, y + s * dx + c * dy]])
-            if float(clearance(to)[0]) <= here:
-                continue
-            mp = make_step_primitive(self.ctx.stance(carrying), lib.standing_height, dx, dy,
-                                     0.0, lib.skeleton, lib.fps, "carry" if carrying else "walk")
-            if self.placed_clear(mp, self.state.pose, samples=None):
-                self.add(mp, self.state.pose, -1, self.ctx.overlap)
-                self.state.pose = self.hand_over_pose(mp, self.state.pose)
-                self.state.gait_state = None
-                return True
-        return False
+        to = np.array([[x + c * dx - s * dy, y + s * dx + c * dy] for dx, dy in STEP_MOVES])
+        roomier = clearance(to) > here
+        if not self.take_steps([((dx, dy, 0.0),) for (dx, dy), ok in zip(STEP_MOVES, roomier)
+                                if ok]):
+            return False
+        self.state.gait_state = None
+        return True
 
     def square_up(self, goal: Goal, carrying: bool) -> bool:
         """In a narrow gap (its middle has less floor clearance on the footprint map than
@@ -654,10 +650,7 @@ class StepExecutor:
             yield from [mp for mp in self.ctx.index.primitives
                         if mp.task == task and mp.meta.get("step") == GAIT_STEP_BACK
                         and not mp.meta.get("turn")][:1]
-            moves = [(-back, 0.0) for back in STEP_OUT_DISTANCES] \
-                + [(0.0, side) for side in SIDE_STEPS] \
-                + [(-back, side) for back in STEP_OUT_DISTANCES for side in SIDE_STEPS]
-            for dx, dy in moves:                       # made when tried
+            for dx, dy in STEP_MOVES:                  # made when tried
                 yield make_step_primitive(self.ctx.stance(carrying), lib.standing_height, dx, dy,
                                           0.0, lib.skeleton, lib.fps, task)
 
@@ -711,7 +704,7 @@ class StepExecutor:
                 continue
             if isinstance(res, SearchFailure):
                 if not stepped and used < budget.max_nodes and self._got_nowhere(res, start) \
-                        and self.step_away(carry, goal.clearance or self.ctx.clearance):
+                        and self.step_away(goal.clearance or self.ctx.clearance):
                     # No way on from where it stands (facing a rack in an aisle with a
                     # part in hand, too close to turn): step away first.
                     stepped, forbidden = True, set()
@@ -723,7 +716,7 @@ class StepExecutor:
             if bad is None:
                 break
             if bad == 0 and not stepped and self.ctx.index.standing[res.primitives[0]] \
-                    and self.step_away(carry, goal.clearance or self.ctx.clearance):
+                    and self.step_away(goal.clearance or self.ctx.clearance):
                 # Too tight a place to turn (a thigh into a conveyor): step away first.
                 stepped, forbidden = True, set()
                 continue

@@ -171,17 +171,20 @@ def speed_rows(kin: BodyKinematics, limits: np.ndarray, seconds: float
     return np.vstack([J, -J]), np.concatenate([bound, bound])
 
 
+@lru_cache(maxsize=4)
 def _com_weights(joints: int) -> np.ndarray:
     """Weights (J,) of the joint positions in the verifier's centre of mass (Winter's
     segment masses, :func:`~ltl_human_motion.motion.ik.center_of_mass`, which is linear
-    in them)."""
+    in them). Shared: read-only."""
     from ltl_human_motion.motion.ik import SEGMENT_MASS
     from ltl_human_motion.motion.skeleton import JOINT_INDEX
     w = np.zeros(joints)
     for a, b, mass, frac in SEGMENT_MASS:
         w[JOINT_INDEX[a]] += mass * (1.0 - frac)
         w[JOINT_INDEX[b]] += mass * frac
-    return w / w.sum()
+    w /= w.sum()
+    w.flags.writeable = False
+    return w
 
 
 def support_edges(pos: np.ndarray, stature: float) -> np.ndarray:

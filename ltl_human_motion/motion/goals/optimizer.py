@@ -208,6 +208,7 @@ class _Tracker:
         from pink.tasks import ComTask, FrameTask, PostureTask
         self.kin, self.ref, self.opts, self.dt = kin, ref, opts, 1.0 / fps
         self.stature = stature
+        self.ranges = None if opts.ranges is None else {k: (lo, hi) for k, lo, hi in opts.ranges}
         # The frames the verifier's balance check reads (both feet planted, the pelvis
         # still): the balance rows hold there only.
         self.static = np.zeros(len(ref), dtype=bool)
@@ -294,8 +295,8 @@ class _Tracker:
             parts.append(self_rows(kin, pos, opts.self_pairs, opts.self_influence,
                                    opts.damper))
         if opts.ranges is not None:
-            parts.append(rom_rows(kin, pos, {k: (lo, hi) for k, lo, hi in opts.ranges},
-                                  opts.range_influence, opts.range_margin, opts.damper))
+            parts.append(rom_rows(kin, pos, self.ranges, opts.range_influence,
+                                  opts.range_margin, opts.damper))
         if self.static[t]:
             parts.append(balance_rows(kin, pos, support_edges(pos, self.stature),
                                       opts.balance_influence, opts.damper, self.ref[t],

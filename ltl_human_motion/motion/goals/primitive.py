@@ -131,14 +131,12 @@ def within_speed_limits(mp: MotionPrimitive, stature: float) -> MotionPrimitive:
     ratio = float(np.max(speed / limit)) if speed.size else 0.0
     if ratio <= 1.0:
         return mp
+    from ltl_human_motion.motion.ops import resample_positions
     factor = ratio / GOAL_SPEED_ROOM
     T = mp.n_frames
-    n = int(np.ceil((T - 1) * factor)) + 1
-    at = np.linspace(0.0, T - 1, n)
-    lo = np.minimum(np.floor(at).astype(int), T - 2)
-    w = (at - lo)[:, None]
-    poses = mp.poses[lo] * (1.0 - w[..., None]) + mp.poses[lo + 1] * w[..., None]
-    root = mp.root[lo] * (1.0 - w) + mp.root[lo + 1] * w
+    poses = resample_positions(mp.poses, mp.fps / factor, mp.fps)
+    root = resample_positions(mp.root, mp.fps / factor, mp.fps)
+    n = len(poses)
 
     def frame(f: int) -> int:
         return min(round(int(f) * (n - 1) / (T - 1)), n - 1)
