@@ -317,6 +317,23 @@ def body_samples_clear(grid, lo, res, far, pos, cand, samples, ia, ib, long, nee
 
 
 @_jit
+def _placed(disp, path, p, x, y, yaw, c, s, xs, ys, values, in_lo, in_hi, ends, gap, m
+            ) -> None:
+    """ends[m] and gap[m] of primitive p started at (x, y, yaw) (:func:`placed_paths`)."""
+    ends[m, 0] = x + c * disp[p, 0] - s * disp[p, 1]
+    ends[m, 1] = y + s * disp[p, 0] + c * disp[p, 1]
+    ends[m, 2] = yaw + disp[p, 2]
+    least = np.inf
+    for k in range(path.shape[1]):
+        v = _bilinear_at(xs, ys, values, in_lo, in_hi,
+                         x + c * path[p, k, 0] - s * path[p, k, 1],
+                         y + s * path[p, k, 0] + c * path[p, k, 1])
+        if v < least or k == 0:
+            least = v
+    gap[m] = least
+
+
+@_jit
 def placed_paths(disp, path, ids, x, y, yaw, c, s, xs, ys, values, in_lo, in_hi, ends, gap
                  ) -> None:
     """The search's successor poses and root-path clearances in one call: for primitive
@@ -324,15 +341,15 @@ def placed_paths(disp, path, ids, x, y, yaw, c, s, xs, ys, values, in_lo, in_hi,
     (``astar._place``'s arithmetic) and gap[m] the least :func:`bilinear` clearance of
     its root path's points path[ids[m]] (S, 2) placed there (``astar._path_points``)."""
     for m in range(ids.shape[0]):
-        p = ids[m]
-        ends[m, 0] = x + c * disp[p, 0] - s * disp[p, 1]
-        ends[m, 1] = y + s * disp[p, 0] + c * disp[p, 1]
-        ends[m, 2] = yaw + disp[p, 2]
-        least = np.inf
-        for k in range(path.shape[1]):
-            v = _bilinear_at(xs, ys, values, in_lo, in_hi,
-                             x + c * path[p, k, 0] - s * path[p, k, 1],
-                             y + s * path[p, k, 0] + c * path[p, k, 1])
-            if v < least or k == 0:
-                least = v
-        gap[m] = least
+        _placed(disp, path, ids[m], x, y, yaw, c, s, xs, ys, values, in_lo, in_hi, ends,
+                gap, m)
+
+
+@_jit
+def placed_paths_from(disp, path, ids, starts, c, s, xs, ys, values, in_lo, in_hi, ends,
+                      gap) -> None:
+    """:func:`placed_paths` with a start pose per primitive: ids[m] started at starts[m]
+    (x, y, yaw), c[m] and s[m] the cosine and sine of its yaw."""
+    for m in range(ids.shape[0]):
+        _placed(disp, path, ids[m], starts[m, 0], starts[m, 1], starts[m, 2], c[m], s[m],
+                xs, ys, values, in_lo, in_hi, ends, gap, m)

@@ -282,6 +282,21 @@ def _arrivals(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, goal: Goal,
     return done, tail
 
 
+def _placed_from(index: GaitIndex, ids: np.ndarray, at: np.ndarray,
+                 clearance: Callable[[np.ndarray], np.ndarray]
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """End poses (M, 3) of primitives ``ids`` (M,) started at ``at`` (M, 3) and the least
+    ``clearance`` along their root paths (M,); in one compiled call on a
+    :class:`ClearanceMap` where the compiled kernel is in use (the same numbers)."""
+    placed = (clearance.placed_paths_from(index.disp, index.path, ids, at)
+              if isinstance(clearance, ClearanceMap) else None)
+    if placed is not None:
+        return placed
+    ends = _place(index, ids, at[:, 0], at[:, 1], at[:, 2])
+    path = _path_points(index, ids, at[:, 0, None], at[:, 1, None], at[:, 2, None])
+    return ends, clearance(path.reshape(-1, 2)).reshape(path.shape[:2]).min(axis=1)
+
+
 def _first_stop(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, near: np.ndarray,
                 goal: Goal, allowed: np.ndarray,
                 clearance: Callable[[np.ndarray], np.ndarray],
@@ -312,11 +327,8 @@ def _first_stop(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, near: np.n
     if not keep.any():
         return None
     owner, cand = owner[keep], cand[keep]
-    at = ends[owner]                                                 # (K, 3)
-    cand_ends = _place(index, cand, at[:, 0], at[:, 1], at[:, 2])
-    path = _path_points(index, cand, at[:, 0, None], at[:, 1, None], at[:, 2, None])
-    ok = clearance(path.reshape(-1, 2)).reshape(path.shape[:2]).min(axis=1) \
-        > options.body_radius
+    cand_ends, gap = _placed_from(index, cand, ends[owner], clearance)
+    ok = gap > options.body_radius
     if ok.any():
         ok[ok] = goal.reached(cand_ends[ok, 0], cand_ends[ok, 1], cand_ends[ok, 2])
     if ok.any() and body_clear is not None and index.body.size:

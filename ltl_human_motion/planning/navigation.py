@@ -286,6 +286,21 @@ class ClearanceMap:
                         self._xs, self._ys, self._values, self._in_lo, self._in_hi, ends, gap)
         return ends, gap
 
+    def placed_paths_from(self, disp: np.ndarray, path: np.ndarray, ids: np.ndarray,
+                          starts: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """:meth:`placed_paths` with a start pose per primitive: ``ids`` (M,) started at
+        ``starts`` (M, 3) (x, y, yaw), their end poses (M, 3) and least root-path
+        clearances (M,); None where the compiled kernel is not in use."""
+        nb = _compiled_loops()
+        if nb is None:
+            return None
+        ends = np.empty((len(ids), 3))
+        gap = np.empty(len(ids))
+        nb.placed_paths_from(disp, path, ids, starts, np.cos(starts[:, 2]),
+                             np.sin(starts[:, 2]), self._xs, self._ys, self._values,
+                             self._in_lo, self._in_hi, ends, gap)
+        return ends, gap
+
 
 def _trilinear(grid: np.ndarray, u: np.ndarray) -> np.ndarray:
     """Trilinear interpolation of ``grid`` (nx, ny, nz) at index coordinates ``u`` (N, 3).
