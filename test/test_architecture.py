@@ -222,3 +222,19 @@ def test_the_planner_parts_set_attributes_only_when_made() -> None:
                               for t in node.targets if isinstance(t, ast.Attribute)
                               and isinstance(t.value, ast.Name) and t.value.id == "self"]
     assert not offenders
+
+
+def test_only_the_worker_state_moves_the_worker() -> None:
+    """The worker's pose changes only through WorkerState (start_at, place, restore): the
+    planner's parts place segments and pass poses as arguments, never writing ``pose``."""
+    writers = []
+    for path in sorted((PACKAGE / "planning").glob("*.py")):
+        if path.name == "plan_state.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            targets = node.targets if isinstance(node, ast.Assign) else \
+                [node.target] if isinstance(node, (ast.AugAssign, ast.AnnAssign)) else []
+            names = [e for t in targets for e in (t.elts if isinstance(t, ast.Tuple) else [t])]
+            writers += [f"{path.name}:{node.lineno}" for e in names
+                        if isinstance(e, ast.Attribute) and e.attr == "pose"]
+    assert not writers

@@ -105,7 +105,7 @@ def test_walk_squeezes_through_a_narrow_corridor() -> None:
     cell = cell_from_yaml(CORRIDOR)
     lib = get_library(1.75)
     planner = SequencePlanner(cell, lib, np.random.default_rng(0))
-    planner.state.pose = (0.0, 0.0, 0.0)
+    planner.state.start_at((0.0, 0.0, 0.0))
     assert planner.ctx.clearance(np.array([[2.5, 0.0]]))[0] <= planner.ctx.options.body_radius
     goal = planner.goals.region(cell.region("R_in"), "walk into R_in", "walk(R_in)")
     assert goal.clearance is planner.ctx.stand_map
@@ -123,7 +123,7 @@ def test_roomy_floor_needs_no_squeeze() -> None:
     from ltl_human_motion.planning.planner import SequencePlanner
     cell = cell_from_yaml(CORRIDOR.replace("0.65", "0.95"))      # 1.4 m apart
     planner = SequencePlanner(cell, get_library(1.75), np.random.default_rng(0))
-    planner.state.pose = (0.0, 0.0, 0.0)
+    planner.state.start_at((0.0, 0.0, 0.0))
     goal = planner.goals.region(cell.region("R_in"), "walk into R_in", "walk(R_in)")
     assert goal.clearance is planner.ctx.clearance
 
@@ -165,7 +165,7 @@ def test_search_walks_around_a_gap_the_body_does_not_pass() -> None:
     cell = resolve_cell(root / "scenarios" / "cells" / "cluttered.yaml")
     lib = get_library(1.75)
     planner = SequencePlanner(cell, lib, np.random.default_rng(0))
-    planner.state.pose = (-1.39, 1.26, 2.39)
+    planner.state.start_at((-1.39, 1.26, 2.39))
     target = planner.target_of("grasp", ("O1",))
     goal, _ = planner.goals.reach(target, standing_offset(planner.ctx, "grasp", target,
                                                           "grasp(O1)"),
@@ -219,7 +219,7 @@ def test_arms_come_up_after_a_step_aside_from_a_board_at_elbow_height() -> None:
                         / "aisle.yaml")
     lib = get_library(1.75)
     planner = SequencePlanner(cell, lib, np.random.default_rng(0))
-    planner.state.pose = (1.2, -0.1, 0.0)
+    planner.state.start_at((1.2, -0.1, 0.0))
     planner.executor.stand_still(-1, 0.3)
     planner.executor.arm_transition(False, -1)
     assert abs(planner.state.pose[1] + 0.1) > 0.05                 # stepped aside
@@ -245,7 +245,7 @@ def test_field_leads_from_the_floor_beside_the_lanes() -> None:
     from ltl_human_motion.planning.walk_goals import LANE_NARROW_COST, PASSAGE_RADIUS
     cell = cell_from_yaml(TABLE)
     planner = SequencePlanner(cell, get_library(1.95), np.random.default_rng(0))
-    planner.state.pose = (0.3, 0.0, 0.0)
+    planner.state.start_at((0.3, 0.0, 0.0))
     radius = planner.ctx.options.body_radius
     here = planner.ctx.clearance(np.array([[0.3, 0.0]]))[0]
     assert radius < here < PASSAGE_RADIUS

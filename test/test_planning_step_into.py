@@ -31,7 +31,7 @@ def test_a_worker_beside_a_small_reach_spot_steps_into_it(steps: bool,
     cell = load_cell(CELLS / "machine_tending.yaml")
     lib = get_library(1.95)
     planner = SequencePlanner(cell, lib, np.random.default_rng(0))
-    planner.state.pose = (1.07, -0.22, -0.45)
+    planner.state.start_at((1.07, -0.22, -0.45))
     target = planner.target_of("extract", ("done", "fixture"))
     placement, _ = planner._placement("extract", target, "extract(done, fixture)",
                                       ("done", "fixture"))

@@ -56,7 +56,7 @@ def test_a_side_into_the_shelf_wall_is_refused_before_any_search(gear) -> None:
     goal, _ = planner.goals.reach(target, placement, "reach gear", "grasp(gear)",
                                   sector=(math.radians(60), 0.5))
     assert goal.possible() is False
-    planner.state.pose = (0.0, 0.0, 0.0)
+    planner.state.start_at((0.0, 0.0, 0.0))
     with pytest.raises(PlanningError) as err:
         planner.goal_steps.approach(target, placement, "grasp(gear)",
                                     sector=(math.radians(60), 0.5))

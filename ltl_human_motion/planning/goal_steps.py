@@ -293,8 +293,7 @@ class GoalSteps:
         if mp is None:
             raise self.refusal(text, kind, attempts, blocked, grasped, (kept_in, self_hits),
                                part, container, note)
-        seg = self.executor.add(mp, self.state.pose, label, self.ctx.overlap)
-        self.state.pose = self.executor.hand_over_pose(mp, self.state.pose)
+        seg = self.executor.advance(mp, label)
         self.state.gait_state = None
         if kind == "standUp" and not np.array_equal(kwargs["start_pose"],
                                                     self.ctx.stance(self.state.carrying)):

@@ -189,8 +189,7 @@ def lift_in(steps: GoalSteps, part: str, target: np.ndarray, placement: tuple[fl
                                lib.fps, "carry")
     if not ex.placed_clear(step, state.pose):
         raise refuse("the step in meets an obstacle")
-    ex.add(step, state.pose, -1, ctx.overlap)
-    state.pose = ex.hand_over_pose(step, state.pose)
+    ex.advance(step)
     state.gait_state = None
     return walked, StartArms(lifted, rise)
 
@@ -271,8 +270,7 @@ def settle(steps: GoalSteps, arms: StartArms, label: int, text: str,
         if not ex.placed_clear(lower, pose, put_down=put_down):
             continue
         if step is not None:
-            ex.add(step, state.pose, label, ctx.overlap)
-            state.pose = pose
+            ex.add(step, state.pose, label, ctx.overlap, pose)
         ex.add(lower, state.pose, label, ctx.overlap)
         state.gait_state = None
         return

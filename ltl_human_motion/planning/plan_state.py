@@ -249,6 +249,20 @@ class WorkerState:
         """Whether a hand holds a part (the arms are in the carry stance)."""
         return bool(self.held)
 
+    def start_at(self, pose: Pose) -> None:
+        """Begin the plan with the worker standing at ``pose`` (x, y, yaw)."""
+        self.pose = pose
+
+    def place(self, segment: PlacedSegment, end: Pose | None = None) -> int:
+        """Append ``segment`` to the motion; returns its index. With ``end`` (its hand-over
+        pose) the next segment starts there; without, the segment was made in place (a
+        stand-still, an arm motion) and the next starts where it did. With
+        :meth:`start_at` and :meth:`restore`, the only writer of :attr:`pose`."""
+        self.segments.append(segment)
+        if end is not None:
+            self.pose = end
+        return len(self.segments) - 1
+
     def mark(self) -> tuple[int, Pose, int | None, StartArms | None]:
         """Where the plan stands now, for :meth:`restore`: (segments, pose, gait state,
         start arms)."""

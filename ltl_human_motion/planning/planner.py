@@ -214,7 +214,7 @@ class SequencePlanner:
 
     def plan(self, tasks: list[TaskStep], start: Pose) -> Plan:
         """Plan every step (:func:`~ltl_human_motion.vocabulary.task_step` makes them)."""
-        self.state.pose = start
+        self.state.start_at(start)
         self.executor.stand_still(-1, END_STILL_SECONDS)
         for i, task in enumerate(tasks):
             first = len(self.state.segments)

@@ -246,14 +246,20 @@ class StepExecutor:
         # Walk starts where stepping away did not get a search any further.
         self._stuck: set[tuple] = set()
 
-    def add(self, mp: MotionPrimitive, pose: Pose, label: int, blend: int) -> int:
+    def add(self, mp: MotionPrimitive, pose: Pose, label: int, blend: int,
+            end: Pose | None = None) -> int:
         """Place ``mp`` at ``pose`` as the next segment (task label ``label``, blended over
-        ``blend`` frames with the one before); returns its index."""
-        pos = world_positions(mp, *pose)
-        yaw = pose[2] + mp.root[:, 3]
-        segments = self.state.segments
-        segments.append(PlacedSegment(pos, yaw, label, blend if segments else 0, mp.name))
-        return len(self.state.segments) - 1
+        ``blend`` frames with the one before); the worker then stands at ``end`` if given,
+        else where it stood (a motion in place). Returns the segment's index."""
+        segment = PlacedSegment(world_positions(mp, *pose), pose[2] + mp.root[:, 3], label,
+                                blend if self.state.segments else 0, mp.name)
+        return self.state.place(segment, end)
+
+    def advance(self, mp: MotionPrimitive, label: int = -1) -> int:
+        """Place ``mp`` where the worker stands and move the worker to its hand-over pose
+        (:meth:`hand_over_pose`); returns the segment's index."""
+        pose = self.state.pose
+        return self.add(mp, pose, label, self.ctx.overlap, self.hand_over_pose(mp, pose))
 
     def hand_over_pose(self, mp: MotionPrimitive, pose: Pose) -> Pose:
         """The floor pose where ``mp`` placed at ``pose`` hands over to the next segment
@@ -516,8 +522,7 @@ class StepExecutor:
                                      0.0, lib.skeleton, lib.fps,
                                      "carry" if carrying else "walk")
             if self.placed_clear(mp, self.state.pose, samples=None):
-                self.add(mp, self.state.pose, -1, self.ctx.overlap)
-                self.state.pose = self.hand_over_pose(mp, self.state.pose)
+                self.advance(mp)
                 return
 
     def step_away(self, clearance: Callable[[np.ndarray], np.ndarray]) -> bool:
@@ -657,8 +662,7 @@ class StepExecutor:
         for mp in steps():
             pose = self.hand_over_pose(mp, self.state.pose)
             if self.placed_clear(mp, self.state.pose) and self.placed_clear(then, pose):
-                self.add(mp, self.state.pose, label, self.ctx.overlap)
-                self.state.pose = pose
+                self.add(mp, self.state.pose, label, self.ctx.overlap, pose)
                 return True
         return False
 
@@ -731,10 +735,9 @@ class StepExecutor:
             return self.walk(goal, task, label, carry, budget)    # square to the gap
         if isinstance(res, SearchFailure):
             raise _search_refusal(task, goal, res, used)
-        for prim_id, pose in zip(res.primitives, res.poses):
-            self.add(self.ctx.index.primitives[prim_id], pose, label, self.ctx.overlap)
+        for prim_id, pose, end in zip(res.primitives, res.poses, [*res.poses[1:], res.end_pose]):
+            self.add(self.ctx.index.primitives[prim_id], pose, label, self.ctx.overlap, end)
         if res.primitives:
-            self.state.pose = res.end_pose
             self.state.gait_state = None  # every walk ends with a stop primitive
         return len(res.primitives)
 
@@ -856,9 +859,8 @@ class StepExecutor:
             for mp in moves[:-1]:
                 poses.append(self.hand_over_pose(mp, poses[-1]))
             if all(self.placed_clear(mp, pose) for mp, pose in zip(moves, poses)):
-                for mp, pose in zip(moves, poses):
-                    self.add(mp, pose, -1, self.ctx.overlap)
-                self.state.pose = self.hand_over_pose(moves[-1], poses[-1])
+                for mp in moves:
+                    self.advance(mp)
                 return True
         return False
 
@@ -883,8 +885,7 @@ class StepExecutor:
                                  "carry" if self.state.carrying else "walk")
         if not self.placed_clear(mp, self.state.pose):
             return False
-        self.add(mp, self.state.pose, -1, self.ctx.overlap)
-        self.state.pose = self.hand_over_pose(mp, self.state.pose)
+        self.advance(mp)
         return True
 
     def adjust_to(self, target: np.ndarray, placement: tuple[float, float], task: str,
@@ -937,8 +938,7 @@ class StepExecutor:
                 pose = self.hand_over_pose(mp, pose)
             if len(plan) == len(moves):
                 for mp in plan:
-                    self.add(mp, self.state.pose, -1, self.ctx.overlap)
-                    self.state.pose = self.hand_over_pose(mp, self.state.pose)
+                    self.advance(mp)
                 return True
         return False
 

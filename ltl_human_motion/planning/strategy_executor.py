@@ -399,9 +399,10 @@ class StrategyExecutor:
                               dict(self._inputs), self._inputs_stamp, self._start,
                               self._reacted_at)
 
-    def _pose(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _pose(self, t: np.ndarray, blend: float | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
         """Positions (N, J, 3) and yaw (N,) of the current clip at step times ``t`` (N,),
-        the junction offset blended out."""
+        the junction offset blended out over ``blend`` s (default: the junction's)."""
         clip = self._clip
         n = len(clip.positions)
         f = np.clip(t * clip.fps, 0.0, n - 1)
@@ -410,7 +411,7 @@ class StrategyExecutor:
         w = f - i0
         pos = clip.positions[i0] * (1 - w)[:, None, None] + clip.positions[i1] * w[:, None, None]
         yaw = clip.yaw[i0] * (1 - w) + clip.yaw[i1] * w
-        u = np.clip(t / self._blend, 0.0, 1.0)
+        u = np.clip(t / (self._blend if blend is None else blend), 0.0, 1.0)
         fade = 1.0 - u * u * (3.0 - 2.0 * u)                          # smoothstep down
         if self._residual.shape == pos.shape[1:]:
             # The junction's rigid part (a turn about z through the clip's first pelvis and
@@ -488,14 +489,10 @@ class StrategyExecutor:
         out over ``blend`` s: through the blend and the speed window after it (at most
         the clip), at the clip's frame rate."""
         with self._lock:
-            clip, kept = self._clip, self._blend
+            clip = self._clip
             w = max(1, round(SPEED_WINDOW * clip.fps))
             n = min(int(np.ceil(blend * clip.fps)) + w, len(clip.positions) - 1)
-            self._blend = float(blend)
-            try:
-                return self._pose(np.arange(n + 1) / clip.fps)[0]
-            finally:
-                self._blend = kept
+            return self._pose(np.arange(n + 1) / clip.fps, float(blend))[0]
 
     def _verify_junction(self, blend: float, pose: np.ndarray, yaw: float,
                          before: np.ndarray, previous: str) -> None:

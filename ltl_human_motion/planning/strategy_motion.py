@@ -143,33 +143,30 @@ def strategy_moves(worker: ReactiveWorker) -> list[Move]:
     SpecError
         When the strategy has more than :data:`MAX_EXPLORED_MEMORIES` states.
     """
-    strategy = worker.strategy
     values = list(input_valuations(worker.gr1.inputs))
     moves: set[Move] = set()
     seen: set[tuple] = {()}
     queue: deque[dict] = deque([{}])
-    try:
-        while queue:
-            state = queue.popleft()
-            strategy.state, strategy._chosen = dict(state), {}
-            try:
-                task = strategy.choose()
-            except SpecError:
-                continue                       # inputs that broke an assumption
-            chosen = dict(strategy._chosen)
-            moves.add(Move(int(state["cs"]) if state else START, task, int(chosen["cs"])))
-            for v in values:
-                strategy.state, strategy._chosen = dict(state), dict(chosen)
-                strategy.observe(v)
-                key = strategy.memory()
-                if key not in seen:
-                    if len(seen) >= MAX_EXPLORED_MEMORIES:
-                        raise SpecError(f"the strategy has more than {MAX_EXPLORED_MEMORIES} "
-                                        "states (MAX_EXPLORED_MEMORIES); use fewer inputs")
-                    seen.add(key)
-                    queue.append(dict(strategy.state))
-    finally:
-        strategy.reset()
+    while queue:
+        state = queue.popleft()
+        # Each state is explored on its own copy: the worker's strategy is not touched.
+        strategy = replace(worker.strategy, state=dict(state), _chosen={})
+        try:
+            task = strategy.choose()
+        except SpecError:
+            continue                           # inputs that broke an assumption
+        chosen = dict(strategy._chosen)
+        moves.add(Move(int(state["cs"]) if state else START, task, int(chosen["cs"])))
+        for v in values:
+            strategy = replace(worker.strategy, state=dict(state), _chosen=dict(chosen))
+            strategy.observe(v)
+            key = strategy.memory()
+            if key not in seen:
+                if len(seen) >= MAX_EXPLORED_MEMORIES:
+                    raise SpecError(f"the strategy has more than {MAX_EXPLORED_MEMORIES} "
+                                    "states (MAX_EXPLORED_MEMORIES); use fewer inputs")
+                seen.add(key)
+                queue.append(dict(strategy.state))
     return sorted(moves, key=lambda m: (m.source, m.task, m.target))
 
 
