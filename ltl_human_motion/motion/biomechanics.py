@@ -202,6 +202,9 @@ def joint_angles(positions: np.ndarray, names: Collection[str] | None = None
         Only these keys (the same values); default all.
     """
     p = np.asarray(positions, dtype=np.float64)
+    nb = compiled_module("ltl_human_motion.motion._angles_numba")
+    if nb is not None and p.ndim == 3:
+        return _joint_angles_compiled(nb, p, names)
     want = (lambda key: True) if names is None else frozenset(names).__contains__
     deg = np.degrees
     out: dict[str, np.ndarray] = {}
@@ -243,6 +246,41 @@ def joint_angles(positions: np.ndarray, names: Collection[str] | None = None
         if want("neck_lateral"):
             out["neck_lateral"] = deg(np.arcsin(np.clip(dot3(h, cl), -1, 1)))
     return out
+
+
+#: The joints :mod:`._angles_numba` reads, in its order, and the keys of its outputs
+#: (arctan2, arcsin, arccos rows) in :func:`joint_angles`' order.
+_ANGLE_JOINTS = np.array([_J[n] for n in (
+    "pelvis", "spine", "chest", "neck", "head", "l_shoulder", "r_shoulder", "l_hip", "r_hip",
+    *(f"{s}_{n}" for s in "lr" for n in ("hip", "knee", "ankle", "toe", "elbow", "wrist")))],
+    dtype=np.int64)
+_ANGLE_ROWS = {
+    **{f"{s}_{n}": (kind, 2 * k + i) for k, s in enumerate("lr")
+       for kind, pair in ((0, ("knee_flexion", "hip_flexion")),
+                          (1, ("hip_abduction", "shoulder_extension")))
+       for i, n in enumerate(pair)},
+    "l_elbow_flexion": (2, 0), "r_elbow_flexion": (2, 1), "trunk_flexion": (0, 4),
+    "trunk_lateral": (1, 4), "trunk_rotation": (0, 5), "neck_flexion": (0, 6),
+    "neck_lateral": (1, 5)}
+_ANGLE_ORDER = tuple(f"{s}_{n}" for s in "lr" for n in (
+    "knee_flexion", "hip_flexion", "hip_abduction", "elbow_flexion",
+    "shoulder_extension")) + ("trunk_flexion", "trunk_lateral", "trunk_rotation",
+                              "neck_flexion", "neck_lateral")
+
+
+def _joint_angles_compiled(nb, p: np.ndarray, names: Collection[str] | None
+                           ) -> dict[str, np.ndarray]:
+    """:func:`joint_angles` of poses ``p`` (T, J, 3) by the compiled loop (the same
+    numbers): its arguments of arctan2 (7, T), arcsin (6, T) and arccos (2, T), then
+    numpy's functions on them."""
+    T = p.shape[0]
+    y, z, s, c = np.empty((7, T)), np.empty((7, T)), np.empty((6, T)), np.empty((2, T))
+    nb.angle_arguments(np.ascontiguousarray(p), _ANGLE_JOINTS, y, z, s, c)
+    rows = (np.degrees(np.arctan2(y, z)), np.degrees(np.arcsin(s)),
+            np.degrees(np.arccos(c)))
+    wanted = None if names is None else frozenset(names)
+    keys = _ANGLE_ORDER if wanted is None else [k for k in _ANGLE_ORDER if k in wanted]
+    return {k: rows[_ANGLE_ROWS[k][0]][_ANGLE_ROWS[k][1]] for k in keys}
 
 
 def _rom_key(name: str) -> str:
