@@ -12,7 +12,7 @@ from functools import lru_cache
 import numpy as np
 
 from ltl_human_motion.motion.goals.body import _Start
-from ltl_human_motion.motion.goals.postures import _grid
+from ltl_human_motion.motion.goals.postures import _grid, least_cost
 from ltl_human_motion.motion.goals.tasks import (
     LEVEL_PATH_TASKS,
     _check_board,
@@ -57,10 +57,13 @@ def _placement(task: str, height: float, stature: float, hand: str,
             target = np.array([x, lateral, height])
             targets, active, _ = _hand_targets(task, target, "both" if both else (
                 "l_hand" if lateral > 0 else "r_hand"))
-            _, _, _, cost, capped, kneel = _grid(
-                skeleton, st, targets, active, task,
-                None if board is None else (x - board[0] - margin, board[1], board[2]))
-            c = float(np.min(cost if full else np.where(capped | kneel, cost, np.inf)))
+            if board is None:
+                c = least_cost(skeleton, st, targets, active, task, capped_only=not full)
+            else:
+                _, _, _, cost, capped, kneel = _grid(
+                    skeleton, st, targets, active, task, (x - board[0] - margin, board[1],
+                                                          board[2]))
+                c = float(np.min(cost if full else np.where(capped | kneel, cost, np.inf)))
             if c < best[0]:
                 best = (c, float(x))
         if best[1] is not None:

@@ -176,6 +176,57 @@ def _kneel_set(skeleton: Skeleton, st: _Start) -> tuple[np.ndarray, ...]:
             np.ones(P.size, bool))
 
 
+def _reach_cost(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
+                board: tuple[float, float, float] | None
+                ) -> tuple[np.ndarray, ...]:
+    """The candidates of :func:`_grid_base` with the hands' reach: P, D, shift, cost,
+    feasible (the hands within reach and, under ``board``, turned before its edge),
+    capped, kneel, each (C,)."""
+    arm = _arm_length(skeleton)
+    P, D, shift, cost, shoulders, feasible, capped, kneel = _grid_base(skeleton, st,
+                                                                        board is not None)
+    for k in active:
+        d = np.linalg.norm(targets[k] - shoulders[:, k], axis=-1)
+        feasible = feasible & (d <= _REACH_FRACTION * arm)
+        cost = cost + 0.5 * (d / arm - 0.8) ** 2
+    if board is not None:
+        feasible = feasible & _turns_before_edge(shoulders, active, board)
+    return P, D, shift, cost, feasible, capped, kneel
+
+
+def _self_blocked(poses: np.ndarray, stature: float) -> np.ndarray:
+    """Whether contact poses (C, J, 3) put a body part within ``_SELF_CLEARANCE`` of
+    another (planning.biomechanics' self-penetration), (C,)."""
+    from ltl_human_motion.motion.biomechanics import self_penetration
+    return self_penetration(poses, stature)[0].max(axis=1) > -_SELF_CLEARANCE
+
+
+#: Candidates :func:`least_cost` measures at a time, cheapest first.
+_LEAST_CHUNK = 24
+
+
+def least_cost(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
+               task: str, capped_only: bool = False) -> float:
+    """The least cost of :func:`_grid` without a board, obstacles or furniture (over the
+    capped or kneeling candidates only, with ``capped_only``): the same number, with the
+    body test run on the cheapest candidates :data:`_LEAST_CHUNK` at a time until one
+    passes instead of on every candidate (a standing place's search asks only this)."""
+    P, D, shift, cost, feasible, capped, kneel = _reach_cost(skeleton, st, targets, active,
+                                                             None)
+    if capped_only:
+        feasible = feasible & (capped | kneel)
+    idx = np.flatnonzero(feasible)
+    order = idx[np.argsort(cost[idx], kind="stable")]
+    for k in range(0, order.size, _LEAST_CHUNK):
+        some = order[k:k + _LEAST_CHUNK]
+        poses = _contact_poses(skeleton, st, P[some], D[some], shift[some], targets, active,
+                               task, cap=capped[some], kneel=kneel[some])
+        free = ~_self_blocked(poses, skeleton.stature)
+        if free.any():
+            return float(cost[some[int(np.argmax(free))]])
+    return float("inf")
+
+
 def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int, ...],
           task: str | None = None, board: tuple[float, float, float] | None = None,
           obstacles: ObstacleClearance | None = None, strict: bool = False,
@@ -199,21 +250,13 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     whether the pelvis tilt is capped (C,) and whether the posture kneels (C,)
     (:func:`_grid_base`).
     """
-    arm = _arm_length(skeleton)
-    P, D, shift, cost, shoulders, feasible, capped, kneel = _grid_base(skeleton, st,
-                                                                        board is not None)
-    for k in active:
-        d = np.linalg.norm(targets[k] - shoulders[:, k], axis=-1)
-        feasible = feasible & (d <= _REACH_FRACTION * arm)
-        cost = cost + 0.5 * (d / arm - 0.8) ** 2
-    if board is not None:
-        feasible = feasible & _turns_before_edge(shoulders, active, board)
+    P, D, shift, cost, feasible, capped, kneel = _reach_cost(skeleton, st, targets, active,
+                                                             board)
     idx = np.flatnonzero(feasible)
     if idx.size:
-        from ltl_human_motion.motion.biomechanics import self_penetration
         poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
                                task, cap=capped[idx], kneel=kneel[idx])
-        blocked = self_penetration(poses, skeleton.stature)[0].max(axis=1) > -_SELF_CLEARANCE
+        blocked = _self_blocked(poses, skeleton.stature)
         if board is not None:
             blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
             blocked |= _board_way_blocked(skeleton, st, (P[idx], D[idx], shift[idx]), active,
