@@ -180,10 +180,16 @@ class NavigationField:
         return bool(np.isfinite(self.distance(np.array([x]), np.array([y]))[0]))
 
 
+_LOOPS: list[ModuleType | None] = []
+
+
 def _compiled_loops() -> ModuleType | None:
-    """The compiled loops (:mod:`._navigation_numba`), where the compiled kernel is in use."""
-    from ltl_human_motion.kernel.segments import compiled_module
-    return compiled_module("ltl_human_motion.planning._navigation_numba")
+    """The compiled loops (:mod:`._navigation_numba`), where the compiled kernel is in use
+    (decided on the first call)."""
+    if not _LOOPS:
+        from ltl_human_motion.kernel.segments import compiled_module
+        _LOOPS.append(compiled_module("ltl_human_motion.planning._navigation_numba"))
+    return _LOOPS[0]
 
 
 #: How much closer than its footprint a tall part counts for walking (the swinging arms
@@ -499,8 +505,9 @@ class ObstacleField:
         if nb is not None and np.isfinite(pos).all():
             # (every candidate and sample; the bounding-box test is done)
             ok[check] = self._compiled_clear(nb, pos, np.arange(len(pos)),
-                                             np.arange(pos.shape[1]), (ia, ib, long, radii),
-                                             margin, relative, np.inf)
+                                             np.arange(pos.shape[1]),
+                                             self._sample_test(stature, parts, margin),
+                                             relative, np.inf)
             return ok
         d_joint = self.distance(pos)                                        # (m, S, J)
         d_mid = self.distance((pos[..., ia[long], :] + pos[..., ib[long], :]) / 2.0)
@@ -535,26 +542,40 @@ class ObstacleField:
         pos = np.asarray(poses, dtype=np.float64)
         if self.empty or nb is None or not np.isfinite(pos).all():
             return self.clear(pos[cand][:, samples], stature, margin, relative, parts)
-        capsules = _capsule_table(float(stature), _parts_key(parts))
-        limit = capsules[3].max() + margin + self.res * (0.4 + np.sqrt(3.0))
-        return self._compiled_clear(nb, pos, cand, samples, capsules, margin, relative,
-                                    float(limit) if limit <= self.far else np.inf)
+        test = self._sample_test(stature, parts, margin)
+        return self._compiled_clear(nb, pos, cand, samples, test, relative, test[5])
+
+    def _sample_test(self, stature: float, parts: np.ndarray | None, margin: float
+                     ) -> tuple:
+        """What the compiled test of :meth:`clear_samples` reads for a body, its parts and
+        margin, computed once per field: the capsules of :func:`_capsule_table` (ia, ib,
+        long, radii), the gap each needs (K,) and the bounding-box pre-test's limit (inf
+        where the field is too small for it)."""
+        cache = self.__dict__.setdefault("_sample_tests", {})
+        key = (float(stature), _parts_key(parts), margin)
+        test = cache.get(key)
+        if test is None:
+            ia, ib, long, radii = _capsule_table(key[0], key[1])
+            limit = radii.max() + margin + self.res * (0.4 + np.sqrt(3.0))
+            test = (ia, ib, long, radii, radii + margin + self.res * 0.4,
+                    float(limit) if limit <= self.far else np.inf)
+            cache[key] = test
+        return test
 
     def _compiled_clear(self, nb: ModuleType, pos: np.ndarray, cand: np.ndarray,
-                        samples: np.ndarray, capsules: tuple[np.ndarray, ...], margin: float,
-                        relative: bool, limit: float) -> np.ndarray:
-        """The compiled test of :meth:`clear_samples` for the ``capsules`` of
-        :func:`_capsule_table` (``limit``: of the bounding-box pre-test, ``inf`` to read
+                        samples: np.ndarray, test: tuple, relative: bool, limit: float
+                        ) -> np.ndarray:
+        """The compiled test of :meth:`clear_samples` for the capsules and gaps of
+        :meth:`_sample_test` (``limit``: of the bounding-box pre-test, ``inf`` to read
         the field for every candidate), shape (N,)."""
-        ia, ib, long, radii = capsules
+        ia, ib, long, _, need, _ = test
         out = np.empty(len(cand), dtype=np.bool_)
         nb.body_samples_clear(
             np.ascontiguousarray(self.dist, dtype=np.float64),
             np.asarray(self.lo, dtype=np.float64), float(self.res), float(self.far),
             np.ascontiguousarray(pos), np.asarray(cand, dtype=np.int64),
-            np.asarray(samples, dtype=np.int64), ia, ib, long,
-            radii + margin + self.res * 0.4, bool(relative), self.part_lo, self.part_hi,
-            limit, out)
+            np.asarray(samples, dtype=np.int64), ia, ib, long, need, bool(relative),
+            self.part_lo, self.part_hi, limit, out)
         return out
 
 
