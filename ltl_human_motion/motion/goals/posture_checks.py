@@ -205,7 +205,11 @@ def _obstacle_blocked(skeleton: Skeleton, st: _Start,
                                                                                "r_foot"}
     whole = tuple(p for p in BODY_PARTS if p not in fixed)
     hit = obstacles(contact, whole) <= _OBSTACLE_CLEARANCE
-    way = _way_poses(skeleton, st, posture, cap, (), kneel)
-    S, C = len(_POSTURE_WAY), posture[0].size
-    near = obstacles(way, _WAY_PARTS).reshape(S, C) <= _OBSTACLE_CLEARANCE
-    return hit | near.any(axis=0)
+    # the way into the postures not already hit
+    todo = np.flatnonzero(~hit)
+    if todo.size:
+        way = _way_poses(skeleton, st, tuple(a[todo] for a in posture), cap[todo], (),
+                         None if kneel is None else kneel[todo])
+        near = obstacles(way, _WAY_PARTS).reshape(len(_POSTURE_WAY), todo.size)
+        hit[todo] = (near <= _OBSTACLE_CLEARANCE).any(axis=0)
+    return hit
