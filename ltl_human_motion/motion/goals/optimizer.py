@@ -315,10 +315,16 @@ class _Tracker:
         import qpsolvers
         G, h = rows
         dt = self.dt * frames
+        # The program of the step, built once (the relaxed retry solves a fresh copy).
+        built = pink.build_ik(conf, tasks, dt, damping=self.opts.damping, limits=[],
+                              constraints=self.feet)
+        parts = tuple(None if a is None else a.copy()
+                      for a in (built.P, built.q, built.G, built.h, built.A, built.b))
+        lb, ub = self.bounds(conf.q, t, frames)
         for relax in (False, True):
-            problem = pink.build_ik(conf, tasks, dt, damping=self.opts.damping, limits=[],
-                                    constraints=self.feet)
-            problem.lb, problem.ub = self.bounds(conf.q, t, frames)
+            problem = built if not relax else qpsolvers.Problem(
+                *(None if a is None else a.copy() for a in parts))
+            problem.lb, problem.ub = (lb, ub) if not relax else (lb.copy(), ub.copy())
             if len(h):
                 hh = np.maximum(h, 0.0) if relax else h
                 problem.G = G if problem.G is None else np.vstack([problem.G, G])
