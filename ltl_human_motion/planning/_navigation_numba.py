@@ -353,3 +353,22 @@ def placed_paths_from(disp, path, ids, starts, c, s, xs, ys, values, in_lo, in_h
     for m in range(ids.shape[0]):
         _placed(disp, path, ids[m], starts[m, 0], starts[m, 1], starts[m, 2], c[m], s[m],
                 xs, ys, values, in_lo, in_hi, ends, gap, m)
+
+
+@_jit
+def _cell_index(v, lo, res, n):
+    """``NavigationField._cells``' index of coordinate v: ``rint((v - lo) / res)`` as
+    numpy's cast makes it an int64 (the least int64 where the float is not finite or out
+    of range), clamped to [0, n - 1]."""
+    r = np.rint((v - lo) / res)
+    k = int(r) if abs(r) < 9.2e18 else -9223372036854775807 - 1
+    return min(max(k, 0), n - 1)
+
+
+@_jit
+def cell_values(table, lo0, lo1, res, x, y, out) -> None:
+    """out[m] = table (nx, ny) at the grid cell of floor point (x[m], y[m]) (cells of
+    side ``res`` centred on lo + k res, clamped to the table)."""
+    nx, ny = table.shape
+    for m in range(x.shape[0]):
+        out[m] = table[_cell_index(x[m], lo0, res, nx), _cell_index(y[m], lo1, res, ny)]

@@ -165,15 +165,26 @@ class NavigationField:
         return (np.minimum(np.maximum(i, 0), self.shape[0] - 1),
                 np.minimum(np.maximum(j, 0), self.shape[1] - 1))
 
+    def _at(self, table: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``table`` (nx, ny) at the cells of floor points (x, y): by the compiled loop for
+        float vectors (the search's successors; the same numbers), else :meth:`_cells`."""
+        nb = _compiled_loops()
+        if nb is not None and type(x) is np.ndarray and type(y) is np.ndarray \
+                and x.ndim == 1 and x.shape == y.shape and x.dtype == np.float64 \
+                and y.dtype == np.float64:
+            out = np.empty(x.shape[0])
+            nb.cell_values(table, float(self.lo[0]), float(self.lo[1]), self.res, x, y, out)
+            return out
+        i, j = self._cells(x, y)
+        return table[i, j]
+
     def distance(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Path length to the goal from floor points, shape like ``x`` (inf: no way)."""
-        i, j = self._cells(x, y)
-        return self.dist[i, j]
+        return self._at(self.dist, x, y)
 
     def heading(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Direction of the shortest way to the goal, radians, shape like ``x``."""
-        i, j = self._cells(x, y)
-        return self.descent[i, j]
+        return self._at(self.descent, x, y)
 
     def reachable_from(self, x: float, y: float) -> bool:
         """Whether a way to the goal starts at (x, y)."""
