@@ -201,6 +201,51 @@ def _self_blocked(poses: np.ndarray, stature: float) -> np.ndarray:
     return self_penetration(poses, stature)[0].max(axis=1) > -_SELF_CLEARANCE
 
 
+def _cheapest_clear(skeleton: Skeleton, st: _Start, targets: np.ndarray,
+                    active: tuple[int, ...], task: str,
+                    board: tuple[float, float, float] | None,
+                    obstacles: ObstacleClearance | None, furniture: tuple | None
+                    ) -> list[int] | None:
+    """The candidates (indices into :func:`_grid_base`'s arrays) of :func:`_grid`'s
+    :data:`_POSTURE_TRIES` cheapest feasible postures, measured cheapest first
+    :data:`_LEAST_CHUNK` at a time: the first ones clear of the body, the board and the
+    furniture, where the cheapest of them is clear of the obstacles (``_grid`` then
+    measures no other against them, and a clear one makes its furniture tests apply to
+    all). None where ``_grid``'s answer needs every candidate measured: none is clear
+    of the body, board and furniture, or the cheapest such one meets an obstacle."""
+    P, D, shift, cost, feasible, capped, kneel = _reach_cost(skeleton, st, targets, active,
+                                                             board)
+    idx = np.flatnonzero(feasible)
+    order = idx[np.argsort(cost[idx], kind="stable")]
+    under, over = furniture or (None, None)
+    H = skeleton.stature
+    chosen: list[int] = []
+    for k in range(0, order.size, _LEAST_CHUNK):
+        some = order[k:k + _LEAST_CHUNK]
+        posture = (P[some], D[some], shift[some])
+        poses = _contact_poses(skeleton, st, *posture, targets, active, task,
+                               cap=capped[some], kneel=kneel[some])
+        blocked = _self_blocked(poses, H)
+        if board is not None:
+            blocked |= _board_depth(poses, board, H) > 0.0
+            blocked |= _board_way_blocked(skeleton, st, posture, active, board, capped[some],
+                                          kneel[some])
+        if under is not None:
+            blocked |= _support_depth(poses, under, H) > 0.0
+        if over is not None:
+            blocked |= _slab_depth(poses, over, H) > 0.0
+        for i in np.flatnonzero(~blocked).tolist():
+            one = some[i:i + 1]
+            if not chosen and obstacles is not None and _obstacle_blocked(
+                    skeleton, st, (P[one], D[one], shift[one]), poses[i:i + 1], active,
+                    obstacles, capped[one], kneel[one])[0]:
+                return None
+            chosen.append(int(some[i]))
+            if len(chosen) == _POSTURE_TRIES:
+                return chosen
+    return chosen or None
+
+
 #: Candidates :func:`least_cost` measures at a time, cheapest first.
 _LEAST_CHUNK = 24
 
@@ -360,10 +405,15 @@ def _reach_postures(skeleton: Skeleton, st: _Start, targets: np.ndarray, active:
                     ) -> list[ReachPosture]:
     """The cheapest feasible postures (:func:`_grid`, at most :data:`_POSTURE_TRIES`,
     cheapest first); ValueError where none reaches."""
-    P, D, S, cost, capped, kneel = _grid(skeleton, st, targets, active, task, board, obstacles,
-                                  furniture=furniture)
-    order = np.argsort(cost, kind="stable")[:_POSTURE_TRIES]
-    order = order[np.isfinite(cost[order])]
+    chosen = _cheapest_clear(skeleton, st, targets, active, task, board, obstacles, furniture)
+    if chosen is not None:
+        P, D, S, _, _, _, capped, kneel = _grid_base(skeleton, st, board is not None)
+        order = np.asarray(chosen, dtype=np.intp)
+    else:
+        P, D, S, cost, capped, kneel = _grid(skeleton, st, targets, active, task, board,
+                                             obstacles, furniture=furniture)
+        order = np.argsort(cost, kind="stable")[:_POSTURE_TRIES]
+        order = order[np.isfinite(cost[order])]
     if order.size == 0:
         raise ValueError(
             f"{task}: target {np.round(target, 3).tolist()} (start frame) is out of reach for a "
