@@ -14,7 +14,7 @@ from ltl_human_motion.motion.skeleton import Skeleton
 def test_least_cost_is_the_grid_minimum() -> None:
     rng = np.random.default_rng(3)
     reached = 0
-    for trial in range(40):
+    for _ in range(40):
         sk = Skeleton(float(rng.choice([1.55, 1.75, 1.95])))
         st = _Start(sk, None)
         task = str(rng.choice(["grasp", "release", "assemble", "leftHand"]))
@@ -110,3 +110,18 @@ def test_reach_postures_are_the_grid_cheapest() -> None:
             assert got == want
             kinds.add(len(got))
     assert 0 in kinds and 4 in kinds
+
+
+def test_no_posture_is_clear_where_every_posture_meets_an_obstacle() -> None:
+    """posture_clear (the strict search) with an obstacle that every pose enters: never
+    clear, also where a single candidate reaches the target (at the edge of reach)."""
+    from ltl_human_motion.motion.goals import posture_clear
+    sk = Skeleton(1.75)
+
+    def everywhere(poses: np.ndarray, parts: tuple[str, ...]) -> np.ndarray:
+        return np.full(len(poses), -1.0)
+
+    free = [(task, x, z) for x in np.linspace(0.3, 0.9, 13) for z in np.linspace(0.1, 1.9, 19)
+            for task in ("grasp", "rightHand")
+            if posture_clear(task, np.array([x, -0.15, z]), sk, everywhere)]
+    assert free == []

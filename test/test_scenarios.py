@@ -421,7 +421,7 @@ FIXED_FAMILY_RUNS = {
     ("aisle/job/aisle_carry_out", 1.95, 0): "carry:squeeze_square_up",
     # ... to the body's middle, where the most gait starts keep the swinging arms clear
     ("aisle/single/carry(O2, R2)", 1.95, 1): "walk:squeeze_body_middle",
-    # the last try for room round a target (goal_steps.motion_room) made while seated
+    # the goal model's check of a stance round a target (stance_search) made while seated
     # read the obstacles the goal model is given only standing (KeyError)
     ("seats/job/fetch_then_sit", 1.55, 0): "crash:room_while_seated",
     # a hand swung into a crate between the search's samples
@@ -454,7 +454,7 @@ FIXED_FAMILY_RUNS = {
     ("bench_at_wall/single/carry(P3, Zone12)", 1.75, 0): "no place to stop at the bench",
     # a floor part 0.14 m from a cart's long face: the stooping head and the reaching
     # upper arm in the cart from every 60 degree approach; from the side where the goal
-    # primitive itself is clear (goal_steps.motion_room), also with O1 in the other hand
+    # primitive itself is clear (planning/stance_search.py), also with O1 in the other hand
     ("cluttered/single/grasp(O2)", 1.95, 1): "head into the cart stooping",
     ("cluttered/single/move(O2, R1)", 1.75, 1): "head into the cart stooping",
     ("cluttered/dwyer/absence_after/0", 1.95, 1): "head into the cart, other hand full",

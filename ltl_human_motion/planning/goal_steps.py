@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -57,11 +57,16 @@ from ltl_human_motion.planning.plan_state import (
     lift_frame,
     object_position,
 )
+from ltl_human_motion.planning.stance_search import (
+    Stance,
+    StanceTries,
+    candidate_stances,
+    clear_stances,
+)
 from ltl_human_motion.planning.standing import (
     SQUARE_BOARD_HEIGHT,
     board_local,
     ceiling_local,
-    ideal_placement,
     low_board,
     posture_clearance,
     pull_length,
@@ -108,38 +113,17 @@ ALTERNATE_APPROACHES: tuple[tuple[float, float, bool], ...] = (
     (0.0, 0.08, False), (0.0, 0.0, True), (math.pi / 3, 0.0, False),
     (-math.pi / 3, 0.0, False))
 
-#: More ways to stand, tried after ``ALTERNATE_APPROACHES`` and only where the posture
-#: search finds a reach clear of the obstacles from there (:meth:`GoalSteps.posture_room`,
-#: before any walk): two steps further back (a head under the board above a low shelf
-#: stays in front of its edge) and square to either side of the target (a side panel or
-#: a cart face in front of a part on the floor).
-CHECKED_APPROACHES: tuple[tuple[float, float], ...] = (
-    (0.0, 0.16), (0.0, 0.24), (math.pi / 2, 0.0), (-math.pi / 2, 0.0))
+#: Walks to the nearest stances where the goal model's motion is clear
+#: (:mod:`.stance_search`) a blocked step tries, at most.
+STANCE_WALKS = 3
 
-#: Where in the side of an alternative approach :meth:`GoalSteps.posture_room` looks for
-#: a clear reach, fractions of ``APPROACH_HALF_WIDTH`` either side of its middle (the
-#: walk ends anywhere in the side).
-ROOM_SIDE_SPREAD: tuple[float, ...] = (0.0, -0.5, 0.5)
-
-#: Sides of the target (evenly spaced, from the first approach's) at which
-#: :meth:`GoalSteps.motion_room` makes the goal primitive itself, for each hand, when no
-#: other approach gave a clear one: every 15 degrees. A floor part 0.14 m from a cart's
-#: long face is reached clear only from spots 15 degrees wide (the body beside the cart,
-#: the arm between them), which the 60 degree sectors of the other approaches miss.
-MOTION_ROOM_SIDES = 24
-
-#: Half width of the side the walk to a spot :meth:`GoalSteps.motion_room` found ends in,
-#: rad (the spacing of ``MOTION_ROOM_SIDES``: a walk to half of it ran out of nodes
-#: without a place to stop).
-MOTION_ROOM_HALF_WIDTH = 2 * math.pi / MOTION_ROOM_SIDES
-
-#: Node budget of the walk to a spot :meth:`GoalSteps.motion_room` found (the walk
-#: from the front of a cart round to the 30 degree side beside it took 816 nodes).
-MOTION_ROOM_NODES = 1000
+#: Node budget of the walk to a clear stance (the walk from the front of a cart round to
+#: the 30 degree side beside it took 816 nodes).
+STANCE_NODES = 1000
 #: ... and the nodes it may expand after it first came to the goal's floor cells
 #: without a place to stop (a spot that a search found took 212 after it came there).
-MOTION_ROOM_AT_GOAL_NODES = 300
-MOTION_ROOM_BUDGET = SearchBudget(MOTION_ROOM_NODES, at_goal_nodes=MOTION_ROOM_AT_GOAL_NODES)
+STANCE_AT_GOAL_NODES = 300
+STANCE_BUDGET = SearchBudget(STANCE_NODES, at_goal_nodes=STANCE_AT_GOAL_NODES)
 
 #: Node budget of the walk to an alternative approach (most are a few steps round the
 #: target; a side that needs a long way round is not worth the search).
@@ -432,10 +416,12 @@ class GoalSteps:
         """What to try when the goal primitive is blocked, in order: (target, prepare),
         where ``prepare()`` moves the worker first and returns the primitives walked.
         release: other places to let go, then ahead from a roomy spot; bend/stoop/kneel/
-        wait: a roomier spot; tasks with a target: :meth:`lift_tries`, the other
-        ``ALTERNATE_APPROACHES`` (further back, other sides), ``CHECKED_APPROACHES``, then a
-        side where the motion itself is clear (:meth:`motion_room`); with ``raise_back``
-        the arms are raised at each of those spots (they stayed down at the first)."""
+        wait: a roomier spot; tasks with a target: :meth:`lift_tries`, the open arc of the
+        target, ``ALTERNATE_APPROACHES`` (further back, other sides), a step back from
+        where the first try stood, then the nearest stances where the goal model's own
+        motion is clear (:mod:`.stance_search`, ``STANCE_WALKS`` of them); with
+        ``raise_back`` the arms are raised at each of those spots (they stayed down at the
+        first)."""
         if kind == "release":
             # Last, where every place around the worker is in the furniture (a short
             # worker at a shelf it took the part from): from a roomy spot, straight ahead.
@@ -454,36 +440,25 @@ class GoalSteps:
         # placement already, the step back from the placement comes to the same spot).
         mirrored = functools.cache(
             lambda: self.other_hand_placement(kind, args, target, placement, text))
-        stood = float(math.cos(yaw) * (target[0] - x) + math.sin(yaw) * (target[1] - y))
+        ahead = float(math.cos(yaw) * (target[0] - x) + math.sin(yaw) * (target[1] - y))
         back = max(b for _, b, _ in ALTERNATE_APPROACHES)
-
-        def further() -> bool:
-            return stood > placement[0] + back and self.reaches(
-                kind, args, (stood + back, placement[1], target[2]), raised)
-
         walk_there = functools.partial(self.walk_there, target, text, raised, raise_back)
 
-        def approach(turn: float, back: float, other: bool, ahead: float | None = None,
-                     checked: bool = False) -> int:
-            if (other and mirrored() is None) or (ahead is not None and not further()) \
-                    or (checked and not self.posture_room(kind, args, target, placement,
-                                                          first + turn, back, raised)):
+        def further() -> bool:
+            return ahead > placement[0] + back and self.reaches(
+                kind, args, (ahead + back, placement[1], target[2]), raised)
+
+        def approach(turn: float, back: float, other: bool, stand: float | None = None
+                     ) -> int:
+            if (other and mirrored() is None) or (stand is not None and not further()):
                 raise PlanningError(f"task {text}: no reach clear of the obstacles from "
                                     "that side", task=text, reason="blocked")
             d, lat = mirrored() if other else placement
-            return walk_there((d + back if ahead is None else ahead, lat),
+            return walk_there((d + back if stand is None else stand, lat),
                               (first + turn, APPROACH_HALF_WIDTH), ALTERNATIVE_BUDGET)
 
-        def room() -> int:
-            # Last: the side where the goal primitive itself was clear (made there first).
-            found = self.motion_room(kind, args, target, first, [placement] + (
-                [mirrored()] if mirrored() is not None else []), raised)
-            if found is None:
-                raise PlanningError(f"task {text}: no side of the target where the "
-                                    "motion keeps clear of the obstacles", task=text,
-                                    reason="blocked")
-            side, yaw, spot = found
-            return walk_there(spot, (side, MOTION_ROOM_HALF_WIDTH), MOTION_ROOM_BUDGET, yaw)
+        walk_to_stance = self.stance_walks(kind, args, target, placement, text, raised,
+                                           walk_there, mirrored)
 
         return [(target, None)] + self.lift_tries(kind, args, target, placement, text,
                                                   raised, raise_back) + [
@@ -492,9 +467,44 @@ class GoalSteps:
                                                        raised)))] + [
             (target, functools.partial(approach, turn, back, other))
             for turn, back, other in ALTERNATE_APPROACHES
-        ] + [(target, functools.partial(approach, 0.0, 0.0, False, stood + back))] + [
-            (target, functools.partial(approach, turn, back, False, checked=True))
-            for turn, back in CHECKED_APPROACHES] + [(target, room)]
+        ] + [(target, functools.partial(approach, 0.0, 0.0, False, ahead + back))] + [
+            (target, walk_to_stance) for _ in range(STANCE_WALKS)]
+
+    def stance_walks(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                     placement: tuple[float, float], text: str, raised: bool,
+                     walk_there: Callable[..., int],
+                     mirrored: Callable[[], tuple[float, float] | None]
+                     ) -> Callable[[], int]:
+        """A try's preparation that walks to the next stance of :mod:`.stance_search`
+        for ``target`` (3,) (from ``placement`` and the other hand's, ``mirrored()``)
+        where the goal model's motion is clear, the first found when it is first called;
+        returns the gait primitives walked, or raises PlanningError (``blocked``)."""
+        stood = self.state.pose
+        first = math.atan2(stood[1] - target[1], stood[0] - target[0])
+
+        def find() -> Iterator[Stance]:
+            spots = [placement] + ([mirrored()] if mirrored() is not None else [])
+            candidates = candidate_stances(self.ctx, target, stood, first, spots)
+            return clear_stances(
+                candidates,
+                functools.partial(self.posture_clear_at, kind, args, target, raised),
+                functools.partial(self.motion_clear_at, kind, args, target, raised))
+
+        stances = StanceTries(find)
+
+        def walk_to_stance() -> int:
+            stance = stances.next()
+            if stance is None:
+                raise PlanningError(f"task {text}: no other stance where the motion keeps "
+                                    "clear of the obstacles", task=text, reason="blocked")
+            try:
+                return walk_there(stance.spot, (stance.side, APPROACH_HALF_WIDTH),
+                                  STANCE_BUDGET, stance.pose[2])
+            except PlanningError:
+                stances.walk_failed(stance)
+                raise
+
+        return walk_to_stance
 
     def walk_there(self, target: np.ndarray, text: str, raised: bool, raise_back: bool,
                    spot: tuple[float, float], sector: tuple[float, float],
@@ -542,7 +552,7 @@ class GoalSteps:
         if arc is None:
             raise PlanningError(f"task {text}: no other side of the target open to it",
                                 task=text, reason="blocked")
-        return walk_there(reach.placement, (arc.centre, arc.half_width), MOTION_ROOM_BUDGET)
+        return walk_there(reach.placement, (arc.centre, arc.half_width), STANCE_BUDGET)
 
     def approach_arc(self, target: np.ndarray, placement: tuple[float, float], text: str,
                      arc: Arc | None) -> int:
@@ -587,78 +597,36 @@ class GoalSteps:
             tries.append((target, lift_off))
         return tries
 
-    def posture_room(self, kind: str, args: tuple[str, ...], target: np.ndarray,
-                     placement: tuple[float, float], side: float, back: float,
-                     raised: bool) -> bool:
-        """Whether the goal model finds a posture clear of the obstacles
-        (:func:`.motion.goals.posture_clear`) for the worker standing ``placement`` from
-        ``target`` (3,) plus ``back`` metres where a walk from the side of it at angle
-        ``side`` (rad, from the target; within ``ROOM_SIDE_SPREAD`` of the sector's half
-        width) would stand (:func:`.standing.ideal_placement`, with its steps back from
-        an obstacle), with the hand the goal primitive's first tries there use."""
+    def posture_clear_at(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                         raised: bool, pose: Pose) -> bool:
+        """Whether the goal model's posture search finds a posture clear of the obstacles
+        (:func:`.motion.goals.posture_clear`) for ``target`` (3,) from ``pose``, with the
+        hand and stance the goal primitive there starts with."""
         from ltl_human_motion.motion.goals import posture_clear
-        ahead = placement[0] + back
-        turns = side + APPROACH_HALF_WIDTH * np.asarray(ROOM_SIDE_SPREAD)
-        far = 2.0 * math.hypot(ahead, placement[1])
-        px, py, yaw, free = ideal_placement(
-            self.ctx, target, (ahead, placement[1]), target[0] + far * np.cos(turns),
-            target[1] + far * np.sin(turns), self.ctx.options.max_step_back)
-        fixed = acting_hand(self.state, kind, args[0] if args else None)
-        stance = self.ctx.stance(self.state.carrying or raised)
-        for k in np.flatnonzero(free):
-            pose = (float(px[k]), float(py[k]), float(yaw[k]))
-            c, s = math.cos(-pose[2]), math.sin(-pose[2])
-            dx, dy = target[0] - pose[0], target[1] - pose[1]
-            local = np.array([c * dx - s * dy, s * dx + c * dy, float(target[2])])
-            board = board_local(self.ctx.cell, target, local, pose[2], self.ctx.stature) \
-                if kind in LEVEL_PATH_TASKS else None
-            if posture_clear(kind, local, self.ctx.library.skeleton,
-                             posture_clearance(self.ctx, pose), start_pose=stance,
-                             hand=fixed or "auto", board=board):
-                return True
-        return False
+        local, kwargs, _ = self.goal_kwargs(kind, target, self.state.carrying or raised,
+                                            None, None, None, None, pose=pose)
+        obstacles = kwargs.get("obstacles")
+        # (no obstacles around, or seated: no posture to rule out)
+        return obstacles is None or posture_clear(
+            kind, local, self.ctx.library.skeleton, obstacles,
+            start_pose=kwargs["start_pose"], hand=kwargs.get("hand", "auto"))
 
-    def motion_room(self, kind: str, args: tuple[str, ...], target: np.ndarray,
-                    first: float, placements: list[tuple[float, float]], raised: bool
-                    ) -> tuple[float, float, tuple[float, float]] | None:
-        """The first side of ``target`` (3,) (``MOTION_ROOM_SIDES`` of them, from
-        ``first``, rad, outwards both ways) and placement of ``placements`` ((ahead, left)
-        for each hand) where the worker standing as :func:`.standing.ideal_placement`
-        puts it makes a goal primitive that keeps clear (:meth:`goal_clear`, made with a
-        fixed seed: the plan's random stream stays as it was; only where the posture
-        search finds a clear posture, :func:`.motion.goals.posture_clear`), as (side,
-        facing yaw there, placement), rad, rad, m; or None."""
-        from ltl_human_motion.motion.goals import posture_clear
-        step = 2.0 * math.pi / MOTION_ROOM_SIDES
-        order = np.arange(MOTION_ROOM_SIDES)
-        sides = first + step * ((order + 1) // 2) * np.where(order % 2 == 1, 1.0, -1.0)
+    def motion_clear_at(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                        raised: bool, pose: Pose) -> bool | None:
+        """Whether the goal primitive made for ``target`` (3,) from ``pose`` (with a fixed
+        seed: the plan's random stream stays as it was) keeps clear (:meth:`goal_clear`);
+        None where the goal model does not reach the target from there."""
         grasped = args[0] if kind == "grasp" and args else None
         part = args[0] if kind in ("move", "insert", "release", "extract") and args else None
         container = args[1] if kind == "extract" and len(args) > 1 else None
-        stance = self.ctx.stance(self.state.carrying or raised)
-        for spot in placements:
-            far = 2.0 * math.hypot(*spot)
-            px, py, yaw, free = ideal_placement(
-                self.ctx, target, spot, target[0] + far * np.cos(sides),
-                target[1] + far * np.sin(sides), self.ctx.options.max_step_back)
-            for k in np.flatnonzero(free):
-                pose = (float(px[k]), float(py[k]), float(yaw[k]))
-                local, kwargs, _ = self.goal_kwargs(kind, target, self.state.carrying or raised,
-                                                    None, grasped, part, container, pose=pose)
-                kwargs["rng"] = np.random.default_rng(0)
-                # (no obstacles around, or seated: no posture to rule out)
-                obstacles = kwargs.get("obstacles")
-                if obstacles is not None and not posture_clear(
-                        kind, local, self.ctx.library.skeleton, obstacles,
-                        start_pose=stance, hand=kwargs.get("hand", "auto")):
-                    continue
-                try:
-                    mp = self.ctx.library.goal(kind, local, **kwargs)
-                except ValueError:
-                    continue
-                if self.goal_clear(mp, pose, grasped, part if kind == "extract" else None):
-                    return float(sides[k]), float(yaw[k]), spot
-        return None
+        local, kwargs, _ = self.goal_kwargs(kind, target, self.state.carrying or raised,
+                                            None, grasped, part, container, pose=pose)
+        kwargs["rng"] = np.random.default_rng(0)
+        try:
+            mp = self.ctx.library.goal(kind, local, **kwargs)
+        except ValueError:
+            return None
+        return self.goal_clear(mp, pose, grasped, part if kind == "extract" else None)
 
     def reaches(self, kind: str, args: tuple[str, ...], local: tuple[float, float, float],
                 raised: bool) -> bool:
@@ -1005,3 +973,4 @@ def body_failures(mp: MotionPrimitive, kind: str, stature: float) -> list[str]:
     world = world_positions(mp)
     checks = check_biomechanics(world, mp.fps, stature=stature, labels=[kind] * len(world))
     return [name for name, entry in checks.items() if not entry["passed"]]
+

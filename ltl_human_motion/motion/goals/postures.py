@@ -317,14 +317,14 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
             # The cheapest candidate first: where it is clear it is the posture (the
             # others are not measured); else every candidate.
             free = np.r_[free[np.argmin(cost[idx[free]])], free]
-            for some in (free[:1], free[1:]):
+            for probe, some in ((True, free[:1]), (False, free[1:])):
                 hit = _obstacle_blocked(skeleton, st, (P[idx[some]], D[idx[some]],
                                                        shift[idx[some]]), poses[some],
                                         active, obstacles, capped[idx[some]],
                                         kneel[idx[some]])
-                if not hit[0] and some.size == 1:
+                if probe and not hit[0]:
                     break
-                if some.size > 1 and (strict or not np.all(hit)):
+                if not probe and (strict or not np.all(hit)):
                     blocked[some[hit]] = True
         feasible = feasible.copy()
         feasible[idx[blocked]] = False
@@ -417,6 +417,6 @@ def _reach_postures(skeleton: Skeleton, st: _Start, targets: np.ndarray, active:
     if order.size == 0:
         raise ValueError(
             f"{task}: target {np.round(target, 3).tolist()} (start frame) is out of reach for a "
-            f"{skeleton.stature:.2f} m worker; place the worker with reach_placement()")
+            f"{skeleton.stature:.2f} m worker")
     return [ReachPosture(float(P[i]), float(D[i]), float(S[i]), bool(capped[i]),
                          bool(kneel[i])) for i in order]
