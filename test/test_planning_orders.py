@@ -148,20 +148,20 @@ def _steps(cell, texts: list[tuple[str, tuple[str, ...]]]):
 
 
 def test_a_step_that_failed_in_the_same_situation_fails_without_a_search() -> None:
-    """Holding O1 in the right hand, a 1.75 m worker coming from the aisle's end finds no
-    grasp of O2 on the knee board without the whole-body program (every goal model's
-    motion hits the rack above; the program, off here, finds one); another order
-    that comes to it the same way fails the same way at once, its earlier steps planned
-    as before. The hand that holds O1 is part of the situation."""
+    """Holding O1 in the right hand, a 1.75 m worker who assembled at R2 first and comes
+    from the aisle's end finds no grasp of O2 on the knee board without the whole-body
+    program (the program, off here, finds one); another order that comes to it the same
+    way fails the same way at once, its earlier steps planned as before. The hand that
+    holds O1 is part of the situation."""
     tail = [("grasp", ("O1",)), ("walk", ("R1",)), ("grasp", ("O2",))]
     cell, first = _aisle_planner()
     with pytest.raises(PlanningError) as err:
-        first.plan(_steps(cell, [("wait", ("1.0",)), *tail]), (0.0, 0.0, 0.0))
+        first.plan(_steps(cell, [("assemble", ("R2",)), *tail]), (0.0, 0.0, 0.0))
     failure = err.value
     assert failure.step_index == 3
     assert failure.situation[:3] == ("grasp(O2)", "walk(R1)", frozenset({("O1", "r_hand")}))
 
-    again = [("assemble", ("R2",)), *tail]
+    again = [("wait", ("1.0",)), *tail]
     cell, before = _aisle_planner()
     before.plan(_steps(cell, again[:-1]), (0.0, 0.0, 0.0))      # the steps before it plan
     cell, second = _aisle_planner({failure.situation: failure})
