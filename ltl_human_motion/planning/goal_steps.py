@@ -485,10 +485,11 @@ class GoalSteps:
         def find() -> Iterator[Stance]:
             spots = [placement] + ([mirrored()] if mirrored() is not None else [])
             candidates = candidate_stances(self.ctx, target, stood, first, spots)
+            model = functools.lru_cache(maxsize=1)(
+                functools.partial(self.stance_model, kind, args, target, raised))
             return clear_stances(
-                candidates,
-                functools.partial(self.posture_clear_at, kind, args, target, raised),
-                functools.partial(self.motion_clear_at, kind, args, target, raised))
+                candidates, lambda pose: self.posture_clear_at(kind, model(pose)),
+                lambda pose: self.motion_clear_at(kind, args, model(pose), pose))
 
         stances = StanceTries(find)
 
@@ -597,36 +598,43 @@ class GoalSteps:
             tries.append((target, lift_off))
         return tries
 
-    def posture_clear_at(self, kind: str, args: tuple[str, ...], target: np.ndarray,
-                         raised: bool, pose: Pose) -> bool:
-        """Whether the goal model's posture search finds a posture clear of the obstacles
-        (:func:`.motion.goals.posture_clear`) for ``target`` (3,) from ``pose``, with the
-        hand and stance the goal primitive there starts with."""
-        from ltl_human_motion.motion.goals import posture_clear
-        local, kwargs, _ = self.goal_kwargs(kind, target, self.state.carrying or raised,
-                                            None, None, None, None, pose=pose)
-        obstacles = kwargs.get("obstacles")
-        # (no obstacles around, or seated: no posture to rule out)
-        return obstacles is None or posture_clear(
-            kind, local, self.ctx.library.skeleton, obstacles,
-            start_pose=kwargs["start_pose"], hand=kwargs.get("hand", "auto"))
-
-    def motion_clear_at(self, kind: str, args: tuple[str, ...], target: np.ndarray,
-                        raised: bool, pose: Pose) -> bool | None:
-        """Whether the goal primitive made for ``target`` (3,) from ``pose`` (with a fixed
-        seed: the plan's random stream stays as it was) keeps clear (:meth:`goal_clear`);
-        None where the goal model does not reach the target from there."""
+    def stance_model(self, kind: str, args: tuple[str, ...], target: np.ndarray,
+                     raised: bool, pose: Pose) -> tuple[np.ndarray, dict]:
+        """What the goal primitive of ``kind`` for ``target`` (3,) is made from for a worker
+        standing at ``pose`` (:meth:`goal_kwargs` with the task's parts: the hand holding
+        a part moves it), with a fixed seed: the plan's random stream stays as it was."""
         grasped = args[0] if kind == "grasp" and args else None
         part = args[0] if kind in ("move", "insert", "release", "extract") and args else None
         container = args[1] if kind == "extract" and len(args) > 1 else None
         local, kwargs, _ = self.goal_kwargs(kind, target, self.state.carrying or raised,
                                             None, grasped, part, container, pose=pose)
-        kwargs["rng"] = np.random.default_rng(0)
+        return local, {**kwargs, "rng": np.random.default_rng(0)}
+
+    def posture_clear_at(self, kind: str, model: tuple[np.ndarray, dict]) -> bool:
+        """Whether the goal model's posture search finds a posture clear of the obstacles
+        (:func:`.motion.goals.posture_clear`) for the goal primitive made from ``model``
+        (:meth:`stance_model`), with its hand, start stance and low board."""
+        from ltl_human_motion.motion.goals import posture_clear
+        local, kwargs = model
+        obstacles = kwargs.get("obstacles")
+        # (no obstacles around, or seated: no posture to rule out)
+        return obstacles is None or posture_clear(
+            kind, local, self.ctx.library.skeleton, obstacles,
+            start_pose=kwargs["start_pose"], hand=kwargs.get("hand", "auto"),
+            board=kwargs.get("board"))
+
+    def motion_clear_at(self, kind: str, args: tuple[str, ...],
+                        model: tuple[np.ndarray, dict], pose: Pose) -> bool | None:
+        """Whether the goal primitive made from ``model`` (:meth:`stance_model`) placed at
+        ``pose`` keeps clear (:meth:`goal_clear`); None where the goal model does not
+        reach the target from there."""
+        local, kwargs = model
         try:
             mp = self.ctx.library.goal(kind, local, **kwargs)
         except ValueError:
             return None
-        return self.goal_clear(mp, pose, grasped, part if kind == "extract" else None)
+        return self.goal_clear(mp, pose, args[0] if kind == "grasp" and args else None,
+                               args[0] if kind == "extract" and args else None)
 
     def reaches(self, kind: str, args: tuple[str, ...], local: tuple[float, float, float],
                 raised: bool) -> bool:

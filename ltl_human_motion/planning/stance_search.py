@@ -146,8 +146,8 @@ def clear_stances(candidates: list[Stance], posture_ok: Callable[[Pose], bool],
     search finds a clear posture (``posture_ok``) and the goal primitive made there is
     clear (``motion_ok`` True, one seed; at most ``STANCE_CHECKS`` made), then, nearest
     first, those where that primitive was blocked (False) or no posture was clear (the
-    try there makes its primitives with the plan's own seeds); never one out of the
-    model's reach (None)."""
+    try there makes its primitives with the plan's own seeds); never one where the goal
+    model did not reach the target (``motion_ok`` None)."""
     checked: list[Stance] = []
     blocked: list[Stance] = []
     unposed: list[Stance] = []
