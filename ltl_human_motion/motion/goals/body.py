@@ -95,7 +95,8 @@ def _trunk(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray,
 
 def _body(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, ankles: np.ndarray,
           toes: np.ndarray, knee_pole: np.ndarray, hands: np.ndarray, hand_dir: np.ndarray,
-          elbow_pole: np.ndarray, trunk: np.ndarray | None = None) -> np.ndarray:
+          elbow_pole: np.ndarray, trunk: np.ndarray | None = None,
+          frame: float | None = None) -> np.ndarray:
     """Full pose of every frame.
 
     Parameters
@@ -104,6 +105,10 @@ def _body(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, ankles: np.
     (T, 2, 3) with index 0 = left, 1 = right.
     trunk : (T, J, 3), optional
         ``_trunk(skeleton, pelvis, pitch)`` if already computed (it is not modified).
+    frame : float, optional
+        Seconds between the T poses where they are the frames of a motion (the elbow
+        poles are kept from flipping between frames, :func:`_elbow_pole`); None for
+        separate candidates.
 
     Returns
     -------
@@ -120,10 +125,119 @@ def _body(skeleton: Skeleton, pelvis: np.ndarray, pitch: np.ndarray, ankles: np.
         out[:, toe] = an + b[toe] * fdir / np.linalg.norm(fdir, axis=-1, keepdims=True)
         sh, el, wr, ha = (_J[f"{s}_{n}"] for n in ("shoulder", "elbow", "wrist", "hand"))
         hd = hand_dir[:, k] / np.linalg.norm(hand_dir[:, k], axis=-1, keepdims=True)
-        elbow, wrist = two_bone_ik(out[:, sh], hands[:, k] - b[ha] * hd, b[el], b[wr],
-                                   elbow_pole[:, k], max_stretch=1.0,
+        aim = hands[:, k] - b[ha] * hd
+        pole = elbow_pole[:, k] if frame is None \
+            else _elbow_pole(out[:, sh], aim, elbow_pole[:, k], k, (b[el], b[wr]), frame)
+        elbow, wrist = two_bone_ik(out[:, sh], aim, b[el], b[wr], pole, max_stretch=1.0,
                                    max_flexion=_ELBOW_MAX_FLEXION)
         out[:, el], out[:, wr], out[:, ha] = elbow, wrist, wrist + b[ha] * hd
+    return out
+
+
+#: Where an elbow pole comes within this share of its length of the shoulder-wrist line
+#: in a motion with the elbow bent at least :data:`POLE_BENT` off that line (a pole along
+#: the arm leaves the side the elbow bends to undefined, and an arm passing its pole
+#: flipped the elbow to the other side in one frame: a 1.95 m worker's carton move, the
+#: elbow at 11 m/s, which the reach's retiming answered by slowing the move to 42 s), the
+#: elbow's swivel about that line is interpolated in time over the frames where the share
+#: is below :data:`POLE_DEGENERATE` and the arm bent, from its angle at the frame before
+#: them to its angle at the frame after them (:func:`_elbow_pole`).
+POLE_FLIP = 0.1
+POLE_DEGENERATE = 0.3
+#: m/s the elbow swings at most about the shoulder-wrist line where its swivel is
+#: interpolated.
+SWIVEL_SPEED = 1.0
+#: Metres the elbow is off the shoulder-wrist line below which its swivel does not
+#: matter (the arm is nearly straight).
+POLE_BENT = 0.005
+
+
+def _swivel_reference(u: np.ndarray, k: int) -> np.ndarray:
+    """Unit vectors (..., 3) perpendicular to the unit shoulder-wrist directions ``u``
+    (..., 3) of arm ``k`` (0 left), continuous in ``u`` but at one direction (across the
+    trunk and behind it, where no arm reaches): elbow down with the arm forward and out,
+    carried over the sphere of arm directions by the rotation from there. The angle of
+    the elbow's swivel is measured from it."""
+    side = 1.0 if k == 0 else -1.0
+    a = np.array([0.6, 0.8 * side, 0.0])
+    e = np.array([0.0, 0.0, -1.0])
+    axis = np.cross(a, u)
+    cos = np.clip(u @ a, -1.0 + 1e-6, None)[..., None]
+    turned = np.cross(axis, e)
+    ref = e + turned + np.cross(axis, turned) / (1.0 + cos)
+    ref = ref - np.sum(ref * u, axis=-1, keepdims=True) * u
+    return ref / np.maximum(np.linalg.norm(ref, axis=-1, keepdims=True), 1e-12)
+
+
+def _elbow_pole(shoulder: np.ndarray, wrist: np.ndarray, pole: np.ndarray, k: int,
+                bones: tuple[float, float], frame: float) -> np.ndarray:
+    """Elbow poles (T, 3) of arm ``k`` over the frames of a motion ``frame`` seconds apart
+    from ``pole`` (T, 3), with the shoulders and wrist targets (T, 3) and the upper and
+    lower arm's lengths ``bones`` (m): where the pole comes within :data:`POLE_FLIP` of a
+    bent arm, its swivel angle (from :func:`_swivel_reference`) over each run of frames
+    with the arm bent and the pole below :data:`POLE_DEGENERATE` (widened where the elbow
+    would swing faster than :data:`SWIVEL_SPEED`) goes linearly, the short way, from the
+    frame before the run to the frame after it (held where the run starts or ends the
+    motion; where the run is the whole motion, held at its angle where the pole is
+    furthest off the arm); ``pole`` elsewhere (a nearly straight arm's elbow is where
+    the pole puts it, whatever its side)."""
+    u = wrist - shoulder
+    dist = np.linalg.norm(u, axis=-1)
+    u = u / np.maximum(dist, 1e-12)[:, None]
+    unit = pole / np.maximum(np.linalg.norm(pole, axis=-1, keepdims=True), 1e-12)
+    off = unit - np.sum(unit * u, axis=-1, keepdims=True) * u
+    share = np.linalg.norm(off, axis=-1)
+    l1, l2 = bones
+    fold = float(np.sqrt(l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * np.cos(_ELBOW_MAX_FLEXION)))
+    d = np.clip(dist, fold, l1 + l2)
+    along = (l1 * l1 - l2 * l2 + d * d) / (2.0 * d)
+    offset = np.sqrt(np.maximum(l1 * l1 - along * along, 0.0))
+    bent = offset >= POLE_BENT
+    if len(share) < 2 or not np.any((share < POLE_FLIP) & bent):
+        return pole
+    r = _swivel_reference(u, k)
+    b = np.cross(u, r)
+    angle = np.arctan2(np.sum(off * b, axis=-1), np.sum(off * r, axis=-1))
+    low = (share < POLE_DEGENERATE) & bent
+    if low.all():
+        best = angle[int(np.argmax(share))]
+        return np.cos(best) * r + np.sin(best) * b
+    phi = angle.copy()
+    for lo, hi in _swivel_runs(low, angle, offset, frame):
+        before = angle[lo - 1] if lo > 0 else angle[hi]
+        after = angle[hi] if hi < len(angle) else before
+        turn = (after - before + np.pi) % (2.0 * np.pi) - np.pi
+        phi[lo:hi] = before + (np.arange(lo, hi) - lo + 1) / (hi - lo + 1) * turn
+    changed = phi != angle
+    out = pole.copy()
+    out[changed] = (np.cos(phi)[:, None] * r + np.sin(phi)[:, None] * b)[changed]
+    return out
+
+
+def _swivel_runs(low: np.ndarray, angle: np.ndarray, offset: np.ndarray, frame: float
+                 ) -> list[tuple[int, int]]:
+    """The runs [lo, hi) of ``low`` (T,) frames, each widened on both sides (and merged
+    with the runs it meets) until turning the swivel ``angle`` (T,) from the frame before
+    it to the frame after it at the elbow's largest ``offset`` (T,) from the arm's line
+    keeps under :data:`SWIVEL_SPEED` (frames ``frame`` seconds apart)."""
+    T = len(low)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], low.astype(np.int8), [0]])))
+    runs = [(int(lo), int(hi)) for lo, hi in zip(edges[::2], edges[1::2], strict=True)]
+    out: list[tuple[int, int]] = []
+    for lo, hi in runs:
+        if out and lo <= out[-1][1]:
+            lo = out.pop()[0]
+        while True:
+            before = angle[lo - 1] if lo > 0 else angle[min(hi, T - 1)]
+            after = angle[hi] if hi < T else before
+            turn = abs((after - before + np.pi) % (2.0 * np.pi) - np.pi)
+            span = float(offset[max(lo - 1, 0):hi + 1].max()) * turn
+            if span <= SWIVEL_SPEED * (hi - lo + 1) * frame or (lo == 0 and hi == T):
+                break
+            lo, hi = max(lo - 1, 0), min(hi + 1, T)
+            if out and lo <= out[-1][1]:
+                lo = out.pop()[0]
+        out.append((lo, hi))
     return out
 
 
@@ -314,5 +428,6 @@ def _frames(skeleton: Skeleton, st: _Start, t: np.ndarray, pelvis: np.ndarray,
     ankles = np.broadcast_to(st.ankles, (T, 2, 3)) if ankles is None else ankles
     toes = np.broadcast_to(st.toes, (T, 2, 3)) if toes is None else toes
     knee_pole = np.broadcast_to(st.knee_pole, (T, 2, 3)) if knee_pole is None else knee_pole
+    frame = float(t[1] - t[0]) if T > 1 else None
     return _body(skeleton, pelvis, pitch, ankles, toes, knee_pole, hands, hand_dir, elbow_pole,
-                 trunk)
+                 trunk, frame)

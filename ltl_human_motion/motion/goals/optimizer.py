@@ -124,7 +124,8 @@ class TrackingResult:
     within ``influence``); the largest distance (m) of a tracked palm from its reference
     and its frame; how far (m) the program's last frame was from the reference's before
     the fade; QP steps with no feasible solution; the frames from the first one solved
-    to the last one near an obstacle."""
+    to the last one near an obstacle; how fast (m/s) the program was closing on the
+    reference's last pose over its last :data:`RETURN_SECONDS` (negative: moving away)."""
 
     positions: np.ndarray
     constrained: bool
@@ -134,6 +135,7 @@ class TrackingResult:
     end_miss: float = 0.0
     failed_steps: int = 0
     window: tuple[int, int] = (0, 0)
+    closing: float = 0.0
 
 
 def _missed(out: np.ndarray, ref: np.ndarray, tracked: tuple[str, ...],
@@ -428,6 +430,8 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
             out[t + 1:] = ref[t + 1:]
             break
     end_miss = float(np.abs(out[-1] - ref[-1]).max())
+    back = min(int(RETURN_SECONDS * fps), len(ref) - 1)
+    closing = (float(np.abs(out[-1 - back] - ref[-1]).max()) - end_miss) / max(back / fps, 1e-9)
     if end_miss > 0.0:
         out = _blend_end(out, ref, int(RETURN_SECONDS * fps))
     final = reference_clearance(kin, out, field_, opts.influence, held, held_from)
@@ -437,4 +441,4 @@ def track_reference(reference: np.ndarray, stature: float, field_: ObstacleField
                                                axis=-1))
     least = float(final.min())
     return TrackingResult(out, constrained, least, float(miss.max()), int(miss.argmax()),
-                          end_miss, failed, (first, last_near))
+                          end_miss, failed, (first, last_near), closing)
