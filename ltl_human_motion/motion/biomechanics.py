@@ -147,16 +147,22 @@ def _kind(label: str) -> str:
     return str(label).split("(", 1)[0]
 
 
-def _speed_limits(n: int, labels: Sequence[str], lim: BiomechanicsLimits,
-                  scale: float) -> np.ndarray:
-    """Per-interval, per-joint speed limit (n, J) from the activity label of each frame."""
+def _label_flags(labels: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Whether each frame's activity (labels (n,)) is a hand goal task, and whether a
+    posture transition: bool (n,) each."""
+    distinct = {x: k for k, x in enumerate(set(labels))}    # a few labels, long runs
+    kinds = [_kind(x) for x in distinct]
+    code = np.fromiter(map(distinct.__getitem__, labels), dtype=np.intp, count=len(labels))
+    return (np.isin(kinds, HAND_TASKS)[code] if kinds else np.zeros(0, dtype=bool),
+            np.isin(kinds, POSTURE_TRANSITION_TASKS)[code] if kinds
+            else np.zeros(0, dtype=bool))
+
+
+def _flag_limits(n: int, hand_goal: np.ndarray, posture: np.ndarray,
+                 lim: BiomechanicsLimits, scale: float) -> np.ndarray:
+    """Per-interval, per-joint speed limit (n, J) from each frame's flags
+    (:func:`_label_flags`)."""
     out = np.full((n, len(JOINT_NAMES)), lim.other_speed)
-    names: dict[str, int] = {}
-    code = np.fromiter((names.setdefault(str(x), len(names)) for x in labels[:n]),
-                       dtype=np.intp, count=min(n, len(labels)))
-    kinds = [_kind(x) for x in names]
-    hand_goal = np.isin(kinds, HAND_TASKS)[code]
-    posture = np.isin(kinds, POSTURE_TRANSITION_TASKS)[code]
     for s in "lr":
         out[:, _J[f"{s}_hand"]] = np.where(hand_goal, lim.hand_speed_goal, lim.hand_speed)
         out[:, _J[f"{s}_wrist"]] = np.where(hand_goal, lim.hand_speed_goal, lim.hand_speed)
@@ -164,6 +170,12 @@ def _speed_limits(n: int, labels: Sequence[str], lim: BiomechanicsLimits,
         out[:, _J[f"{s}_ankle"]] = lim.ankle_speed
         out[:, _J[f"{s}_toe"]] = lim.toe_speed
     return out * scale
+
+
+def _speed_limits(n: int, labels: Sequence[str], lim: BiomechanicsLimits,
+                  scale: float) -> np.ndarray:
+    """Per-interval, per-joint speed limit (n, J) from the activity label of each frame."""
+    return _flag_limits(n, *_label_flags(labels[:n]), lim, scale)
 
 
 # ---------------------------------------------------------------------- angles
@@ -571,8 +583,9 @@ def _speeds_and_limits(p: np.ndarray, fps: float, labels: Sequence[str],
     T = len(p)
     speed = joint_speeds(p, fps)
     w = T - len(speed)
-    lim_a = _speed_limits(T - w, labels[:T - w], limits, scale)
-    lim_b = _speed_limits(T - w, labels[w:], limits, scale)
+    hand_goal, posture = _label_flags(labels[:T])
+    lim_a = _flag_limits(T - w, hand_goal[:T - w], posture[:T - w], limits, scale)
+    lim_b = _flag_limits(T - w, hand_goal[w:], posture[w:], limits, scale)
     return speed, np.minimum(lim_a, lim_b)
 
 
