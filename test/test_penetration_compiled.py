@@ -48,3 +48,16 @@ def test_penetration_entry_without_the_kernel_is_the_same(monkeypatch) -> None:
     fast = biomechanics._penetration_entry(p, 120.0, labels, 1.8)
     monkeypatch.setattr(biomechanics, "_deepest_penetration", lambda *args: None)
     assert biomechanics._penetration_entry(p, 120.0, labels, 1.8) == fast
+
+
+def test_max_self_penetration_is_the_table_maximum(monkeypatch) -> None:
+    """By the compiled search and without it, the largest depth of the (T, P) table."""
+    rng = np.random.default_rng(10)
+    poses = [_walk(int(rng.integers(1, 300)), rng, Skeleton(1.7), noise)
+             for noise in (0.0, 0.02, 0.2)]
+    poses[1][3, 4, 0] = np.nan                      # not finite: the table's maximum, nan
+    want = [float(np.max(biomechanics.self_penetration(p, 1.7)[0])) for p in poses]
+    for _ in range(2):
+        got = [biomechanics.max_self_penetration(p, 1.7) for p in poses]
+        assert got[0] == want[0] and got[2] == want[2] and np.isnan(got[1])
+        monkeypatch.setattr(biomechanics, "_deepest_penetration", lambda *args: None)

@@ -73,6 +73,7 @@ __all__ = [
     "foot_skate",
     "joint_angles",
     "joint_speeds",
+    "max_self_penetration",
     "self_penetration",
 ]
 
@@ -354,6 +355,16 @@ def _deepest_penetration(p: np.ndarray, stature: float) -> tuple[int, int, float
                                   np.ascontiguousarray(np.maximum(r[a], r[b]),
                                                        dtype=np.float64), where)
     return int(where[0]), int(where[1]), float(depth)
+
+
+def max_self_penetration(positions: np.ndarray, stature: float = DEFAULT_STATURE) -> float:
+    """The largest depth of :func:`self_penetration` over every frame and pair of
+    ``positions`` (T, J, 3), T >= 1 (the same number), by the compiled search for the
+    deepest pair where it is in use; positive = some capsule enters another."""
+    deepest = _deepest_penetration(positions, stature)
+    if deepest is not None:
+        return deepest[2]
+    return float(np.max(self_penetration(positions, stature)[0]))
 
 
 def self_penetration(positions: np.ndarray, stature: float = DEFAULT_STATURE

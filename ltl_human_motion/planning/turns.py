@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ltl_human_motion.motion.biomechanics import self_penetration
+from ltl_human_motion.motion.biomechanics import max_self_penetration, self_penetration
 from ltl_human_motion.motion.ik import min_jerk, two_bone_ik
 from ltl_human_motion.motion.skeleton import JOINT_INDEX, Skeleton
 from ltl_human_motion.motion.types import MotionPrimitive
@@ -151,7 +151,7 @@ def make_step_primitive(stand: np.ndarray, height: float, dx: float, dy: float, 
         for side in (lead, other):
             mp = _step_primitive(stand, height, dx, dy, angle, skeleton, fps, task, lift,
                                  side, n_steps)
-            depth = float(self_penetration(mp.poses, skeleton.stature)[0].max())
+            depth = max_self_penetration(mp.poses, skeleton.stature)
             if depth <= 0.0:
                 return mp
             if best is None or depth < best[0]:

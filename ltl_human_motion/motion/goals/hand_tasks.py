@@ -180,8 +180,8 @@ def _hand_task(task: str, target: np.ndarray, skeleton: Skeleton, st: _Start,
 def _self_penetrates(world: np.ndarray, stature: float) -> bool:
     """Whether a body capsule's bone axis enters another, non-neighbouring one in any frame
     of ``world`` (T, J, 3) (the verifier's self-penetration check)."""
-    from ltl_human_motion.motion.biomechanics import self_penetration
-    return bool(np.max(self_penetration(world, stature)[0]) > 0.0)
+    from ltl_human_motion.motion.biomechanics import max_self_penetration
+    return max_self_penetration(world, stature) > 0.0
 
 
 def _hanging(st: _Start) -> bool:
