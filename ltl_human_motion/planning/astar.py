@@ -240,16 +240,16 @@ def _clear_successors(index: GaitIndex, prim: int, pose: Pose, allowed: np.ndarr
     else:
         ends, gap = placed
     clear = gap > options.body_radius
-    if not clear.any():
+    if not np.count_nonzero(clear):
         return None
     succ, ends, gap = succ[clear], ends[clear], gap[clear]
     if body_clear is not None and index.body.size:
         exact = index.standing[succ] | (gap < options.near_radius)
-        if exact.any():
+        if np.count_nonzero(exact):
             ok = np.ones(len(succ), dtype=bool)
             ok[exact] = body_clear(_body_at(index, succ[exact], px, py, pyaw),
                                    index.standing[succ[exact]])
-            if not ok.any():
+            if not np.count_nonzero(ok):
                 return None
             succ, ends = succ[ok], ends[ok]
     return succ, ends
@@ -267,7 +267,7 @@ def _arrivals(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, goal: Goal,
     near = goal.reached(ends[:, 0], ends[:, 1], ends[:, 2])
     done = near & index.stops[succ]
     tail: list[tuple[int, Pose]] = []
-    if not done.any() and near.any():
+    if not np.count_nonzero(done) and np.count_nonzero(near):
         at = np.flatnonzero(near)
         found = _first_stop(index, succ, ends, at, goal, allowed, clearance, body_clear,
                             forbidden, options)
@@ -318,27 +318,27 @@ def _first_stop(index: GaitIndex, succ: np.ndarray, ends: np.ndarray, near: np.n
     cand = index.indices[np.repeat(first, counts) + offsets]
     owner = np.repeat(near, counts)
     keep = index.stops[cand] & allowed[cand]
-    if forbidden and keep.any():
+    if forbidden and np.count_nonzero(keep):
         for k in np.flatnonzero(keep).tolist():
             at = ends[owner[k]]
             there = placement_key(float(at[0]), float(at[1]), float(at[2]), options.grid,
                                   options.yaw_bins)
             keep[k] = (int(cand[k]), *there) not in forbidden
-    if not keep.any():
+    if not np.count_nonzero(keep):
         return None
     owner, cand = owner[keep], cand[keep]
     cand_ends, gap = _placed_from(index, cand, ends[owner], clearance)
     ok = gap > options.body_radius
-    if ok.any():
+    if np.count_nonzero(ok):
         ok[ok] = goal.reached(cand_ends[ok, 0], cand_ends[ok, 1], cand_ends[ok, 2])
-    if ok.any() and body_clear is not None and index.body.size:
+    if np.count_nonzero(ok) and body_clear is not None and index.body.size:
         # The arms swing as the worker stops: check the whole body, as for every move.
         sel = np.flatnonzero(ok)
         groups = np.split(sel, np.flatnonzero(np.diff(owner[sel])) + 1)   # per successor
         body = np.concatenate([_body_at(index, cand[g], *(float(v) for v in ends[owner[g[0]]]))
                                for g in groups])
         ok[sel] = body_clear(body, index.standing[cand[sel]])
-    if not ok.any():
+    if not np.count_nonzero(ok):
         return None
     k = int(np.flatnonzero(ok)[0])
     return int(owner[k]), int(cand[k]), cand_ends[k]
@@ -409,7 +409,7 @@ def _step_costs(index: GaitIndex, options: SearchOptions, carry: bool,
     """The primitives a search may take (carry or walk ones; all if the library has none
     of that kind), bool (P,), and their costs with the seeded noise, (P,)."""
     allowed = index.carry == carry
-    if not allowed.any():
+    if not np.count_nonzero(allowed):
         allowed = np.ones_like(allowed)
     noise = (1.0 + options.cost_noise * rng.random(len(index.cost))
              if (rng is not None and options.cost_noise) else np.ones(len(index.cost)))
@@ -555,14 +555,14 @@ def astar(index: GaitIndex, start: Pose, goal: Goal, *, start_primitive: int | N
         done, tail = _arrivals(index, succ, ends, goal, allowed, clearance, body_clear,
                                forbidden, options)
         g_new = tree.g_cost[node] + step_cost[succ]
-        if done.any():
+        if np.count_nonzero(done):
             best = int(np.argmin(np.where(done, g_new, np.inf)))
             chain, chain_poses = tree.chain(node, int(succ[best]), tail)
             return SearchResult(chain, chain_poses, tuple(float(v) for v in ends[best]),
                                 expanded, time.perf_counter() - t0)
         h_new, left = _heuristic(goal, options, ends[:, 0], ends[:, 1], ends[:, 2])
         keep = np.isfinite(h_new)
-        if not keep.any():
+        if not np.count_nonzero(keep):
             continue
         near.update(left[keep], ends[keep], expanded)
         tree.push(node, succ[keep], ends[keep], g_new[keep], g_new[keep] + h_new[keep])
