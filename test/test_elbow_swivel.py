@@ -52,6 +52,20 @@ def test_an_arm_swept_through_its_pole_keeps_its_elbow_moving_smoothly(k):
     assert away.any() and np.allclose(kept[away], flipped[away])
 
 
+@pytest.mark.parametrize("frames", [3, 5, 10])
+def test_a_sweep_too_quick_to_swivel_in_keeps_the_elbow_with_the_arm(frames):
+    """Passing the pole in a few frames leaves no time to turn the elbow at
+    :data:`SWIVEL_SPEED`: the swivel is held over the whole motion, and the elbow moves
+    no faster than the wrist."""
+    shoulder, wrist = _sweep_through_pole(1, frames)
+    pole = np.broadcast_to(_goal_elbow_pole(1), wrist.shape)
+    kept, _ = two_bone_ik(shoulder, wrist, UPPER, LOWER,
+                          _elbow_pole(shoulder, wrist, pole, 1, (UPPER, LOWER), 1 / 120),
+                          max_stretch=1.0)
+    wrist_step = np.linalg.norm(np.diff(wrist, axis=0), axis=-1).max()
+    assert np.linalg.norm(np.diff(kept, axis=0), axis=-1).max() <= wrist_step
+
+
 def test_the_swivel_reference_is_perpendicular_and_continuous():
     rng = np.random.default_rng(0)
     u = rng.normal(size=(2000, 3))

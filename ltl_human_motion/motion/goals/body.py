@@ -199,13 +199,14 @@ def _elbow_pole(shoulder: np.ndarray, wrist: np.ndarray, pole: np.ndarray, k: in
     b = np.cross(u, r)
     angle = np.arctan2(np.sum(off * b, axis=-1), np.sum(off * r, axis=-1))
     low = (share < POLE_DEGENERATE) & bent
-    if low.all():
-        best = angle[int(np.argmax(share))]
-        return np.cos(best) * r + np.sin(best) * b
+    T = len(low)
     phi = angle.copy()
     for lo, hi in _swivel_runs(low, angle, offset, frame):
+        if lo == 0 and hi == T:
+            phi[:] = angle[int(np.argmax(share))]
+            continue
         before = angle[lo - 1] if lo > 0 else angle[hi]
-        after = angle[hi] if hi < len(angle) else before
+        after = angle[hi] if hi < T else before
         turn = (after - before + np.pi) % (2.0 * np.pi) - np.pi
         phi[lo:hi] = before + (np.arange(lo, hi) - lo + 1) / (hi - lo + 1) * turn
     changed = phi != angle
