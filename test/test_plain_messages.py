@@ -4,7 +4,7 @@ its number is and against which limit."""
 from __future__ import annotations
 
 from ltl_human_motion.cli.coexist import _breaches
-from ltl_human_motion.cli.demo import _status
+from ltl_human_motion.cli.demo import _comparison_words, _status
 from ltl_human_motion.cli.library import _print_quality
 from ltl_human_motion.planning.steps import _approach
 
@@ -38,6 +38,15 @@ def test_demo_status_is_not_a_plain_ok_with_a_warning() -> None:
     assert _status({"ok": True}) == "ok"
     assert _status({"ok": True, "warning": "missed 72 deadlines"}) == "ok but"
     assert _status({"ok": False, "warning": "x"}) == "FAILED"
+
+
+def test_the_demos_study_line_names_what_differs_between_the_layouts() -> None:
+    """It read "1 figure(s) differ", which sounded like a failed picture comparison."""
+    words = _comparison_words({"min_separation": {"diff": 0.109, "ci95": [0.069, 0.1496],
+                                                  "significant": True}})
+    assert words == ("; B - A: minimum human-robot separation +0.109 m "
+                     "(95% CI +0.069 .. +0.15)")
+    assert _comparison_words({}) == "; A and B alike"
 
 
 def test_library_quality_names_each_limit(capsys) -> None:

@@ -166,8 +166,7 @@ def run(args: argparse.Namespace) -> int:
                                                          "the report says why)"
                                                          if res["failed"].get(k) else "")
                                for k, n in res["motions"].items())
-            line += (f"  -> {res['html']} ({counts}; {len(res['comparison'])} figure(s) "
-                     "differ)")
+            line += f"  -> {res['html']} ({counts}{_comparison_words(res['comparison'])})"
         elif not res["ok"]:
             line += f"  {res.get('error', '')}"
         print(line)
@@ -175,3 +174,13 @@ def run(args: argparse.Namespace) -> int:
             print(f"         but: {res['warning']}")
     print(f"  summary: {args.out / 'summary.json'}")
     return 0 if all(r["ok"] for r in results.values()) else 1
+
+
+def _comparison_words(comparison: dict) -> str:
+    """The measures where layout B differs from A beyond chance (Welch's 95 % interval
+    excludes 0), in words; nothing where none does."""
+    from ltl_human_motion.study.report import METRICS
+    parts = [f"{METRICS[key][0]} {c['diff']:+.3g}{' ' + METRICS[key][1] if METRICS[key][1] else ''}"
+             f" (95% CI {c['ci95'][0]:+.3g} .. {c['ci95'][1]:+.3g})"
+             for key, c in comparison.items()]
+    return "; B - A: " + ", ".join(parts) if parts else "; A and B alike"
