@@ -205,14 +205,22 @@ def _elbow_pole(shoulder: np.ndarray, wrist: np.ndarray, pole: np.ndarray, k: in
         if lo == 0 and hi == T:
             phi[:] = angle[int(np.argmax(share))]
             continue
-        before = angle[lo - 1] if lo > 0 else angle[hi]
-        after = angle[hi] if hi < T else before
-        turn = (after - before + np.pi) % (2.0 * np.pi) - np.pi
+        before, turn = _swivel_turn(angle, lo, hi)
         phi[lo:hi] = before + (np.arange(lo, hi) - lo + 1) / (hi - lo + 1) * turn
     changed = phi != angle
     out = pole.copy()
     out[changed] = (np.cos(phi)[:, None] * r + np.sin(phi)[:, None] * b)[changed]
     return out
+
+
+def _swivel_turn(angle: np.ndarray, lo: int, hi: int) -> tuple[float, float]:
+    """The swivel ``angle`` (T,) at the frame before the run [lo, hi) (after it where the
+    run starts the motion) and the short way (rad) from there to the frame after it
+    (none where the run ends the motion)."""
+    T = len(angle)
+    before = angle[lo - 1] if lo > 0 else angle[min(hi, T - 1)]
+    after = angle[hi] if hi < T else before
+    return float(before), float((after - before + np.pi) % (2.0 * np.pi) - np.pi)
 
 
 def _swivel_runs(low: np.ndarray, angle: np.ndarray, offset: np.ndarray, frame: float
@@ -229,10 +237,8 @@ def _swivel_runs(low: np.ndarray, angle: np.ndarray, offset: np.ndarray, frame: 
         if out and lo <= out[-1][1]:
             lo = out.pop()[0]
         while True:
-            before = angle[lo - 1] if lo > 0 else angle[min(hi, T - 1)]
-            after = angle[hi] if hi < T else before
-            turn = abs((after - before + np.pi) % (2.0 * np.pi) - np.pi)
-            span = float(offset[max(lo - 1, 0):hi + 1].max()) * turn
+            span = float(offset[max(lo - 1, 0):hi + 1].max()) \
+                * abs(_swivel_turn(angle, lo, hi)[1])
             if span <= SWIVEL_SPEED * (hi - lo + 1) * frame or (lo == 0 and hi == T):
                 break
             lo, hi = max(lo - 1, 0), min(hi + 1, T)

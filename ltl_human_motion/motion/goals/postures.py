@@ -201,6 +201,30 @@ def _self_blocked(poses: np.ndarray, stature: float) -> np.ndarray:
     return self_penetration(poses, stature)[0].max(axis=1) > -_SELF_CLEARANCE
 
 
+def _body_board_blocked(skeleton: Skeleton, st: _Start,
+                        posture: tuple[np.ndarray, np.ndarray, np.ndarray], poses: np.ndarray,
+                        active: tuple[int, ...], board: tuple[float, float, float] | None,
+                        capped: np.ndarray, kneel: np.ndarray) -> np.ndarray:
+    """Whether each candidate posture (pitch, drop, shift, each (C,)) with the hands on
+    the targets (``poses`` (C, J, 3)) puts a body part through another, or into the low
+    ``board`` there or on the way to it; bool (C,)."""
+    blocked = _self_blocked(poses, skeleton.stature)
+    if board is not None:
+        blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
+        blocked |= _board_way_blocked(skeleton, st, posture, active, board, capped, kneel)
+    return blocked
+
+
+def _furniture_depths(poses: np.ndarray, furniture: tuple | None, stature: float
+                      ) -> list[np.ndarray]:
+    """How deep (C,) the postures ``poses`` (C, J, 3) go into the furniture under the
+    targets, then into the board over them (``furniture``: see :func:`_grid`), for those
+    given."""
+    under, over = furniture or (None, None)
+    return ([] if under is None else [_support_depth(poses, under, stature)]) \
+        + ([] if over is None else [_slab_depth(poses, over, stature)])
+
+
 def _cheapest_clear(skeleton: Skeleton, st: _Start, targets: np.ndarray,
                     active: tuple[int, ...], task: str,
                     board: tuple[float, float, float] | None,
@@ -217,7 +241,6 @@ def _cheapest_clear(skeleton: Skeleton, st: _Start, targets: np.ndarray,
                                                              board)
     idx = np.flatnonzero(feasible)
     order = idx[np.argsort(cost[idx], kind="stable")]
-    under, over = furniture or (None, None)
     H = skeleton.stature
     chosen: list[int] = []
     for k in range(0, order.size, _LEAST_CHUNK):
@@ -225,15 +248,10 @@ def _cheapest_clear(skeleton: Skeleton, st: _Start, targets: np.ndarray,
         posture = (P[some], D[some], shift[some])
         poses = _contact_poses(skeleton, st, *posture, targets, active, task,
                                cap=capped[some], kneel=kneel[some])
-        blocked = _self_blocked(poses, H)
-        if board is not None:
-            blocked |= _board_depth(poses, board, H) > 0.0
-            blocked |= _board_way_blocked(skeleton, st, posture, active, board, capped[some],
-                                          kneel[some])
-        if under is not None:
-            blocked |= _support_depth(poses, under, H) > 0.0
-        if over is not None:
-            blocked |= _slab_depth(poses, over, H) > 0.0
+        blocked = _body_board_blocked(skeleton, st, posture, poses, active, board,
+                                      capped[some], kneel[some])
+        for depth in _furniture_depths(poses, furniture, H):
+            blocked |= depth > 0.0
         for i in np.flatnonzero(~blocked).tolist():
             one = some[i:i + 1]
             if not chosen and obstacles is not None and _obstacle_blocked(
@@ -301,15 +319,9 @@ def _grid(skeleton: Skeleton, st: _Start, targets: np.ndarray, active: tuple[int
     if idx.size:
         poses = _contact_poses(skeleton, st, P[idx], D[idx], shift[idx], targets, active,
                                task, cap=capped[idx], kneel=kneel[idx])
-        blocked = _self_blocked(poses, skeleton.stature)
-        if board is not None:
-            blocked |= _board_depth(poses, board, skeleton.stature) > 0.0
-            blocked |= _board_way_blocked(skeleton, st, (P[idx], D[idx], shift[idx]), active,
-                                          board, capped[idx], kneel[idx])
-        under, over = furniture or (None, None)
-        for depth in ([] if under is None else [_support_depth(poses, under, skeleton.stature)]) \
-                + ([] if over is None else [_slab_depth(poses, over, skeleton.stature)]):
-            # The furniture under the targets, then the board over them (a shelf's).
+        blocked = _body_board_blocked(skeleton, st, (P[idx], D[idx], shift[idx]), poses,
+                                      active, board, capped[idx], kneel[idx])
+        for depth in _furniture_depths(poses, furniture, skeleton.stature):
             if not np.all(blocked | (depth > 0.0)):
                 blocked |= depth > 0.0
         if obstacles is not None and not np.all(blocked):
